@@ -1,0 +1,117 @@
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+void cli_error(const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("glint: error: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+void cli_warning(const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("glint: warning: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+void cli_print_warning(void *user, const char *message) {
+    (void)user;
+    cli_warning("%s", message);
+}
+
+int cli_parse_int(const char *option, const char *text, long long lo, long long hi, long long *out) {
+    char *end = NULL;
+    errno = 0;
+    long long v = strtoll(text, &end, 10);
+    if (errno || end == text || *end != '\0' || v < lo || v > hi) {
+        cli_error("%s: expected an integer in [%lld, %lld], got '%s'", option, lo, hi, text);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int cli_parse_u64(const char *option, const char *text, uint64_t *out) {
+    char *end = NULL;
+    errno = 0;
+    unsigned long long v = strtoull(text, &end, 10);
+    if (errno || end == text || *end != '\0' || text[0] == '-') {
+        cli_error("%s: expected a non-negative integer, got '%s'", option, text);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int cli_parse_float(const char *option, const char *text, double lo, double hi, double *out) {
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (errno || end == text || *end != '\0' || !isfinite(v) || v < lo || v > hi) {
+        cli_error("%s: expected a number in [%g, %g], got '%s'", option, lo, hi, text);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int cli_parse_size(const char *option, const char *text, int *width, int *height) {
+    char *end = NULL;
+    errno = 0;
+    long w = strtol(text, &end, 10);
+    long h = 0;
+    int ok = !errno && end != text && (*end == 'x' || *end == 'X');
+    if (ok) {
+        const char *hs = end + 1;
+        h = strtol(hs, &end, 10);
+        ok = !errno && end != hs && *end == '\0';
+    }
+    if (!ok || w < 1 || h < 1 || w > 16384 || h > 16384) {
+        cli_error("%s: expected WIDTHxHEIGHT (1..16384 each), got '%s'", option, text);
+        return -1;
+    }
+    *width = (int)w;
+    *height = (int)h;
+    return 0;
+}
+
+const char *cli_value(int argc, char **argv, int *i) {
+    if (*i + 1 >= argc) {
+        cli_error("%s needs a value (see --help)", argv[*i]);
+        return NULL;
+    }
+    return argv[++*i];
+}
+
+double cli_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int cli_check_output_dir(const char *option, const char *path) {
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash) snprintf(dir, sizeof dir, ".");
+    else if (slash == path) snprintf(dir, sizeof dir, "/");
+    else snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    if (access(dir, W_OK | X_OK) != 0) {
+        cli_error("%s: %s: cannot write into directory '%s' (%s)", option, path, dir, strerror(errno));
+        return -1;
+    }
+    return 0;
+}

@@ -1,0 +1,33 @@
+/* glint — command-line plumbing shared by the commands: messages, strict number parsing. */
+#ifndef GLINT_CLI_H
+#define GLINT_CLI_H
+
+#include <stdint.h>
+
+/* Exit codes. */
+enum { EXIT_OK = 0, EXIT_FAILURE_ = 1, EXIT_USAGE = 2 };
+
+/* "glint: error: ..." and "glint: warning: ..." on stderr, one line each. */
+void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+void cli_warning(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+/* A scene_warn_fn that prints warnings (user unused). */
+void cli_print_warning(void *user, const char *message);
+
+/* Parsers: return 0 on success, else print "glint: error: OPTION: ..." and return -1. */
+int cli_parse_int(const char *option, const char *text, long long lo, long long hi, long long *out);
+int cli_parse_u64(const char *option, const char *text, uint64_t *out);
+int cli_parse_float(const char *option, const char *text, double lo, double hi, double *out);
+/* "WxH", each 1..16384. */
+int cli_parse_size(const char *option, const char *text, int *width, int *height);
+
+/* Fetches the value of option argv[*i] (advancing *i); prints a usage error when missing. */
+const char *cli_value(int argc, char **argv, int *i);
+
+/* Seconds on a monotonic clock. */
+double cli_now(void);
+
+/* Fails (with a message) when the directory that would hold path does not exist or is not
+ * writable: checked before a long render rather than after it. */
+int cli_check_output_dir(const char *option, const char *path);
+
+#endif

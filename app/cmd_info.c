@@ -1,0 +1,66 @@
+/* glint info: what a scene holds. */
+#include <stdio.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include "cli.h"
+#include "commands.h"
+
+static void print_info_help(void) {
+    printf("usage: glint info [SCENE] [--env FILE]\n"
+           "\n"
+           "Prints a summary of SCENE (default: the built-in scene): geometry, materials, lights,\n"
+           "cameras, size.\n");
+}
+
+int cmd_info(int argc, char **argv) {
+    const char *path = NULL, *env = NULL;
+    for (int i = 0; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            print_info_help();
+            return EXIT_OK;
+        } else if (strcmp(argv[i], "--env") == 0) {
+            if (!(env = cli_value(argc, argv, &i))) return EXIT_USAGE;
+        } else if (argv[i][0] == '-') {
+            cli_error("unknown option '%s' (see glint info --help)", argv[i]);
+            return EXIT_USAGE;
+        } else if (!path) {
+            path = argv[i];
+        } else {
+            cli_error("more than one scene given ('%s' and '%s')", path, argv[i]);
+            return EXIT_USAGE;
+        }
+    }
+    double t0 = cli_now();
+    scene *s = load_scene_or_default(path, env, 0.0f);
+    if (!s) return EXIT_FAILURE_;
+    double load_seconds = cli_now() - t0;
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    int by_model[3] = {0, 0, 0}, emissive = 0;
+    for (int i = 0; i < s->num_materials; i++) {
+        by_model[s->materials[i].model]++;
+        emissive += max_comp3(s->materials[i].emission) > 0.0f;
+    }
+    int by_type[5] = {0, 0, 0, 0, 0};
+    for (int i = 0; i < s->num_lights; i++) by_type[s->lights[i].type]++;
+    vec3 ext = sub3(s->bounds.hi, s->bounds.lo);
+    printf("scene:      %s\n", s->path);
+    printf("geometry:   %d triangles, %d vertices\n", s->num_triangles, s->num_vertices);
+    printf("size:       %.4g x %.4g x %.4g (diagonal %.4g), ray offset %.3g\n", (double)ext.x, (double)ext.y,
+           (double)ext.z, (double)s->diag, (double)s->ray_eps);
+    printf("materials:  %d (%d metallic-roughness, %d Phong, %d Ward; %d emissive)\n", s->num_materials,
+           by_model[MATERIAL_GLTF], by_model[MATERIAL_PHONG], by_model[MATERIAL_WARD], emissive);
+    printf("textures:   %d (%d images)\n", s->num_textures, s->num_images);
+    printf("lights:     %d point, %d spot, %d directional, %d emissive triangles, %s\n", by_type[LIGHT_POINT],
+           by_type[LIGHT_SPOT], by_type[LIGHT_DIRECTIONAL], by_type[LIGHT_TRIANGLE],
+           s->env ? "an environment map" : "no environment map");
+    printf("cameras:    %d", s->num_cameras);
+    for (int i = 0; i < s->num_cameras; i++) printf("%s%d '%s'", i ? ", " : " (", i, s->cameras[i].name);
+    printf("%s\n", s->num_cameras ? ")" : " (a framing view is used)");
+    /* Load includes parsing, flattening, the light list and the BVH build; ru_maxrss is in KiB. */
+    printf("load:       %.3f s, peak memory %.1f MiB\n", load_seconds, (double)ru.ru_maxrss / 1024.0);
+    if (s->num_warnings) printf("warnings:   %d (printed above)\n", s->num_warnings);
+    scene_destroy(s);
+    return EXIT_OK;
+}

@@ -1,0 +1,305 @@
+/* glint render: headless progressive rendering to EXR, PNG and JSON statistics. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "camera.h"
+#include "cli.h"
+#include "commands.h"
+#include "film.h"
+#include "image_io.h"
+#include "session.h"
+
+typedef struct {
+    const char *scene_path;
+    render_params params;
+    long long spp;      /* frames to render; 0 with seconds > 0 means "until time is up" */
+    double seconds;
+    const char *env_path;
+    double env_rotation_deg;
+    long long camera_index;
+    const char *out_exr, *out_png, *out_stats;
+    double exposure;
+    int quiet;
+} render_options;
+
+#define DEFAULT_SPP 64
+
+static void print_render_help(void) {
+    printf("usage: glint render [SCENE] [options]\n"
+           "\n"
+           "Renders SCENE (a .gltf/.glb; default: the built-in scene) progressively, one sample per\n"
+           "pixel per frame, and writes the running mean.\n"
+           "\n"
+           "options (default in brackets):\n"
+           "  --method NAME        estimator: pt [pt]\n"
+           "  --spp N              samples per pixel (frames) [%d]\n"
+           "  --time SECONDS       render until this much time has passed instead of --spp\n"
+           "  --size WxH           image size [960x540]\n"
+           "  --max-depth D        scattering events per path; 1 = direct light only [%d]\n"
+           "  --env FILE           environment map, equirectangular .exr or .hdr [none]\n"
+           "  --env-rotation DEG   rotate the environment about +Y [0]\n"
+           "  --camera INDEX       glTF camera to render from [0; a framing view without cameras]\n"
+           "  --seed S             random seed; runs with the same seed reproduce [0]\n"
+           "  --threads N          render threads, 0 = one per core [0]\n"
+           "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers [none]\n"
+           "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
+           "  --exposure EV        exposure for the PNG, in stops [0]\n"
+           "  --stats FILE.json    statistics: frames, spp, seconds, rays by kind, rejected samples [none]\n"
+           "  --quiet              no progress line\n"
+           "  --help               this text\n"
+           "\n"
+           "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
+           "new file render.png (render-1.png, ... if taken).\n",
+           DEFAULT_SPP, DEFAULT_MAX_DEPTH);
+}
+
+/* Returns 0 to render, 1 when --help was shown, -1 on a usage error (already reported). */
+static int parse_render_options(int argc, char **argv, render_options *o) {
+    memset(o, 0, sizeof *o);
+    o->spp = -1;
+    o->camera_index = -1;
+    int spp_given = 0, time_given = 0;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = NULL;
+        long long n;
+#define VALUE() \
+    if (!(v = cli_value(argc, argv, &i))) return -1
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            print_render_help();
+            return 1;
+        } else if (strcmp(a, "--quiet") == 0) {
+            o->quiet = 1;
+        } else if (strcmp(a, "--method") == 0) {
+            VALUE();
+            int m = method_from_name(v);
+            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt)", v), -1;
+            o->params.method = (render_method)m;
+        } else if (strcmp(a, "--spp") == 0) {
+            VALUE();
+            if (cli_parse_int(a, v, 1, 100000000, &o->spp)) return -1;
+            spp_given = 1;
+        } else if (strcmp(a, "--time") == 0) {
+            VALUE();
+            if (cli_parse_float(a, v, 1e-3, 1e7, &o->seconds)) return -1;
+            time_given = 1;
+        } else if (strcmp(a, "--size") == 0) {
+            VALUE();
+            if (cli_parse_size(a, v, &o->params.width, &o->params.height)) return -1;
+        } else if (strcmp(a, "--max-depth") == 0) {
+            VALUE();
+            if (cli_parse_int(a, v, 1, 10000, &n)) return -1;
+            o->params.max_depth = (int)n;
+        } else if (strcmp(a, "--env") == 0) {
+            VALUE();
+            o->env_path = v;
+        } else if (strcmp(a, "--env-rotation") == 0) {
+            VALUE();
+            if (cli_parse_float(a, v, -36000.0, 36000.0, &o->env_rotation_deg)) return -1;
+        } else if (strcmp(a, "--camera") == 0) {
+            VALUE();
+            if (cli_parse_int(a, v, 0, 1000000, &o->camera_index)) return -1;
+        } else if (strcmp(a, "--seed") == 0) {
+            VALUE();
+            if (cli_parse_u64(a, v, &o->params.seed)) return -1;
+        } else if (strcmp(a, "--threads") == 0) {
+            VALUE();
+            if (cli_parse_int(a, v, 0, 1024, &n)) return -1;
+            o->params.threads = (int)n;
+        } else if (strcmp(a, "--out") == 0) {
+            VALUE();
+            o->out_exr = v;
+        } else if (strcmp(a, "--png") == 0) {
+            VALUE();
+            o->out_png = v;
+        } else if (strcmp(a, "--stats") == 0) {
+            VALUE();
+            o->out_stats = v;
+        } else if (strcmp(a, "--exposure") == 0) {
+            VALUE();
+            if (cli_parse_float(a, v, -50.0, 50.0, &o->exposure)) return -1;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            cli_error("unknown option '%s' (see glint render --help)", a);
+            return -1;
+        } else if (!o->scene_path) {
+            o->scene_path = a;
+        } else {
+            cli_error("more than one scene given ('%s' and '%s')", o->scene_path, a);
+            return -1;
+        }
+#undef VALUE
+    }
+    if (spp_given && time_given) return cli_error("--spp and --time exclude each other"), -1;
+    if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
+    return 0;
+}
+
+/* Progress: one updating line on a terminal, a plain line every few seconds otherwise. */
+typedef struct {
+    int enabled, tty;
+    double start, last;
+} progress;
+
+static void progress_update(progress *pg, const render_options *o, long long frames, double now, int final) {
+    if (!pg->enabled) return;
+    double elapsed = now - pg->start;
+    double total = o->spp > 0 ? elapsed * (double)o->spp / (double)(frames > 0 ? frames : 1) : o->seconds;
+    double left = fmax(total - elapsed, 0.0);
+    if (pg->tty) {
+        if (!final && now - pg->last < 0.1) return;
+        if (o->spp > 0)
+            fprintf(stderr, "\r\033[Kglint: frame %lld/%lld  %lld spp  %.1f s elapsed  %.1f s left", frames, o->spp, frames,
+                    elapsed, left);
+        else
+            fprintf(stderr, "\r\033[Kglint: frame %lld  %lld spp  %.1f s elapsed  %.1f s left", frames, frames, elapsed, left);
+        if (final) fputc('\n', stderr);
+    } else {
+        if (!final && now - pg->last < 5.0) return;
+        fprintf(stderr, "glint: frame %lld  %lld spp  %.1f s elapsed  %.1f s left%s\n", frames, frames, elapsed, left,
+                final ? "  (done)" : "");
+    }
+    fflush(stderr);
+    pg->last = now;
+}
+
+/* JSON string escaping for paths. */
+static void json_string(FILE *f, const char *s) {
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+        else if (c < 0x20) fprintf(f, "\\u%04x", c);
+        else fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static int write_stats(const char *path, const render_options *o, const render_session *rs, const scene *s,
+                       double seconds) {
+    char *buf = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&buf, &size);
+    if (!f) return cli_error("%s: out of memory", path), -1;
+    const render_params *p = session_params(rs);
+    render_stats st = session_stats(rs);
+    long long frames = session_frames(rs);
+    uint64_t total = 0;
+    for (int k = 0; k < RAY_KIND_COUNT; k++) total += st.rays[k];
+    fprintf(f, "{\n  \"method\": \"%s\",\n  \"scene\": ", method_name(p->method));
+    json_string(f, s->path);
+    fprintf(f, ",\n  \"width\": %d,\n  \"height\": %d,\n  \"frames\": %lld,\n  \"spp\": %lld,\n", p->width, p->height,
+            frames, frames);
+    fprintf(f, "  \"seconds\": %.6f,\n  \"max_depth\": %d,\n  \"seed\": %llu,\n  \"threads\": %d,\n", seconds,
+            p->max_depth, (unsigned long long)p->seed, p->threads);
+    fprintf(f, "  \"rays\": {");
+    for (int k = 0; k < RAY_KIND_COUNT; k++)
+        fprintf(f, "\"%s\": %llu, ", ray_kind_names[k], (unsigned long long)st.rays[k]);
+    fprintf(f, "\"total\": %llu},\n", (unsigned long long)total);
+    fprintf(f, "  \"rays_per_second\": %.1f,\n", seconds > 0 ? (double)total / seconds : 0.0);
+    fprintf(f, "  \"rejected_samples\": %llu\n}\n", (unsigned long long)st.rejected_samples);
+    fclose(f);
+    char err[1024];
+    int status = write_file_atomic(path, buf, size, WRITE_REPLACE, err, sizeof err);
+    free(buf);
+    if (status) cli_error("%s", err);
+    (void)o;
+    return status;
+}
+
+static int write_outputs(const render_options *o, const render_session *rs, const scene *s, double seconds) {
+    const film *fm = session_film(rs);
+    char err[1024];
+    /* Highlights are a layer of their own only once an estimator produces them. */
+    const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT);
+    if (o->out_exr && film_save_exr(fm, layers, o->out_exr, WRITE_REPLACE, err, sizeof err) != 0) {
+        cli_error("%s", err);
+        return -1;
+    }
+    const char *png = o->out_png;
+    char fallback[4096];
+    if (!o->out_exr && !o->out_png && !o->out_stats) {
+        if (unique_path("render.png", fallback, sizeof fallback) != 0) {
+            cli_error("render.png: no free file name");
+            return -1;
+        }
+        png = fallback;
+    }
+    if (png) {
+        tonemap_params tp = {(float)o->exposure, 0.0f, 0.0f};
+        if (film_save_png(fm, COMP_MASK_ALL, &tp, png, png == fallback ? WRITE_NO_REPLACE : WRITE_REPLACE, err,
+                          sizeof err) != 0) {
+            cli_error("%s", err);
+            return -1;
+        }
+        if (png == fallback) printf("wrote %s\n", png);
+    }
+    if (o->out_stats) return write_stats(o->out_stats, o, rs, s, seconds);
+    return 0;
+}
+
+scene *load_scene_or_default(const char *path, const char *env_path, float env_rotation) {
+    char err[1024];
+    scene *s = path ? scene_load(path, cli_print_warning, NULL, err, sizeof err)
+                    : scene_load_default(cli_print_warning, NULL, err, sizeof err);
+    if (!s) {
+        cli_error("%s", err);
+        return NULL;
+    }
+    if (env_path && scene_set_env(s, env_path, env_rotation, err, sizeof err) != 0) {
+        cli_error("%s", err);
+        scene_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+int cmd_render(int argc, char **argv) {
+    render_options o;
+    int parsed = parse_render_options(argc, argv, &o);
+    if (parsed != 0) return parsed > 0 ? EXIT_OK : EXIT_USAGE;
+    if ((o.out_exr && cli_check_output_dir("--out", o.out_exr)) || (o.out_png && cli_check_output_dir("--png", o.out_png)) ||
+        (o.out_stats && cli_check_output_dir("--stats", o.out_stats)))
+        return EXIT_FAILURE_;
+
+    scene *s = load_scene_or_default(o.scene_path, o.env_path, (float)(o.env_rotation_deg * 3.14159265358979 / 180.0));
+    if (!s) return EXIT_FAILURE_;
+    if (o.camera_index >= 0 && o.camera_index >= s->num_cameras) {
+        cli_error("%s: --camera %lld: the scene has %d camera%s", s->path, o.camera_index, s->num_cameras,
+                  s->num_cameras == 1 ? "" : "s");
+        scene_destroy(s);
+        return EXIT_USAGE;
+    }
+    render_params p = o.params;
+    if (p.width <= 0) p.width = 960, p.height = 540;
+    camera cam = scene_camera(s, (int)o.camera_index, (float)p.width / (float)p.height);
+    char err[1024];
+    render_session *rs = session_create(s, &cam, &p, err, sizeof err);
+    if (!rs) {
+        cli_error("%s", err);
+        scene_destroy(s);
+        return EXIT_FAILURE_;
+    }
+
+    progress pg = {!o.quiet, isatty(STDERR_FILENO), cli_now(), 0.0};
+    pg.last = pg.start;
+    double elapsed = 0.0;
+    for (long long frame = 0;; frame++) {
+        if (o.spp > 0 ? frame >= o.spp : (frame > 0 && elapsed >= o.seconds)) break;
+        session_render_frame(rs);
+        double now = cli_now();
+        elapsed = now - pg.start;
+        progress_update(&pg, &o, frame + 1, now, 0);
+    }
+    progress_update(&pg, &o, session_frames(rs), cli_now(), 1);
+    render_stats st = session_stats(rs);
+    if (st.rejected_samples) cli_warning("%llu NaN/Inf samples were rejected", (unsigned long long)st.rejected_samples);
+
+    int status = write_outputs(&o, rs, s, elapsed);
+    session_destroy(rs);
+    scene_destroy(s);
+    return status == 0 ? EXIT_OK : EXIT_FAILURE_;
+}

@@ -1,0 +1,1011 @@
+/* glint view: the interactive, progressive viewer.
+ *
+ * Two threads. The render thread owns the scene and the render sessions: it renders frame after
+ * frame, applies requested changes between frames, and publishes each resolved image by swapping
+ * buffers under a lock held only for the swap. The UI thread owns the window: it handles input
+ * and scripts, tone-maps and draws the newest image, and never waits for a frame.
+ *
+ * While the camera moves, frames come from a preview session at a fraction of the resolution so
+ * the image follows the input; once things rest, the full-resolution session accumulates. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <GLFW/glfw3.h>
+
+#include "camera.h"
+#include "cli.h"
+#include "commands.h"
+#include "session.h"
+#include "ui.h"
+#include "view_script.h"
+
+#define PREVIEW_DIVISOR 3      /* preview resolution = full / 3 on each axis */
+#define PREVIEW_HOLD_SECONDS 0.3
+#define MAX_VIEW_CAMERAS 32
+
+/* ---- shared state --------------------------------------------------------------------------- */
+
+typedef struct {
+    float *rgb;
+    int width, height;
+    int preview;
+} image_buf;
+
+typedef struct {
+    char name[1024];
+    int num_cameras;
+    camera cameras[MAX_VIEW_CAMERAS];
+    bounds3 bounds;
+    float diag;
+} scene_info;
+
+typedef struct {
+    pthread_mutex_t lock;
+    /* requests: UI -> render thread */
+    camera cam;
+    render_params params;
+    uint64_t generation;     /* bumped by every change that resets the accumulation */
+    double changed_at;       /* when the last such change happened (cli_now) */
+    unsigned show_mask;
+    int render_w, render_h;  /* requested full resolution */
+    char export_path[1024];
+    int export_pending;
+    char load_path[1024];
+    int load_kind;           /* 0 none, 1 scene, 2 environment map */
+    int quit;
+    /* results: render thread -> UI */
+    image_buf image;
+    uint64_t image_serial;
+    uint64_t frames_generation; /* the request generation those frames show */
+    long long frames;        /* full-resolution frames since the last reset */
+    uint64_t frames_total;   /* full-resolution frames ever */
+    uint64_t resets;
+    double reset_at, frame_ms, rays_per_second;
+    unsigned long long rejected;
+    char message[1200];
+    uint64_t message_serial;
+    scene_info info;
+    uint64_t info_serial;
+} shared_state;
+
+typedef struct {
+    shared_state sh;
+    scene *scene;                       /* render thread */
+    render_session *full, *preview;     /* render thread */
+    image_buf back;                     /* render thread */
+} viewer;
+
+static double seconds_since(double t) { return cli_now() - t; }
+
+/* ---- render thread -------------------------------------------------------------------------- */
+
+static void fill_info(scene_info *info, const scene *s) {
+    snprintf(info->name, sizeof info->name, "%s", s->path);
+    info->num_cameras = s->num_cameras < MAX_VIEW_CAMERAS ? s->num_cameras : MAX_VIEW_CAMERAS;
+    for (int i = 0; i < info->num_cameras; i++) info->cameras[i] = s->cameras[i];
+    info->bounds = s->bounds;
+    info->diag = s->diag;
+}
+
+static void set_message(viewer *v, const char *fmt, const char *a, const char *b) {
+    pthread_mutex_lock(&v->sh.lock);
+    snprintf(v->sh.message, sizeof v->sh.message, fmt, a, b);
+    v->sh.message_serial++;
+    pthread_mutex_unlock(&v->sh.lock);
+}
+
+/* (Re)creates both sessions for the current scene at w x h. Returns 0 or -1 (message set). */
+static int make_sessions(viewer *v, int w, int h, const camera *cam, const render_params *params) {
+    session_destroy(v->full);
+    session_destroy(v->preview);
+    v->full = v->preview = NULL;
+    render_params p = *params;
+    char err[512];
+    p.width = w;
+    p.height = h;
+    v->full = session_create(v->scene, cam, &p, err, sizeof err);
+    p.width = w / PREVIEW_DIVISOR > 0 ? w / PREVIEW_DIVISOR : 1;
+    p.height = h / PREVIEW_DIVISOR > 0 ? h / PREVIEW_DIVISOR : 1;
+    if (v->full) v->preview = session_create(v->scene, cam, &p, err, sizeof err);
+    if (!v->full || !v->preview) {
+        set_message(v, "%s%s", err, "");
+        return -1;
+    }
+    return 0;
+}
+
+static void handle_load(viewer *v, int kind, const char *path, const camera *cam, const render_params *params) {
+    char err[1024];
+    if (kind == 1) {
+        scene *s = scene_load(path, cli_print_warning, NULL, err, sizeof err);
+        if (!s) {
+            cli_error("%s", err);
+            set_message(v, "%s%s", err, "");
+            return;
+        }
+        /* The sessions read the old scene: replace them with it. */
+        int w = session_params(v->full)->width, h = session_params(v->full)->height;
+        session_destroy(v->full);
+        session_destroy(v->preview);
+        v->full = v->preview = NULL;
+        scene_destroy(v->scene);
+        v->scene = s;
+        camera c = scene_camera(s, -1, (float)w / (float)h);
+        make_sessions(v, w, h, &c, params);
+        pthread_mutex_lock(&v->sh.lock);
+        fill_info(&v->sh.info, s);
+        v->sh.info_serial++;
+        pthread_mutex_unlock(&v->sh.lock);
+        set_message(v, "loaded %s%s", path, "");
+    } else {
+        if (scene_set_env(v->scene, path, 0.0f, err, sizeof err) != 0) {
+            cli_error("%s", err);
+            set_message(v, "%s%s", err, "");
+            return;
+        }
+        session_set_camera(v->full, cam);
+        session_set_camera(v->preview, cam);
+        set_message(v, "environment %s%s", path, "");
+    }
+}
+
+static void publish(viewer *v, render_session *rs, int preview, double frame_ms, uint64_t resets_seen, uint64_t gen,
+                    unsigned mask) {
+    const film *f = session_film(rs);
+    if (v->back.width != f->width || v->back.height != f->height) {
+        free(v->back.rgb);
+        v->back.rgb = malloc(sizeof(float) * 3 * (size_t)f->width * (size_t)f->height);
+        v->back.width = v->back.rgb ? f->width : 0;
+        v->back.height = v->back.rgb ? f->height : 0;
+        if (!v->back.rgb) return;
+    }
+    film_resolve(f, mask, v->back.rgb);
+    v->back.preview = preview;
+    render_stats st = session_stats(rs);
+    uint64_t rays = 0;
+    for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st.rays[k];
+    pthread_mutex_lock(&v->sh.lock);
+    if (v->sh.resets == resets_seen) { /* drop a frame of a state already replaced */
+        image_buf t = v->sh.image;
+        v->sh.image = v->back;
+        v->back = t;
+        v->sh.image_serial++;
+        if (!preview) {
+            v->sh.frames_generation = gen;
+            v->sh.frames = session_frames(rs);
+            v->sh.frames_total++;
+        }
+        v->sh.frame_ms = frame_ms;
+        double secs = seconds_since(v->sh.reset_at);
+        v->sh.rays_per_second = secs > 0.0 && !preview ? (double)rays / secs : 0.0;
+        v->sh.rejected = st.rejected_samples;
+    }
+    pthread_mutex_unlock(&v->sh.lock);
+}
+
+static void *render_main(void *arg) {
+    viewer *v = arg;
+    uint64_t applied = 0;
+    pthread_mutex_lock(&v->sh.lock);
+    for (;;) {
+        /* Exports and loads first: a quit right after an export request still writes it. */
+        if (v->sh.export_pending) {
+            char path[1024], err[1200];
+            snprintf(path, sizeof path, "%s", v->sh.export_path);
+            v->sh.export_pending = 0;
+            pthread_mutex_unlock(&v->sh.lock);
+            const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT);
+            if (film_save_exr(session_film(v->full), layers, path, WRITE_NO_REPLACE, err, sizeof err) != 0) {
+                cli_error("%s", err);
+                set_message(v, "%s%s", err, "");
+            } else {
+                printf("glint: wrote %s\n", path);
+                fflush(stdout);
+                set_message(v, "wrote %s%s", path, "");
+            }
+            pthread_mutex_lock(&v->sh.lock);
+            continue;
+        }
+        if (v->sh.quit) break;
+        if (v->sh.load_kind) {
+            int kind = v->sh.load_kind;
+            char path[1024];
+            snprintf(path, sizeof path, "%s", v->sh.load_path);
+            v->sh.load_kind = 0;
+            camera cam = v->sh.cam;
+            render_params params = v->sh.params;
+            pthread_mutex_unlock(&v->sh.lock);
+            handle_load(v, kind, path, &cam, &params);
+            pthread_mutex_lock(&v->sh.lock);
+            applied = 0; /* re-apply the camera and parameters to the new sessions */
+            continue;
+        }
+        const film *ff = session_film(v->full);
+        int resize = ff->width != v->sh.render_w || ff->height != v->sh.render_h;
+        uint64_t gen = v->sh.generation;
+        camera cam = v->sh.cam;
+        render_params params = v->sh.params;
+        int preview = seconds_since(v->sh.changed_at) < PREVIEW_HOLD_SECONDS;
+        unsigned mask = v->sh.show_mask;
+        int rw = v->sh.render_w, rh = v->sh.render_h;
+        if (gen != applied || resize) {
+            v->sh.resets++;
+            v->sh.reset_at = cli_now();
+            v->sh.frames = 0;
+        }
+        uint64_t resets_seen = v->sh.resets;
+        pthread_mutex_unlock(&v->sh.lock);
+
+        if (resize) {
+            if (make_sessions(v, rw, rh, &cam, &params) != 0) break;
+            applied = gen;
+        } else if (gen != applied) {
+            session_set_params(v->full, &params);
+            session_set_params(v->preview, &params);
+            session_set_camera(v->full, &cam);
+            session_set_camera(v->preview, &cam);
+            applied = gen;
+        }
+        render_session *rs = preview ? v->preview : v->full;
+        double t0 = cli_now();
+        session_render_frame(rs);
+        publish(v, rs, preview, 1e3 * seconds_since(t0), resets_seen, gen, mask);
+        pthread_mutex_lock(&v->sh.lock);
+    }
+    pthread_mutex_unlock(&v->sh.lock);
+    return NULL;
+}
+
+/* ---- camera control (UI thread) --------------------------------------------------------------- */
+
+typedef struct {
+    vec3 pos;
+    float yaw, pitch; /* radians; yaw 0 looks along -z, pitch up positive */
+    float dist;       /* to the orbit centre */
+    float yfov;
+} cam_ctl;
+
+static vec3 ctl_forward(const cam_ctl *c) {
+    return v3(cosf(c->pitch) * sinf(c->yaw), sinf(c->pitch), -cosf(c->pitch) * cosf(c->yaw));
+}
+
+static camera ctl_camera(const cam_ctl *c) {
+    return camera_look_at(c->pos, add3(c->pos, ctl_forward(c)), v3(0, 1, 0), c->yfov);
+}
+
+static cam_ctl ctl_from_camera(const camera *cam, const scene_info *info) {
+    cam_ctl c;
+    c.pos = cam->position;
+    c.yaw = atan2f(cam->forward.x, -cam->forward.z);
+    c.pitch = asinf(clampf(cam->forward.y, -0.999f, 0.999f));
+    c.yfov = cam->yfov;
+    float d = dot3(sub3(bounds_center(info->bounds), cam->position), cam->forward);
+    c.dist = fmaxf(d, 0.05f * info->diag);
+    return c;
+}
+
+static void ctl_orbit(cam_ctl *c, float dyaw, float dpitch) {
+    vec3 target = madd3(c->pos, ctl_forward(c), c->dist);
+    c->yaw += dyaw;
+    c->pitch = clampf(c->pitch + dpitch, -1.55f, 1.55f);
+    c->pos = madd3(target, ctl_forward(c), -c->dist);
+}
+
+static void ctl_pan(cam_ctl *c, float dx, float dy) {
+    camera cam = ctl_camera(c);
+    c->pos = add3(c->pos, add3(scale3(cam.right, dx * c->dist), scale3(cam.up, dy * c->dist)));
+}
+
+static void ctl_zoom(cam_ctl *c, float factor) {
+    vec3 target = madd3(c->pos, ctl_forward(c), c->dist);
+    c->dist *= factor;
+    c->pos = madd3(target, ctl_forward(c), -c->dist);
+}
+
+/* ---- the UI thread ---------------------------------------------------------------------------- */
+
+typedef struct {
+    const char *scene_path, *env_path, *script_path;
+    int width, height;
+    render_params params;
+    int camera;
+    double exposure;
+} view_options;
+
+typedef struct {
+    viewer *v;
+    GLFWwindow *win;
+    ui_controls ctl, applied_ctl;
+    cam_ctl cam;
+    scene_info info;
+    uint64_t info_serial, image_serial, message_serial;
+    image_buf front;
+    unsigned char *pixels;
+    int pixels_cap;
+    unsigned texture;
+    int tex_w, tex_h;
+    int need_tonemap;
+    char message[1200];
+    /* statistics copied from the render thread */
+    long long frames;
+    uint64_t frames_total, resets, frames_generation;
+    uint64_t sent_generation;
+    double reset_at, frame_ms, rays_per_second;
+    unsigned long long rejected;
+    /* input */
+    double mouse_x, mouse_y;
+    double scroll;
+    int keys_pressed[GLFW_KEY_LAST + 1];
+    double last_time;
+    /* script */
+    view_script script;
+    const char *script_path_for_errors;
+    char window_shot[1024]; /* a pending capture of the window, taken after the next draw */
+    int script_pos, script_waiting, script_errors;
+    long long script_wait_target;
+    uint64_t script_wait_generation;
+    int quit;
+} ui_thread;
+
+static unsigned show_mask_of(int show) {
+    switch (show) {
+    case UI_SHOW_DIRECT: return 1u << COMP_DIRECT;
+    case UI_SHOW_INDIRECT: return 1u << COMP_INDIRECT;
+    case UI_SHOW_HIGHLIGHTS: return 1u << COMP_HIGHLIGHTS;
+    default: return COMP_MASK_ALL;
+    }
+}
+
+static void reset_view(ui_thread *u) {
+    int w, h;
+    glfwGetFramebufferSize(u->win, &w, &h);
+    float aspect = h > 0 ? (float)w / (float)h : 16.0f / 9.0f;
+    camera c = u->ctl.camera >= 0 && u->ctl.camera < u->info.num_cameras
+                   ? u->info.cameras[u->ctl.camera]
+                   : (u->info.num_cameras > 0 ? u->info.cameras[0] : camera_frame_bounds(u->info.bounds, 0.8f, aspect));
+    u->cam = ctl_from_camera(&c, &u->info);
+}
+
+/* Sends the camera and estimator settings to the render thread; each call is a change that
+ * resets the accumulation. */
+static void send_change(ui_thread *u) {
+    shared_state *sh = &u->v->sh;
+    pthread_mutex_lock(&sh->lock);
+    sh->cam = ctl_camera(&u->cam);
+    sh->params.max_depth = u->ctl.max_depth;
+    sh->params.method = (render_method)u->ctl.method;
+    u->sent_generation = ++sh->generation;
+    sh->changed_at = cli_now();
+    pthread_mutex_unlock(&sh->lock);
+}
+
+/* Full-resolution frames rendered in the state the UI last asked for. */
+static long long frames_of_current_state(const ui_thread *u) {
+    return u->frames_generation == u->sent_generation ? u->frames : 0;
+}
+
+/* Sends what changed in the controls since the last call: estimator settings reset the
+ * accumulation; display settings only change how the image is shown. */
+static void apply_controls(ui_thread *u, int camera_changed) {
+    if (u->ctl.method != u->applied_ctl.method || u->ctl.max_depth != u->applied_ctl.max_depth) camera_changed = 1;
+    if (camera_changed) send_change(u);
+    if (u->ctl.exposure != u->applied_ctl.exposure) u->need_tonemap = 1;
+    if (u->ctl.show != u->applied_ctl.show) {
+        pthread_mutex_lock(&u->v->sh.lock);
+        u->v->sh.show_mask = show_mask_of(u->ctl.show);
+        pthread_mutex_unlock(&u->v->sh.lock);
+    }
+    u->applied_ctl = u->ctl;
+}
+
+static void request_export(ui_thread *u, const char *name) {
+    char path[1024];
+    if (unique_path(name, path, sizeof path) != 0) {
+        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
+        return;
+    }
+    shared_state *sh = &u->v->sh;
+    pthread_mutex_lock(&sh->lock);
+    snprintf(sh->export_path, sizeof sh->export_path, "%s", path);
+    sh->export_pending = 1;
+    pthread_mutex_unlock(&sh->lock);
+}
+
+static void take_screenshot(ui_thread *u, const char *name) {
+    char path[1024], err[1200];
+    if (!u->front.rgb || !u->pixels) {
+        snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
+        cli_error("%s", u->message);
+        return;
+    }
+    if (unique_path(name, path, sizeof path) != 0) {
+        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
+        cli_error("%s", u->message);
+        return;
+    }
+    if (png_save_rgb8(path, u->front.width, u->front.height, u->pixels, WRITE_NO_REPLACE, err, sizeof err) != 0) {
+        snprintf(u->message, sizeof u->message, "%s", err);
+        cli_error("%s", err);
+        return;
+    }
+    snprintf(u->message, sizeof u->message, "wrote %s", path);
+    printf("glint: wrote %s\n", path);
+    fflush(stdout);
+}
+
+static void request_load(ui_thread *u, int kind, const char *path) {
+    shared_state *sh = &u->v->sh;
+    pthread_mutex_lock(&sh->lock);
+    snprintf(sh->load_path, sizeof sh->load_path, "%s", path);
+    sh->load_kind = kind;
+    /* A new generation: frames counted after this show the result of the load. */
+    u->sent_generation = ++sh->generation;
+    pthread_mutex_unlock(&sh->lock);
+}
+
+static void print_stats(ui_thread *u) {
+    printf("stats scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
+           "max_depth=%d method=%s rejected=%llu\n",
+           u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
+           u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
+           method_name((render_method)u->ctl.method), u->rejected);
+    fflush(stdout);
+}
+
+/* A live parameter by its command-line name. Returns 0, or -1 with a message. */
+static int set_parameter(ui_thread *u, const char *name, const char *value, char *err, size_t errlen) {
+    char opt[80];
+    snprintf(opt, sizeof opt, "--%s", name);
+    long long n;
+    double x;
+    if (strcmp(name, "method") == 0) {
+        int m = method_from_name(value);
+        if (m < 0) return snprintf(err, errlen, "unknown method '%s'", value), -1;
+        u->ctl.method = m;
+    } else if (strcmp(name, "max-depth") == 0) {
+        if (cli_parse_int(opt, value, 1, 1000, &n) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        u->ctl.max_depth = (int)n;
+    } else if (strcmp(name, "exposure") == 0) {
+        if (cli_parse_float(opt, value, -30, 30, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        u->ctl.exposure = (float)x;
+    } else if (strcmp(name, "show") == 0) {
+        static const char *names[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights"};
+        int found = -1;
+        for (int i = 0; i < UI_SHOW_COUNT; i++)
+            if (strcmp(value, names[i]) == 0) found = i;
+        if (found < 0) return snprintf(err, errlen, "show: one of all, direct, indirect, highlights"), -1;
+        u->ctl.show = found;
+    } else if (strcmp(name, "camera") == 0) {
+        if (cli_parse_int(opt, value, -1, u->info.num_cameras - 1, &n) != 0)
+            return snprintf(err, errlen, "no camera %s", value), -1;
+        u->ctl.camera = (int)n;
+    } else if (strcmp(name, "panel") == 0) {
+        if (cli_parse_int(opt, value, 0, 1, &n) != 0) return snprintf(err, errlen, "panel: 0 or 1"), -1;
+        u->ctl.show_panel = (int)n;
+    } else {
+        return snprintf(err, errlen, "unknown parameter '%s'", name), -1;
+    }
+    return 0;
+}
+
+static void press_key(ui_thread *u, int key) {
+    if (key >= 0 && key <= GLFW_KEY_LAST) u->keys_pressed[key] = 1;
+}
+
+static int key_from_name(const char *name) {
+    if (strcmp(name, "r") == 0) return GLFW_KEY_R;
+    if (strcmp(name, "f11") == 0) return GLFW_KEY_F11;
+    if (strcmp(name, "f12") == 0) return GLFW_KEY_F12;
+    if (strcmp(name, "tab") == 0) return GLFW_KEY_TAB;
+    if (strcmp(name, "escape") == 0) return GLFW_KEY_ESCAPE;
+    if (strlen(name) == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
+    return -1;
+}
+
+/* Runs script actions until one has to wait. */
+static void run_script(ui_thread *u) {
+    while (u->script_pos < u->script.count && !u->quit) {
+        const script_action *a = &u->script.actions[u->script_pos];
+        char err[1200];
+        switch (a->kind) {
+        case ACT_WAIT:
+            /* N frames of the current state: frames of a state already replaced do not count. */
+            if (!u->script_waiting || u->script_wait_generation != u->sent_generation) {
+                u->script_waiting = 1;
+                u->script_wait_generation = u->sent_generation;
+                u->script_wait_target = frames_of_current_state(u) + (long long)a->a;
+            }
+            if (frames_of_current_state(u) < u->script_wait_target) return;
+            u->script_waiting = 0;
+            break;
+        case ACT_SET:
+            if (set_parameter(u, a->name, a->text, err, sizeof err) != 0) {
+                cli_error("%s:%d: %s", u->script_path_for_errors, a->line, err);
+                u->script_errors++;
+            }
+            if (u->ctl.camera != u->applied_ctl.camera) {
+                reset_view(u);
+                apply_controls(u, 1);
+            } else {
+                apply_controls(u, 0);
+            }
+            break;
+        case ACT_ORBIT:
+            ctl_orbit(&u->cam, (float)(a->a * 3.14159265358979 / 180.0), (float)(a->b * 3.14159265358979 / 180.0));
+            send_change(u);
+            break;
+        case ACT_PAN:
+            ctl_pan(&u->cam, (float)a->a, (float)a->b);
+            send_change(u);
+            break;
+        case ACT_ZOOM:
+            ctl_zoom(&u->cam, (float)a->a);
+            send_change(u);
+            break;
+        case ACT_KEY: {
+            int k = key_from_name(a->name);
+            if (k < 0) {
+                cli_error("%s:%d: unknown key '%s'", u->script_path_for_errors, a->line, a->name);
+                u->script_errors++;
+            } else {
+                press_key(u, k);
+            }
+            break;
+        }
+        case ACT_SCREENSHOT: take_screenshot(u, a->text); break;
+        case ACT_EXPORT: request_export(u, a->text); break;
+        case ACT_LOAD: request_load(u, 1, a->text); break;
+        case ACT_ENV: request_load(u, 2, a->text); break;
+        case ACT_WINDOW_SHOT: snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text); break;
+        case ACT_STATS: print_stats(u); break;
+        case ACT_QUIT: u->quit = 1; break;
+        }
+        u->script_pos++;
+    }
+}
+
+/* ---- input ---------------------------------------------------------------------------------- */
+
+static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods) {
+    (void)scancode;
+    (void)mods;
+    ui_thread *u = glfwGetWindowUserPointer(win);
+    if (action == GLFW_PRESS && !ui_wants_keyboard()) press_key(u, key);
+}
+
+static void on_scroll(GLFWwindow *win, double dx, double dy) {
+    (void)dx;
+    ui_thread *u = glfwGetWindowUserPointer(win);
+    if (!ui_wants_mouse()) u->scroll += dy;
+}
+
+static void on_drop(GLFWwindow *win, int count, const char **paths) {
+    ui_thread *u = glfwGetWindowUserPointer(win);
+    if (count < 1) return;
+    /* An image is an environment map; anything else is taken for a scene. */
+    const char *dot = strrchr(paths[0], '.');
+    int env = dot && (strcmp(dot, ".exr") == 0 || strcmp(dot, ".hdr") == 0);
+    request_load(u, env ? 2 : 1, paths[0]);
+}
+
+/* Keys, mouse and the panel's actions. Returns 1 when the camera changed. */
+static int handle_input(ui_thread *u, double dt) {
+    int changed = 0;
+    float speed = 0.25f * u->info.diag; /* scene sizes per second */
+    if (!ui_wants_keyboard()) {
+        camera c = ctl_camera(&u->cam);
+        vec3 move = v3s(0.0f);
+        if (glfwGetKey(u->win, GLFW_KEY_W) == GLFW_PRESS) move = add3(move, c.forward);
+        if (glfwGetKey(u->win, GLFW_KEY_S) == GLFW_PRESS) move = sub3(move, c.forward);
+        if (glfwGetKey(u->win, GLFW_KEY_D) == GLFW_PRESS) move = add3(move, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_A) == GLFW_PRESS) move = sub3(move, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_E) == GLFW_PRESS) move = add3(move, v3(0, 1, 0));
+        if (glfwGetKey(u->win, GLFW_KEY_Q) == GLFW_PRESS) move = sub3(move, v3(0, 1, 0));
+        if (!is_black3(move)) {
+            u->cam.pos = madd3(u->cam.pos, normalize3(move), speed * (float)dt);
+            changed = 1;
+        }
+    }
+    double x, y;
+    glfwGetCursorPos(u->win, &x, &y);
+    double dx = x - u->mouse_x, dy = y - u->mouse_y;
+    u->mouse_x = x;
+    u->mouse_y = y;
+    if (!ui_wants_mouse() && (dx != 0.0 || dy != 0.0)) {
+        int wh;
+        glfwGetWindowSize(u->win, NULL, &wh);
+        float scale = 1.0f / (float)(wh > 0 ? wh : 1);
+        if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+            ctl_orbit(&u->cam, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
+            changed = 1;
+        } else if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
+                   glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) {
+            ctl_pan(&u->cam, (float)-dx * scale, (float)dy * scale);
+            changed = 1;
+        }
+    }
+    if (u->scroll != 0.0) {
+        ctl_zoom(&u->cam, powf(0.85f, (float)u->scroll));
+        u->scroll = 0.0;
+        changed = 1;
+    }
+    if (u->keys_pressed[GLFW_KEY_R]) u->ctl.reset_view = 1;
+    if (u->keys_pressed[GLFW_KEY_F12]) u->ctl.screenshot = 1;
+    if (u->keys_pressed[GLFW_KEY_F11]) u->ctl.export_exr = 1;
+    if (u->keys_pressed[GLFW_KEY_TAB]) u->ctl.show_panel = !u->ctl.show_panel;
+    if (u->keys_pressed[GLFW_KEY_ESCAPE]) u->quit = 1;
+    for (int k = 1; k <= 9; k++)
+        if (u->keys_pressed[GLFW_KEY_0 + k] && k - 1 < u->info.num_cameras) u->ctl.camera = k - 1;
+    memset(u->keys_pressed, 0, sizeof u->keys_pressed);
+
+    if (u->ctl.camera != u->applied_ctl.camera) u->ctl.reset_view = 1;
+    if (u->ctl.reset_view) {
+        reset_view(u);
+        u->ctl.reset_view = 0;
+        changed = 1;
+    }
+    if (u->ctl.screenshot) take_screenshot(u, "glint-screenshot.png");
+    if (u->ctl.export_exr) request_export(u, "glint-export.exr");
+    if (u->ctl.load_scene) request_load(u, 1, u->ctl.path);
+    if (u->ctl.load_env) request_load(u, 2, u->ctl.path);
+    u->ctl.screenshot = u->ctl.export_exr = u->ctl.load_scene = u->ctl.load_env = 0;
+    return changed;
+}
+
+/* ---- display -------------------------------------------------------------------------------- */
+
+/* Takes the newest published image and statistics. Returns 1 when the image is new. */
+static int fetch(ui_thread *u) {
+    shared_state *sh = &u->v->sh;
+    int fresh = 0, new_info = 0;
+    pthread_mutex_lock(&sh->lock);
+    if (sh->image_serial != u->image_serial) {
+        image_buf t = u->front;
+        u->front = sh->image;
+        sh->image = t;
+        u->image_serial = sh->image_serial;
+        fresh = 1;
+    }
+    u->frames = sh->frames;
+    u->frames_total = sh->frames_total;
+    u->frames_generation = sh->frames_generation;
+    u->resets = sh->resets;
+    u->reset_at = sh->reset_at;
+    u->frame_ms = sh->frame_ms;
+    u->rays_per_second = sh->rays_per_second;
+    u->rejected = sh->rejected;
+    if (sh->message_serial != u->message_serial) {
+        snprintf(u->message, sizeof u->message, "%s", sh->message);
+        u->message_serial = sh->message_serial;
+    }
+    if (sh->info_serial != u->info_serial) {
+        u->info = sh->info;
+        u->info_serial = sh->info_serial;
+        new_info = 1;
+    }
+    pthread_mutex_unlock(&sh->lock);
+    if (new_info) { /* a new scene: its own view */
+        u->ctl.camera = -1;
+        u->applied_ctl.camera = -1;
+        u->ctl.reset_view = 1;
+    }
+    return fresh;
+}
+
+static void tonemap_and_upload(ui_thread *u) {
+    int w = u->front.width, h = u->front.height;
+    if (!u->front.rgb || w <= 0 || h <= 0) return;
+    if (w * h > u->pixels_cap) {
+        free(u->pixels);
+        u->pixels = malloc(3 * (size_t)w * (size_t)h);
+        u->pixels_cap = u->pixels ? w * h : 0;
+        if (!u->pixels) return;
+    }
+    tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f};
+    tonemap_reinhard(u->front.rgb, w * h, &tp, u->pixels);
+    if (!u->texture) {
+        GLuint t;
+        glGenTextures(1, &t);
+        u->texture = t;
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_2D, u->texture);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    if (w != u->tex_w || h != u->tex_h) {
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, w, h, 0, GL_RGB, GL_UNSIGNED_BYTE, u->pixels);
+        u->tex_w = w;
+        u->tex_h = h;
+    } else {
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, u->pixels);
+    }
+}
+
+/* Saves the window's back buffer as drawn (panel included). */
+static void capture_window(ui_thread *u, int w, int h) {
+    char path[1024], err[1200];
+    unsigned char *px = malloc(3 * (size_t)w * (size_t)h), *row = malloc(3 * (size_t)w);
+    if (!px || !row || unique_path(u->window_shot, path, sizeof path) != 0) {
+        cli_error("%s: cannot capture the window", u->window_shot);
+    } else {
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, px);
+        for (int y = 0; y < h / 2; y++) { /* OpenGL's rows run bottom-up */
+            memcpy(row, px + 3 * (size_t)w * (size_t)y, 3 * (size_t)w);
+            memcpy(px + 3 * (size_t)w * (size_t)y, px + 3 * (size_t)w * (size_t)(h - 1 - y), 3 * (size_t)w);
+            memcpy(px + 3 * (size_t)w * (size_t)(h - 1 - y), row, 3 * (size_t)w);
+        }
+        if (png_save_rgb8(path, w, h, px, WRITE_NO_REPLACE, err, sizeof err) != 0) cli_error("%s", err);
+        else printf("glint: wrote %s\n", path);
+    }
+    free(px);
+    free(row);
+    u->window_shot[0] = 0;
+}
+
+/* ---- options and the main loop ---------------------------------------------------------------- */
+
+static void print_view_help(void) {
+    printf("usage: glint [view] [SCENE] [options]\n"
+           "\n"
+           "Opens the interactive viewer on SCENE (default: the built-in scene).\n"
+           "\n"
+           "options:\n"
+           "  --size WxH           window and render size [960x540]\n"
+           "  --method NAME        estimator: pt [pt]\n"
+           "  --max-depth D        scattering events per path [%d]\n"
+           "  --env FILE           environment map (.exr or .hdr)\n"
+           "  --camera INDEX       start from the scene's camera INDEX\n"
+           "  --seed S             random seed [0]\n"
+           "  --exposure STOPS     display exposure [0]\n"
+           "  --script FILE        replay a script of viewer actions (see README)\n"
+           "\n"
+           "controls: left drag orbit, right/middle drag pan, wheel zoom, WASD/QE fly, R reset view,\n"
+           "1-9 scene cameras, F12 screenshot (PNG), F11 export (EXR), Tab panel, Esc quit.\n"
+           "Drop a .gltf/.glb on the window to open it, an .exr/.hdr to light the scene with it.\n",
+           DEFAULT_MAX_DEPTH);
+}
+
+static int parse_view_options(int argc, char **argv, view_options *o) {
+    memset(o, 0, sizeof *o);
+    o->width = 960;
+    o->height = 540;
+    o->camera = -1;
+    o->params.max_depth = DEFAULT_MAX_DEPTH;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i], *v;
+        long long n;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            print_view_help();
+            return 1;
+        } else if (strcmp(a, "--size") == 0) {
+            if (!(v = cli_value(argc, argv, &i)) || cli_parse_size(a, v, &o->width, &o->height)) return -1;
+        } else if (strcmp(a, "--method") == 0) {
+            if (!(v = cli_value(argc, argv, &i))) return -1;
+            int m = method_from_name(v);
+            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt)", v), -1;
+            o->params.method = (render_method)m;
+        } else if (strcmp(a, "--max-depth") == 0) {
+            if (!(v = cli_value(argc, argv, &i)) || cli_parse_int(a, v, 1, 1000, &n)) return -1;
+            o->params.max_depth = (int)n;
+        } else if (strcmp(a, "--env") == 0) {
+            if (!(o->env_path = cli_value(argc, argv, &i))) return -1;
+        } else if (strcmp(a, "--camera") == 0) {
+            if (!(v = cli_value(argc, argv, &i)) || cli_parse_int(a, v, 0, 1 << 20, &n)) return -1;
+            o->camera = (int)n;
+        } else if (strcmp(a, "--seed") == 0) {
+            if (!(v = cli_value(argc, argv, &i)) || cli_parse_u64(a, v, &o->params.seed)) return -1;
+        } else if (strcmp(a, "--exposure") == 0) {
+            if (!(v = cli_value(argc, argv, &i)) || cli_parse_float(a, v, -30, 30, &o->exposure)) return -1;
+        } else if (strcmp(a, "--script") == 0) {
+            if (!(o->script_path = cli_value(argc, argv, &i))) return -1;
+        } else if (a[0] == '-') {
+            return cli_error("unknown option '%s' (see glint view --help)", a), -1;
+        } else if (!o->scene_path) {
+            o->scene_path = a;
+        } else {
+            return cli_error("more than one scene given ('%s' and '%s')", o->scene_path, a), -1;
+        }
+    }
+    return 0;
+}
+
+static void on_glfw_error(int code, const char *description) {
+    (void)code;
+    cli_warning("window system: %s", description);
+}
+
+int cmd_view(int argc, char **argv) {
+    view_options o;
+    int r = parse_view_options(argc, argv, &o);
+    if (r) return r > 0 ? EXIT_OK : EXIT_USAGE;
+
+    static ui_thread u; /* large (key table, buffers): not on the stack */
+    memset(&u, 0, sizeof u);
+    char err[1200];
+    if (o.script_path) {
+        if (view_script_load(o.script_path, &u.script, err, sizeof err) != 0) {
+            cli_error("%s", err);
+            return EXIT_USAGE;
+        }
+        u.script_path_for_errors = o.script_path;
+    }
+
+    scene *s = load_scene_or_default(o.scene_path, o.env_path, 0.0f);
+    if (!s) {
+        view_script_free(&u.script);
+        return EXIT_FAILURE_;
+    }
+    if (o.camera >= 0 && o.camera >= s->num_cameras) {
+        cli_error("--camera: the scene has %d camera%s", s->num_cameras, s->num_cameras == 1 ? "" : "s");
+        scene_destroy(s);
+        view_script_free(&u.script);
+        return EXIT_USAGE;
+    }
+
+    glfwSetErrorCallback(on_glfw_error);
+    if (!glfwInit()) {
+        cli_error("cannot open a window (no display?); glint render renders without one");
+        scene_destroy(s);
+        view_script_free(&u.script);
+        return EXIT_FAILURE_;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    char title[1200];
+    snprintf(title, sizeof title, "glint — %s", s->path);
+    GLFWwindow *win = glfwCreateWindow(o.width, o.height, title, NULL, NULL);
+    if (!win) {
+        cli_error("cannot create an OpenGL 3.3 window");
+        glfwTerminate();
+        scene_destroy(s);
+        view_script_free(&u.script);
+        return EXIT_FAILURE_;
+    }
+    glfwMakeContextCurrent(win);
+    glfwSwapInterval(1);
+    glfwSetWindowUserPointer(win, &u);
+    /* Our callbacks first: Dear ImGui's backend chains to them. */
+    glfwSetKeyCallback(win, on_key);
+    glfwSetScrollCallback(win, on_scroll);
+    glfwSetDropCallback(win, on_drop);
+    if (ui_init(win) != 0) {
+        cli_error("cannot initialise the panel");
+        glfwDestroyWindow(win);
+        glfwTerminate();
+        scene_destroy(s);
+        view_script_free(&u.script);
+        return EXIT_FAILURE_;
+    }
+
+    static viewer v;
+    memset(&v, 0, sizeof v);
+    pthread_mutex_init(&v.sh.lock, NULL);
+    v.scene = s;
+    u.v = &v;
+    u.win = win;
+    fill_info(&u.info, s);
+    v.sh.info = u.info;
+    u.ctl = (ui_controls){.method = o.params.method,
+                          .max_depth = o.params.max_depth,
+                          .camera = o.camera,
+                          .exposure = (float)o.exposure,
+                          .show = UI_SHOW_ALL,
+                          .show_panel = 1};
+    u.applied_ctl = u.ctl;
+    int fw, fh;
+    glfwGetFramebufferSize(win, &fw, &fh);
+    reset_view(&u);
+    v.sh.cam = ctl_camera(&u.cam);
+    v.sh.params = o.params;
+    v.sh.render_w = fw > 0 ? fw : o.width;
+    v.sh.render_h = fh > 0 ? fh : o.height;
+    v.sh.show_mask = COMP_MASK_ALL;
+    v.sh.changed_at = -1e9;
+    if (make_sessions(&v, v.sh.render_w, v.sh.render_h, &v.sh.cam, &o.params) != 0) {
+        cli_error("%s", v.sh.message);
+        ui_shutdown();
+        glfwDestroyWindow(win);
+        glfwTerminate();
+        scene_destroy(s);
+        view_script_free(&u.script);
+        return EXIT_FAILURE_;
+    }
+    pthread_t render_thread;
+    pthread_create(&render_thread, NULL, render_main, &v);
+
+    glfwGetCursorPos(win, &u.mouse_x, &u.mouse_y);
+    u.last_time = cli_now();
+    double resized_at = 0.0;
+    int pending_w = 0, pending_h = 0;
+    while (!u.quit && !glfwWindowShouldClose(win)) {
+        glfwWaitEventsTimeout(1.0 / 60.0);
+        double now = cli_now(), dt = now - u.last_time;
+        u.last_time = now;
+        if (fetch(&u)) u.need_tonemap = 1;
+        run_script(&u);
+
+        ui_begin_frame();
+        ui_draw_image(u.texture);
+        ui_stats st = {.scene_name = u.info.name,
+                       .frames = u.frames,
+                       .spp = (double)u.frames,
+                       .seconds = seconds_since(u.reset_at),
+                       .frame_ms = u.frame_ms,
+                       .rays_per_second = u.rays_per_second,
+                       .rejected_samples = u.rejected,
+                       .width = u.front.width,
+                       .height = u.front.height,
+                       .previewing = u.front.preview,
+                       .num_cameras = u.info.num_cameras,
+                       .message = u.message};
+        const char *methods[METHOD_COUNT];
+        for (int m = 0; m < METHOD_COUNT; m++) methods[m] = method_name((render_method)m);
+        st.method_names = methods;
+        st.num_methods = METHOD_COUNT;
+        ui_panel(&u.ctl, &st);
+
+        apply_controls(&u, handle_input(&u, dt));
+
+        /* A new window size becomes the render size once it has stopped changing. */
+        glfwGetFramebufferSize(win, &fw, &fh);
+        if (fw > 0 && fh > 0 && (fw != v.sh.render_w || fh != v.sh.render_h)) {
+            if (fw != pending_w || fh != pending_h) {
+                pending_w = fw;
+                pending_h = fh;
+                resized_at = now;
+            } else if (now - resized_at > 0.2) {
+                pthread_mutex_lock(&v.sh.lock);
+                v.sh.render_w = fw;
+                v.sh.render_h = fh;
+                pthread_mutex_unlock(&v.sh.lock);
+                /* the aspect ratio changed: recompute the camera */
+                send_change(&u);
+            }
+        }
+
+        if (u.need_tonemap) {
+            tonemap_and_upload(&u);
+            u.need_tonemap = 0;
+        }
+        glViewport(0, 0, fw, fh);
+        glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ui_end_frame();
+        if (u.window_shot[0]) capture_window(&u, fw, fh);
+        glfwSwapBuffers(win);
+    }
+
+    pthread_mutex_lock(&v.sh.lock);
+    v.sh.quit = 1;
+    pthread_mutex_unlock(&v.sh.lock);
+    pthread_join(render_thread, NULL);
+    if (u.texture) {
+        GLuint t = u.texture;
+        glDeleteTextures(1, &t);
+    }
+    ui_shutdown();
+    glfwDestroyWindow(win);
+    glfwTerminate();
+    session_destroy(v.full);
+    session_destroy(v.preview);
+    scene_destroy(v.scene);
+    free(v.back.rgb);
+    free(v.sh.image.rgb);
+    free(u.front.rgb);
+    free(u.pixels);
+    pthread_mutex_destroy(&v.sh.lock);
+    int errors = u.script_errors;
+    view_script_free(&u.script);
+    return errors ? EXIT_FAILURE_ : EXIT_OK;
+}

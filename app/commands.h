@@ -1,0 +1,17 @@
+/* glint — the program's commands. Each takes the arguments after its name and returns the exit
+ * code. */
+#ifndef GLINT_COMMANDS_H
+#define GLINT_COMMANDS_H
+
+#include "scene.h"
+
+int cmd_render(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+/* The interactive viewer. */
+int cmd_view(int argc, char **argv);
+
+/* Loads SCENE (NULL: the built-in default) and attaches --env when given. Prints the error and
+ * returns NULL on failure. */
+scene *load_scene_or_default(const char *path, const char *env_path, float env_rotation);
+
+#endif

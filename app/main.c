@@ -1,0 +1,40 @@
+/* glint — interactive, progressive rendering of glossy global illumination. */
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli.h"
+#include "commands.h"
+
+static void print_help(void) {
+    printf("glint %s — progressive rendering of glossy global illumination\n"
+           "\n"
+           "usage:\n"
+           "  glint [view] [SCENE] [options]   open the interactive viewer (see glint view --help)\n"
+           "  glint render [SCENE] [options]   render headless to EXR/PNG (see glint render --help)\n"
+           "  glint info [SCENE]               print a summary of the scene\n"
+           "  glint --help | --version\n"
+           "\n"
+           "SCENE is a glTF 2.0 file (.gltf or .glb); without one, the built-in default scene.\n",
+           GLINT_VERSION);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2) return cmd_view(0, argv + 1);
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+        print_help();
+        return EXIT_OK;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("glint %s\n", GLINT_VERSION);
+        return EXIT_OK;
+    }
+    if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 2, argv + 2);
+    if (strcmp(argv[1], "info") == 0) return cmd_info(argc - 2, argv + 2);
+    if (strcmp(argv[1], "view") == 0) return cmd_view(argc - 2, argv + 2);
+    /* `glint SCENE [options]` and `glint --option ...` open the viewer too. */
+    struct stat st;
+    if (argv[1][0] == '-' || stat(argv[1], &st) == 0) return cmd_view(argc - 1, argv + 1);
+    cli_error("unknown command or missing scene file '%s' (see glint --help)", argv[1]);
+    return EXIT_USAGE;
+}

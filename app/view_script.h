@@ -1,0 +1,54 @@
+/* glint — viewer automation scripts: one action a line, replayed through the viewer's own input
+ * paths so the real window can be driven in tests (under xvfb-run).
+ *
+ *   # comment                 wait FRAMES            set NAME VALUE
+ *   orbit DX_DEG DY_DEG       pan DX DY              zoom FACTOR
+ *   key NAME                  screenshot FILE.png    export FILE.exr
+ *   load SCENE                env MAP.exr|MAP.hdr    window-shot FILE.png
+ *   stats                     quit
+ *
+ * `window-shot` captures the window as drawn, panel included (for documentation).
+ * `wait` waits for FRAMES new full-resolution frames; `stats` prints one line of the viewer's
+ * counters to stdout; `key` presses a named key (r, f11, f12, tab, 1-9). */
+#ifndef GLINT_VIEW_SCRIPT_H
+#define GLINT_VIEW_SCRIPT_H
+
+#include <stddef.h>
+
+typedef enum {
+    ACT_WAIT,
+    ACT_SET,
+    ACT_ORBIT,
+    ACT_PAN,
+    ACT_ZOOM,
+    ACT_KEY,
+    ACT_SCREENSHOT,
+    ACT_EXPORT,
+    ACT_LOAD,
+    ACT_ENV,
+    ACT_WINDOW_SHOT, /* the whole window, panel included */
+    ACT_STATS,
+    ACT_QUIT,
+} script_action_kind;
+
+typedef struct {
+    script_action_kind kind;
+    int line;
+    double a, b;     /* numbers: frames, degrees, offsets, factor */
+    char name[64];   /* set: parameter; key: key name */
+    char text[1024]; /* set: value; screenshot, export, load, env: path */
+} script_action;
+
+typedef struct {
+    script_action *actions;
+    int count;
+} view_script;
+
+/* Parses a script file. Returns 0, or -1 with err = "FILE:LINE: problem" (or "FILE: problem"). */
+int view_script_load(const char *path, view_script *out, char *err, size_t errlen);
+/* Parses one line (already without its newline). Returns 1 for an action, 0 for a blank or
+ * comment line, -1 with err = "problem" for a bad line. */
+int view_script_parse_line(const char *line, script_action *out, char *err, size_t errlen);
+void view_script_free(view_script *s);
+
+#endif

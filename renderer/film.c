@@ -1,0 +1,125 @@
+#include "film.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const film_component_names[COMP_COUNT] = {"direct", "indirect", "highlights"};
+
+int film_init(film *f, int width, int height) {
+    memset(f, 0, sizeof *f);
+    if (width <= 0 || height <= 0) return -1;
+    size_t n = (size_t)width * (size_t)height;
+    f->width = width;
+    f->height = height;
+    int ok = (f->count = calloc(n, sizeof(double))) != NULL;
+    for (int c = 0; c < COMP_COUNT; c++) ok &= (f->sum[c] = calloc(3 * n, sizeof(double))) != NULL;
+    if (!ok) {
+        film_deinit(f);
+        return -1;
+    }
+    return 0;
+}
+
+void film_deinit(film *f) {
+    for (int c = 0; c < COMP_COUNT; c++) free(f->sum[c]);
+    free(f->count);
+    memset(f, 0, sizeof *f);
+}
+
+void film_clear(film *f) {
+    size_t n = (size_t)f->width * (size_t)f->height;
+    for (int c = 0; c < COMP_COUNT; c++) memset(f->sum[c], 0, 3 * n * sizeof(double));
+    memset(f->count, 0, n * sizeof(double));
+}
+
+void film_resolve(const film *f, unsigned mask, float *rgb) {
+    size_t n = (size_t)f->width * (size_t)f->height;
+    for (size_t i = 0; i < n; i++) {
+        double acc[3] = {0, 0, 0};
+        for (int c = 0; c < COMP_COUNT; c++) {
+            if (!(mask & (1u << c))) continue;
+            const double *s = f->sum[c] + 3 * i;
+            acc[0] += s[0];
+            acc[1] += s[1];
+            acc[2] += s[2];
+        }
+        double inv = f->count[i] > 0.0 ? 1.0 / f->count[i] : 0.0;
+        for (int k = 0; k < 3; k++) rgb[3 * i + (size_t)k] = (float)(acc[k] * inv);
+    }
+}
+
+float srgb_encode(float x) {
+    if (!(x > 0.0f)) return 0.0f;
+    if (x >= 1.0f) return 1.0f;
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+}
+
+static float lum(const float *c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+
+void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *out) {
+    /* Log-average luminance (Reinhard's eq. 1), delta guarding log(0). */
+    double log_sum = 0.0;
+    int counted = 0;
+    for (int i = 0; i < num_pixels; i++) {
+        float l = lum(rgb + 3 * (size_t)i);
+        if (!isfinite(l)) continue;
+        log_sum += log(1e-4 + (double)fmaxf(l, 0.0f));
+        counted++;
+    }
+    double avg = counted ? exp(log_sum / counted) : 1.0;
+    float key = p->key > 0.0f ? p->key : 0.18f;
+    float scale = (float)((double)key / avg) * exp2f(p->exposure);
+    float inv_white2 = p->white > 0.0f ? 1.0f / (p->white * p->white) : 0.0f;
+    for (int i = 0; i < num_pixels; i++) {
+        const float *c = rgb + 3 * (size_t)i;
+        float l = lum(c);
+        float ls = l * scale;
+        float ld = ls * (1.0f + ls * inv_white2) / (1.0f + ls);
+        float k = l > 0.0f && isfinite(l) ? ld / l : 0.0f;
+        for (int j = 0; j < 3; j++) {
+            float v = srgb_encode(c[j] * k);
+            out[3 * (size_t)i + (size_t)j] = (uint8_t)(v * 255.0f + 0.5f);
+        }
+    }
+}
+
+int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen) {
+    size_t n = 3 * (size_t)f->width * (size_t)f->height;
+    float *planes[1 + COMP_COUNT] = {0};
+    exr_layer layers[1 + COMP_COUNT];
+    int nl = 0, status = -1;
+    for (int c = -1; c < COMP_COUNT; c++) {
+        if (c >= 0 && !(layers_mask & (1u << c))) continue;
+        if (!(planes[nl] = malloc(sizeof(float) * n))) {
+            snprintf(err, errlen, "%s: out of memory", path);
+            goto done;
+        }
+        film_resolve(f, c < 0 ? COMP_MASK_ALL : 1u << c, planes[nl]);
+        layers[nl] = (exr_layer){c < 0 ? "" : film_component_names[c], planes[nl]};
+        nl++;
+    }
+    status = exr_save_layers(path, f->width, f->height, layers, nl, mode, err, errlen);
+done:
+    for (int i = 0; i < nl; i++) free(planes[i]);
+    return status;
+}
+
+int film_save_png(const film *f, unsigned mask, const tonemap_params *tp, const char *path, write_mode mode, char *err,
+                  size_t errlen) {
+    size_t n = (size_t)f->width * (size_t)f->height;
+    float *rgb = malloc(sizeof(float) * 3 * n);
+    uint8_t *px = malloc(3 * n);
+    int status = -1;
+    if (!rgb || !px) {
+        snprintf(err, errlen, "%s: out of memory", path);
+    } else {
+        film_resolve(f, mask, rgb);
+        tonemap_reinhard(rgb, (int)n, tp, px);
+        status = png_save_rgb8(path, f->width, f->height, px, mode, err, errlen);
+    }
+    free(rgb);
+    free(px);
+    return status;
+}

@@ -1,0 +1,66 @@
+/* glint — the film: per-component sums and per-pixel sample counts in double (thousands of
+ * frames accumulate without drift), resolved to means on demand; Reinhard's global tone
+ * operator and sRGB encoding for display. */
+#ifndef GLINT_FILM_H
+#define GLINT_FILM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "image_io.h"
+
+/* Path-space components, each in its own buffer: the image is their sum. */
+typedef enum {
+    COMP_DIRECT = 0, /* emitted + direct lighting at the first hit */
+    COMP_INDIRECT,   /* everything after the first bounce (minus highlights when those are on) */
+    COMP_HIGHLIGHTS, /* E-glossy-glossy-light paths of the highlight estimator */
+    COMP_COUNT
+} film_component;
+
+#define COMP_MASK_ALL ((1u << COMP_COUNT) - 1u)
+
+extern const char *const film_component_names[COMP_COUNT]; /* "direct", "indirect", "highlights" */
+
+typedef struct {
+    int width, height;
+    double *sum[COMP_COUNT]; /* 3 per pixel */
+    double *count;           /* samples per pixel */
+} film;
+
+int film_init(film *f, int width, int height); /* 0 or -1 (out of memory) */
+void film_deinit(film *f);
+void film_clear(film *f);
+
+/* Adds one sample (3 floats per component) to pixel i. */
+static inline void film_add(film *f, int i, const float rgb[COMP_COUNT][3]) {
+    for (int c = 0; c < COMP_COUNT; c++) {
+        double *s = f->sum[c] + 3 * (size_t)i;
+        s[0] += (double)rgb[c][0];
+        s[1] += (double)rgb[c][1];
+        s[2] += (double)rgb[c][2];
+    }
+    f->count[i] += 1.0;
+}
+
+/* Mean radiance of the components in mask (bit c = component c) into rgb (3 floats per pixel). */
+void film_resolve(const film *f, unsigned mask, float *rgb);
+
+typedef struct {
+    float exposure; /* stops: the scaled luminance is multiplied by 2^exposure */
+    float key;      /* Reinhard's key value a (0 = 0.18) */
+    float white;    /* smallest scaled luminance mapped to white (0 = infinity: L/(1+L)) */
+} tonemap_params;
+
+/* Reinhard et al. 2002, global operator: scale by key / log-average luminance, compress
+ * luminance, keep chromaticity; then the sRGB transfer function to 8 bits. */
+void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *srgb8);
+float srgb_encode(float linear);
+
+/* Exports (atomic; see image_io.h for write_mode). The EXR holds R,G,B (the sum of the
+ * components) plus one layer per component in layers_mask ("direct.R", ...). The PNG is the sum,
+ * tone-mapped. Return 0, or -1 with err = "PATH: problem". */
+int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen);
+int film_save_png(const film *f, unsigned mask, const tonemap_params *tp, const char *path, write_mode mode, char *err,
+                  size_t errlen);
+
+#endif

@@ -1,0 +1,603 @@
+// glint — glTF 2.0 import through tinygltf (Debian's libtinygltf, compiled library: no
+// TINYGLTF_IMPLEMENTATION here). The only C++ in the renderer: it validates what tinygltf parsed
+// and hands plain arrays to the C scene builder (scene_add_*).
+#include "gltf_import.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include <stb_image.h>
+#include <tiny_gltf.h>
+
+namespace {
+
+using tinygltf::Accessor;
+using tinygltf::Model;
+using tinygltf::Value;
+
+// Thrown inside the importer for any problem with the file; caught at the C boundary.
+struct import_error {
+    std::string what;
+};
+
+[[noreturn]] void fail(const std::string &what) { throw import_error{what}; }
+
+std::string first_line(const std::string &s) {
+    size_t a = s.find_first_not_of(" \n\r\t");
+    if (a == std::string::npos) return "";
+    size_t b = s.find_first_of("\n\r", a);
+    return s.substr(a, b == std::string::npos ? std::string::npos : b - a);
+}
+
+// ---- accessors ----------------------------------------------------------------------------
+
+int component_size(int type) {
+    switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_INT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+    }
+}
+
+int type_components(int type) {
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0;
+    }
+}
+
+// One component as double: normalized integers map to [0,1] or [-1,1] as the spec says.
+double read_component(const unsigned char *p, int type, bool normalized) {
+    switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float f;
+        std::memcpy(&f, p, 4);
+        return f;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        int8_t v;
+        std::memcpy(&v, p, 1);
+        return normalized ? std::fmax(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? std::fmax(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_INT: {
+        int32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+    }
+    default: return 0.0;
+    }
+}
+
+// Checked view of `count` elements of `elem_size` bytes in a bufferView; returns the first
+// element's address and the stride.
+const unsigned char *view_elements(const Model &m, int view_index, size_t offset, size_t count, size_t elem_size,
+                                   size_t *stride, const std::string &what) {
+    if (view_index < 0 || (size_t)view_index >= m.bufferViews.size())
+        fail(what + ": bufferView " + std::to_string(view_index) + " out of range");
+    const tinygltf::BufferView &bv = m.bufferViews[(size_t)view_index];
+    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
+        fail(what + ": buffer " + std::to_string(bv.buffer) + " out of range");
+    const tinygltf::Buffer &buf = m.buffers[(size_t)bv.buffer];
+    if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset)
+        fail(what + ": bufferView " + std::to_string(view_index) + " extends past the end of its buffer (" +
+             std::to_string(buf.data.size()) + " bytes; truncated file?)");
+    size_t s = bv.byteStride ? bv.byteStride : elem_size;
+    if (s < elem_size) fail(what + ": byteStride smaller than the element");
+    if (count > 0) {
+        // offset + s*(count-1) + elem_size <= byteLength, without overflow
+        if (offset > bv.byteLength || elem_size > bv.byteLength - offset ||
+            (count > 1 && (bv.byteLength - offset - elem_size) / s < count - 1))
+            fail(what + ": accessor reads past the end of bufferView " + std::to_string(view_index));
+    }
+    *stride = s;
+    return buf.data.data() + bv.byteOffset + offset;
+}
+
+// Reads an accessor as `want` doubles per element (sparse accessors applied).
+std::vector<double> read_accessor(const Model &m, int index, int want, const std::string &what) {
+    if (index < 0 || (size_t)index >= m.accessors.size())
+        fail(what + ": accessor " + std::to_string(index) + " out of range");
+    const Accessor &a = m.accessors[(size_t)index];
+    int nc = type_components(a.type), cs = component_size(a.componentType);
+    if (nc != want || cs == 0)
+        fail(what + ": accessor " + std::to_string(index) + " has the wrong type (" + std::to_string(nc) +
+             " components, expected " + std::to_string(want) + ")");
+    if (a.count > (1u << 28)) fail(what + ": accessor " + std::to_string(index) + " is too large");
+    std::vector<double> out(a.count * (size_t)want, 0.0);
+    if (a.bufferView >= 0) {
+        size_t stride;
+        const unsigned char *p =
+            view_elements(m, a.bufferView, a.byteOffset, a.count, (size_t)(nc * cs), &stride, what);
+        for (size_t i = 0; i < a.count; i++)
+            for (int c = 0; c < nc; c++)
+                out[i * (size_t)want + (size_t)c] = read_component(p + i * stride + (size_t)(c * cs), a.componentType, a.normalized);
+    }
+    if (a.sparse.isSparse) {
+        size_t n = (size_t)a.sparse.count, istride, vstride;
+        int ics = component_size(a.sparse.indices.componentType);
+        if (ics == 0 || n > a.count) fail(what + ": invalid sparse accessor " + std::to_string(index));
+        const unsigned char *ip =
+            view_elements(m, a.sparse.indices.bufferView, (size_t)a.sparse.indices.byteOffset, n, (size_t)ics, &istride, what);
+        const unsigned char *vp =
+            view_elements(m, a.sparse.values.bufferView, (size_t)a.sparse.values.byteOffset, n, (size_t)(nc * cs), &vstride, what);
+        istride = (size_t)ics; // sparse arrays are tightly packed
+        vstride = (size_t)(nc * cs);
+        for (size_t i = 0; i < n; i++) {
+            double target = read_component(ip + i * istride, a.sparse.indices.componentType, false);
+            if (!(target >= 0.0) || target >= (double)a.count) fail(what + ": sparse index out of range");
+            for (int c = 0; c < nc; c++)
+                out[(size_t)target * (size_t)want + (size_t)c] =
+                    read_component(vp + i * vstride + (size_t)(c * cs), a.componentType, a.normalized);
+        }
+    }
+    for (double v : out)
+        if (!std::isfinite(v)) fail(what + ": accessor " + std::to_string(index) + " holds non-finite values");
+    return out;
+}
+
+std::vector<float> to_float(const std::vector<double> &d) { return std::vector<float>(d.begin(), d.end()); }
+
+// ---- materials and textures ---------------------------------------------------------------
+
+double number_or(const Value &obj, const char *key, double fallback) {
+    if (!obj.IsObject() || !obj.Has(key)) return fallback;
+    const Value &v = obj.Get(key);
+    return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
+vec3 color_or(const Value &obj, const char *key, vec3 fallback) {
+    if (!obj.IsObject() || !obj.Has(key)) return fallback;
+    const Value &v = obj.Get(key);
+    if (!v.IsArray() || v.ArrayLen() < 3) return fallback;
+    float c[3];
+    for (int i = 0; i < 3; i++) {
+        const Value &e = v.Get(i);
+        if (!e.IsNumber()) return fallback;
+        c[i] = (float)e.GetNumberAsDouble();
+    }
+    return v3(c[0], c[1], c[2]);
+}
+
+vec3 vec3_from(const std::vector<double> &v, vec3 fallback) {
+    return v.size() >= 3 ? v3((float)v[0], (float)v[1], (float)v[2]) : fallback;
+}
+
+struct importer {
+    scene *s;
+    const Model &m;
+    std::string name;
+    std::vector<int> texture_map; // glTF texture -> scene texture (-1 until used)
+    std::vector<int> image_map;   // glTF image -> scene image
+    std::vector<int> material_map;
+    std::vector<char> on_stack;   // node recursion guard: cycles are an error
+
+    importer(scene *sc, const Model &model, const std::string &n) : s(sc), m(model), name(n) {}
+
+    texture_slot texture(int index, int texcoord, const std::string &what) {
+        if (index < 0) return texture_slot{-1, 0};
+        if ((size_t)index >= m.textures.size()) fail(what + ": texture " + std::to_string(index) + " out of range");
+        if (texcoord < 0 || texcoord > 1) {
+            scene_warn(s, "%s: %s uses TEXCOORD_%d; only TEXCOORD_0 and _1 are supported, using 0", name.c_str(),
+                       what.c_str(), texcoord);
+            texcoord = 0;
+        }
+        int &mapped = texture_map[(size_t)index];
+        if (mapped < 0) {
+            const tinygltf::Texture &t = m.textures[(size_t)index];
+            int src = t.source;
+            if (src < 0 || (size_t)src >= m.images.size())
+                fail(what + ": texture " + std::to_string(index) + " has no valid image (source " + std::to_string(src) + ")");
+            int &img = image_map[(size_t)src];
+            if (img < 0) {
+                const tinygltf::Image &im = m.images[(size_t)src];
+                std::string label = im.uri.empty() ? "image " + std::to_string(src) : "'" + im.uri + "'";
+                if (im.image.empty() || im.width <= 0 || im.height <= 0)
+                    fail("texture image " + label + " is missing or unreadable");
+                size_t need = (size_t)im.width * (size_t)im.height * (size_t)im.component * (size_t)(im.bits / 8);
+                if (im.image.size() < need) fail("texture image " + label + " is truncated");
+                img = scene_add_image(s, im.width, im.height, im.component, im.bits, im.image.data());
+                if (img < 0) fail("texture image " + label + " has an unsupported format");
+            }
+            scene_texture st{img, WRAP_REPEAT, WRAP_REPEAT};
+            if (t.sampler >= 0 && (size_t)t.sampler < m.samplers.size()) {
+                auto wrap = [](int w) {
+                    return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE  ? WRAP_CLAMP
+                           : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? WRAP_MIRROR
+                                                                        : WRAP_REPEAT;
+                };
+                st.wrap_s = wrap(m.samplers[(size_t)t.sampler].wrapS);
+                st.wrap_t = wrap(m.samplers[(size_t)t.sampler].wrapT);
+            }
+            mapped = scene_add_texture(s, st);
+            if (mapped < 0) fail("out of memory");
+        }
+        return texture_slot{mapped, texcoord};
+    }
+
+    void materials() {
+        material_map.assign(m.materials.size(), -1);
+        for (size_t i = 0; i < m.materials.size(); i++) {
+            const tinygltf::Material &gm = m.materials[i];
+            std::string what = "material " + std::to_string(i);
+            material mat = material_default();
+            std::snprintf(mat.name, sizeof mat.name, "%s", gm.name.empty() ? what.c_str() : gm.name.c_str());
+            const auto &pbr = gm.pbrMetallicRoughness;
+            mat.base_color = vec3_from(pbr.baseColorFactor, v3s(1.0f));
+            mat.metallic = (float)pbr.metallicFactor;
+            mat.roughness = (float)pbr.roughnessFactor;
+            mat.base_color_tex = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what);
+            mat.metal_rough_tex = texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what);
+            mat.emission = vec3_from(gm.emissiveFactor, v3s(0.0f));
+            mat.emissive_tex = texture(gm.emissiveTexture.index, gm.emissiveTexture.texCoord, what);
+            mat.double_sided = gm.doubleSided;
+            for (const auto &ext : gm.extensions) {
+                const Value &e = ext.second;
+                if (ext.first == "KHR_materials_emissive_strength") {
+                    mat.emission = scale3(mat.emission, (float)number_or(e, "emissiveStrength", 1.0));
+                } else if (ext.first == "KHR_materials_anisotropy") {
+                    mat.anisotropy_strength = (float)number_or(e, "anisotropyStrength", 0.0);
+                    mat.anisotropy_rotation = (float)number_or(e, "anisotropyRotation", 0.0);
+                    if (e.Has("anisotropyTexture")) {
+                        const Value &t = e.Get("anisotropyTexture");
+                        mat.anisotropy_tex = texture((int)number_or(t, "index", -1), (int)number_or(t, "texCoord", 0), what);
+                    }
+                }
+            }
+            // The papers' lobes: extras.glint = {model: "phong"|"ward", kd, ks, exponent, alpha_x, alpha_y, rotation}
+            if (gm.extras.IsObject() && gm.extras.Has("glint")) {
+                const Value &g = gm.extras.Get("glint");
+                std::string model = g.Has("model") && g.Get("model").IsString() ? g.Get("model").Get<std::string>() : "";
+                if (model == "phong" || model == "ward") {
+                    mat.model = model == "phong" ? MATERIAL_PHONG : MATERIAL_WARD;
+                    mat.kd = color_or(g, "kd", v3s(0.0f));
+                    mat.ks = color_or(g, "ks", v3s(0.5f));
+                    mat.exponent = (float)number_or(g, "exponent", 64.0);
+                    mat.alpha_x = (float)number_or(g, "alpha_x", 0.1);
+                    mat.alpha_y = (float)number_or(g, "alpha_y", number_or(g, "alpha_x", 0.1));
+                    mat.anisotropy_rotation = (float)number_or(g, "rotation", 0.0);
+                    // Textures other than emission do not apply to these lobes, except base colour tinting kd.
+                } else if (!model.empty() && model != "gltf") {
+                    scene_warn(s, "%s: %s: unknown extras.glint.model '%s', using metallic-roughness", name.c_str(),
+                               mat.name, model.c_str());
+                }
+            }
+            if (gm.alphaMode == "BLEND" || gm.alphaMode == "MASK")
+                scene_warn(s, "%s: alphaMode %s is not supported; surfaces are opaque", name.c_str(), gm.alphaMode.c_str());
+            if (gm.normalTexture.index >= 0)
+                scene_warn(s, "%s: normal maps are not supported yet; using interpolated normals", name.c_str());
+            material_map[i] = scene_add_material(s, &mat);
+            if (material_map[i] < 0) fail("out of memory");
+        }
+    }
+
+    // ---- nodes, meshes, lights, cameras ----------------------------------------------------
+
+    static mat4 node_local(const tinygltf::Node &n) {
+        mat4 r = mat4_identity();
+        if (n.matrix.size() == 16) {
+            for (int c = 0; c < 4; c++)
+                for (int row = 0; row < 4; row++) r.m[row][c] = (float)n.matrix[(size_t)(c * 4 + row)]; // column-major
+            return r;
+        }
+        vec3 t = vec3_from(n.translation, v3s(0.0f));
+        vec3 sc = vec3_from(n.scale, v3s(1.0f));
+        double q[4] = {0, 0, 0, 1};
+        if (n.rotation.size() == 4)
+            for (int i = 0; i < 4; i++) q[i] = n.rotation[(size_t)i];
+        double qn = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        if (qn > 0) for (double &c : q) c /= qn;
+        double x = q[0], y = q[1], z = q[2], w = q[3];
+        double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                          {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                          {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+        float scl[3] = {sc.x, sc.y, sc.z};
+        for (int row = 0; row < 3; row++)
+            for (int c = 0; c < 3; c++) r.m[row][c] = (float)(R[row][c] * scl[c]);
+        r.m[0][3] = t.x;
+        r.m[1][3] = t.y;
+        r.m[2][3] = t.z;
+        return r;
+    }
+
+    void mesh(int index, const mat4 &xf) {
+        if (index < 0 || (size_t)index >= m.meshes.size()) fail("mesh " + std::to_string(index) + " out of range");
+        const tinygltf::Mesh &gm = m.meshes[(size_t)index];
+        for (size_t pi = 0; pi < gm.primitives.size(); pi++) {
+            const tinygltf::Primitive &p = gm.primitives[pi];
+            std::string what = "mesh " + std::to_string(index) + " primitive " + std::to_string(pi);
+            int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+            if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+                scene_warn(s, "%s: skipping %s: points and lines are not rendered", name.c_str(), what.c_str());
+                continue;
+            }
+            auto attr = [&](const char *key) { auto it = p.attributes.find(key); return it == p.attributes.end() ? -1 : it->second; };
+            if (attr("POSITION") < 0) fail(what + " has no POSITION");
+            std::vector<float> pos = to_float(read_accessor(m, attr("POSITION"), 3, what + " POSITION"));
+            size_t nv = pos.size() / 3;
+            if (nv == 0) continue;
+            auto optional = [&](const char *key, int comps) {
+                std::vector<float> v;
+                if (attr(key) >= 0) {
+                    v = to_float(read_accessor(m, attr(key), comps, what + " " + key));
+                    if (v.size() / (size_t)comps != nv) fail(what + ": " + key + " count differs from POSITION");
+                }
+                return v;
+            };
+            std::vector<float> nrm = optional("NORMAL", 3), tan = optional("TANGENT", 4);
+            std::vector<float> uv0 = optional("TEXCOORD_0", 2), uv1 = optional("TEXCOORD_1", 2);
+            std::vector<uint32_t> idx;
+            if (p.indices >= 0) {
+                if ((size_t)p.indices >= m.accessors.size()) fail(what + ": index accessor out of range");
+                const Accessor &ia = m.accessors[(size_t)p.indices];
+                if (ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                    ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                    ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+                    fail(what + ": indices must be unsigned integers");
+                std::vector<double> raw = read_accessor(m, p.indices, 1, what + " indices");
+                idx.reserve(raw.size());
+                for (double d : raw) {
+                    if (d >= (double)nv)
+                        fail(what + ": vertex index " + std::to_string((unsigned long long)d) + " out of range (" +
+                             std::to_string(nv) + " vertices)");
+                    idx.push_back((uint32_t)d);
+                }
+            } else if (mode != TINYGLTF_MODE_TRIANGLES) {
+                for (size_t i = 0; i < nv; i++) idx.push_back((uint32_t)i);
+            }
+            if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+                std::vector<uint32_t> tri;
+                for (size_t i = 2; i < idx.size(); i++) {
+                    if (mode == TINYGLTF_MODE_TRIANGLE_FAN) tri.insert(tri.end(), {idx[0], idx[i - 1], idx[i]});
+                    else if (i % 2 == 0) tri.insert(tri.end(), {idx[i - 2], idx[i - 1], idx[i]});
+                    else tri.insert(tri.end(), {idx[i - 1], idx[i - 2], idx[i]});
+                }
+                idx.swap(tri);
+            }
+            size_t ncount = p.indices >= 0 || mode != TINYGLTF_MODE_TRIANGLES ? idx.size() : nv;
+            if (ncount % 3 != 0) {
+                scene_warn(s, "%s: %s has %zu indices, not a multiple of 3; dropping the rest", name.c_str(), what.c_str(), ncount);
+                ncount -= ncount % 3;
+                if (!idx.empty()) idx.resize(ncount);
+            }
+            if (ncount == 0) continue;
+            if (ncount > (1u << 30) || nv > (1u << 30)) fail(what + " is too large");
+            int material = -1;
+            if (p.material >= 0) {
+                if ((size_t)p.material >= material_map.size()) fail(what + ": material " + std::to_string(p.material) + " out of range");
+                material = material_map[(size_t)p.material];
+            }
+            mesh_desc md{};
+            md.num_vertices = (int)nv;
+            md.positions = pos.data();
+            md.normals = nrm.empty() ? nullptr : nrm.data();
+            md.tangents = tan.empty() ? nullptr : tan.data();
+            md.uv0 = uv0.empty() ? nullptr : uv0.data();
+            md.uv1 = uv1.empty() ? nullptr : uv1.data();
+            md.num_indices = idx.empty() ? 0 : (int)idx.size();
+            md.indices = idx.empty() ? nullptr : idx.data();
+            if (idx.empty() && nv % 3 != 0) md.num_vertices = (int)(nv - nv % 3);
+            md.material = material;
+            char err[256];
+            if (scene_add_mesh(s, &md, &xf, err, sizeof err) != 0) fail(what + ": " + err);
+        }
+    }
+
+    void punctual(const Value &ext, const mat4 &xf) {
+        int li = (int)number_or(ext, "light", -1);
+        if (li < 0 || (size_t)li >= m.lights.size()) fail("KHR_lights_punctual: light " + std::to_string(li) + " out of range");
+        const tinygltf::Light &gl = m.lights[(size_t)li];
+        light l;
+        std::memset(&l, 0, sizeof l);
+        std::snprintf(l.name, sizeof l.name, "%s", gl.name.empty() ? ("light " + std::to_string(li)).c_str() : gl.name.c_str());
+        l.color = scale3(vec3_from(gl.color, v3s(1.0f)), (float)gl.intensity);
+        l.position = xform_point(&xf, v3(0, 0, 0));
+        l.direction = normalize3(xform_vector(&xf, v3(0, 0, -1)));
+        l.range = (float)gl.range;
+        if (gl.type == "point") {
+            l.type = LIGHT_POINT;
+        } else if (gl.type == "spot") {
+            l.type = LIGHT_SPOT;
+            double outer = std::fmin(std::fmax(gl.spot.outerConeAngle, 0.0), M_PI / 2);
+            double inner = std::fmin(std::fmax(gl.spot.innerConeAngle, 0.0), outer);
+            l.cos_inner = (float)std::cos(inner);
+            l.cos_outer = (float)std::cos(outer);
+        } else if (gl.type == "directional") {
+            l.type = LIGHT_DIRECTIONAL;
+        } else {
+            scene_warn(s, "%s: light '%s' has unknown type '%s'; ignored", name.c_str(), l.name, gl.type.c_str());
+            return;
+        }
+        if (!is_finite3(l.color) || !is_finite3(l.position) || !is_finite3(l.direction) || length_sq3(l.direction) == 0.0f)
+            fail(std::string("light '") + l.name + "' has an invalid transform or intensity");
+        if (scene_add_light(s, &l) < 0) fail("out of memory");
+    }
+
+    void add_camera(int ci, const mat4 &xf) {
+        if (ci < 0 || (size_t)ci >= m.cameras.size()) fail("camera " + std::to_string(ci) + " out of range");
+        const tinygltf::Camera &gc = m.cameras[(size_t)ci];
+        if (gc.type != "perspective") {
+            scene_warn(s, "%s: camera %d is %s; only perspective cameras are supported", name.c_str(), ci, gc.type.c_str());
+            return;
+        }
+        camera c;
+        std::memset(&c, 0, sizeof c);
+        std::snprintf(c.name, sizeof c.name, "%s", gc.name.empty() ? ("camera " + std::to_string(ci)).c_str() : gc.name.c_str());
+        c.position = xform_point(&xf, v3(0, 0, 0));
+        c.forward = normalize3(xform_vector(&xf, v3(0, 0, -1)));
+        vec3 up = xform_vector(&xf, v3(0, 1, 0));
+        c.right = normalize3(cross3(c.forward, up));
+        c.up = cross3(c.right, c.forward);
+        c.yfov = (float)gc.perspective.yfov;
+        if (!(c.yfov > 1e-4f && c.yfov < 3.1f) || !is_finite3(c.position) || !is_finite3(c.right) || length_sq3(c.right) < 0.5f) {
+            scene_warn(s, "%s: camera %d has an invalid transform or field of view; ignored", name.c_str(), ci);
+            return;
+        }
+        if (scene_add_camera(s, &c) < 0) fail("out of memory");
+    }
+
+    void node(int index, const mat4 &parent, int depth) {
+        if (index < 0 || (size_t)index >= m.nodes.size()) fail("node " + std::to_string(index) + " out of range");
+        if (on_stack[(size_t)index] || depth > 1000) fail("node hierarchy has a cycle at node " + std::to_string(index));
+        on_stack[(size_t)index] = 1;
+        const tinygltf::Node &n = m.nodes[(size_t)index];
+        mat4 xf = mat4_mul(parent, node_local(n));
+        if (n.mesh >= 0) mesh(n.mesh, xf);
+        if (n.camera >= 0) add_camera(n.camera, xf);
+        auto it = n.extensions.find("KHR_lights_punctual");
+        if (it != n.extensions.end()) punctual(it->second, xf);
+        for (int c : n.children) node(c, xf, depth + 1);
+        on_stack[(size_t)index] = 0;
+    }
+
+    void run() {
+        static const char *supported[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                          "KHR_materials_anisotropy"};
+        for (const std::string &e : m.extensionsUsed) {
+            bool ok = false;
+            for (const char *sup : supported) ok = ok || e == sup;
+            if (!ok) scene_warn(s, "%s: ignoring unsupported extension %s", name.c_str(), e.c_str());
+        }
+        texture_map.assign(m.textures.size(), -1);
+        image_map.assign(m.images.size(), -1);
+        on_stack.assign(m.nodes.size(), 0);
+        materials();
+        mat4 id = mat4_identity();
+        if (!m.scenes.empty()) {
+            int si = m.defaultScene >= 0 && (size_t)m.defaultScene < m.scenes.size() ? m.defaultScene : 0;
+            for (int r : m.scenes[(size_t)si].nodes) node(r, id, 0);
+        } else {
+            // No scene: render every root node (one that is nobody's child).
+            std::vector<char> is_child(m.nodes.size(), 0);
+            for (const auto &n : m.nodes)
+                for (int c : n.children)
+                    if (c >= 0 && (size_t)c < m.nodes.size()) is_child[(size_t)c] = 1;
+            for (size_t i = 0; i < m.nodes.size(); i++)
+                if (!is_child[i]) node((int)i, id, 0);
+        }
+    }
+};
+
+// Images through stb (Debian's libstb), keeping 8 or 16 bits as stored.
+bool load_image(tinygltf::Image *image, const int index, std::string *err, std::string *warn, int, int,
+                const unsigned char *bytes, int size, void *) {
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_memory(bytes, size, &w, &h, &comp) || w <= 0 || h <= 0 || (long long)w * h > (1LL << 28)) {
+        if (err) *err += "image " + std::to_string(index) + " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown format") + "\n";
+        return false;
+    }
+    bool sixteen = stbi_is_16_bit_from_memory(bytes, size) != 0;
+    void *pixels = sixteen ? (void *)stbi_load_16_from_memory(bytes, size, &w, &h, &comp, 0)
+                           : (void *)stbi_load_from_memory(bytes, size, &w, &h, &comp, 0);
+    if (!pixels) {
+        if (err) *err += "image " + std::to_string(index) + " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt data") + "\n";
+        return false;
+    }
+    size_t n = (size_t)w * (size_t)h * (size_t)comp * (sixteen ? 2u : 1u);
+    image->width = w;
+    image->height = h;
+    image->component = comp;
+    image->bits = sixteen ? 16 : 8;
+    image->pixel_type = sixteen ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    image->image.assign((const unsigned char *)pixels, (const unsigned char *)pixels + n);
+    stbi_image_free(pixels);
+    (void)warn;
+    return true;
+}
+
+int import(scene *s, const unsigned char *data, size_t size, const std::string &base_dir, const std::string &name,
+           char *err, size_t errlen) {
+    try {
+        if (size < 4) fail("file is empty or truncated");
+        tinygltf::TinyGLTF loader;
+        loader.SetImageLoader(load_image, nullptr);
+        Model model;
+        std::string e, w;
+        bool glb = std::memcmp(data, "glTF", 4) == 0;
+        if (size > 0x7fffffffu) fail("file is too large");
+        bool ok = glb ? loader.LoadBinaryFromMemory(&model, &e, &w, data, (unsigned int)size, base_dir)
+                      : loader.LoadASCIIFromString(&model, &e, &w, (const char *)data, (unsigned int)size, base_dir);
+        if (!ok) {
+            std::string why = first_line(e);
+            fail(why.empty() ? "not a valid glTF file" : why);
+        }
+        // tinygltf only warns about missing external files; an image we need is checked when used.
+        std::string line;
+        for (size_t a = 0; a < w.size();) {
+            size_t b = w.find('\n', a);
+            line = w.substr(a, b == std::string::npos ? std::string::npos : b - a);
+            if (!line.empty()) scene_warn(s, "%s: %s", name.c_str(), line.c_str());
+            if (b == std::string::npos) break;
+            a = b + 1;
+        }
+        importer imp(s, model, name);
+        imp.run();
+        return 0;
+    } catch (const import_error &ie) {
+        std::snprintf(err, errlen, "%s: %s", name.c_str(), ie.what.c_str());
+    } catch (const std::bad_alloc &) {
+        std::snprintf(err, errlen, "%s: out of memory", name.c_str());
+    } catch (const std::exception &ex) {
+        std::snprintf(err, errlen, "%s: malformed glTF (%s)", name.c_str(), ex.what());
+    }
+    return -1;
+}
+
+std::string dir_of(const std::string &path) {
+    size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? std::string(".") : path.substr(0, slash == 0 ? 1 : slash);
+}
+
+} // namespace
+
+extern "C" int gltf_import_file(scene *s, const char *path, char *err, size_t errlen) {
+    FILE *f = std::fopen(path, "rb");
+    if (!f) return std::snprintf(err, errlen, "%s: %s", path, std::strerror(errno)), -1;
+    std::vector<unsigned char> data;
+    unsigned char buf[1 << 16];
+    size_t n;
+    bool read_error = false;
+    try {
+        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) data.insert(data.end(), buf, buf + n);
+        read_error = std::ferror(f) != 0;
+    } catch (const std::bad_alloc &) {
+        std::fclose(f);
+        return std::snprintf(err, errlen, "%s: out of memory", path), -1;
+    }
+    std::fclose(f);
+    if (read_error) return std::snprintf(err, errlen, "%s: cannot read (is it a directory?)", path), -1;
+    return import(s, data.data(), data.size(), dir_of(path), path, err, errlen);
+}
+
+extern "C" int gltf_import_memory(scene *s, const void *data, size_t size, const char *base_dir, const char *name,
+                                  char *err, size_t errlen) {
+    return import(s, (const unsigned char *)data, size, base_dir ? base_dir : ".", name ? name : "<memory>", err, errlen);
+}

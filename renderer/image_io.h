@@ -1,0 +1,80 @@
+/* glint — image files: OpenEXR (C API) and Radiance HDR in, OpenEXR and PNG out, and the one
+ * atomic file writer every export goes through.
+ *
+ * Errors: functions that can fail return 0 on success and -1 on failure, with a one-line message
+ * in err (at most errlen bytes, "PATH: problem", no trailing newline, no "glint: error:" prefix).
+ * Pixel arrays are row-major, top row first. */
+#ifndef GLINT_IMAGE_IO_H
+#define GLINT_IMAGE_IO_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+
+/* Interleaved linear RGB float image (3 floats per pixel). */
+typedef struct {
+    int width, height;
+    float *rgb; /* owned: free with image_rgb_free */
+} image_rgb;
+
+/* Loads a linear RGB image: .exr through OpenEXR's C API (any compression it supports, plus
+ * DWAA/DWAB decoded here; half or float channels; R,G,B or a single Y channel; alpha ignored),
+ * .hdr through stb_image. The format is recognised by the file's magic bytes, not its name.
+ * Non-finite or negative texels are an error, except slightly negative texels of DWA's lossy
+ * DCT, which are coding noise and read as zero. */
+int image_rgb_load(const char *path, image_rgb *out, char *err, size_t errlen);
+void image_rgb_free(image_rgb *img);
+
+/* A multi-channel float image as read from an EXR: one plane of width*height floats per channel. */
+typedef struct {
+    int width, height;
+    int num_channels;
+    char **names;   /* owned, e.g. "R", "G", "B", "direct.R", ... */
+    float **planes; /* owned, one per channel */
+} exr_image;
+
+int exr_image_load(const char *path, exr_image *out, char *err, size_t errlen);
+void exr_image_free(exr_image *img);
+/* The plane of the named channel, or NULL. */
+const float *exr_image_channel(const exr_image *img, const char *name);
+
+/* One RGB layer to write: prefix "" writes R,G,B; prefix "direct" writes direct.R, direct.G, direct.B. */
+typedef struct {
+    const char *prefix;
+    const float *rgb; /* interleaved width*height*3 floats */
+} exr_layer;
+
+/* How an export treats an existing file at its path. */
+typedef enum {
+    WRITE_REPLACE,    /* the user named this output: replace it */
+    WRITE_NO_REPLACE, /* fail with "PATH: file exists" rather than replace */
+} write_mode;
+
+/* Writes a scanline EXR of 32-bit float channels (ZIP compression) atomically. */
+int exr_save_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers,
+                    write_mode mode, char *err, size_t errlen);
+
+/* Writes 8-bit sRGB (already encoded) RGB pixels as PNG atomically. */
+int png_save_rgb8(const char *path, int width, int height, const unsigned char *rgb, write_mode mode,
+                  char *err, size_t errlen);
+
+/* Writes size bytes to path atomically: a temporary file in the same directory, fsync, then
+ * rename (WRITE_REPLACE) or link (WRITE_NO_REPLACE, so an existing file is never replaced even
+ * in a race). Never leaves a partial file at path, and removes its temporary file on failure. */
+int write_file_atomic(const char *path, const void *data, size_t size, write_mode mode, char *err,
+                      size_t errlen);
+
+/* Finds a free name for an export that must never overwrite: "dir/stem.ext" if it does not
+ * exist, else "dir/stem-1.ext", "dir/stem-2.ext", ... Writes the chosen path to out. Returns 0,
+ * or -1 when none is free or out is too small. (Write with WRITE_NO_REPLACE: a race with another
+ * writer then fails instead of overwriting.) */
+int unique_path(const char *path, char *out, size_t outlen);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

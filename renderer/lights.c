@@ -1,0 +1,328 @@
+/* Lights: building the list, sampling for next-event estimation, pdfs for MIS, the environment. */
+#include "lights.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- environment map ----------------------------------------------------------------------- */
+
+vec3 env_direction(const env_map *env, vec2 uv) {
+    float phi = 2.0f * PI_F * (uv.x - 0.5f) + env->rotation;
+    float theta = PI_F * uv.y;
+    float st = sinf(theta);
+    return v3(st * cosf(phi), cosf(theta), st * sinf(phi));
+}
+
+vec2 env_uv(const env_map *env, vec3 d) {
+    float phi = atan2f(d.z, d.x) - env->rotation;
+    float u = 0.5f + phi * INV_2PI_F;
+    u -= floorf(u);
+    float v = acosf(clampf(d.y, -1.0f, 1.0f)) * INV_PI_F;
+    return v2(u, v);
+}
+
+static vec3 env_texel(const image_rgb *img, int x, int y) {
+    const float *p = img->rgb + 3 * ((size_t)y * (size_t)img->width + (size_t)x);
+    return v3(p[0], p[1], p[2]);
+}
+
+/* Bilinear, wrapping in u and clamping in v. */
+static vec3 env_lookup(const env_map *env, vec2 uv) {
+    const image_rgb *img = &env->image;
+    float x = uv.x * (float)img->width - 0.5f, y = uv.y * (float)img->height - 0.5f;
+    float fx = floorf(x), fy = floorf(y);
+    float ax = x - fx, ay = y - fy;
+    int x0 = (int)fx, y0 = (int)fy;
+    int x1 = x0 + 1, y1 = y0 + 1;
+    x0 = ((x0 % img->width) + img->width) % img->width;
+    x1 = ((x1 % img->width) + img->width) % img->width;
+    y0 = y0 < 0 ? 0 : (y0 >= img->height ? img->height - 1 : y0);
+    y1 = y1 < 0 ? 0 : (y1 >= img->height ? img->height - 1 : y1);
+    vec3 a = lerp3(env_texel(img, x0, y0), env_texel(img, x1, y0), ax);
+    vec3 b = lerp3(env_texel(img, x0, y1), env_texel(img, x1, y1), ax);
+    return lerp3(a, b, ay);
+}
+
+env_map *env_map_create(image_rgb *image, float rotation, char *err, size_t errlen) {
+    int w = image->width, h = image->height;
+    if (w <= 0 || h <= 0 || !image->rgb) {
+        image_rgb_free(image);
+        snprintf(err, errlen, "empty environment image");
+        return NULL;
+    }
+    env_map *env = calloc(1, sizeof(env_map));
+    float *func = malloc(sizeof(float) * (size_t)w * (size_t)h);
+    if (!env || !func) {
+        free(env);
+        free(func);
+        image_rgb_free(image);
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    env->image = *image;
+    *image = (image_rgb){0};
+    env->rotation = rotation;
+    /* Sampling density: luminance times sin(theta) (the equirectangular Jacobian), each texel
+     * dilated to the maximum of its neighbours so that wherever bilinear lookup is non-zero the
+     * density is too (otherwise those directions could never be sampled: bias). */
+    double sum = 0.0, weight = 0.0;
+    for (int y = 0; y < h; y++) {
+        float st = sinf(PI_F * ((float)y + 0.5f) / (float)h);
+        for (int x = 0; x < w; x++) {
+            float m = 0.0f;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    int yy = y + dy, xx = ((x + dx) % w + w) % w;
+                    if (yy < 0 || yy >= h) continue;
+                    m = fmaxf(m, luminance3(env_texel(&env->image, xx, yy)));
+                }
+            func[(size_t)y * (size_t)w + (size_t)x] = m * st;
+            sum += (double)(luminance3(env_texel(&env->image, x, y)) * st);
+            weight += (double)st;
+        }
+    }
+    env->mean_luminance = weight > 0.0 ? (float)(sum / weight) : 0.0f;
+    int status = dist2d_init(&env->dist, func, w, h);
+    free(func);
+    if (status != 0) {
+        env_map_destroy(env);
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    return env;
+}
+
+void env_map_destroy(env_map *env) {
+    if (!env) return;
+    image_rgb_free(&env->image);
+    dist2d_deinit(&env->dist);
+    free(env);
+}
+
+vec3 env_eval(const scene *s, vec3 d) {
+    if (!s->env) return v3(0, 0, 0);
+    return env_lookup(s->env, env_uv(s->env, d));
+}
+
+int scene_set_env_image(scene *s, image_rgb *image, float rotation, char *err, size_t errlen) {
+    env_map *env = env_map_create(image, rotation, err, errlen);
+    if (!env) return -1;
+    env_map *old = s->env;
+    s->env = env;
+    if (scene_build_lights(s, err, errlen) != 0) {
+        char ignored[256];
+        s->env = old;
+        env_map_destroy(env);
+        scene_build_lights(s, ignored, sizeof ignored);
+        return -1;
+    }
+    env_map_destroy(old);
+    return 0;
+}
+
+int scene_set_env(scene *s, const char *path, float rotation, char *err, size_t errlen) {
+    image_rgb img;
+    if (image_rgb_load(path, &img, err, errlen) != 0) return -1;
+    char sub[256];
+    if (scene_set_env_image(s, &img, rotation, sub, sizeof sub) != 0) return snprintf(err, errlen, "%s: %s", path, sub), -1;
+    return 0;
+}
+
+/* ---- the light list ------------------------------------------------------------------------ */
+
+static float triangle_area(const scene *s, int t) {
+    const uint32_t *v = &s->indices[3 * t];
+    vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
+    return 0.5f * length3(cross3(sub3(p1, p0), sub3(p2, p0)));
+}
+
+/* Mean emitted luminance over a triangle, estimated from a 4x4 stratified set of points. Never
+ * zero for an emissive material: a triangle whose texture looks black at these points may still
+ * emit elsewhere, and a zero selection probability would make that light unreachable. */
+static float triangle_mean_luminance(const scene *s, int t) {
+    const material *m = &s->materials[s->tri_material[t]];
+    float upper = luminance3(m->emission);
+    if (m->emissive_tex.texture < 0) return upper;
+    const uint32_t *v = &s->indices[3 * t];
+    float sum = 0.0f;
+    for (int i = 0; i < 16; i++) {
+        vec2 b = sample_uniform_triangle(v2(((float)(i & 3) + 0.5f) / 4.0f, ((float)(i >> 2) + 0.5f) / 4.0f));
+        float b0 = 1.0f - b.x - b.y;
+        vec2 uv0 = v2(b0 * s->uv0[v[0]].x + b.x * s->uv0[v[1]].x + b.y * s->uv0[v[2]].x,
+                      b0 * s->uv0[v[0]].y + b.x * s->uv0[v[1]].y + b.y * s->uv0[v[2]].y);
+        vec2 uv1 = v2(b0 * s->uv1[v[0]].x + b.x * s->uv1[v[1]].x + b.y * s->uv1[v[2]].x,
+                      b0 * s->uv1[v[0]].y + b.x * s->uv1[v[1]].y + b.y * s->uv1[v[2]].y);
+        vec4 c = texture_lookup(s, m->emissive_tex, uv0, uv1, 1);
+        sum += luminance3(mul3(m->emission, v3(c.x, c.y, c.z)));
+    }
+    return fmaxf(sum / 16.0f, 0.01f * upper);
+}
+
+int scene_build_lights(scene *s, char *err, size_t errlen) {
+    /* Keep the punctual lights (the importer added them), drop derived ones. */
+    int kept = 0;
+    for (int i = 0; i < s->num_lights; i++)
+        if (s->lights[i].type != LIGHT_TRIANGLE && s->lights[i].type != LIGHT_ENV) s->lights[kept++] = s->lights[i];
+    s->num_lights = kept;
+    s->env_light = -1;
+    float r = 0.5f * s->diag;
+    for (int i = 0; i < s->num_lights; i++) {
+        light *l = &s->lights[i];
+        float lum = luminance3(l->color);
+        switch (l->type) {
+        case LIGHT_POINT: l->power = 4.0f * PI_F * lum; break;
+        case LIGHT_SPOT: l->power = 2.0f * PI_F * (1.0f - 0.5f * (l->cos_inner + l->cos_outer)) * lum; break;
+        case LIGHT_DIRECTIONAL: l->power = PI_F * r * r * lum; break;
+        default: l->power = 0.0f; break;
+        }
+    }
+    for (int t = 0; t < s->num_triangles; t++) {
+        s->tri_light[t] = -1;
+        const material *m = &s->materials[s->tri_material[t]];
+        if (!(max_comp3(m->emission) > 0.0f)) continue;
+        light l;
+        memset(&l, 0, sizeof l);
+        l.type = LIGHT_TRIANGLE;
+        l.triangle = t;
+        l.color = m->emission;
+        snprintf(l.name, sizeof l.name, "%s", m->name);
+        l.power = triangle_area(s, t) * PI_F * (m->double_sided ? 2.0f : 1.0f) * triangle_mean_luminance(s, t);
+        int idx = scene_add_light(s, &l);
+        if (idx < 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+        s->tri_light[t] = idx;
+    }
+    if (s->env && s->env->mean_luminance > 0.0f) {
+        light l;
+        memset(&l, 0, sizeof l);
+        l.type = LIGHT_ENV;
+        snprintf(l.name, sizeof l.name, "environment");
+        /* As pbrt-v4: the flux through a disk of the scene's radius from every direction. */
+        l.power = 4.0f * PI_F * PI_F * r * r * s->env->mean_luminance;
+        s->env_light = scene_add_light(s, &l);
+        if (s->env_light < 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    }
+    dist1d_deinit(&s->light_dist);
+    if (s->num_lights > 0) {
+        float *power = malloc(sizeof(float) * (size_t)s->num_lights);
+        if (!power) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+        for (int i = 0; i < s->num_lights; i++) power[i] = s->lights[i].power;
+        int status = dist1d_init(&s->light_dist, power, s->num_lights);
+        free(power);
+        if (status != 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    }
+    return 0;
+}
+
+/* ---- sampling ------------------------------------------------------------------------------ */
+
+int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out) {
+    if (s->num_lights == 0) return 0;
+    float pmf;
+    int li = dist1d_sample_discrete(&s->light_dist, u_select, &pmf, NULL);
+    if (!(pmf > 0.0f)) return 0;
+    const light *l = &s->lights[li];
+    out->light = li;
+    out->delta = 0;
+    switch (l->type) {
+    case LIGHT_POINT:
+    case LIGHT_SPOT: {
+        vec3 d = sub3(l->position, p);
+        float d2 = length_sq3(d);
+        if (!(d2 > 0.0f)) return 0;
+        float dist = sqrtf(d2);
+        out->wi = scale3(d, 1.0f / dist);
+        out->dist = dist;
+        out->p_light = l->position;
+        out->n_light = neg3(out->wi);
+        float falloff = 1.0f;
+        if (l->type == LIGHT_SPOT) {
+            float cd = -dot3(out->wi, l->direction);
+            float t = clampf((cd - l->cos_outer) / fmaxf(l->cos_inner - l->cos_outer, 1e-4f), 0.0f, 1.0f);
+            falloff = t * t;
+            if (falloff <= 0.0f) return 0;
+        }
+        out->radiance = scale3(l->color, falloff / d2);
+        out->pdf = pmf;
+        out->delta = 1;
+        return 1;
+    }
+    case LIGHT_DIRECTIONAL:
+        out->wi = neg3(l->direction);
+        out->dist = INFINITY;
+        out->p_light = p;
+        out->n_light = l->direction;
+        out->radiance = l->color;
+        out->pdf = pmf;
+        out->delta = 1;
+        return 1;
+    case LIGHT_TRIANGLE: {
+        const uint32_t *v = &s->indices[3 * l->triangle];
+        vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
+        vec2 b = sample_uniform_triangle(u);
+        float b0 = 1.0f - b.x - b.y;
+        vec3 q = add3(add3(scale3(p0, b0), scale3(p1, b.x)), scale3(p2, b.y));
+        vec3 n = cross3(sub3(p1, p0), sub3(p2, p0));
+        float area2 = length3(n);
+        n = scale3(n, 1.0f / area2);
+        vec3 d = sub3(q, p);
+        float d2 = length_sq3(d);
+        if (!(d2 > 0.0f)) return 0;
+        float dist = sqrtf(d2);
+        vec3 wi = scale3(d, 1.0f / dist);
+        float cos_l = dot3(n, wi); /* > 0: we see the back (winding) side */
+        surface_hit h;
+        memset(&h, 0, sizeof h);
+        h.tri = l->triangle;
+        h.material = s->tri_material[l->triangle];
+        h.backface = cos_l > 0.0f;
+        h.uv0 = v2(b0 * s->uv0[v[0]].x + b.x * s->uv0[v[1]].x + b.y * s->uv0[v[2]].x,
+                   b0 * s->uv0[v[0]].y + b.x * s->uv0[v[1]].y + b.y * s->uv0[v[2]].y);
+        h.uv1 = v2(b0 * s->uv1[v[0]].x + b.x * s->uv1[v[1]].x + b.y * s->uv1[v[2]].x,
+                   b0 * s->uv1[v[0]].y + b.x * s->uv1[v[1]].y + b.y * s->uv1[v[2]].y);
+        vec3 le = material_emission(s, &h);
+        float abs_cos = fabsf(cos_l);
+        if (is_black3(le) || !(abs_cos > 0.0f)) return 0;
+        out->wi = wi;
+        out->dist = dist;
+        out->p_light = q;
+        out->n_light = cos_l > 0.0f ? neg3(n) : n; /* facing the shading point */
+        out->radiance = le;
+        out->pdf = pmf * d2 / (abs_cos * 0.5f * area2);
+        return isfinite(out->pdf) && out->pdf > 0.0f;
+    }
+    case LIGHT_ENV: {
+        float pdf_uv;
+        vec2 uv = dist2d_sample(&s->env->dist, u, &pdf_uv);
+        float st = sinf(PI_F * uv.y);
+        if (!(pdf_uv > 0.0f) || !(st > 0.0f)) return 0;
+        out->wi = env_direction(s->env, uv);
+        out->dist = INFINITY;
+        out->p_light = p;
+        out->n_light = neg3(out->wi);
+        out->radiance = env_lookup(s->env, uv);
+        out->pdf = pmf * pdf_uv / (2.0f * PI_F * PI_F * st);
+        return isfinite(out->pdf) && out->pdf > 0.0f;
+    }
+    }
+    return 0;
+}
+
+float light_pdf_triangle(const scene *s, int li, vec3 p, const surface_hit *h) {
+    const uint32_t *v = &s->indices[3 * h->tri];
+    vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
+    float area = 0.5f * length3(cross3(sub3(p1, p0), sub3(p2, p0)));
+    vec3 d = sub3(h->p, p);
+    float d2 = length_sq3(d);
+    float cos_l = fabsf(dot3(h->ng, d)) / sqrtf(d2);
+    if (!(cos_l > 0.0f) || !(area > 0.0f)) return 0.0f;
+    return dist1d_pmf(&s->light_dist, li) * d2 / (cos_l * area);
+}
+
+float light_pdf_env(const scene *s, vec3 d) {
+    if (s->env_light < 0) return 0.0f;
+    vec2 uv = env_uv(s->env, d);
+    float st = sinf(PI_F * uv.y);
+    if (!(st > 0.0f)) return 0.0f;
+    return dist1d_pmf(&s->light_dist, s->env_light) * dist2d_pdf(&s->env->dist, uv) / (2.0f * PI_F * PI_F * st);
+}

@@ -1,0 +1,43 @@
+/* glint — lights: selection by power, sampling a light from a shading point (next-event
+ * estimation), the matching pdfs for multiple importance sampling, and the environment map. */
+#ifndef GLINT_LIGHTS_H
+#define GLINT_LIGHTS_H
+
+#include "scene.h"
+
+typedef struct {
+    int light;      /* index into scene.lights */
+    vec3 wi;        /* unit direction from the shading point toward the light */
+    float dist;     /* distance to the sampled point; INFINITY for directional and environment */
+    vec3 p_light;   /* the sampled point (area lights, point and spot lights) */
+    vec3 n_light;   /* its geometric normal, facing the shading point (area lights) */
+    vec3 radiance;  /* area/environment: radiance arriving along -wi; delta lights: the
+                     * irradiance-like value intensity/d^2 (or lux) */
+    float pdf;      /* solid-angle pdf times the selection probability; for delta lights just
+                     * the selection probability */
+    int delta;      /* a point, spot or directional light: no MIS possible */
+} light_sample;
+
+/* Picks a light by power (u_select) and a point or direction on it (u) as seen from p.
+ * Returns 0 when the sample carries nothing (no lights, back of a single-sided emitter, outside
+ * a spot cone, zero pdf). */
+int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out);
+
+/* The pdf light_sample_direct would have given for reaching emissive triangle light `light` at
+ * hit h from p: selection probability times area-to-solid-angle density. */
+float light_pdf_triangle(const scene *s, int light, vec3 p, const surface_hit *h);
+/* The pdf light_sample_direct would have given for the environment along direction d. */
+float light_pdf_env(const scene *s, vec3 d);
+
+/* Rebuilds the light list after geometry, materials or the environment changed: keeps the
+ * punctual lights, re-derives emissive triangles and the environment light, powers and the
+ * selection distribution. Returns 0 or -1 with err set. */
+int scene_build_lights(scene *s, char *err, size_t errlen);
+
+/* Environment maps. */
+env_map *env_map_create(image_rgb *image, float rotation, char *err, size_t errlen); /* takes the image */
+void env_map_destroy(env_map *env);
+vec3 env_direction(const env_map *env, vec2 uv);
+vec2 env_uv(const env_map *env, vec3 d);
+
+#endif

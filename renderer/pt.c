@@ -1,0 +1,90 @@
+#include "pt.h"
+
+#include "lights.h"
+
+/* The component a path belongs to, by the index of the vertex where it reaches an emitter
+ * (0: the camera hit itself, 1: one bounce, i.e. direct lighting). */
+static inline film_component component_of(int emitter_vertex) {
+    return emitter_vertex <= 1 ? COMP_DIRECT : COMP_INDIRECT;
+}
+
+void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
+                 uint64_t rays[RAY_KIND_COUNT]) {
+    for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
+    vec3 beta = v3s(1.0f);
+    float prev_pdf = 0.0f; /* solid-angle pdf of the BSDF sample that produced the current ray */
+    vec3 prev_p = o;
+    for (int depth = 0;; depth++) {
+        surface_hit h;
+        rays[depth == 0 ? RAY_CAMERA : RAY_BOUNCE]++;
+        if (!scene_intersect(s, o, d, INFINITY, &h)) {
+            vec3 le = env_eval(s, d);
+            if (!is_black3(le)) {
+                float w = depth == 0 ? 1.0f : mis_power(prev_pdf, light_pdf_env(s, d));
+                out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+            }
+            break;
+        }
+        vec3 le = material_emission(s, &h);
+        if (!is_black3(le)) {
+            float w = 1.0f;
+            if (depth > 0) {
+                int li = s->tri_light[h.tri];
+                w = mis_power(prev_pdf, li >= 0 ? light_pdf_triangle(s, li, prev_p, &h) : 0.0f);
+            }
+            out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+        }
+        if (depth >= max_depth) break;
+
+        frame3 fr;
+        bsdf b = material_bsdf(s, &h, &fr);
+        vec3 wo = to_local(fr, neg3(d));
+
+        /* Next-event estimation. */
+        light_sample ls;
+        float u_sel = rng_float(rng);
+        vec2 u_light = rng_vec2(rng);
+        if (light_sample_direct(s, h.p, u_sel, u_light, &ls) && dot3(ls.wi, h.ng) > 0.0f) {
+            vec3 wi = to_local(fr, ls.wi);
+            vec3 f = wi.z > 0.0f ? bsdf_eval(&b, wo, wi, BSDF_ALL) : v3(0, 0, 0);
+            if (!is_black3(f)) {
+                vec3 org = offset_origin(s, h.p, h.ng, ls.wi);
+                vec3 dir = ls.wi;
+                float tmax = INFINITY;
+                if (isfinite(ls.dist)) {
+                    vec3 target = ls.delta ? ls.p_light : offset_origin(s, ls.p_light, ls.n_light, neg3(ls.wi));
+                    vec3 span = sub3(target, org);
+                    tmax = length3(span);
+                    dir = tmax > 0.0f ? scale3(span, 1.0f / tmax) : ls.wi;
+                }
+                rays[RAY_SHADOW]++;
+                if (tmax > 0.0f && !scene_occluded(s, org, dir, tmax)) {
+                    float w = ls.delta ? 1.0f : mis_power(ls.pdf, bsdf_pdf(&b, wo, wi, BSDF_ALL));
+                    vec3 c = scale3(mul3(mul3(beta, f), ls.radiance), wi.z * w / ls.pdf);
+                    out[component_of(depth + 1)] = add3(out[component_of(depth + 1)], c);
+                }
+            }
+        }
+
+        /* Continue the path by sampling the BSDF. */
+        float u_lobe = rng_float(rng);
+        vec2 u_dir = rng_vec2(rng);
+        bsdf_sample_result bs;
+        if (!bsdf_sample(&b, wo, BSDF_ALL, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
+        vec3 wi = to_world(fr, bs.wi);
+        if (dot3(wi, h.ng) <= 0.0f) break; /* below the geometric surface: no transmission */
+        beta = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
+        if (is_black3(beta) || !is_finite3(beta)) break;
+        prev_pdf = bs.pdf;
+        prev_p = h.p;
+        o = offset_origin(s, h.p, h.ng, wi);
+        d = wi;
+
+        /* Russian roulette after a few bounces, by throughput. */
+        if (depth >= 3) {
+            float q = fminf(0.95f, max_comp3(beta));
+            if (rng_float(rng) >= q) break;
+            beta = scale3(beta, 1.0f / q);
+        }
+    }
+}

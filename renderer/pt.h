@@ -1,0 +1,18 @@
+/* glint — the unbiased path tracer: next-event estimation with multiple importance sampling
+ * (power heuristic) for area and environment lights, Russian roulette, a maximum depth. It is
+ * the reference every other estimator is judged against. */
+#ifndef GLINT_PT_H
+#define GLINT_PT_H
+
+#include "film.h"
+#include "rng.h"
+#include "scene.h"
+#include "session.h"
+
+/* Radiance along the ray (o, d), split by path-space component: out[COMP_DIRECT] gets emission
+ * seen directly and light arriving at the first hit directly from an emitter, out[COMP_INDIRECT]
+ * the rest. Counts rays into rays[]. */
+void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
+                 uint64_t rays[RAY_KIND_COUNT]);
+
+#endif

@@ -1,0 +1,88 @@
+/* glint — sampling routines, each with its pdf. Directions are in a local frame around +z.
+ * Every routine here lives once; estimators call these, never their own copies. */
+#ifndef GLINT_SAMPLING_H
+#define GLINT_SAMPLING_H
+
+#include "gmath.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+
+/* Cosine-weighted hemisphere around +z; pdf = cos(theta) / pi. */
+vec3 sample_cosine_hemisphere(vec2 u);
+static inline float pdf_cosine_hemisphere(vec3 w) { return w.z > 0.0f ? w.z * INV_PI_F : 0.0f; }
+
+/* Uniform sphere; pdf = 1 / (4 pi). */
+vec3 sample_uniform_sphere(vec2 u);
+static inline float pdf_uniform_sphere(void) { return INV_4PI_F; }
+
+/* Uniform cone around +z given 1 - cos(theta_max) in (0, 2]; pdf = 1 / (2 pi (1 - cos theta_max)).
+ * Taking 1 - cos rather than cos keeps tiny cones (distant lights) exact. */
+vec3 sample_uniform_cone(vec2 u, float one_minus_cos_max);
+static inline float pdf_uniform_cone(float one_minus_cos_max) { return INV_2PI_F / one_minus_cos_max; }
+
+/* 1 - cos(theta_max) for a sphere of radius r seen from distance d, s = r/d < 1, without
+ * cancellation: s^2 / (1 + sqrt(1 - s^2)). Returns 1 (a hemisphere) when s >= 1: the point is inside. */
+float cone_one_minus_cos(float sin_theta_max);
+
+/* Power-cosine lobe around +z: pdf = (n + 1) / (2 pi) cos^n(theta) over the sphere's upper half. */
+vec3 sample_power_cosine(vec2 u, float exponent);
+float pdf_power_cosine(float cos_theta, float exponent);
+
+/* Uniform point on a triangle as barycentrics (b1, b2); b0 = 1 - b1 - b2. */
+vec2 sample_uniform_triangle(vec2 u);
+
+/* Concentric map of the unit square onto the unit disk (Shirley-Chiu). */
+vec2 sample_concentric_disk(vec2 u);
+
+/* Multiple importance sampling weights for strategy a against b (n samples each). */
+static inline float mis_balance(float pdf_a, float pdf_b) {
+    float s = pdf_a + pdf_b;
+    return s > 0.0f ? pdf_a / s : 0.0f;
+}
+static inline float mis_power(float pdf_a, float pdf_b) {
+    /* Divide first: squaring a pdf of 1e20 would overflow float. */
+    if (pdf_a <= 0.0f) return 0.0f;
+    if (!(pdf_b > 0.0f)) return 1.0f;
+    float r = pdf_b / pdf_a;
+    return 1.0f / (1.0f + r * r);
+}
+
+/* Piecewise-constant 1D distribution over [0,1) with n bins. Owns its arrays (init/deinit). */
+typedef struct {
+    int n;
+    float *func;   /* n non-negative values (copied; non-finite or negative input counted as 0) */
+    double *cdf;   /* n + 1 values, cdf[0] = 0, cdf[n] = 1 */
+    double integral; /* sum(func) / n; 0 means the input was all zero and sampling is uniform */
+} dist1d;
+
+/* Returns 0 on success, -1 when out of memory or n < 1. */
+int dist1d_init(dist1d *d, const float *func, int n);
+void dist1d_deinit(dist1d *d);
+/* Discrete sample: bin index with probability pmf; *u_remapped (optional) reuses u inside the bin. */
+int dist1d_sample_discrete(const dist1d *d, float u, float *pmf, float *u_remapped);
+float dist1d_pmf(const dist1d *d, int index);
+/* Continuous sample in [0,1) with density pdf (relative to [0,1)); *bin (optional) receives the bin. */
+float dist1d_sample_continuous(const dist1d *d, float u, float *pdf, int *bin);
+float dist1d_pdf(const dist1d *d, float x);
+
+/* Piecewise-constant 2D distribution over [0,1)^2 from nu x nv values (row-major, v rows). */
+typedef struct {
+    int nu, nv;
+    dist1d *rows;    /* nv conditionals p(u | v) */
+    dist1d marginal; /* p(v) */
+} dist2d;
+
+int dist2d_init(dist2d *d, const float *func, int nu, int nv);
+void dist2d_deinit(dist2d *d);
+/* Sample (u, v) in [0,1)^2 with density *pdf relative to the unit square. */
+vec2 dist2d_sample(const dist2d *d, vec2 u, float *pdf);
+float dist2d_pdf(const dist2d *d, vec2 uv);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

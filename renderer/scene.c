@@ -1,0 +1,532 @@
+/* The scene: building from meshes, finalizing (normals, tangents, lights, BVH), ray queries and
+ * material evaluation at hits. */
+#include "scene.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gltf_import.h"
+#include "lights.h"
+
+typedef struct {
+    scene_warn_fn fn;
+    void *user;
+} warn_sink;
+
+/* The warning sink lives beside the scene; kept out of the public struct. */
+typedef struct {
+    scene s;
+    warn_sink warn;
+} scene_box;
+
+scene *scene_create(scene_warn_fn warn, void *warn_user) {
+    scene_box *box = calloc(1, sizeof(scene_box));
+    if (!box) return NULL;
+    box->warn = (warn_sink){warn, warn_user};
+    box->s.env_light = -1;
+    box->s.bounds = bounds_empty();
+    return &box->s;
+}
+
+void scene_warn(scene *s, const char *fmt, ...) {
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    /* Keep the first few for display, and do not repeat the same warning. */
+    int kept = s->num_warnings < 8 ? s->num_warnings : 8;
+    for (int i = 0; i < kept; i++)
+        if (strncmp(s->warnings[i], msg, sizeof s->warnings[i] - 1) == 0) return;
+    if (s->num_warnings < 8) snprintf(s->warnings[s->num_warnings], sizeof s->warnings[0], "%.255s", msg);
+    s->num_warnings++;
+    scene_box *box = (scene_box *)s;
+    if (box->warn.fn) box->warn.fn(box->warn.user, msg);
+}
+
+void scene_destroy(scene *s) {
+    if (!s) return;
+    if (s->rtc) rtcReleaseScene(s->rtc);
+    if (s->device) rtcReleaseDevice(s->device);
+    free(s->positions);
+    free(s->normals);
+    free(s->tangents);
+    free(s->uv0);
+    free(s->uv1);
+    free(s->indices);
+    free(s->tri_material);
+    free(s->tri_light);
+    free(s->materials);
+    for (int i = 0; i < s->num_images; i++) free(s->images[i].rgba);
+    free(s->images);
+    free(s->textures);
+    free(s->lights);
+    free(s->cameras);
+    env_map_destroy(s->env);
+    dist1d_deinit(&s->light_dist);
+    free((scene_box *)s);
+}
+
+/* Grows *arr (elements of size elem) to hold at least need; cap doubles. */
+static int grow(void **arr, int *cap, int need, size_t elem) {
+    if (need <= *cap) return 0;
+    long long c = *cap ? *cap : 16;
+    while (c < need) c *= 2;
+    if (c > (1LL << 30)) return -1;
+    void *n = realloc(*arr, elem * (size_t)c);
+    if (!n) return -1;
+    *arr = n;
+    *cap = (int)c;
+    return 0;
+}
+
+#define GROW(s, arr, cap, need) grow((void **)&(s)->arr, &(s)->cap, (need), sizeof(*(s)->arr))
+
+static int realloc_to(void **arr, size_t elem, long long count) {
+    void *n = realloc(*arr, elem * (size_t)count);
+    if (!n) return -1;
+    *arr = n;
+    return 0;
+}
+
+/* The vertex arrays are parallel and share one capacity; positions keep one spare element of
+ * padding because Embree reads vertices 16 bytes at a time. */
+static int reserve_vertices(scene *s, int need) {
+    if (need <= s->cap_vertices) return 0;
+    long long c = s->cap_vertices ? s->cap_vertices : 1024;
+    while (c < need) c *= 2;
+    if (realloc_to((void **)&s->positions, sizeof(vec3), c + 1) || realloc_to((void **)&s->normals, sizeof(vec3), c) ||
+        realloc_to((void **)&s->tangents, sizeof(vec4), c) || realloc_to((void **)&s->uv0, sizeof(vec2), c) ||
+        realloc_to((void **)&s->uv1, sizeof(vec2), c))
+        return -1;
+    s->cap_vertices = (int)c;
+    return 0;
+}
+
+static int reserve_triangles(scene *s, int need) {
+    if (need <= s->cap_triangles) return 0;
+    long long c = s->cap_triangles ? s->cap_triangles : 1024;
+    while (c < need) c *= 2;
+    if (realloc_to((void **)&s->indices, 3 * sizeof(uint32_t), c) || realloc_to((void **)&s->tri_material, sizeof(int32_t), c) ||
+        realloc_to((void **)&s->tri_light, sizeof(int32_t), c))
+        return -1;
+    s->cap_triangles = (int)c;
+    return 0;
+}
+
+int scene_add_texture(scene *s, scene_texture t) {
+    if (GROW(s, textures, cap_textures, s->num_textures + 1)) return -1;
+    s->textures[s->num_textures] = t;
+    return s->num_textures++;
+}
+
+int scene_add_material(scene *s, const material *m) {
+    if (GROW(s, materials, cap_materials, s->num_materials + 1)) return -1;
+    s->materials[s->num_materials] = *m;
+    return s->num_materials++;
+}
+
+int scene_add_light(scene *s, const light *l) {
+    if (GROW(s, lights, cap_lights, s->num_lights + 1)) return -1;
+    s->lights[s->num_lights] = *l;
+    return s->num_lights++;
+}
+
+int scene_add_camera(scene *s, const camera *c) {
+    if (GROW(s, cameras, cap_cameras, s->num_cameras + 1)) return -1;
+    s->cameras[s->num_cameras] = *c;
+    return s->num_cameras++;
+}
+
+material material_default(void) {
+    material m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.name, sizeof m.name, "default");
+    m.model = MATERIAL_GLTF;
+    m.base_color = v3s(1.0f);
+    m.metallic = 1.0f;
+    m.roughness = 1.0f;
+    m.base_color_tex = m.metal_rough_tex = m.anisotropy_tex = m.emissive_tex = (texture_slot){-1, 0};
+    return m;
+}
+
+/* Upper 3x3 cofactor matrix: det(M) M^-T, the normal transform up to scale. */
+static void cofactor3(const mat4 *m, float c[3][3], float *det) {
+    const float(*a)[4] = m->m;
+    c[0][0] = a[1][1] * a[2][2] - a[1][2] * a[2][1];
+    c[0][1] = a[1][2] * a[2][0] - a[1][0] * a[2][2];
+    c[0][2] = a[1][0] * a[2][1] - a[1][1] * a[2][0];
+    c[1][0] = a[0][2] * a[2][1] - a[0][1] * a[2][2];
+    c[1][1] = a[0][0] * a[2][2] - a[0][2] * a[2][0];
+    c[1][2] = a[0][1] * a[2][0] - a[0][0] * a[2][1];
+    c[2][0] = a[0][1] * a[1][2] - a[0][2] * a[1][1];
+    c[2][1] = a[0][2] * a[1][0] - a[0][0] * a[1][2];
+    c[2][2] = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    *det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+}
+
+static vec3 load3(const float *p, int i) { return v3(p[3 * i], p[3 * i + 1], p[3 * i + 2]); }
+
+/* Any unit vector perpendicular to n. */
+static vec3 any_tangent(vec3 n) { return frame_from_normal(n).t; }
+
+int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err, size_t errlen) {
+    int nv = mesh->num_vertices;
+    int ni = mesh->num_indices ? mesh->num_indices : nv;
+    if (nv <= 0 || !mesh->positions) return snprintf(err, errlen, "mesh without vertices"), -1;
+    if (ni % 3 != 0) return snprintf(err, errlen, "index count %d is not a multiple of 3", ni), -1;
+    if (mesh->material < -1 || mesh->material >= s->num_materials)
+        return snprintf(err, errlen, "material %d out of range", mesh->material), -1;
+    for (int i = 0; mesh->indices && i < ni; i++)
+        if (mesh->indices[i] >= (uint32_t)nv)
+            return snprintf(err, errlen, "vertex index %u out of range (%d vertices)", mesh->indices[i], nv), -1;
+
+    int mat_index = mesh->material;
+    if (mat_index < 0) {
+        /* One shared default material, created on first use. */
+        int found = -1;
+        for (int i = 0; i < s->num_materials; i++)
+            if (strcmp(s->materials[i].name, "<glint default>") == 0) found = i;
+        if (found < 0) {
+            material m = material_default();
+            snprintf(m.name, sizeof m.name, "<glint default>");
+            found = scene_add_material(s, &m);
+            if (found < 0) return snprintf(err, errlen, "out of memory"), -1;
+        }
+        mat_index = found;
+    }
+
+    /* Without normals, glTF asks for flat shading: every triangle gets its own vertices. */
+    int flat = mesh->normals == NULL;
+    int out_vertices = flat ? ni : nv;
+    long long total_v = (long long)s->num_vertices + out_vertices;
+    long long total_t = (long long)s->num_triangles + ni / 3;
+    if (total_v > (1LL << 30) || total_t > (1LL << 30)) return snprintf(err, errlen, "too many triangles"), -1;
+    if (reserve_vertices(s, (int)total_v) || reserve_triangles(s, (int)total_t)) goto oom;
+
+    float cof[3][3], det;
+    cofactor3(xform, cof, &det);
+    float det_sign = det < 0.0f ? -1.0f : 1.0f;
+    int base = s->num_vertices;
+
+    /* Vertices: transform to world space. */
+    for (int k = 0; k < out_vertices; k++) {
+        int src = flat ? (mesh->indices ? (int)mesh->indices[k] : k) : k;
+        vec3 p = xform_point(xform, load3(mesh->positions, src));
+        s->positions[base + k] = p;
+        vec3 n = v3(0, 0, 0);
+        if (mesh->normals) {
+            vec3 on = load3(mesh->normals, src);
+            n = v3(cof[0][0] * on.x + cof[0][1] * on.y + cof[0][2] * on.z,
+                   cof[1][0] * on.x + cof[1][1] * on.y + cof[1][2] * on.z,
+                   cof[2][0] * on.x + cof[2][1] * on.y + cof[2][2] * on.z);
+            n = normalize3(scale3(n, det_sign));
+        }
+        s->normals[base + k] = n;
+        s->uv0[base + k] = mesh->uv0 ? v2(mesh->uv0[2 * src], mesh->uv0[2 * src + 1]) : v2(0, 0);
+        s->uv1[base + k] = mesh->uv1 ? v2(mesh->uv1[2 * src], mesh->uv1[2 * src + 1]) : s->uv0[base + k];
+        vec4 t = {0, 0, 0, 0};
+        if (mesh->tangents && !flat) {
+            const float *tp = mesh->tangents + 4 * src;
+            vec3 tw = normalize3(xform_vector(xform, v3(tp[0], tp[1], tp[2])));
+            t = (vec4){tw.x, tw.y, tw.z, (tp[3] < 0.0f ? -1.0f : 1.0f) * det_sign};
+        }
+        s->tangents[base + k] = t;
+    }
+
+    /* Triangles: skip degenerate ones (they cannot be hit and would only produce NaN normals). */
+    int tri_base = s->num_triangles, kept = 0, skipped = 0;
+    for (int f = 0; f < ni / 3; f++) {
+        uint32_t v[3];
+        for (int c = 0; c < 3; c++) {
+            int k = 3 * f + c;
+            v[c] = (uint32_t)base + (flat ? (uint32_t)k : (mesh->indices ? mesh->indices[k] : (uint32_t)k));
+        }
+        if (det < 0.0f) { /* a mirroring transform flips winding; swap to keep the front face */
+            uint32_t tmp = v[1];
+            v[1] = v[2];
+            v[2] = tmp;
+        }
+        vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
+        vec3 ng = cross3(sub3(p1, p0), sub3(p2, p0));
+        float a2 = length_sq3(ng);
+        if (!(a2 > 0.0f) || !isfinite(a2) || !is_finite3(p0) || !is_finite3(p1) || !is_finite3(p2)) {
+            skipped++;
+            continue;
+        }
+        int t = tri_base + kept++;
+        memcpy(&s->indices[3 * t], v, sizeof v);
+        s->tri_material[t] = mat_index;
+        s->tri_light[t] = -1;
+        if (flat) {
+            vec3 n = normalize3(ng);
+            for (int c = 0; c < 3; c++) s->normals[v[c]] = n;
+        }
+    }
+    if (skipped) scene_warn(s, "skipped %d degenerate or non-finite triangle%s", skipped, skipped > 1 ? "s" : "");
+
+    /* Tangents from uv0 where the mesh has none (Lengyel): area-weighted per vertex, then
+     * orthogonalised against the normal; a fallback frame where the uvs are degenerate. */
+    if (!mesh->tangents || flat) {
+        vec3 *tan = calloc((size_t)out_vertices, sizeof(vec3));
+        vec3 *bit = calloc((size_t)out_vertices, sizeof(vec3));
+        if (!tan || !bit) {
+            free(tan);
+            free(bit);
+            goto oom;
+        }
+        if (mesh->uv0) {
+            for (int t = tri_base; t < tri_base + kept; t++) {
+                uint32_t *v = &s->indices[3 * t];
+                vec3 e1 = sub3(s->positions[v[1]], s->positions[v[0]]);
+                vec3 e2 = sub3(s->positions[v[2]], s->positions[v[0]]);
+                vec2 a = s->uv0[v[0]], b = s->uv0[v[1]], c = s->uv0[v[2]];
+                float du1 = b.x - a.x, dv1 = b.y - a.y, du2 = c.x - a.x, dv2 = c.y - a.y;
+                float d = du1 * dv2 - du2 * dv1;
+                if (!(fabsf(d) > 1e-20f)) continue;
+                float r = 1.0f / d;
+                /* Weighting by |d| turns r into sign(d): area-weighted in uv space. */
+                float w = fabsf(d);
+                vec3 sdir = scale3(sub3(scale3(e1, dv2), scale3(e2, dv1)), r * w);
+                vec3 tdir = scale3(sub3(scale3(e2, du1), scale3(e1, du2)), r * w);
+                for (int c2 = 0; c2 < 3; c2++) {
+                    tan[v[c2] - (uint32_t)base] = add3(tan[v[c2] - (uint32_t)base], sdir);
+                    bit[v[c2] - (uint32_t)base] = add3(bit[v[c2] - (uint32_t)base], tdir);
+                }
+            }
+        }
+        for (int k = 0; k < out_vertices; k++) {
+            vec3 n = s->normals[base + k];
+            vec3 t = tan[k];
+            vec3 to = sub3(t, scale3(n, dot3(n, t)));
+            float l2 = length_sq3(to);
+            vec3 tt;
+            float w = 1.0f;
+            if (l2 > 1e-30f && isfinite(l2)) {
+                tt = scale3(to, 1.0f / sqrtf(l2));
+                w = dot3(cross3(n, tt), bit[k]) < 0.0f ? -1.0f : 1.0f;
+            } else {
+                tt = length_sq3(n) > 0.0f ? any_tangent(n) : v3(1, 0, 0);
+            }
+            s->tangents[base + k] = (vec4){tt.x, tt.y, tt.z, w};
+        }
+        free(tan);
+        free(bit);
+    }
+
+    s->num_vertices += out_vertices;
+    s->num_triangles += kept;
+    return 0;
+oom:
+    snprintf(err, errlen, "out of memory");
+    return -1;
+}
+
+/* ---- finalize ------------------------------------------------------------------------------ */
+
+static void embree_error(void *user, enum RTCError code, const char *str) {
+    (void)user;
+    fprintf(stderr, "glint: error: embree: %s (code %d)\n", str ? str : "unknown error", (int)code);
+}
+
+int scene_finalize(scene *s, char *err, size_t errlen) {
+    if (s->num_triangles == 0) return snprintf(err, errlen, "%s: no triangles to render", s->path), -1;
+    bounds3 b = bounds_empty();
+    for (int t = 0; t < s->num_triangles; t++)
+        for (int c = 0; c < 3; c++) b = bounds_add(b, s->positions[s->indices[3 * t + c]]);
+    s->bounds = b;
+    s->diag = bounds_diagonal(b);
+    if (!(s->diag > 0.0f) || !isfinite(s->diag)) return snprintf(err, errlen, "%s: scene has no extent", s->path), -1;
+    s->ray_eps = 1e-5f * s->diag;
+
+    /* Pad the vertex array for Embree (the slot exists: positions has one spare element). */
+    s->positions[s->num_vertices] = v3(0, 0, 0);
+
+    if (scene_build_lights(s, err, errlen) != 0) return -1;
+
+    s->device = rtcNewDevice(NULL);
+    if (!s->device) return snprintf(err, errlen, "%s: cannot create an Embree device", s->path), -1;
+    rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
+    s->rtc = rtcNewScene(s->device);
+    RTCGeometry geom = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->positions, 0,
+                               sizeof(vec3), (size_t)s->num_vertices);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->indices, 0,
+                               3 * sizeof(uint32_t), (size_t)s->num_triangles);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(s->rtc, geom, 0);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(s->rtc);
+    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE)
+        return snprintf(err, errlen, "%s: building the BVH failed", s->path), -1;
+    return 0;
+}
+
+/* ---- loading ------------------------------------------------------------------------------- */
+
+static scene *finish_load(scene *s, int status, char *err, size_t errlen) {
+    if (status == 0 && scene_finalize(s, err, errlen) == 0) return s;
+    scene_destroy(s);
+    return NULL;
+}
+
+scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
+    scene *s = scene_create(warn, warn_user);
+    if (!s) return snprintf(err, errlen, "%s: out of memory", path), NULL;
+    snprintf(s->path, sizeof s->path, "%s", path);
+    return finish_load(s, gltf_import_file(s, path, err, errlen), err, errlen);
+}
+
+scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name,
+                         scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
+    scene *s = scene_create(warn, warn_user);
+    if (!s) return snprintf(err, errlen, "%s: out of memory", name), NULL;
+    snprintf(s->path, sizeof s->path, "%s", name);
+    return finish_load(s, gltf_import_memory(s, data, size, base_dir, name, err, errlen), err, errlen);
+}
+
+extern const unsigned char glint_default_scene_gltf[];
+extern const size_t glint_default_scene_gltf_size;
+
+scene *scene_load_default(scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
+    return scene_load_memory(glint_default_scene_gltf, glint_default_scene_gltf_size, "", "<default>", warn,
+                             warn_user, err, errlen);
+}
+
+/* ---- ray queries --------------------------------------------------------------------------- */
+
+static void init_ray(struct RTCRay *r, vec3 o, vec3 d, float tmax) {
+    r->org_x = o.x;
+    r->org_y = o.y;
+    r->org_z = o.z;
+    r->tnear = 0.0f;
+    r->dir_x = d.x;
+    r->dir_y = d.y;
+    r->dir_z = d.z;
+    r->time = 0.0f;
+    r->tfar = tmax;
+    r->mask = 0xFFFFFFFFu;
+    r->id = 0;
+    r->flags = 0;
+}
+
+int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) {
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    init_ray(&rh.ray, o, d, tmax);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(s->rtc, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+
+    int t = (int)rh.hit.primID;
+    const uint32_t *v = &s->indices[3 * t];
+    float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0f - b1 - b2;
+    vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
+    h->t = rh.ray.tfar;
+    h->tri = t;
+    h->material = s->tri_material[t];
+    /* Barycentric interpolation is more accurate than o + t d far from the origin. */
+    h->p = add3(add3(scale3(p0, b0), scale3(p1, b1)), scale3(p2, b2));
+    vec3 ng = normalize3(cross3(sub3(p1, p0), sub3(p2, p0)));
+    h->backface = dot3(ng, d) > 0.0f;
+    if (h->backface) ng = neg3(ng);
+    h->ng = ng;
+    h->uv0 = v2(b0 * s->uv0[v[0]].x + b1 * s->uv0[v[1]].x + b2 * s->uv0[v[2]].x,
+                b0 * s->uv0[v[0]].y + b1 * s->uv0[v[1]].y + b2 * s->uv0[v[2]].y);
+    h->uv1 = v2(b0 * s->uv1[v[0]].x + b1 * s->uv1[v[1]].x + b2 * s->uv1[v[2]].x,
+                b0 * s->uv1[v[0]].y + b1 * s->uv1[v[1]].y + b2 * s->uv1[v[2]].y);
+
+    vec3 ns = add3(add3(scale3(s->normals[v[0]], b0), scale3(s->normals[v[1]], b1)), scale3(s->normals[v[2]], b2));
+    float l2 = length_sq3(ns);
+    ns = (l2 > 1e-12f && isfinite(l2)) ? scale3(ns, 1.0f / sqrtf(l2)) : ng;
+    /* The shading normal lives on the same side as the geometric one... */
+    if (dot3(ns, ng) < 0.0f) ns = neg3(ns);
+    /* ...and must see the viewer: bend it toward wo when interpolation tilts it away. */
+    vec3 wo = neg3(d);
+    float cos_o = dot3(ns, wo);
+    const float min_cos = 1e-3f;
+    if (cos_o < min_cos) ns = normalize3(madd3(ns, wo, min_cos - cos_o));
+
+    const vec4 *tg = s->tangents;
+    vec3 tan = add3(add3(scale3(v3(tg[v[0]].x, tg[v[0]].y, tg[v[0]].z), b0), scale3(v3(tg[v[1]].x, tg[v[1]].y, tg[v[1]].z), b1)),
+                    scale3(v3(tg[v[2]].x, tg[v[2]].y, tg[v[2]].z), b2));
+    h->shading = frame_from_normal_tangent(ns, tan);
+    /* glTF bitangent = cross(n, t) * w; keep the handedness so anisotropy rotations turn the right way. */
+    if (tg[v[0]].w < 0.0f) h->shading.b = neg3(h->shading.b);
+    return 1;
+}
+
+int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax) {
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay r;
+    init_ray(&r, o, d, tmax);
+    rtcOccluded1(s->rtc, &ctx, &r);
+    return r.tfar < 0.0f; /* Embree sets tfar to -inf on a hit */
+}
+
+/* ---- materials at hits --------------------------------------------------------------------- */
+
+/* Rotates the frame's tangent by angle about n (toward b for positive angles). */
+static void rotate_tangent(frame3 *f, float c, float sn) {
+    vec3 t = add3(scale3(f->t, c), scale3(f->b, sn));
+    vec3 b = sub3(scale3(f->b, c), scale3(f->t, sn));
+    f->t = t;
+    f->b = b;
+}
+
+bsdf material_bsdf(const scene *s, const surface_hit *h, frame3 *frame) {
+    const material *m = &s->materials[h->material];
+    *frame = h->shading;
+    vec3 tint = v3s(1.0f);
+    if (m->base_color_tex.texture >= 0) {
+        vec4 c = texture_lookup(s, m->base_color_tex, h->uv0, h->uv1, 1);
+        tint = v3(c.x, c.y, c.z);
+    }
+    switch (m->model) {
+    case MATERIAL_PHONG: return make_bsdf_phong(mul3(m->kd, tint), m->ks, m->exponent);
+    case MATERIAL_WARD:
+        if (m->anisotropy_rotation != 0.0f)
+            rotate_tangent(frame, cosf(m->anisotropy_rotation), sinf(m->anisotropy_rotation));
+        return make_bsdf_ward(mul3(m->kd, tint), m->ks, m->alpha_x, m->alpha_y);
+    case MATERIAL_GLTF:
+    default: {
+        float metallic = m->metallic, roughness = m->roughness;
+        if (m->metal_rough_tex.texture >= 0) {
+            vec4 mr = texture_lookup(s, m->metal_rough_tex, h->uv0, h->uv1, 0);
+            roughness *= mr.y;
+            metallic *= mr.z;
+        }
+        float aniso = m->anisotropy_strength;
+        if (aniso > 0.0f) {
+            float dx = 1.0f, dy = 0.0f;
+            if (m->anisotropy_tex.texture >= 0) {
+                vec4 a = texture_lookup(s, m->anisotropy_tex, h->uv0, h->uv1, 0);
+                dx = 2.0f * a.x - 1.0f;
+                dy = 2.0f * a.y - 1.0f;
+                aniso *= a.z;
+            }
+            float c = cosf(m->anisotropy_rotation), sn = sinf(m->anisotropy_rotation);
+            float rx = c * dx - sn * dy, ry = sn * dx + c * dy;
+            float len = sqrtf(rx * rx + ry * ry);
+            if (len > 1e-6f) rotate_tangent(frame, rx / len, ry / len);
+        }
+        return make_bsdf_gltf(mul3(m->base_color, tint), metallic, roughness, aniso);
+    }
+    }
+}
+
+vec3 material_emission(const scene *s, const surface_hit *h) {
+    const material *m = &s->materials[h->material];
+    if (is_black3(m->emission) || (h->backface && !m->double_sided)) return v3(0, 0, 0);
+    vec3 e = m->emission;
+    if (m->emissive_tex.texture >= 0) {
+        vec4 c = texture_lookup(s, m->emissive_tex, h->uv0, h->uv1, 1);
+        e = mul3(e, v3(c.x, c.y, c.z));
+    }
+    return e;
+}

@@ -1,0 +1,251 @@
+/* glint — the scene: world-space triangles, materials, textures, lights, cameras, an environment
+ * map, and the Embree BVH over the triangles. Elements refer to each other by index.
+ *
+ * Life cycle: scene_create() -> scene_add_*() (the glTF importer calls these) ->
+ * scene_finalize() (normals, tangents, light list, scale, BVH) -> read-only while rendering ->
+ * scene_destroy(). The loaders below do all of it. */
+#ifndef GLINT_SCENE_H
+#define GLINT_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <embree3/rtcore.h>
+
+#include "bsdf.h"
+#include "gmath.h"
+#include "image_io.h"
+#include "sampling.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+
+/* ---- textures ------------------------------------------------------------------------------ */
+
+typedef enum { WRAP_REPEAT = 0, WRAP_CLAMP, WRAP_MIRROR } wrap_mode;
+
+typedef struct {
+    int width, height;
+    uint8_t *rgba; /* owned, 8 bits per channel; colour space is decided by the slot using it */
+} scene_image;
+
+typedef struct {
+    int image;
+    wrap_mode wrap_s, wrap_t;
+} scene_texture;
+
+/* A material's reference to a texture: texture < 0 means none. */
+typedef struct {
+    int texture;
+    int texcoord; /* 0 or 1 */
+} texture_slot;
+
+/* ---- materials ----------------------------------------------------------------------------- */
+
+typedef enum {
+    MATERIAL_GLTF = 0, /* metallic-roughness: Lambert + GGX */
+    MATERIAL_PHONG,    /* extras.glint.model = "phong" */
+    MATERIAL_WARD,     /* extras.glint.model = "ward" */
+} material_model;
+
+typedef struct {
+    char name[64];
+    material_model model;
+    /* glTF metallic-roughness */
+    vec3 base_color;
+    float metallic, roughness;
+    texture_slot base_color_tex;    /* sRGB */
+    texture_slot metal_rough_tex;   /* linear: G roughness, B metallic */
+    float anisotropy_strength;      /* KHR_materials_anisotropy */
+    float anisotropy_rotation;      /* radians about the normal, from the tangent (also Ward's) */
+    texture_slot anisotropy_tex;    /* linear: RG direction, B strength */
+    /* Phong and Ward (the papers' lobes) */
+    vec3 kd, ks;
+    float exponent;                 /* Phong */
+    float alpha_x, alpha_y;         /* Ward */
+    /* emission: radiance = emission * emissive texture */
+    vec3 emission;                  /* emissiveFactor * KHR_materials_emissive_strength */
+    texture_slot emissive_tex;      /* sRGB */
+    int double_sided;               /* emits from both faces */
+} material;
+
+/* ---- lights and cameras -------------------------------------------------------------------- */
+
+typedef enum {
+    LIGHT_POINT = 0,
+    LIGHT_SPOT,
+    LIGHT_DIRECTIONAL,
+    LIGHT_TRIANGLE, /* one emissive triangle */
+    LIGHT_ENV,      /* the environment map */
+} light_type;
+
+typedef struct {
+    light_type type;
+    char name[64];
+    /* Radiometric stand-ins for the glTF units, one consistent scale: candela -> W/sr (point,
+     * spot), lux -> W/m^2 (directional). color already includes the intensity. */
+    vec3 color;
+    vec3 position;      /* point, spot */
+    vec3 direction;     /* spot, directional: where the light shines (unit) */
+    float cos_inner;    /* spot */
+    float cos_outer;    /* spot */
+    float range;        /* point, spot: glTF range (0 = infinite) */
+    int triangle;       /* LIGHT_TRIANGLE */
+    float power;        /* estimate of emitted power (luminance), for light selection */
+} light;
+
+typedef struct {
+    char name[64];
+    vec3 position;
+    vec3 right, up, forward; /* orthonormal */
+    float yfov;              /* radians */
+} camera;
+
+/* Environment map: equirectangular, linear RGB. Direction convention (Blender's): image centre
+ * u = 0.5 is +X, u = 0.75 is +Z, the top row is +Y. */
+typedef struct {
+    image_rgb image;
+    dist2d dist;        /* over (u, v), luminance * sin(theta), dilated for bilinear lookups */
+    float rotation;     /* radians about +Y */
+    float mean_luminance;
+} env_map;
+
+/* ---- the scene ----------------------------------------------------------------------------- */
+
+typedef struct scene {
+    char path[1024]; /* where it came from ("<default>" for the built-in scene) */
+
+    /* world-space geometry, flattened: vertex arrays parallel, 3 indices per triangle */
+    int num_vertices, cap_vertices;
+    vec3 *positions;  /* padded by one element for Embree's 16-byte reads */
+    vec3 *normals;
+    vec4 *tangents;   /* xyz tangent, w = bitangent sign */
+    vec2 *uv0, *uv1;
+    int num_triangles, cap_triangles;
+    uint32_t *indices;
+    int32_t *tri_material;
+    int32_t *tri_light; /* light index of an emissive triangle, else -1 */
+
+    material *materials;
+    int num_materials, cap_materials;
+    scene_image *images;
+    int num_images, cap_images;
+    scene_texture *textures;
+    int num_textures, cap_textures;
+    light *lights; /* punctual lights, then emissive triangles, then the environment */
+    int num_lights, cap_lights;
+    camera *cameras;
+    int num_cameras, cap_cameras;
+    env_map *env; /* NULL without one */
+    int env_light; /* index into lights, or -1 */
+
+    dist1d light_dist; /* light selection by power */
+
+    bounds3 bounds;
+    float diag;    /* bounding-box diagonal: the scene's size */
+    float ray_eps; /* base ray offset, relative to the scene's size */
+
+    int num_warnings;
+    char warnings[8][256]; /* the first few warnings, for display; all are printed */
+
+    RTCDevice device;
+    RTCScene rtc;
+} scene;
+
+/* ---- loading ------------------------------------------------------------------------------- */
+
+/* Error messages are one line, "PATH: problem". Warnings (ignored extensions, ...) go to warn_fn
+ * (may be NULL) as they happen, without a trailing newline. */
+typedef void (*scene_warn_fn)(void *user, const char *message);
+
+/* Loads a .gltf/.glb file. Returns a new scene (caller destroys) or NULL with err set. */
+scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
+/* Loads the built-in default scene (compiled into the program). */
+scene *scene_load_default(scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
+/* Loads glTF JSON or GLB from memory; base_dir resolves external URIs; name is used in messages. */
+scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name,
+                         scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
+/* Attaches an environment map (.exr or .hdr) to a loaded scene, replacing any previous one. The
+ * scene must not be rendering. Returns 0, or -1 with err set (the scene keeps its old map). */
+int scene_set_env(scene *s, const char *path, float rotation, char *err, size_t errlen);
+/* The same from an image in memory (taken over: *image is emptied, also on failure). */
+int scene_set_env_image(scene *s, image_rgb *image, float rotation, char *err, size_t errlen);
+void scene_destroy(scene *s);
+
+/* ---- building (used by the importer and by tests that make scenes in code) ---------------- */
+
+scene *scene_create(scene_warn_fn warn, void *warn_user);
+void scene_warn(scene *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+typedef struct {
+    int num_vertices;
+    const float *positions;  /* 3 per vertex (required) */
+    const float *normals;    /* 3 per vertex, or NULL: generated (area-weighted, smooth) */
+    const float *tangents;   /* 4 per vertex, or NULL: generated from uv0 when it exists */
+    const float *uv0, *uv1;  /* 2 per vertex, or NULL */
+    int num_indices;         /* 0: non-indexed, every 3 vertices a triangle */
+    const uint32_t *indices; /* all < num_vertices (the importer checks) */
+    int material;            /* index, or -1 for the default grey material */
+} mesh_desc;
+
+/* Adds a mesh instance transformed by xform. Returns 0, or -1 on bad input / out of memory with
+ * err set (no "PATH:" prefix; the caller adds context). */
+int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err, size_t errlen);
+/* Adds an image given as 1-4 channels of 8 or 16 bits; returns its index or -1. */
+int scene_add_image(scene *s, int width, int height, int channels, int bits, const void *pixels);
+int scene_add_texture(scene *s, scene_texture t);
+int scene_add_material(scene *s, const material *m);
+int scene_add_light(scene *s, const light *l);
+int scene_add_camera(scene *s, const camera *c);
+material material_default(void);
+/* Builds what rendering needs: light list and selection, scale, the BVH. Returns 0 or -1. */
+int scene_finalize(scene *s, char *err, size_t errlen);
+
+/* ---- queries during rendering (thread-safe, read-only) ------------------------------------ */
+
+typedef struct {
+    float t;
+    int tri;       /* triangle index */
+    int material;
+    vec3 p;        /* position */
+    vec3 ng;       /* geometric normal, facing the incoming ray */
+    frame3 shading;/* shading frame: n faces the incoming ray's side, t along the tangent */
+    vec2 uv0, uv1;
+    int backface;  /* the ray hit the triangle's back (winding) side */
+} surface_hit;
+
+/* Closest hit along o + t d for t in (0, tmax]. Returns 1 on hit and fills h. */
+int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h);
+/* 1 if anything blocks o + t d for t in (0, tmax). */
+int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax);
+
+/* Ray origin leaving a surface point toward dir without hitting its own triangle: offset along
+ * the geometric normal by an epsilon relative to the scene's size and the point's magnitude. */
+static inline float scene_offset_eps(const scene *s, vec3 p) {
+    float m = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
+    return s->ray_eps + 4e-6f * m;
+}
+static inline vec3 offset_origin(const scene *s, vec3 p, vec3 ng, vec3 dir) {
+    float e = scene_offset_eps(s, p);
+    return madd3(p, ng, dot3(dir, ng) >= 0.0f ? e : -e);
+}
+
+/* The BSDF at a hit (textures looked up), in the hit's shading frame; *frame may be rotated for
+ * anisotropy. */
+bsdf material_bsdf(const scene *s, const surface_hit *h, frame3 *frame);
+/* Emitted radiance leaving the hit toward the side the ray came from (0 for the back of a
+ * single-sided emitter). */
+vec3 material_emission(const scene *s, const surface_hit *h);
+/* Texture lookup (bilinear, wrap modes), returns linear RGBA; srgb decodes the colour channels. */
+vec4 texture_lookup(const scene *s, texture_slot slot, vec2 uv0, vec2 uv1, int srgb);
+
+/* Environment radiance seen along direction d (world). 0 without a map. */
+vec3 env_eval(const scene *s, vec3 d);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

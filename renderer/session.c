@@ -1,0 +1,150 @@
+#include "session.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera.h"
+#include "pt.h"
+#include "rng.h"
+#include "threadpool.h"
+
+static const char *const method_names[METHOD_COUNT] = {"pt"};
+const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
+
+const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? method_names[m] : "?"; }
+
+int method_from_name(const char *name) {
+    for (int i = 0; i < METHOD_COUNT; i++)
+        if (strcmp(name, method_names[i]) == 0) return i;
+    return -1;
+}
+
+#define TILE 16
+
+/* Per-worker counters, padded so threads never share a cache line. */
+typedef struct {
+    render_stats st;
+    char pad[64];
+} worker_stats;
+
+struct render_session {
+    const scene *scene;
+    camera cam;
+    render_params params;
+    film film;
+    long long frames;
+    threadpool *pool;
+    worker_stats *workers;
+    render_stats totals;
+    int tiles_x, tiles_y;
+};
+
+render_session *session_create(const scene *s, const camera *cam, const render_params *params, char *err,
+                               size_t errlen) {
+    render_session *rs = calloc(1, sizeof(render_session));
+    if (!rs) return snprintf(err, errlen, "out of memory"), NULL;
+    rs->scene = s;
+    rs->cam = *cam;
+    rs->params = *params;
+    render_params *p = &rs->params;
+    if (p->width <= 0) p->width = 960;
+    if (p->height <= 0) p->height = 540;
+    if (p->max_depth <= 0) p->max_depth = DEFAULT_MAX_DEPTH;
+    if ((unsigned)p->method >= METHOD_COUNT) p->method = METHOD_PT;
+    if (film_init(&rs->film, p->width, p->height) != 0) {
+        snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height);
+        free(rs);
+        return NULL;
+    }
+    rs->pool = threadpool_create(p->threads);
+    if (rs->pool) rs->workers = calloc((size_t)threadpool_size(rs->pool), sizeof(worker_stats));
+    if (!rs->pool || !rs->workers) {
+        session_destroy(rs);
+        return snprintf(err, errlen, "cannot start render threads"), NULL;
+    }
+    p->threads = threadpool_size(rs->pool); /* report what runs, not what was asked */
+    rs->tiles_x = (p->width + TILE - 1) / TILE;
+    rs->tiles_y = (p->height + TILE - 1) / TILE;
+    return rs;
+}
+
+void session_destroy(render_session *rs) {
+    if (!rs) return;
+    threadpool_destroy(rs->pool);
+    free(rs->workers);
+    film_deinit(&rs->film);
+    free(rs);
+}
+
+static void render_tile(void *ctx, int tile, int worker) {
+    render_session *rs = ctx;
+    const scene *s = rs->scene;
+    const render_params *p = &rs->params;
+    render_stats *st = &rs->workers[worker].st;
+    int x0 = (tile % rs->tiles_x) * TILE, y0 = (tile / rs->tiles_x) * TILE;
+    int x1 = x0 + TILE < p->width ? x0 + TILE : p->width;
+    int y1 = y0 + TILE < p->height ? y0 + TILE : p->height;
+    float aspect = (float)p->width / (float)p->height;
+    for (int y = y0; y < y1; y++) {
+        for (int x = x0; x < x1; x++) {
+            int pixel = y * p->width + x;
+            rng_state rng = rng_for((uint64_t)pixel, (uint64_t)rs->frames, p->seed);
+            vec2 j = rng_vec2(&rng);
+            vec3 d = camera_ray_dir(&rs->cam, aspect, ((float)x + j.x) / (float)p->width,
+                                    ((float)y + j.y) / (float)p->height);
+            vec3 L[COMP_COUNT];
+            pt_radiance(s, p->max_depth, rs->cam.position, d, &rng, L, st->rays);
+            float sample[COMP_COUNT][3];
+            int finite = 1;
+            for (int c = 0; c < COMP_COUNT; c++) {
+                finite &= is_finite3(L[c]);
+                sample[c][0] = L[c].x;
+                sample[c][1] = L[c].y;
+                sample[c][2] = L[c].z;
+            }
+            /* A NaN or Inf never reaches the film: the sample is dropped (the pixel's count
+             * stays, so its mean is over the good samples) and counted. */
+            if (finite) film_add(&rs->film, pixel, (const float(*)[3])sample);
+            else st->rejected_samples++;
+        }
+    }
+}
+
+void session_render_frame(render_session *rs) {
+    threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
+    rs->frames++;
+    int n = threadpool_size(rs->pool);
+    for (int w = 0; w < n; w++) {
+        render_stats *st = &rs->workers[w].st;
+        for (int k = 0; k < RAY_KIND_COUNT; k++) rs->totals.rays[k] += st->rays[k];
+        rs->totals.rejected_samples += st->rejected_samples;
+        memset(st, 0, sizeof *st);
+    }
+}
+
+void session_reset(render_session *rs) {
+    film_clear(&rs->film);
+    rs->frames = 0;
+}
+
+void session_set_camera(render_session *rs, const camera *cam) {
+    rs->cam = *cam;
+    session_reset(rs);
+}
+
+void session_set_params(render_session *rs, const render_params *params) {
+    render_params p = *params;
+    p.width = rs->params.width;
+    p.height = rs->params.height;
+    p.threads = rs->params.threads;
+    if (p.max_depth <= 0) p.max_depth = DEFAULT_MAX_DEPTH;
+    if ((unsigned)p.method >= METHOD_COUNT) p.method = METHOD_PT;
+    rs->params = p;
+    session_reset(rs);
+}
+
+long long session_frames(const render_session *rs) { return rs->frames; }
+const film *session_film(const render_session *rs) { return &rs->film; }
+const render_params *session_params(const render_session *rs) { return &rs->params; }
+render_stats session_stats(const render_session *rs) { return rs->totals; }

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages glint needs, when any is missing. Sourced by run.sh and test.sh.
+GLINT_PACKAGES=(
+  build-essential cmake pkg-config
+  libglfw3-dev libembree-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev
+  libimgui-dev libstb-dev libgl-dev
+  xvfb xauth embree-tools
+)
+
+glint_install_deps() {
+  local missing=()
+  for p in "${GLINT_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "glint: installing missing packages: ${missing[*]}"
+  local cmd=(apt-get install -y --no-install-recommends "${missing[@]}")
+  if [ "$(id -u)" -eq 0 ]; then
+    DEBIAN_FRONTEND=noninteractive apt-get update -qq && DEBIAN_FRONTEND=noninteractive "${cmd[@]}" -qq
+  elif command -v sudo >/dev/null && sudo -n true 2>/dev/null; then
+    sudo DEBIAN_FRONTEND=noninteractive apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive "${cmd[@]}" -qq
+  else
+    echo "glint: error: missing packages; run as root: apt-get update && ${cmd[*]}" >&2
+    return 1
+  fi
+}

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# glint benchmarks (release build; numbers are ratios measured in one run on a shared machine).
+#   1. Path-tracing throughput against Embree's own `pathtracer` (embree-tools) on the same
+#      triangles, camera, point light, size, spp and path length.
+#   2. Load + BVH build time and peak memory for the 1.04 M-triangle sphere grid.
+# Usage: tests/bench/run.sh [SHARED_SCENES_DIR]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+scenes=${1:-$root/../shared/scenes}
+build=$root/build
+source "$root/scripts/deps.sh"
+glint_install_deps
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DGLINT_TESTS=OFF >/dev/null
+cmake --build "$build" -j"$(nproc)" >/dev/null
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+seconds_of() { # wall seconds of a command, its output discarded
+  local t0 t1
+  t0=$(date +%s.%N)
+  "$@" >/dev/null 2>&1
+  t1=$(date +%s.%N)
+  awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }'
+}
+
+echo "## Path-tracing throughput (640x360, 32 spp, path length 8, $(nproc) threads)"
+printf '| scene | glint samples/s | Embree pathtracer samples/s | ratio |\n|---|---|---|---|\n'
+for s in cornell-box/CornellBox-Original.gltf lights-punctual-lamp/glTF/LightsPunctualLamp.gltf; do
+  [ -f "$scenes/$s" ] || { echo "skipping $s: not found"; continue; }
+  out=$("$build/tests/bench/bench_pt" "$scenes/$s" "$work" 640 360 32 8)
+  glint_sps=$(sed -n 's/^glint_samples_per_second: //p' <<<"$out")
+  read -r -a args <<<"$(sed -n 's/^embree_args: //p' <<<"$out")"
+  # Embree renders one frame of --spp samples; subtract a 1-spp run to remove load and BVH time.
+  one=("${args[@]}")
+  for i in "${!one[@]}"; do [ "${one[$i]}" = "--spp" ] && one[$((i + 1))]=1; done
+  t_full=$(seconds_of pathtracer "${args[@]}" --threads "$(nproc)" -o "$work/embree.ppm")
+  t_one=$(seconds_of pathtracer "${one[@]}" --threads "$(nproc)" -o "$work/embree1.ppm")
+  awk -v s="$s" -v g="$glint_sps" -v full="$t_full" -v one="$t_one" \
+    'BEGIN { e = 640 * 360 * 31 / (full - one); printf "| %s | %.0f | %.0f | %.2f |\n", s, g, e, g / e }'
+done
+
+echo
+echo "## Load + BVH build, 1.04 M triangles"
+grid=$scenes/metal-rough-spheres-notextures/glTF/MetalRoughSpheresNoTextures.gltf
+if [ -f "$grid" ]; then
+  "$build/app/glint" info "$grid" | grep -E 'geometry|load'
+else
+  echo "skipping: $grid not found"
+fi

@@ -1,0 +1,215 @@
+/* The glint command line, run as a user would: exit codes (0, 1, 2), one-line errors naming the
+ * file, the outputs (EXR layers that sum to the image, a PNG of the right size, stats JSON),
+ * atomic and non-overwriting exports, progress lines when stderr is not a terminal.
+ * Usage: test_cli PATH_TO_GLINT */
+#define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "image_io.h"
+
+static const char *glint;
+static char tmp[512];
+static char out_text[65536], err_text[65536];
+
+static void read_file(const char *path, char *buf, size_t cap) {
+    buf[0] = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return;
+    size_t n = fread(buf, 1, cap - 1, f);
+    buf[n] = 0;
+    fclose(f);
+}
+
+/* Runs glint with the given arguments (a shell command tail, in directory tmp); captures stdout
+ * and stderr. Returns the exit status, or -1 if it did not exit normally (a crash). */
+static int run(const char *args) {
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt' </dev/null", tmp, glint, args, tmp, tmp);
+    int status = system(cmd);
+    char p[1024];
+    snprintf(p, sizeof p, "%s/stdout.txt", tmp);
+    read_file(p, out_text, sizeof out_text);
+    snprintf(p, sizeof p, "%s/stderr.txt", tmp);
+    read_file(p, err_text, sizeof err_text);
+    if (!WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
+}
+
+static int count_lines(const char *s) {
+    int n = 0;
+    for (; *s; s++) n += *s == '\n';
+    return n;
+}
+
+/* Exit code `code`, and stderr exactly one "glint: error: ..." line containing `needle`. */
+static void expect_failure(const char *args, int code, const char *needle) {
+    int rc = run(args);
+    CHECK(rc == code, "'%s': exit %d, expected %d (stderr: %s)", args, rc, code, err_text);
+    CHECK(strncmp(err_text, "glint: error: ", 14) == 0 && count_lines(err_text) == 1,
+          "'%s': stderr is not one error line: '%s'", args, err_text);
+    CHECK(needle == NULL || strstr(err_text, needle), "'%s': error '%s' lacks '%s'", args, err_text, needle);
+}
+
+static int file_exists(const char *name) {
+    char p[1024];
+    snprintf(p, sizeof p, "%s/%s", tmp, name);
+    struct stat st;
+    return stat(p, &st) == 0;
+}
+
+/* No temporary files may survive an export, failed or not. */
+static int stray_temp_files(void) {
+    DIR *d = opendir(tmp);
+    int n = 0;
+    struct dirent *e;
+    while (d && (e = readdir(d)))
+        if (strstr(e->d_name, ".tmp")) n++;
+    if (d) closedir(d);
+    return n;
+}
+
+static void test_usage(void) {
+    CHECK(run("--help") == 0, "--help exit code");
+    const char *options[] = {"render", "info", "--spp", "--time", "--size", "--max-depth", "--env", "--camera", "--seed",
+                             "--out", "--png", "--stats", "--method", "--quiet"};
+    char all[sizeof out_text * 2];
+    snprintf(all, sizeof all, "%s", out_text);
+    CHECK(run("render --help") == 0, "render --help exit code");
+    strncat(all, out_text, sizeof all - strlen(all) - 1);
+    for (size_t i = 0; i < sizeof options / sizeof options[0]; i++)
+        CHECK(strstr(all, options[i]) != NULL, "help does not mention %s", options[i]);
+    CHECK(run("--version") == 0 && strstr(out_text, "glint"), "--version");
+
+    expect_failure("frobnicate", 2, "frobnicate");
+    expect_failure("render --bogus", 2, "--bogus");
+    expect_failure("render --spp", 2, "--spp");
+    expect_failure("render --spp -3", 2, "--spp");
+    expect_failure("render --spp 10x", 2, "--spp");
+    expect_failure("render --size 0x5", 2, "--size");
+    expect_failure("render --size 100", 2, "--size");
+    expect_failure("render --spp 4 --time 2", 2, NULL);
+    expect_failure("render --method nope", 2, "nope");
+    expect_failure("render --max-depth -1", 2, "--max-depth");
+}
+
+static void test_errors(void) {
+    expect_failure("render missing-scene.gltf --spp 1", 1, "missing-scene.gltf");
+    expect_failure("info missing-scene.gltf", 1, "missing-scene.gltf");
+    char p[1024];
+    snprintf(p, sizeof p, "%s/broken.gltf", tmp);
+    FILE *f = fopen(p, "w");
+    fputs("{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [", f);
+    fclose(f);
+    expect_failure("render broken.gltf --spp 1", 1, "broken.gltf");
+    snprintf(p, sizeof p, "%s/fake.exr", tmp);
+    f = fopen(p, "w");
+    fputs("not an image", f);
+    fclose(f);
+    expect_failure("render --env fake.exr --spp 1 --size 8x8 --png x.png", 1, "fake.exr");
+    expect_failure("render --env none.hdr --spp 1 --size 8x8 --png x.png", 1, "none.hdr");
+    CHECK(!file_exists("x.png"), "a failed render wrote its output");
+    expect_failure("render --spp 1 --size 8x8 --png no-such-dir/x.png", 1, "no-such-dir");
+    CHECK(stray_temp_files() == 0, "temporary files left behind");
+}
+
+static void test_outputs(void) {
+    int rc = run("render --spp 4 --size 48x27 --max-depth 4 --seed 3 --out img.exr --png img.png --stats img.json --quiet");
+    CHECK(rc == 0, "render: exit %d: %s", rc, err_text);
+    CHECK(err_text[0] == 0, "--quiet render printed to stderr: %s", err_text);
+    char p[1024], err[512];
+    snprintf(p, sizeof p, "%s/img.exr", tmp);
+    exr_image exr;
+    if (exr_image_load(p, &exr, err, sizeof err) == 0) {
+        CHECK(exr.width == 48 && exr.height == 27, "exr size %dx%d", exr.width, exr.height);
+        const char *ch[3] = {"R", "G", "B"};
+        double total = 0.0;
+        for (int c = 0; c < 3; c++) {
+            char dn[32], in[32];
+            snprintf(dn, sizeof dn, "direct.%s", ch[c]);
+            snprintf(in, sizeof in, "indirect.%s", ch[c]);
+            const float *all = exr_image_channel(&exr, ch[c]), *d = exr_image_channel(&exr, dn),
+                        *ind = exr_image_channel(&exr, in);
+            CHECK(all && d && ind, "exr lacks channel %s, %s or %s", ch[c], dn, in);
+            if (!(all && d && ind)) continue;
+            int bad = 0;
+            for (int i = 0; i < 48 * 27; i++) {
+                if (!(fabsf(all[i] - (d[i] + ind[i])) <= 1e-5f * fabsf(all[i]) + 1e-7f)) bad++;
+                if (!isfinite(all[i]) || all[i] < 0.0f) bad++;
+                total += all[i];
+            }
+            CHECK(bad == 0, "exr %s != direct + indirect (or not finite) at %d pixels", ch[c], bad);
+        }
+        CHECK(total > 0.0, "the render is black");
+        exr_image_free(&exr);
+    } else {
+        CHECK(0, "exr unreadable: %s", err);
+    }
+    /* PNG: signature, then IHDR with the big-endian width and height. */
+    snprintf(p, sizeof p, "%s/img.png", tmp);
+    unsigned char hdr[24] = {0};
+    FILE *pf = fopen(p, "rb");
+    CHECK(pf && fread(hdr, 1, 24, pf) == 24, "png missing or short");
+    if (pf) fclose(pf);
+    CHECK(memcmp(hdr, "\x89PNG", 4) == 0 && hdr[19] == 48 && hdr[23] == 27, "png header or size wrong");
+    char json[8192];
+    snprintf(p, sizeof p, "%s/img.json", tmp);
+    read_file(p, json, sizeof json);
+    CHECK(strstr(json, "\"spp\": 4") && strstr(json, "\"method\": \"pt\"") && strstr(json, "\"width\": 48"),
+          "stats json: %s", json);
+
+    /* Same seed, same image: runs reproduce. */
+    rc = run("render --spp 4 --size 48x27 --max-depth 4 --seed 3 --out img2.exr --quiet");
+    char p2[1024];
+    snprintf(p, sizeof p, "%s/img.exr", tmp);
+    snprintf(p2, sizeof p2, "%s/img2.exr", tmp);
+    exr_image a, b;
+    if (rc == 0 && exr_image_load(p, &a, err, sizeof err) == 0) {
+        if (exr_image_load(p2, &b, err, sizeof err) == 0) {
+            const float *ra = exr_image_channel(&a, "R"), *rb = exr_image_channel(&b, "R");
+            CHECK(ra && rb && memcmp(ra, rb, sizeof(float) * 48 * 27) == 0, "same seed, different image");
+            exr_image_free(&b);
+        }
+        exr_image_free(&a);
+    }
+
+    /* A named output is replaced; the default output never is. */
+    CHECK(run("render --spp 1 --size 16x9 --png img.png --quiet") == 0, "re-render to a named png");
+    CHECK(run("render --spp 1 --size 16x9 --quiet") == 0 && file_exists("render.png"), "default output render.png");
+    CHECK(run("render --spp 1 --size 16x9 --quiet") == 0 && file_exists("render-1.png"), "second default output is "
+                                                                                         "render-1.png");
+    CHECK(stray_temp_files() == 0, "temporary files left behind");
+
+    /* Without a terminal, progress comes as plain lines. */
+    rc = run("render --time 1.5 --size 32x18 --png timed.png");
+    CHECK(rc == 0, "timed render: %s", err_text);
+    CHECK(strstr(err_text, "spp") && !strchr(err_text, '\r') && !strstr(err_text, "\033"),
+          "progress on a non-terminal: '%s'", err_text);
+
+    rc = run("info");
+    CHECK(rc == 0 && strstr(out_text, "triangles"), "glint info: %s%s", out_text, err_text);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_cli GLINT\n");
+        return 2;
+    }
+    glint = argv[1];
+    const char *t = getenv("GLINT_TEST_TMP");
+    snprintf(tmp, sizeof tmp, "%s/cli", t ? t : "/tmp");
+    mkdir(tmp, 0755);
+    /* Start from an empty directory so the default-output numbering is known. */
+    char cmd[1100];
+    snprintf(cmd, sizeof cmd, "rm -f '%s'/*", tmp);
+    if (system(cmd) != 0) return 1;
+    test_usage();
+    test_errors();
+    test_outputs();
+    return check_exit("test_cli");
+}

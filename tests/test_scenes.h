@@ -1,0 +1,104 @@
+/* glint tests — scenes made in code, with answers known in closed form. */
+#ifndef GLINT_TEST_SCENES_H
+#define GLINT_TEST_SCENES_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera.h"
+#include "lights.h"
+#include "scene.h"
+#include "session.h"
+
+static inline scene *ts_new(const char *name) {
+    scene *s = scene_create(NULL, NULL);
+    snprintf(s->path, sizeof s->path, "%s", name);
+    return s;
+}
+
+/* Pure Lambert (a Phong material without a glossy lobe), optionally emissive. */
+static inline int ts_lambert(scene *s, vec3 albedo, vec3 emission, int double_sided) {
+    material m = material_default();
+    m.model = MATERIAL_PHONG;
+    m.kd = albedo;
+    m.ks = v3s(0.0f);
+    m.exponent = 1.0f;
+    m.emission = emission;
+    m.double_sided = double_sided;
+    return scene_add_material(s, &m);
+}
+
+static inline int ts_material(scene *s, material m) { return scene_add_material(s, &m); }
+
+/* Quad p0 p1 p2 p3 (counter-clockwise seen from its front), flat-shaded. */
+static inline void ts_quad(scene *s, vec3 p0, vec3 p1, vec3 p2, vec3 p3, int mat) {
+    float pos[12] = {p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y, p2.z, p3.x, p3.y, p3.z};
+    float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    vec3 n = normalize3(cross3(sub3(p1, p0), sub3(p2, p0)));
+    float nrm[12];
+    for (int i = 0; i < 4; i++) nrm[3 * i] = n.x, nrm[3 * i + 1] = n.y, nrm[3 * i + 2] = n.z;
+    mesh_desc md = {.num_vertices = 4, .positions = pos, .normals = nrm, .uv0 = uv, .num_indices = 6, .indices = idx,
+                    .material = mat};
+    mat4 id = mat4_identity();
+    char err[256];
+    if (scene_add_mesh(s, &md, &id, err, sizeof err) != 0) {
+        fprintf(stderr, "ts_quad: %s\n", err);
+        abort();
+    }
+}
+
+/* Axis-aligned box [lo, hi]; faces point inward (a closed room) or outward (a solid). */
+static inline void ts_box(scene *s, vec3 lo, vec3 hi, int inward, int mat) {
+    vec3 c[8];
+    for (int i = 0; i < 8; i++) c[i] = v3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+    /* outward-facing faces, counter-clockwise seen from outside */
+    int f[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int k = 0; k < 6; k++) {
+        if (inward) ts_quad(s, c[f[k][3]], c[f[k][2]], c[f[k][1]], c[f[k][0]], mat);
+        else ts_quad(s, c[f[k][0]], c[f[k][1]], c[f[k][2]], c[f[k][3]], mat);
+    }
+}
+
+static inline void ts_finalize(scene *s) {
+    char err[256];
+    if (scene_finalize(s, err, sizeof err) != 0) {
+        fprintf(stderr, "ts_finalize: %s\n", err);
+        abort();
+    }
+}
+
+/* Renders spp frames; returns the per-pixel mean image of the components in mask (caller frees). */
+static inline float *ts_render(const scene *s, const camera *cam, int w, int h, int spp, int max_depth, uint64_t seed,
+                               unsigned mask) {
+    render_params p = {.width = w, .height = h, .max_depth = max_depth, .seed = seed};
+    char err[256];
+    render_session *rs = session_create(s, cam, &p, err, sizeof err);
+    if (!rs) {
+        fprintf(stderr, "ts_render: %s\n", err);
+        abort();
+    }
+    for (int i = 0; i < spp; i++) session_render_frame(rs);
+    float *img = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
+    film_resolve(session_film(rs), mask, img);
+    render_stats st = session_stats(rs);
+    if (st.rejected_samples) fprintf(stderr, "ts_render: %llu rejected samples\n", (unsigned long long)st.rejected_samples);
+    session_destroy(rs);
+    return img;
+}
+
+/* Mean and standard error of the mean over pixels of channel-averaged values. */
+static inline void ts_stats(const float *img, int n, double *mean, double *sem) {
+    double s = 0, s2 = 0;
+    for (int i = 0; i < n; i++) {
+        double v = (img[3 * i] + img[3 * i + 1] + img[3 * i + 2]) / 3.0;
+        s += v;
+        s2 += v * v;
+    }
+    *mean = s / n;
+    double var = n > 1 ? (s2 - s * s / n) / (n - 1) : 0.0;
+    *sem = sqrt(var > 0 ? var / n : 0.0);
+}
+
+#endif

@@ -1,0 +1,94 @@
+#!/bin/sh
+# The viewer in a real window under Xvfb, driven by --script: it opens on the default scene,
+# display-only changes keep the accumulated frames, estimator and camera changes reset them,
+# screenshots and EXR exports appear (numbered, never overwriting), a bad file leaves the viewer
+# running, a bad script line is reported with its line number.
+# Usage: test_viewer.sh GLINT TMPDIR [KEEP_MODULES_LIB]
+set -u
+glint=$1
+dir=$2/viewer
+keep_modules=${3:-}
+command -v xvfb-run >/dev/null || { echo "xvfb-run not installed: skipped"; exit 77; }
+rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+# Mesa's llvmpipe and X11 keep allocations past exit; only they are exempt from leak checks.
+printf 'leak:libGLX_mesa\nleak:swrast_dri\nleak:libgallium\nleak:libLLVM\nleak:libX11\nleak:libxcb\nleak:libdbus\nleak:libglfw\nleak:libGL\nleak:dri\n' >lsan.supp
+export LSAN_OPTIONS="suppressions=$dir/lsan.supp:print_suppressions=0"
+# Under ASan the driver's modules must stay loaded for those names to be known (keep_modules.c);
+# the ASan runtime has to come first among preloaded libraries.
+asan=$(ldd "$glint" | sed -n 's/.*libasan[^ ]* => \([^ ]*\).*/\1/p')
+preload=
+if [ -n "$asan" ] && [ -n "$keep_modules" ]; then preload="$asan $keep_modules"; fi
+
+view() { # view ARGS... : runs the viewer headless, stdout to out.txt, stderr to err.txt
+  timeout 300 xvfb-run -a -s "-screen 0 1024x768x24" env LD_PRELOAD="$preload" "$glint" "$@" >out.txt 2>err.txt
+}
+
+printf 'not a scene' >broken.gltf
+cat >session.txt <<'EOF'
+wait 2
+stats
+set exposure 1.5
+set show direct
+wait 1
+stats
+set show all
+set max-depth 3
+wait 1
+stats
+orbit 25 -10
+pan 0.1 0.05
+zoom 0.8
+wait 2
+stats
+key r
+wait 1
+screenshot shot.png
+screenshot shot.png
+export image.exr
+load broken.gltf
+wait 1
+stats
+quit
+EOF
+view --size 320x180 --script session.txt
+rc=$?
+[ $rc -eq 0 ] || fail "scripted session exited $rc: $(cat err.txt)"
+# stats lines: 1 start, 2 after display changes, 3 after max-depth, 4 after camera motion, 5 after a bad load
+field() { sed -n "$1p" stats.txt | tr ' ' '\n' | sed -n "s/^$2=//p"; }
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 5 ] || fail "expected 5 stats lines, got: $(cat out.txt)"
+[ "$(field 1 scene)" = "<default>" ] || fail "the viewer did not open the default scene: $(field 1 scene)"
+[ "$(field 1 frames)" -ge 2 ] || fail "no frames rendered"
+[ "$(field 2 resets)" = "$(field 1 resets)" ] || fail "a display change reset the accumulation"
+[ "$(field 2 frames)" -gt "$(field 1 frames)" ] || fail "frames did not keep accumulating across a display change"
+[ "$(field 2 exposure)" = "1.5" ] && [ "$(field 2 show)" = "1" ] || fail "display settings not applied"
+[ "$(field 3 resets)" -gt "$(field 2 resets)" ] || fail "max-depth did not reset the accumulation"
+[ "$(field 3 max_depth)" = "3" ] || fail "max-depth not applied"
+[ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "camera motion did not reset the accumulation"
+[ "$(field 5 scene)" = "<default>" ] || fail "a bad scene file replaced the scene"
+grep -q 'broken.gltf' err.txt || fail "the bad scene file's error was not reported"
+[ -s shot.png ] && [ -s shot-1.png ] || fail "screenshots missing or overwritten: $(ls)"
+[ -s image.exr ] || fail "EXR export missing"
+# The export holds the image and its component layers.
+head -c 2000 image.exr | grep -q 'direct.R' || fail "EXR export lacks the direct layer"
+ls | grep -q '\.tmp' && fail "temporary files left behind: $(ls)"
+
+# A bad script line is reported with its line number, before any window opens.
+printf 'wait 1\nfrobnicate 3\n' >bad.txt
+view --script bad.txt
+rc=$?
+[ $rc -eq 2 ] || fail "bad script: exit $rc, expected 2"
+grep -q 'bad.txt:2: unknown action' err.txt || fail "bad script line not reported: $(cat err.txt)"
+
+# A bad value at run time is reported with its line and makes the exit status non-zero.
+printf 'set max-depth banana\nquit\n' >badvalue.txt
+view --size 64x36 --script badvalue.txt
+rc=$?
+[ $rc -eq 1 ] || fail "bad value: exit $rc, expected 1"
+grep -q 'badvalue.txt:1:' err.txt || fail "bad value not reported with its line: $(cat err.txt)"
+
+if [ $failures -ne 0 ]; then echo "test_viewer: $failures failures"; exit 1; fi
+echo "test_viewer: all checks passed"

@@ -1,0 +1,107 @@
+// glint — the panel: Dear ImGui (Debian's libimgui 1.86) with its GLFW and OpenGL 3 backends.
+// Only this file sees C++; the viewer talks to it through ui.h.
+#include "ui.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <cstdint>
+#include <cstdio>
+
+extern "C" int ui_init(GLFWwindow *window) {
+    IMGUI_CHECKVERSION();
+    if (!ImGui::CreateContext()) return -1;
+    ImGui::GetIO().IniFilename = nullptr; // no imgui.ini littering the working directory
+    ImGui::StyleColorsDark();
+    if (!ImGui_ImplGlfw_InitForOpenGL(window, true)) return -1;
+    if (!ImGui_ImplOpenGL3_Init("#version 330 core")) return -1;
+    return 0;
+}
+
+extern "C" void ui_shutdown(void) {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+}
+
+extern "C" void ui_begin_frame(void) {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+}
+
+extern "C" void ui_draw_image(unsigned texture) {
+    if (!texture) return;
+    ImVec2 size = ImGui::GetIO().DisplaySize;
+    ImGui::GetBackgroundDrawList()->AddImage((ImTextureID)(intptr_t)texture, ImVec2(0, 0), size);
+}
+
+extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
+    if (!c->show_panel) return;
+    ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowBgAlpha(0.85f);
+    if (!ImGui::Begin("glint", nullptr)) {
+        ImGui::End();
+        return;
+    }
+    ImGui::TextUnformatted(s->scene_name ? s->scene_name : "");
+
+    if (ImGui::CollapsingHeader("Estimator", ImGuiTreeNodeFlags_DefaultOpen)) {
+        if (s->num_methods > 0) {
+            int m = c->method;
+            if (ImGui::Combo("method", &m, s->method_names, s->num_methods)) c->method = m;
+        }
+        ImGui::SliderInt("max depth", &c->max_depth, 1, 64);
+    }
+
+    if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::SliderFloat("exposure", &c->exposure, -8.0f, 8.0f, "%.1f stops");
+        static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights"};
+        ImGui::Combo("show", &c->show, shows, UI_SHOW_COUNT);
+    }
+
+    if (ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) {
+        char label[32];
+        std::snprintf(label, sizeof label, c->camera < 0 ? "free" : "scene camera %d", c->camera);
+        if (ImGui::BeginCombo("camera", label)) {
+            if (ImGui::Selectable("free", c->camera < 0)) c->camera = -1;
+            for (int i = 0; i < s->num_cameras; i++) {
+                std::snprintf(label, sizeof label, "scene camera %d", i);
+                if (ImGui::Selectable(label, c->camera == i)) c->camera = i;
+            }
+            ImGui::EndCombo();
+        }
+        if (ImGui::Button("reset view (R)")) c->reset_view = 1;
+    }
+
+    if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
+        if (ImGui::Button("screenshot (F12)")) c->screenshot = 1;
+        ImGui::SameLine();
+        if (ImGui::Button("export EXR (F11)")) c->export_exr = 1;
+        ImGui::InputText("path", c->path, sizeof c->path);
+        if (ImGui::Button("load scene")) c->load_scene = 1;
+        ImGui::SameLine();
+        if (ImGui::Button("load environment")) c->load_env = 1;
+        if (s->message && s->message[0]) ImGui::TextWrapped("%s", s->message);
+    }
+
+    if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::Text("%d x %d%s", s->width, s->height, s->previewing ? "  (preview while moving)" : "");
+        ImGui::Text("frames %lld   spp %.0f", s->frames, s->spp);
+        ImGui::Text("time %.1f s   frame %.0f ms", s->seconds, s->frame_ms);
+        ImGui::Text("%.2f M rays/s", s->rays_per_second * 1e-6);
+        if (s->rejected_samples) ImGui::Text("rejected samples %llu", s->rejected_samples);
+    }
+    ImGui::End();
+}
+
+extern "C" void ui_end_frame(void) {
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+extern "C" int ui_wants_mouse(void) { return ImGui::GetIO().WantCaptureMouse; }
+extern "C" int ui_wants_keyboard(void) { return ImGui::GetIO().WantCaptureKeyboard; }

@@ -1,0 +1,64 @@
+/* glint — the viewer's panel and display, Dear ImGui behind a C interface (ui.cpp is the only
+ * file that sees C++). The viewer owns the controls; the panel edits them in place and reports
+ * one-shot actions through flags the viewer clears. */
+#ifndef GLINT_UI_H
+#define GLINT_UI_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct GLFWwindow;
+
+/* Components the display can show (film components plus their sum). */
+enum { UI_SHOW_ALL = 0, UI_SHOW_DIRECT, UI_SHOW_INDIRECT, UI_SHOW_HIGHLIGHTS, UI_SHOW_COUNT };
+
+typedef struct {
+    /* estimator settings: a change resets the accumulation */
+    int method;        /* index into the method names given to ui_panel */
+    int max_depth;
+    int camera;        /* scene camera index, -1 for the free camera */
+    /* display settings: a change never resets */
+    float exposure;    /* stops */
+    int show;          /* UI_SHOW_* */
+    int show_panel;
+    /* one-shot actions, set by the panel, cleared by the viewer */
+    int screenshot, export_exr, reset_view, load_scene, load_env;
+    char path[1024];   /* the panel's path field for loading */
+} ui_controls;
+
+typedef struct {
+    const char *scene_name;
+    long long frames;          /* at full resolution since the last reset */
+    double spp;
+    double seconds;            /* since the last reset */
+    double frame_ms;           /* the last frame's render time */
+    double rays_per_second;
+    unsigned long long rejected_samples;
+    int width, height;         /* of the image shown */
+    int previewing;            /* a reduced-resolution frame is shown while things move */
+    int num_cameras;
+    const char *const *method_names;
+    int num_methods;
+    const char *message;       /* last export path or error, shown until replaced */
+} ui_stats;
+
+/* Sets up Dear ImGui for a window with a current OpenGL 3.3 context. Returns 0 or -1. */
+int ui_init(struct GLFWwindow *window);
+void ui_shutdown(void);
+void ui_begin_frame(void);
+/* The image fills the window (a textured quad behind the panel). texture 0 draws nothing. */
+void ui_draw_image(unsigned texture);
+void ui_panel(ui_controls *c, const ui_stats *s);
+void ui_end_frame(void);
+/* Whether the panel has the mouse or keyboard (the viewer then ignores them for the camera). */
+int ui_wants_mouse(void);
+int ui_wants_keyboard(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
