@@ -216,6 +216,37 @@ int scene_build_lights(scene *s, char *err, size_t errlen) {
 
 /* ---- sampling ------------------------------------------------------------------------------ */
 
+/* glTF spot cone: full inside the inner angle, a smooth (squared linear) ramp to the outer one.
+ * d is the direction from the light. */
+static float spot_falloff(const light *l, vec3 d) {
+    float t = clampf((dot3(d, l->direction) - l->cos_outer) / fmaxf(l->cos_inner - l->cos_outer, 1e-4f), 0.0f, 1.0f);
+    return t * t;
+}
+
+/* A uniform point on emissive triangle t: position, unit winding normal, twice the area, and a
+ * hit record (front side) for looking up its emission. */
+static surface_hit triangle_point(const scene *s, int t, vec2 u, vec3 *q, vec3 *n, float *area2) {
+    const uint32_t *v = &s->indices[3 * t];
+    vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
+    vec2 b = sample_uniform_triangle(u);
+    float b0 = 1.0f - b.x - b.y;
+    *q = add3(add3(scale3(p0, b0), scale3(p1, b.x)), scale3(p2, b.y));
+    vec3 c = cross3(sub3(p1, p0), sub3(p2, p0));
+    *area2 = length3(c);
+    *n = *area2 > 0.0f ? scale3(c, 1.0f / *area2) : v3(0, 0, 1);
+    surface_hit h;
+    memset(&h, 0, sizeof h);
+    h.tri = t;
+    h.material = s->tri_material[t];
+    h.p = *q;
+    h.ng = *n;
+    h.uv0 = v2(b0 * s->uv0[v[0]].x + b.x * s->uv0[v[1]].x + b.y * s->uv0[v[2]].x,
+               b0 * s->uv0[v[0]].y + b.x * s->uv0[v[1]].y + b.y * s->uv0[v[2]].y);
+    h.uv1 = v2(b0 * s->uv1[v[0]].x + b.x * s->uv1[v[1]].x + b.y * s->uv1[v[2]].x,
+               b0 * s->uv1[v[0]].y + b.x * s->uv1[v[1]].y + b.y * s->uv1[v[2]].y);
+    return h;
+}
+
 int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out) {
     if (s->num_lights == 0) return 0;
     float pmf;
@@ -235,13 +266,8 @@ int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sa
         out->dist = dist;
         out->p_light = l->position;
         out->n_light = neg3(out->wi);
-        float falloff = 1.0f;
-        if (l->type == LIGHT_SPOT) {
-            float cd = -dot3(out->wi, l->direction);
-            float t = clampf((cd - l->cos_outer) / fmaxf(l->cos_inner - l->cos_outer, 1e-4f), 0.0f, 1.0f);
-            falloff = t * t;
-            if (falloff <= 0.0f) return 0;
-        }
+        float falloff = l->type == LIGHT_SPOT ? spot_falloff(l, neg3(out->wi)) : 1.0f;
+        if (falloff <= 0.0f) return 0;
         out->radiance = scale3(l->color, falloff / d2);
         out->pdf = pmf;
         out->delta = 1;
@@ -257,29 +283,16 @@ int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sa
         out->delta = 1;
         return 1;
     case LIGHT_TRIANGLE: {
-        const uint32_t *v = &s->indices[3 * l->triangle];
-        vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
-        vec2 b = sample_uniform_triangle(u);
-        float b0 = 1.0f - b.x - b.y;
-        vec3 q = add3(add3(scale3(p0, b0), scale3(p1, b.x)), scale3(p2, b.y));
-        vec3 n = cross3(sub3(p1, p0), sub3(p2, p0));
-        float area2 = length3(n);
-        n = scale3(n, 1.0f / area2);
+        vec3 q, n;
+        float area2;
+        surface_hit h = triangle_point(s, l->triangle, u, &q, &n, &area2);
         vec3 d = sub3(q, p);
         float d2 = length_sq3(d);
         if (!(d2 > 0.0f)) return 0;
         float dist = sqrtf(d2);
         vec3 wi = scale3(d, 1.0f / dist);
         float cos_l = dot3(n, wi); /* > 0: we see the back (winding) side */
-        surface_hit h;
-        memset(&h, 0, sizeof h);
-        h.tri = l->triangle;
-        h.material = s->tri_material[l->triangle];
         h.backface = cos_l > 0.0f;
-        h.uv0 = v2(b0 * s->uv0[v[0]].x + b.x * s->uv0[v[1]].x + b.y * s->uv0[v[2]].x,
-                   b0 * s->uv0[v[0]].y + b.x * s->uv0[v[1]].y + b.y * s->uv0[v[2]].y);
-        h.uv1 = v2(b0 * s->uv1[v[0]].x + b.x * s->uv1[v[1]].x + b.y * s->uv1[v[2]].x,
-                   b0 * s->uv1[v[0]].y + b.x * s->uv1[v[1]].y + b.y * s->uv1[v[2]].y);
         vec3 le = material_emission(s, &h);
         float abs_cos = fabsf(cos_l);
         if (is_black3(le) || !(abs_cos > 0.0f)) return 0;
@@ -325,4 +338,87 @@ float light_pdf_env(const scene *s, vec3 d) {
     float st = sinf(PI_F * uv.y);
     if (!(st > 0.0f)) return 0.0f;
     return dist1d_pmf(&s->light_dist, s->env_light) * dist2d_pdf(&s->env->dist, uv) / (2.0f * PI_F * PI_F * st);
+}
+
+/* ---- emission (light tracing) -------------------------------------------------------------- */
+
+/* A point on the disk of the scene's bounding sphere facing direction d (the ray then travels
+ * along d): where directional and environment light enters the scene. Returns the disk area. */
+static float entry_disk_point(const scene *s, vec3 d, vec2 u, vec3 *o) {
+    float r = 0.5f * s->diag;
+    vec3 c = bounds_center(s->bounds);
+    frame3 f = frame_from_normal(d);
+    vec2 k = sample_concentric_disk(u);
+    *o = add3(madd3(c, d, -r), add3(scale3(f.t, k.x * r), scale3(f.b, k.y * r)));
+    return PI_F * r * r;
+}
+
+int light_sample_emission(const scene *s, float u_select, vec2 u_pos, vec2 u_dir, light_emission *out) {
+    if (s->num_lights == 0) return 0;
+    float pmf;
+    int li = dist1d_sample_discrete(&s->light_dist, u_select, &pmf, NULL);
+    if (!(pmf > 0.0f)) return 0;
+    const light *l = &s->lights[li];
+    memset(out, 0, sizeof *out);
+    switch (l->type) {
+    case LIGHT_POINT:
+        out->o = l->position;
+        out->d = sample_uniform_sphere(u_dir);
+        out->power = scale3(l->color, 4.0f * PI_F / pmf);
+        break;
+    case LIGHT_SPOT: {
+        /* Uniform in the outer cone; the falloff rides on the power. */
+        float omc = fmaxf(1.0f - l->cos_outer, 1e-7f);
+        frame3 f = frame_from_normal(l->direction);
+        out->o = l->position;
+        out->d = to_world(f, sample_uniform_cone(u_dir, omc));
+        out->power = scale3(l->color, spot_falloff(l, out->d) / (pdf_uniform_cone(omc) * pmf));
+        break;
+    }
+    case LIGHT_DIRECTIONAL: {
+        out->d = l->direction;
+        float area = entry_disk_point(s, l->direction, u_pos, &out->o);
+        out->power = scale3(l->color, area / pmf);
+        break;
+    }
+    case LIGHT_TRIANGLE: {
+        vec3 q, n;
+        float area2;
+        surface_hit h = triangle_point(s, l->triangle, u_pos, &q, &n, &area2);
+        /* A double-sided emitter picks a face with probability 1/2 (the u_dir.x bit reused). */
+        float sides = 1.0f;
+        if (s->materials[h.material].double_sided) {
+            sides = 2.0f;
+            if (u_dir.x < 0.5f) {
+                u_dir.x *= 2.0f;
+            } else {
+                u_dir.x = fminf(2.0f * u_dir.x - 1.0f, 0x1.fffffep-1f);
+                n = neg3(n);
+                h.backface = 1;
+            }
+        }
+        vec3 le = material_emission(s, &h);
+        if (is_black3(le) || !(area2 > 0.0f)) return 0;
+        /* Cosine-weighted: Le cos / (pdf_area pdf_dir) = Le pi area. */
+        out->o = q;
+        out->n = n;
+        out->on_surface = 1;
+        out->d = to_world(frame_from_normal(n), sample_cosine_hemisphere(u_dir));
+        out->power = scale3(le, PI_F * 0.5f * area2 * sides / pmf);
+        break;
+    }
+    case LIGHT_ENV: {
+        float pdf_uv;
+        vec2 uv = dist2d_sample(&s->env->dist, u_dir, &pdf_uv);
+        float st = sinf(PI_F * uv.y);
+        if (!(pdf_uv > 0.0f) || !(st > 0.0f)) return 0;
+        vec3 w = env_direction(s->env, uv); /* toward the environment */
+        float pdf_w = pdf_uv / (2.0f * PI_F * PI_F * st);
+        out->d = neg3(w);
+        float area = entry_disk_point(s, out->d, u_pos, &out->o);
+        out->power = scale3(env_lookup(s->env, uv), area / (pdf_w * pmf));
+        break;
+    }
+    }
+    return is_finite3(out->power) && !is_black3(out->power);
 }

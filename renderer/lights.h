@@ -23,6 +23,20 @@ typedef struct {
  * a spot cone, zero pdf). */
 int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out);
 
+/* A ray leaving a light, for light tracing (virtual lights). */
+typedef struct {
+    vec3 o, d;      /* origin and unit direction */
+    vec3 power;     /* flux carried by this one sample: emitted radiance x cos / (pdf of origin,
+                     * direction and light selection); the mean over samples is the total power */
+    vec3 n;         /* area lights: the emitting side's normal (the origin needs an offset) */
+    int on_surface; /* the origin lies on an emissive triangle */
+} light_emission;
+
+/* Picks a light by power (u_select) and samples an emitted ray from it: a point (u_pos) and a
+ * direction (u_dir). Directional and environment light enter through a disk of the scene's
+ * bounding-sphere radius. Returns 0 when the sample carries nothing. */
+int light_sample_emission(const scene *s, float u_select, vec2 u_pos, vec2 u_dir, light_emission *out);
+
 /* The pdf light_sample_direct would have given for reaching emissive triangle light `light` at
  * hit h from p: selection probability times area-to-solid-angle density. */
 float light_pdf_triangle(const scene *s, int light, vec3 p, const surface_hit *h);

@@ -8,8 +8,11 @@ static inline film_component component_of(int emitter_vertex) {
     return emitter_vertex <= 1 ? COMP_DIRECT : COMP_INDIRECT;
 }
 
-void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
-                 uint64_t rays[RAY_KIND_COUNT]) {
+/* The path tracer; *first (optional) receives the camera ray's hit, and the return value says
+ * whether there was one. */
+static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
+                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first) {
+    int hit_any = 0;
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     float prev_pdf = 0.0f; /* solid-angle pdf of the BSDF sample that produced the current ray */
@@ -24,6 +27,10 @@ void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, 
                 out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
             }
             break;
+        }
+        if (depth == 0) {
+            hit_any = 1;
+            if (first) *first = h;
         }
         vec3 le = material_emission(s, &h);
         if (!is_black3(le)) {
@@ -87,4 +94,18 @@ void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, 
             beta = scale3(beta, 1.0f / q);
         }
     }
+    return hit_any;
+}
+
+void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
+                 uint64_t rays[RAY_KIND_COUNT]) {
+    trace_path(s, max_depth, o, d, rng, out, rays, NULL);
+}
+
+int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
+              uint64_t rays[RAY_KIND_COUNT]) {
+    vec3 out[COMP_COUNT];
+    int hit = trace_path(s, 1, o, d, rng, out, rays, first);
+    *direct = out[COMP_DIRECT];
+    return hit;
 }

@@ -15,4 +15,10 @@
 void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
                  uint64_t rays[RAY_KIND_COUNT]);
 
+/* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
+ * max depth 1, so every method shares one direct estimator), and that hit in *first. Returns 1
+ * when the ray hit a surface. */
+int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
+              uint64_t rays[RAY_KIND_COUNT]);
+
 #endif
