@@ -5,11 +5,12 @@
 #include <string.h>
 
 #include "camera.h"
+#include "manylight.h"
 #include "pt.h"
 #include "rng.h"
 #include "threadpool.h"
 
-static const char *const method_names[METHOD_COUNT] = {"pt"};
+static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl"};
 const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
 
 const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? method_names[m] : "?"; }
@@ -38,6 +39,8 @@ struct render_session {
     worker_stats *workers;
     render_stats totals;
     int tiles_x, tiles_y;
+    manylight ml; /* vpl, vsl: this frame's virtual lights */
+    char error[256];
 };
 
 render_session *session_create(const scene *s, const camera *cam, const render_params *params, char *err,
@@ -72,6 +75,7 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
 void session_destroy(render_session *rs) {
     if (!rs) return;
     threadpool_destroy(rs->pool);
+    manylight_deinit(&rs->ml);
     free(rs->workers);
     film_deinit(&rs->film);
     free(rs);
@@ -94,7 +98,17 @@ static void render_tile(void *ctx, int tile, int worker) {
             vec3 d = camera_ray_dir(&rs->cam, aspect, ((float)x + j.x) / (float)p->width,
                                     ((float)y + j.y) / (float)p->height);
             vec3 L[COMP_COUNT];
-            pt_radiance(s, p->max_depth, rs->cam.position, d, &rng, L, st->rays);
+            if (p->method == METHOD_PT) {
+                pt_radiance(s, p->max_depth, rs->cam.position, d, &rng, L, st->rays);
+            } else {
+                /* Many lights: the shared direct estimator, then the virtual lights at the hit. */
+                surface_hit h;
+                for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
+                if (pt_direct(s, rs->cam.position, d, &rng, &L[COMP_DIRECT], &h, st->rays) && p->max_depth > 1) {
+                    shading_point sp = shading_point_at(s, &h, d);
+                    L[COMP_INDIRECT] = manylight_shade(&rs->ml, s, &sp, &rng, st);
+                }
+            }
             float sample[COMP_COUNT][3];
             int finite = 1;
             for (int c = 0; c < COMP_COUNT; c++) {
@@ -111,17 +125,28 @@ static void render_tile(void *ctx, int tile, int worker) {
     }
 }
 
-void session_render_frame(render_session *rs) {
+int session_render_frame(render_session *rs) {
+    if (rs->params.method != METHOD_PT &&
+        manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, rs->frames, rs->pool, &rs->totals, rs->error,
+                              sizeof rs->error) != 0)
+        return -1;
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
     rs->frames++;
     int n = threadpool_size(rs->pool);
     for (int w = 0; w < n; w++) {
         render_stats *st = &rs->workers[w].st;
-        for (int k = 0; k < RAY_KIND_COUNT; k++) rs->totals.rays[k] += st->rays[k];
-        rs->totals.rejected_samples += st->rejected_samples;
+        render_stats *t = &rs->totals;
+        for (int k = 0; k < RAY_KIND_COUNT; k++) t->rays[k] += st->rays[k];
+        t->rejected_samples += st->rejected_samples;
+        t->vl_connections += st->vl_connections;
+        t->vsl_samples += st->vsl_samples;
+        t->clamped += st->clamped;
         memset(st, 0, sizeof *st);
     }
+    return 0;
 }
+
+const char *session_error(const render_session *rs) { return rs->error; }
 
 void session_reset(render_session *rs) {
     film_clear(&rs->film);

@@ -12,14 +12,41 @@
 
 typedef enum {
     METHOD_PT = 0, /* unbiased path tracing: the reference */
+    METHOD_VPL,    /* virtual point lights (instant radiosity), clamped */
+    METHOD_VSL,    /* virtual spherical lights */
     METHOD_COUNT
 } render_method;
 
-/* "pt", ...; method_from_name returns -1 for an unknown name. */
+/* "pt", "vpl", "vsl"; method_from_name returns -1 for an unknown name. */
 const char *method_name(render_method m);
 int method_from_name(const char *name);
 
 #define DEFAULT_MAX_DEPTH 16
+
+/* The many-light methods (vpl, vsl). Zero means default for every field but the switches. */
+typedef struct {
+    int count;           /* virtual lights per frame [VL_DEFAULT_COUNT] */
+    int clamp;           /* VL_CLAMP_*: clamp each light's contribution [on for vpl, off for vsl] */
+    float clamp_value;   /* the bound on one light's contribution [VL_DEFAULT_CLAMP] */
+    float clamp_growth;  /* > 0: the bound grows as c * frame^growth (consistent VPLs) */
+    int vpl_glossy;      /* vpl: the light's full BSDF instead of its diffuse lobe */
+    float radius_mult;   /* vsl: radius = mult x distance to the 10th nearest light [VL_DEFAULT_RADIUS_MULT] */
+    float radius_shrink; /* vsl, in (0,1): mult shrinks as r_{i+1} = r_i sqrt((i + a) / (i + 1)) */
+    int rows, columns;   /* matrix row-column sampling; columns 0: no clustering [rows 300] */
+    int per_pixel;       /* lights (or cluster representatives) sampled per pixel per frame, by
+                          * power (or cluster norm); -1: every one; 0: the default, which is
+                          * VL_DEFAULT_PER_PIXEL without clustering and every representative with */
+    int highlights;      /* the highlight estimator owns glossy-glossy first-bounce paths */
+} vl_params;
+
+enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
+#define VL_DEFAULT_COUNT 1024
+#define VL_DEFAULT_CLAMP 1.0f
+/* The paper's multipliers (4-12) go with 10^5 lights in one set; radii scale as mult/sqrt(count),
+ * so with ~10^3 fresh lights a frame a multiplier of 1 gives the same radii as 8 at 6.4 10^4. */
+#define VL_DEFAULT_RADIUS_MULT 1.0f
+#define VL_DEFAULT_ROWS 300
+#define VL_DEFAULT_PER_PIXEL 4
 
 /* Zero means default for every field. */
 typedef struct {
@@ -28,6 +55,7 @@ typedef struct {
     int max_depth;        /* scattering events per path; 0: DEFAULT_MAX_DEPTH; 1 is direct light only */
     uint64_t seed;
     int threads;          /* 0: one per core */
+    vl_params vl;
 } render_params;
 
 /* Work done, by kind of ray; summed over the session's frames. */
@@ -37,6 +65,11 @@ extern const char *const ray_kind_names[RAY_KIND_COUNT];
 typedef struct {
     uint64_t rays[RAY_KIND_COUNT];
     uint64_t rejected_samples; /* samples dropped because they were NaN or Inf */
+    uint64_t virtual_lights;   /* deposited, summed over frames (the effective light count) */
+    uint64_t light_paths;      /* traced to deposit them */
+    uint64_t vl_connections;   /* shading point - virtual light evaluations */
+    uint64_t vsl_samples;      /* integration samples of the VSL integrals */
+    uint64_t clamped;          /* contributions the clamp cut down */
 } render_stats;
 
 typedef struct render_session render_session;
@@ -47,8 +80,10 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
                                size_t errlen);
 void session_destroy(render_session *rs);
 
-/* Renders one frame (all threads; returns when done). */
-void session_render_frame(render_session *rs);
+/* Renders one frame (all threads; returns when done). Returns 0, or -1 with the reason in
+ * session_error() when a frame could not be prepared (out of memory); the film is unchanged. */
+int session_render_frame(render_session *rs);
+const char *session_error(const render_session *rs);
 /* Clears the accumulation (the next frame starts a new mean). */
 void session_reset(render_session *rs);
 void session_set_camera(render_session *rs, const camera *cam);

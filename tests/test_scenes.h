@@ -69,23 +69,33 @@ static inline void ts_finalize(scene *s) {
     }
 }
 
-/* Renders spp frames; returns the per-pixel mean image of the components in mask (caller frees). */
-static inline float *ts_render(const scene *s, const camera *cam, int w, int h, int spp, int max_depth, uint64_t seed,
-                               unsigned mask) {
-    render_params p = {.width = w, .height = h, .max_depth = max_depth, .seed = seed};
+/* Renders spp frames with the given parameters; returns the per-pixel mean image of the
+ * components in mask (caller frees). */
+static inline float *ts_render_with(const scene *s, const camera *cam, const render_params *p, int spp, unsigned mask) {
     char err[256];
-    render_session *rs = session_create(s, cam, &p, err, sizeof err);
+    render_session *rs = session_create(s, cam, p, err, sizeof err);
     if (!rs) {
         fprintf(stderr, "ts_render: %s\n", err);
         abort();
     }
-    for (int i = 0; i < spp; i++) session_render_frame(rs);
-    float *img = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
+    for (int i = 0; i < spp; i++)
+        if (session_render_frame(rs) != 0) {
+            fprintf(stderr, "ts_render: %s\n", session_error(rs));
+            abort();
+        }
+    float *img = malloc(sizeof(float) * 3 * (size_t)p->width * (size_t)p->height);
     film_resolve(session_film(rs), mask, img);
     render_stats st = session_stats(rs);
     if (st.rejected_samples) fprintf(stderr, "ts_render: %llu rejected samples\n", (unsigned long long)st.rejected_samples);
     session_destroy(rs);
     return img;
+}
+
+/* Path-traced: spp frames of w x h at max_depth. */
+static inline float *ts_render(const scene *s, const camera *cam, int w, int h, int spp, int max_depth, uint64_t seed,
+                               unsigned mask) {
+    render_params p = {.width = w, .height = h, .max_depth = max_depth, .seed = seed};
+    return ts_render_with(s, cam, &p, spp, mask);
 }
 
 /* Mean and standard error of the mean over pixels of channel-averaged values. */

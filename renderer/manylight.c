@@ -1,0 +1,220 @@
+#include "manylight.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mrcs.h"
+#include "pt.h"
+
+void manylight_deinit(manylight *m) {
+    vlight_set_free(&m->set);
+    free(m->entries);
+    dist1d_deinit(&m->pick);
+    memset(m, 0, sizeof *m);
+}
+
+float vsl_radius_mult_at(float mult, float shrink, long long i) {
+    if (!(shrink > 0.0f)) return mult;
+    double r = mult;
+    for (long long k = 1; k < i; k++) r *= sqrt(((double)k + (double)shrink) / ((double)k + 1.0));
+    return (float)r;
+}
+
+float vpl_clamp_at(float c, float growth, long long i) {
+    return growth > 0.0f && i > 1 ? c * powf((float)i, growth) : c;
+}
+
+shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir) {
+    shading_point x;
+    x.p = h->p;
+    x.ng = h->ng;
+    x.b = material_bsdf(s, h, &x.frame);
+    x.wo = to_local(x.frame, neg3(ray_dir));
+    return x;
+}
+
+/* One light's contribution to x: kernel, then visibility (only when there is something to
+ * block), then the clamp. */
+static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *vl, const shading_point *x,
+                      rng_state *rng, render_stats *st) {
+    st->vl_connections++;
+    vec3 c;
+    if (m->kernel == VL_KERNEL_VSL) {
+        int n = 0;
+        c = vsl_contribution(vl, x, m->terms, rng, &n);
+        st->vsl_samples += (uint64_t)n;
+    } else {
+        c = vpl_contribution(vl, x, m->kernel == VL_KERNEL_VPL_GLOSSY, m->terms);
+    }
+    if (is_black3(c) || !is_finite3(c)) return v3(0, 0, 0);
+    vec3 dir = sub3(vl->p, x->p);
+    vec3 org = offset_origin(s, x->p, x->ng, dir);
+    vec3 target = offset_origin(s, vl->p, vl->ng, neg3(dir));
+    vec3 span = sub3(target, org);
+    float dist = length3(span);
+    st->rays[RAY_SHADOW]++;
+    /* Points closer than the offsets see each other (a VSL enclosing x). */
+    if (dist > 0.0f && dot3(span, dir) > 0.0f && scene_occluded(s, org, scale3(span, 1.0f / dist), dist))
+        return v3(0, 0, 0);
+    if (m->clamp) {
+        float peak = max_comp3(c);
+        if (peak > m->clamp_bound) {
+            c = scale3(c, m->clamp_bound / peak);
+            st->clamped++;
+        }
+    }
+    return c;
+}
+
+vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, rng_state *rng, render_stats *st) {
+    vec3 sum = v3(0, 0, 0);
+    if (m->num_entries == 0 || !bsdf_lobes(&x->b)) return sum;
+    if (m->per_pixel == 0) {
+        for (int e = 0; e < m->num_entries; e++) {
+            vec3 c = shade_one(m, s, &m->set.v[m->entries[e].light], x, rng, st);
+            sum = madd3(sum, c, m->entries[e].scale);
+        }
+        return sum;
+    }
+    for (int k = 0; k < m->per_pixel; k++) {
+        float pmf;
+        int e = dist1d_sample_discrete(&m->pick, rng_float(rng), &pmf, NULL);
+        if (!(pmf > 0.0f)) continue;
+        vec3 c = shade_one(m, s, &m->set.v[m->entries[e].light], x, rng, st);
+        sum = madd3(sum, c, m->entries[e].scale / pmf);
+    }
+    return scale3(sum, 1.0f / (float)m->per_pixel);
+}
+
+/* ---- matrix row-column sampling -------------------------------------------------------------- */
+
+typedef struct {
+    manylight *m;
+    const scene *s;
+    const camera *cam;
+    const render_params *p;
+    long long frame;
+    int rows;
+    float *matrix;        /* rows x lights, luminance */
+    render_stats *row_stats; /* one per row, summed afterwards */
+} row_job;
+
+/* Row r: a random pixel in the r-th slice of the image, its camera hit, every light's clamped
+ * contribution (with visibility) as luminance. */
+static void compute_row(void *ctx, int r, int worker) {
+    (void)worker;
+    row_job *job = ctx;
+    const render_params *p = job->p;
+    int n = job->m->set.count;
+    float *row = job->matrix + (size_t)r * (size_t)n;
+    memset(row, 0, sizeof(float) * (size_t)n);
+    render_stats *st = &job->row_stats[r];
+    long long pixels = (long long)p->width * p->height;
+    rng_state rng = rng_for(0x726f7773ULL + (uint64_t)r, (uint64_t)job->frame, p->seed);
+    long long lo = pixels * r / job->rows, hi = pixels * (r + 1) / job->rows;
+    long long pixel = lo + (long long)(rng_double(&rng) * (double)(hi - lo));
+    if (pixel >= hi) pixel = hi - 1;
+    float x = ((float)(pixel % p->width) + rng_float(&rng)) / (float)p->width;
+    float y = ((float)(pixel / p->width) + rng_float(&rng)) / (float)p->height;
+    vec3 d = camera_ray_dir(job->cam, (float)p->width / (float)p->height, x, y);
+    surface_hit h;
+    st->rays[RAY_CAMERA]++;
+    if (!scene_intersect(job->s, job->cam->position, d, INFINITY, &h)) return;
+    shading_point sp = shading_point_at(job->s, &h, d);
+    if (!bsdf_lobes(&sp.b)) return;
+    for (int j = 0; j < n; j++) row[j] = luminance3(shade_one(job->m, job->s, &job->m->set.v[j], &sp, &rng, st));
+}
+
+static void add_stats(render_stats *to, const render_stats *from) {
+    for (int k = 0; k < RAY_KIND_COUNT; k++) to->rays[k] += from->rays[k];
+    to->vl_connections += from->vl_connections;
+    to->vsl_samples += from->vsl_samples;
+    to->clamped += from->clamped;
+}
+
+static int reserve_entries(manylight *m, int n) {
+    if (n <= m->cap_entries) return 0;
+    ml_entry *e = realloc(m->entries, sizeof(ml_entry) * (size_t)n);
+    if (!e) return -1;
+    m->entries = e;
+    m->cap_entries = n;
+    return 0;
+}
+
+static int cluster_lights(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
+                          threadpool *pool, render_stats *st) {
+    int n = m->set.count, rows = p->vl.rows > 0 ? p->vl.rows : VL_DEFAULT_ROWS;
+    float *matrix = malloc(sizeof(float) * (size_t)rows * (size_t)n);
+    render_stats *row_stats = calloc((size_t)rows, sizeof(render_stats));
+    mrcs_cluster *clusters = malloc(sizeof(mrcs_cluster) * (size_t)p->vl.columns);
+    int status = -1;
+    if (matrix && row_stats && clusters && reserve_entries(m, p->vl.columns) == 0) {
+        row_job job = {m, s, cam, p, frame, rows, matrix, row_stats};
+        threadpool_run(pool, compute_row, &job, rows);
+        for (int r = 0; r < rows; r++) add_stats(st, &row_stats[r]);
+        rng_state rng = rng_for(0x636c7573ULL, (uint64_t)frame, p->seed);
+        int k = mrcs_cluster_columns(matrix, rows, n, p->vl.columns, &rng, clusters);
+        if (k >= 0) {
+            float *weights = malloc(sizeof(float) * (size_t)(k > 0 ? k : 1));
+            if (weights) {
+                for (int c = 0; c < k; c++) {
+                    m->entries[c] = (ml_entry){clusters[c].representative, clusters[c].scale};
+                    weights[c] = clusters[c].weight;
+                }
+                m->num_entries = k;
+                dist1d_deinit(&m->pick);
+                status = k == 0 || m->per_pixel == 0 ? 0 : dist1d_init(&m->pick, weights, k);
+                free(weights);
+            }
+        }
+    }
+    free(matrix);
+    free(row_stats);
+    free(clusters);
+    return status;
+}
+
+int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
+                          threadpool *pool, render_stats *st, char *err, size_t errlen) {
+    const vl_params *vp = &p->vl;
+    long long i = frame + 1;
+    m->kernel = p->method == METHOD_VSL ? VL_KERNEL_VSL : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
+    m->terms = vp->highlights ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
+    m->clamp = vp->clamp == VL_CLAMP_ON || (vp->clamp == VL_CLAMP_DEFAULT && p->method == METHOD_VPL);
+    m->clamp_bound = vpl_clamp_at(vp->clamp_value > 0.0f ? vp->clamp_value : VL_DEFAULT_CLAMP, vp->clamp_growth, i);
+    m->radius_mult = vsl_radius_mult_at(vp->radius_mult > 0.0f ? vp->radius_mult : VL_DEFAULT_RADIUS_MULT,
+                                        vp->radius_shrink, i);
+    m->num_entries = 0;
+    m->clustered = 0;
+    int count = vp->count > 0 ? vp->count : VL_DEFAULT_COUNT;
+    if (vlights_trace(s, count, p->max_depth, p->seed, (uint64_t)frame, &m->set, &st->rays[RAY_BOUNCE]) != 0)
+        return snprintf(err, errlen, "out of memory for %d virtual lights", count), -1;
+    st->virtual_lights += (uint64_t)m->set.count;
+    st->light_paths += (uint64_t)m->set.paths;
+    if (m->set.count == 0) return 0;
+    if (m->kernel == VL_KERNEL_VSL && vlights_set_radii(&m->set, m->radius_mult, s->diag) != 0)
+        return snprintf(err, errlen, "out of memory for the lights' radii"), -1;
+
+    int clustering = vp->columns > 0 && vp->columns < m->set.count;
+    m->per_pixel = vp->per_pixel > 0 ? vp->per_pixel : (clustering || vp->per_pixel < 0 ? 0 : VL_DEFAULT_PER_PIXEL);
+    if (clustering) {
+        if (cluster_lights(m, s, cam, p, frame, pool, st) != 0) return snprintf(err, errlen, "out of memory for the light clusters"), -1;
+        m->clustered = 1;
+        return 0;
+    }
+    /* Every light its own entry; pixels that sample pick lights by power. */
+    if (reserve_entries(m, m->set.count) != 0) return snprintf(err, errlen, "out of memory"), -1;
+    m->num_entries = m->set.count;
+    for (int j = 0; j < m->set.count; j++) m->entries[j] = (ml_entry){j, 1.0f};
+    dist1d_deinit(&m->pick);
+    if (m->per_pixel > 0) {
+        float *power = malloc(sizeof(float) * (size_t)m->set.count);
+        if (!power) return snprintf(err, errlen, "out of memory"), -1;
+        for (int j = 0; j < m->set.count; j++) power[j] = luminance3(m->set.v[j].power);
+        int status = dist1d_init(&m->pick, power, m->set.count);
+        free(power);
+        if (status != 0) return snprintf(err, errlen, "out of memory"), -1;
+    }
+    return 0;
+}

@@ -1,0 +1,52 @@
+/* glint — the many-light methods' frame: trace a fresh set of virtual lights, give VSLs their
+ * radii, optionally cluster the lights by matrix row-column sampling, then shade pixels from
+ * them. The session calls manylight_begin_frame once per frame and manylight_shade per pixel. */
+#ifndef GLINT_MANYLIGHT_H
+#define GLINT_MANYLIGHT_H
+
+#include "camera.h"
+#include "session.h"
+#include "threadpool.h"
+#include "vsl.h"
+
+/* One light the pixels shade from: a virtual light (a cluster's representative) and the factor
+ * its contribution is scaled by (cluster norm / representative norm; 1 without clustering). */
+typedef struct {
+    int light;
+    float scale;
+} ml_entry;
+
+typedef struct {
+    vl_kernel kernel;
+    vl_terms terms;
+    int clamp;          /* on for this method? */
+    float clamp_bound;  /* this frame's bound */
+    float radius_mult;  /* this frame's multiplier */
+    int per_pixel;      /* 0: every entry */
+    vlight_set set;
+    ml_entry *entries;
+    int num_entries, cap_entries;
+    dist1d pick;        /* per-pixel choice of entries: by cluster norm, or by light power */
+    int clustered;      /* entries came from matrix row-column sampling this frame */
+} manylight;
+
+void manylight_deinit(manylight *m);
+
+/* Prepares frame `frame` (0 = first of the running mean) of method p->method. Uses the pool for
+ * the sampled rows of the reduced matrix. Returns 0, or -1 with err set (out of memory). */
+int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
+                          threadpool *pool, render_stats *st, char *err, size_t errlen);
+
+/* Indirect light at x from this frame's virtual lights (visibility, clamping, scaling included). */
+vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, rng_state *rng, render_stats *st);
+
+/* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
+shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);
+
+/* The schedules that make the progressive estimates consistent (DESIGN.md): the VSL radius
+ * multiplier at frame index i >= 1, mult * prod_{k<i} sqrt((k + a) / (k + 1)), and the clamp
+ * bound c i^growth. a <= 0 or growth <= 0 leave them constant. */
+float vsl_radius_mult_at(float mult, float shrink, long long i);
+float vpl_clamp_at(float c, float growth, long long i);
+
+#endif

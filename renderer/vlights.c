@@ -1,0 +1,97 @@
+#include "vlights.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "knn.h"
+#include "lights.h"
+
+void vlight_set_free(vlight_set *set) {
+    free(set->v);
+    memset(set, 0, sizeof *set);
+}
+
+static int push(vlight_set *set, const virtual_light *vl) {
+    if (set->count == set->cap) {
+        int cap = set->cap ? 2 * set->cap : 1024;
+        virtual_light *v = realloc(set->v, sizeof(virtual_light) * (size_t)cap);
+        if (!v) return -1;
+        set->v = v;
+        set->cap = cap;
+    }
+    set->v[set->count++] = *vl;
+    return 0;
+}
+
+int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint64_t frame, vlight_set *set,
+                  uint64_t *bounce_rays) {
+    set->count = 0;
+    set->paths = 0;
+    if (s->num_lights == 0 || target <= 0 || max_depth < 2) return 0;
+    /* One stream for the whole frame: the set is the same whatever the thread count. */
+    rng_state rng = rng_for(0x766c69676874ULL, frame, seed);
+    /* Stop when enough lights are in, but finish the path being traced. A cap on paths keeps a
+     * scene whose light escapes (an open sky) from looping for ever. */
+    long long max_paths = 64LL * target + 1024;
+    while (set->count < target && set->paths < max_paths) {
+        set->paths++;
+        light_emission e;
+        float u_sel = rng_float(&rng);
+        vec2 u_pos = rng_vec2(&rng), u_dir = rng_vec2(&rng);
+        if (!light_sample_emission(s, u_sel, u_pos, u_dir, &e)) continue;
+        vec3 beta = e.power;
+        vec3 o = e.on_surface ? offset_origin(s, e.o, e.n, e.d) : e.o;
+        vec3 d = e.d;
+        for (int depth = 1; depth < max_depth; depth++) {
+            surface_hit h;
+            (*bounce_rays)++;
+            if (!scene_intersect(s, o, d, INFINITY, &h)) break;
+            virtual_light vl;
+            memset(&vl, 0, sizeof vl);
+            vl.b = material_bsdf(s, &h, &vl.frame);
+            if (!bsdf_lobes(&vl.b)) break; /* black: absorbs everything */
+            vl.p = h.p;
+            vl.ng = h.ng;
+            vl.wi = to_local(vl.frame, neg3(d));
+            vl.power = beta;
+            vl.depth = depth;
+            if (vl.wi.z > 0.0f && push(set, &vl) != 0) return -1;
+            if (depth + 1 >= max_depth) break;
+
+            bsdf_sample_result bs;
+            float u_lobe = rng_float(&rng);
+            vec2 u = rng_vec2(&rng);
+            if (!bsdf_sample(&vl.b, vl.wi, BSDF_ALL, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) break;
+            vec3 wi = to_world(vl.frame, bs.wi);
+            if (dot3(wi, h.ng) <= 0.0f) break;
+            vec3 gain = scale3(bs.f, bs.wi.z / bs.pdf);
+            /* Russian roulette by the bounce's gain, after a couple of bounces. */
+            if (depth >= 2) {
+                float q = fminf(0.95f, max_comp3(gain));
+                if (!(rng_float(&rng) < q)) break;
+                gain = scale3(gain, 1.0f / q);
+            }
+            beta = mul3(beta, gain);
+            if (is_black3(beta) || !is_finite3(beta)) break;
+            o = offset_origin(s, h.p, h.ng, wi);
+            d = wi;
+        }
+    }
+    float inv = set->paths > 0 ? 1.0f / (float)set->paths : 0.0f;
+    for (int i = 0; i < set->count; i++) set->v[i].power = scale3(set->v[i].power, inv);
+    return 0;
+}
+
+int vlights_set_radii(vlight_set *set, float mult, float scene_diag) {
+    if (set->count == 0) return 0;
+    float *dist = malloc(sizeof(float) * (size_t)set->count);
+    if (!dist) return -1;
+    if (knn_distances(&set->v[0].p, sizeof(virtual_light), set->count, VSL_NEIGHBOURS, dist) != 0) {
+        free(dist);
+        return -1;
+    }
+    float floor_r = 1e-5f * scene_diag;
+    for (int i = 0; i < set->count; i++) set->v[i].radius = fmaxf(mult * dist[i], floor_r);
+    free(dist);
+    return 0;
+}
