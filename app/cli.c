@@ -115,3 +115,91 @@ int cli_check_output_dir(const char *option, const char *path) {
     }
     return 0;
 }
+
+/* ---- many-light parameters ------------------------------------------------------------------- */
+
+const char *cli_vl_help(void) {
+    static char text[2048];
+    snprintf(text, sizeof text,
+             "many-light methods (vpl, vsl):\n"
+             "  --vsl-count N        virtual lights traced per frame [%d]\n"
+             "  --clamp on|off       clamp each light's contribution [on for vpl, off for vsl]\n"
+             "  --clamp-value C      the clamp bound, in radiance [%g]\n"
+             "  --clamp-growth A     the bound grows as C * frame^A, so clamped VPLs converge [off]\n"
+             "  --vpl-glossy         VPLs reflect with their full BSDF, not only its diffuse part\n"
+             "  --radius-mult M      VSL radius: M x distance to the 10th nearest light [%g]\n"
+             "  --radius-shrink A    0 < A < 1: M shrinks over frames (progressive photon mapping's\n"
+             "                       schedule), so VSLs converge to the path-traced answer [off]\n"
+             "  --rows R             matrix row-column sampling: sampled rows (pixels) [%d]\n"
+             "  --columns C          ... and clusters; 0 = no clustering [0]\n"
+             "  --per-pixel N|all    lights (cluster representatives) each pixel shades per frame,\n"
+             "                       picked by power (cluster norm) [%d; all with --columns]\n",
+             VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_RADIUS_MULT, VL_DEFAULT_ROWS,
+             VL_DEFAULT_PER_PIXEL);
+    return text;
+}
+
+static int on_off(const char *option, const char *value, int *out) {
+    if (strcmp(value, "on") == 0) *out = 1;
+    else if (strcmp(value, "off") == 0) *out = 0;
+    else return cli_error("%s: expected on or off, got '%s'", option, value), -1;
+    return 0;
+}
+
+int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
+    char option[64];
+    snprintf(option, sizeof option, "--%s", name);
+    long long n;
+    double x;
+    int b;
+    if (strcmp(name, "vsl-count") == 0) {
+        if (cli_parse_int(option, value, 1, 50000000, &n)) return -1;
+        vl->count = (int)n;
+    } else if (strcmp(name, "clamp") == 0) {
+        if (on_off(option, value, &b)) return -1;
+        vl->clamp = b ? VL_CLAMP_ON : VL_CLAMP_OFF;
+    } else if (strcmp(name, "clamp-value") == 0) {
+        if (cli_parse_float(option, value, 1e-12, 1e30, &x)) return -1;
+        vl->clamp_value = (float)x;
+    } else if (strcmp(name, "clamp-growth") == 0) {
+        if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
+        vl->clamp_growth = (float)x;
+    } else if (strcmp(name, "vpl-glossy") == 0) {
+        if (on_off(option, value, &b)) return -1;
+        vl->vpl_glossy = b;
+    } else if (strcmp(name, "radius-mult") == 0) {
+        if (cli_parse_float(option, value, 1e-6, 1e6, &x)) return -1;
+        vl->radius_mult = (float)x;
+    } else if (strcmp(name, "radius-shrink") == 0) {
+        if (cli_parse_float(option, value, 0.0, 1.0, &x)) return -1;
+        if (x >= 1.0) return cli_error("%s: must be below 1 (0 turns it off), got '%s'", option, value), -1;
+        vl->radius_shrink = (float)x;
+    } else if (strcmp(name, "rows") == 0) {
+        if (cli_parse_int(option, value, 1, 100000, &n)) return -1;
+        vl->rows = (int)n;
+    } else if (strcmp(name, "columns") == 0) {
+        if (cli_parse_int(option, value, 0, 10000000, &n)) return -1;
+        vl->columns = (int)n;
+    } else if (strcmp(name, "per-pixel") == 0) {
+        if (strcmp(value, "all") == 0) vl->per_pixel = -1;
+        else if (cli_parse_int(option, value, 1, 1000000, &n)) return -1;
+        else vl->per_pixel = (int)n;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+int cli_vl_option(int argc, char **argv, int *i, vl_params *vl) {
+    const char *a = argv[*i];
+    if (strncmp(a, "--", 2) != 0) return 0;
+    if (strcmp(a, "--vpl-glossy") == 0) return cli_set_vl_param("vpl-glossy", "on", vl);
+    static const char *const names[] = {"vsl-count", "clamp", "clamp-value", "clamp-growth", "radius-mult",
+                                         "radius-shrink", "rows", "columns", "per-pixel"};
+    int ours = 0;
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) ours |= strcmp(a + 2, names[k]) == 0;
+    if (!ours) return 0;
+    const char *v = cli_value(argc, argv, i);
+    if (!v) return -1;
+    return cli_set_vl_param(a + 2, v, vl);
+}

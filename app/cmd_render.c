@@ -35,7 +35,8 @@ static void print_render_help(void) {
            "pixel per frame, and writes the running mean.\n"
            "\n"
            "options (default in brackets):\n"
-           "  --method NAME        estimator: pt [pt]\n"
+           "  --method NAME        estimator: pt (path tracing, the reference), vpl (clamped virtual\n"
+           "                       point lights), vsl (virtual spherical lights) [pt]\n"
            "  --spp N              samples per pixel (frames) [%d]\n"
            "  --time SECONDS       render until this much time has passed instead of --spp\n"
            "  --size WxH           image size [960x540]\n"
@@ -52,9 +53,11 @@ static void print_render_help(void) {
            "  --quiet              no progress line\n"
            "  --help               this text\n"
            "\n"
+           "%s"
+           "\n"
            "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
            "new file render.png (render-1.png, ... if taken).\n",
-           DEFAULT_SPP, DEFAULT_MAX_DEPTH);
+           DEFAULT_SPP, DEFAULT_MAX_DEPTH, cli_vl_help());
 }
 
 /* Returns 0 to render, 1 when --help was shown, -1 on a usage error (already reported). */
@@ -67,6 +70,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         const char *a = argv[i];
         const char *v = NULL;
         long long n;
+        int vl;
 #define VALUE() \
     if (!(v = cli_value(argc, argv, &i))) return -1
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -77,7 +81,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         } else if (strcmp(a, "--method") == 0) {
             VALUE();
             int m = method_from_name(v);
-            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt)", v), -1;
+            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl)", v), -1;
             o->params.method = (render_method)m;
         } else if (strcmp(a, "--spp") == 0) {
             VALUE();
@@ -122,6 +126,8 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         } else if (strcmp(a, "--exposure") == 0) {
             VALUE();
             if (cli_parse_float(a, v, -50.0, 50.0, &o->exposure)) return -1;
+        } else if ((vl = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
+            if (vl < 0) return -1;
         } else if (a[0] == '-' && a[1] != '\0') {
             cli_error("unknown option '%s' (see glint render --help)", a);
             return -1;
@@ -200,7 +206,18 @@ static int write_stats(const char *path, const render_options *o, const render_s
         fprintf(f, "\"%s\": %llu, ", ray_kind_names[k], (unsigned long long)st.rays[k]);
     fprintf(f, "\"total\": %llu},\n", (unsigned long long)total);
     fprintf(f, "  \"rays_per_second\": %.1f,\n", seconds > 0 ? (double)total / seconds : 0.0);
-    fprintf(f, "  \"rejected_samples\": %llu\n}\n", (unsigned long long)st.rejected_samples);
+    fprintf(f, "  \"rejected_samples\": %llu", (unsigned long long)st.rejected_samples);
+    if (p->method != METHOD_PT) {
+        const vl_params *vp = &p->vl;
+        fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"virtual_lights_total\": %llu,\n",
+                vp->count > 0 ? vp->count : VL_DEFAULT_COUNT, (unsigned long long)st.virtual_lights);
+        fprintf(f, "  \"light_paths_total\": %llu,\n  \"connections\": %llu,\n  \"vsl_samples\": %llu,\n",
+                (unsigned long long)st.light_paths, (unsigned long long)st.vl_connections,
+                (unsigned long long)st.vsl_samples);
+        fprintf(f, "  \"clamped\": %llu,\n  \"rows\": %d,\n  \"columns\": %d", (unsigned long long)st.clamped,
+                vp->columns > 0 ? (vp->rows > 0 ? vp->rows : VL_DEFAULT_ROWS) : 0, vp->columns);
+    }
+    fprintf(f, "\n}\n");
     fclose(f);
     char err[1024];
     int status = write_file_atomic(path, buf, size, WRITE_REPLACE, err, sizeof err);
@@ -289,7 +306,12 @@ int cmd_render(int argc, char **argv) {
     double elapsed = 0.0;
     for (long long frame = 0;; frame++) {
         if (o.spp > 0 ? frame >= o.spp : (frame > 0 && elapsed >= o.seconds)) break;
-        session_render_frame(rs);
+        if (session_render_frame(rs) != 0) {
+            cli_error("%s: %s", s->path, session_error(rs));
+            session_destroy(rs);
+            scene_destroy(s);
+            return EXIT_FAILURE_;
+        }
         double now = cli_now();
         elapsed = now - pg.start;
         progress_update(&pg, &o, frame + 1, now, 0);

@@ -67,6 +67,7 @@ typedef struct {
     uint64_t resets;
     double reset_at, frame_ms, rays_per_second;
     unsigned long long rejected;
+    unsigned long long virtual_lights;
     char message[1200];
     uint64_t message_serial;
     scene_info info;
@@ -184,6 +185,7 @@ static void publish(viewer *v, render_session *rs, int preview, double frame_ms,
         double secs = seconds_since(v->sh.reset_at);
         v->sh.rays_per_second = secs > 0.0 && !preview ? (double)rays / secs : 0.0;
         v->sh.rejected = st.rejected_samples;
+        if (!preview) v->sh.virtual_lights = st.virtual_lights;
     }
     pthread_mutex_unlock(&v->sh.lock);
 }
@@ -337,6 +339,7 @@ typedef struct {
     uint64_t sent_generation;
     double reset_at, frame_ms, rays_per_second;
     unsigned long long rejected;
+    unsigned long long virtual_lights;
     /* input */
     double mouse_x, mouse_y;
     double scroll;
@@ -371,6 +374,34 @@ static void reset_view(ui_thread *u) {
     u->cam = ctl_from_camera(&c, &u->info);
 }
 
+/* The many-light settings the panel edits, onto the parameters (fields it lacks are kept). */
+static vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
+    vl.clamp = c->clamp;
+    vl.clamp_value = c->clamp_value;
+    vl.radius_mult = c->radius_mult;
+    vl.radius_shrink = c->radius_shrink;
+    vl.count = c->vl_count;
+    vl.columns = c->columns;
+    vl.per_pixel = c->per_pixel;
+    return vl;
+}
+
+static void controls_from_vl(ui_controls *c, const vl_params *vl) {
+    c->clamp = vl->clamp;
+    c->clamp_value = vl->clamp_value > 0.0f ? vl->clamp_value : VL_DEFAULT_CLAMP;
+    c->radius_mult = vl->radius_mult > 0.0f ? vl->radius_mult : VL_DEFAULT_RADIUS_MULT;
+    c->radius_shrink = vl->radius_shrink;
+    c->vl_count = vl->count > 0 ? vl->count : VL_DEFAULT_COUNT;
+    c->columns = vl->columns;
+    c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);
+}
+
+static int vl_controls_differ(const ui_controls *a, const ui_controls *b) {
+    return a->clamp != b->clamp || a->clamp_value != b->clamp_value || a->radius_mult != b->radius_mult ||
+           a->radius_shrink != b->radius_shrink || a->vl_count != b->vl_count || a->columns != b->columns ||
+           a->per_pixel != b->per_pixel;
+}
+
 /* Sends the camera and estimator settings to the render thread; each call is a change that
  * resets the accumulation. */
 static void send_change(ui_thread *u) {
@@ -379,6 +410,7 @@ static void send_change(ui_thread *u) {
     sh->cam = ctl_camera(&u->cam);
     sh->params.max_depth = u->ctl.max_depth;
     sh->params.method = (render_method)u->ctl.method;
+    sh->params.vl = vl_from_controls(&u->ctl, sh->params.vl);
     u->sent_generation = ++sh->generation;
     sh->changed_at = cli_now();
     pthread_mutex_unlock(&sh->lock);
@@ -392,7 +424,9 @@ static long long frames_of_current_state(const ui_thread *u) {
 /* Sends what changed in the controls since the last call: estimator settings reset the
  * accumulation; display settings only change how the image is shown. */
 static void apply_controls(ui_thread *u, int camera_changed) {
-    if (u->ctl.method != u->applied_ctl.method || u->ctl.max_depth != u->applied_ctl.max_depth) camera_changed = 1;
+    if (u->ctl.method != u->applied_ctl.method || u->ctl.max_depth != u->applied_ctl.max_depth ||
+        vl_controls_differ(&u->ctl, &u->applied_ctl))
+        camera_changed = 1;
     if (camera_changed) send_change(u);
     if (u->ctl.exposure != u->applied_ctl.exposure) u->need_tonemap = 1;
     if (u->ctl.show != u->applied_ctl.show) {
@@ -450,10 +484,12 @@ static void request_load(ui_thread *u, int kind, const char *path) {
 
 static void print_stats(ui_thread *u) {
     printf("stats scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
-           "max_depth=%d method=%s rejected=%llu\n",
+           "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
+           "virtual_lights=%llu\n",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
            u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
-           method_name((render_method)u->ctl.method), u->rejected);
+           method_name((render_method)u->ctl.method), u->rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
+           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->virtual_lights);
     fflush(stdout);
 }
 
@@ -463,6 +499,15 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     snprintf(opt, sizeof opt, "--%s", name);
     long long n;
     double x;
+    if (strcmp(name, "vpl-glossy") != 0) { /* the many-light settings, as glint render's options */
+        vl_params vl = vl_from_controls(&u->ctl, (vl_params){0});
+        int applied = cli_set_vl_param(name, value, &vl);
+        if (applied < 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        if (applied > 0) {
+            controls_from_vl(&u->ctl, &vl);
+            return 0;
+        }
+    }
     if (strcmp(name, "method") == 0) {
         int m = method_from_name(value);
         if (m < 0) return snprintf(err, errlen, "unknown method '%s'", value), -1;
@@ -679,6 +724,7 @@ static int fetch(ui_thread *u) {
     u->frame_ms = sh->frame_ms;
     u->rays_per_second = sh->rays_per_second;
     u->rejected = sh->rejected;
+    u->virtual_lights = sh->virtual_lights;
     if (sh->message_serial != u->message_serial) {
         snprintf(u->message, sizeof u->message, "%s", sh->message);
         u->message_serial = sh->message_serial;
@@ -760,7 +806,7 @@ static void print_view_help(void) {
            "\n"
            "options:\n"
            "  --size WxH           window and render size [960x540]\n"
-           "  --method NAME        estimator: pt [pt]\n"
+           "  --method NAME        estimator: pt, vpl, vsl [pt]\n"
            "  --max-depth D        scattering events per path [%d]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
            "  --camera INDEX       start from the scene's camera INDEX\n"
@@ -768,10 +814,12 @@ static void print_view_help(void) {
            "  --exposure STOPS     display exposure [0]\n"
            "  --script FILE        replay a script of viewer actions (see README)\n"
            "\n"
+           "%s"
+           "\n"
            "controls: left drag orbit, right/middle drag pan, wheel zoom, WASD/QE fly, R reset view,\n"
            "1-9 scene cameras, F12 screenshot (PNG), F11 export (EXR), Tab panel, Esc quit.\n"
            "Drop a .gltf/.glb on the window to open it, an .exr/.hdr to light the scene with it.\n",
-           DEFAULT_MAX_DEPTH);
+           DEFAULT_MAX_DEPTH, cli_vl_help());
 }
 
 static int parse_view_options(int argc, char **argv, view_options *o) {
@@ -783,6 +831,7 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *v;
         long long n;
+        int vl;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             print_view_help();
             return 1;
@@ -791,8 +840,10 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         } else if (strcmp(a, "--method") == 0) {
             if (!(v = cli_value(argc, argv, &i))) return -1;
             int m = method_from_name(v);
-            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt)", v), -1;
+            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl)", v), -1;
             o->params.method = (render_method)m;
+        } else if ((vl = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
+            if (vl < 0) return -1;
         } else if (strcmp(a, "--max-depth") == 0) {
             if (!(v = cli_value(argc, argv, &i)) || cli_parse_int(a, v, 1, 1000, &n)) return -1;
             o->params.max_depth = (int)n;
@@ -902,6 +953,7 @@ int cmd_view(int argc, char **argv) {
                           .exposure = (float)o.exposure,
                           .show = UI_SHOW_ALL,
                           .show_panel = 1};
+    controls_from_vl(&u.ctl, &o.params.vl);
     u.applied_ctl = u.ctl;
     int fw, fh;
     glfwGetFramebufferSize(win, &fw, &fh);
@@ -944,6 +996,8 @@ int cmd_view(int argc, char **argv) {
                        .frame_ms = u.frame_ms,
                        .rays_per_second = u.rays_per_second,
                        .rejected_samples = u.rejected,
+                       .many_light = u.ctl.method != METHOD_PT,
+                       .virtual_lights = u.virtual_lights,
                        .width = u.front.width,
                        .height = u.front.height,
                        .previewing = u.front.preview,

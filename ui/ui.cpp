@@ -55,6 +55,18 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
             if (ImGui::Combo("method", &m, s->method_names, s->num_methods)) c->method = m;
         }
         ImGui::SliderInt("max depth", &c->max_depth, 1, 64);
+        if (s->many_light) {
+            static const char *clamps[3] = {"method default", "on", "off"};
+            ImGui::Combo("clamping", &c->clamp, clamps, 3);
+            ImGui::SliderFloat("clamp value", &c->clamp_value, 1e-3f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
+            ImGui::SliderFloat("radius mult", &c->radius_mult, 0.05f, 32.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+            ImGui::SliderFloat("radius shrink", &c->radius_shrink, 0.0f, 0.99f, c->radius_shrink > 0 ? "%.2f" : "off");
+            ImGui::SliderInt("lights/frame", &c->vl_count, 16, 1 << 20, "%d", ImGuiSliderFlags_Logarithmic);
+            ImGui::SliderInt("clusters", &c->columns, 0, 1 << 14, c->columns > 0 ? "%d" : "none",
+                             ImGuiSliderFlags_Logarithmic);
+            ImGui::SliderInt("lights/pixel", &c->per_pixel, -1, 256, c->per_pixel < 0 ? "all" : "%d");
+            if (c->per_pixel == 0) c->per_pixel = 1;
+        }
     }
 
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
@@ -94,6 +106,7 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
         ImGui::Text("time %.1f s   frame %.0f ms", s->seconds, s->frame_ms);
         ImGui::Text("%.2f M rays/s", s->rays_per_second * 1e-6);
         if (s->rejected_samples) ImGui::Text("rejected samples %llu", s->rejected_samples);
+        if (s->many_light) ImGui::Text("virtual lights %llu", s->virtual_lights);
     }
     ImGui::End();
 }

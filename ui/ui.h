@@ -20,6 +20,14 @@ typedef struct {
     int method;        /* index into the method names given to ui_panel */
     int max_depth;
     int camera;        /* scene camera index, -1 for the free camera */
+    /* many-light settings (methods vpl, vsl), as glint render's options */
+    int clamp;         /* 0: the method's default, 1: on, 2: off */
+    float clamp_value;
+    float radius_mult;
+    float radius_shrink; /* 0: off */
+    int vl_count;      /* virtual lights per frame */
+    int columns;       /* clusters; 0: none */
+    int per_pixel;     /* lights shaded per pixel per frame; -1: all */
     /* display settings: a change never resets */
     float exposure;    /* stops */
     int show;          /* UI_SHOW_* */
@@ -42,6 +50,8 @@ typedef struct {
     int num_cameras;
     const char *const *method_names;
     int num_methods;
+    int many_light;            /* the current method uses virtual lights: show their settings */
+    unsigned long long virtual_lights; /* deposited since the last reset */
     const char *message;       /* last export path or error, shown until replaced */
 } ui_stats;
 
