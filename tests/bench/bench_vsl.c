@@ -1,0 +1,156 @@
+/* The VSL paper's comparisons, measured: relative L2 error of indirect illumination against a
+ * path-traced reference at equal wall time (PT, clamped VPL, VSL), and the Fig. 8 sweeps (error
+ * against the radius multiplier and against the column count at a fixed time).
+ *
+ * usage: bench_vsl SCENE|default REF.exr WxH REF_SECONDS "T1,T2,..." SWEEP_SECONDS
+ *   REF.exr is rendered with PT for REF_SECONDS when it does not exist (and reused after).
+ * Prints markdown tables. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "camera.h"
+#include "image_io.h"
+#include "metrics.h"
+#include "session.h"
+
+static double now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void die(const char *what) {
+    fprintf(stderr, "bench_vsl: %s\n", what);
+    exit(1);
+}
+
+typedef struct {
+    const scene *s;
+    camera cam;
+    int w, h;
+    float *ref; /* indirect, interleaved RGB */
+} bench;
+
+static render_session *start(const bench *b, render_params p) {
+    char err[256];
+    p.width = b->w;
+    p.height = b->h;
+    render_session *rs = session_create(b->s, &b->cam, &p, err, sizeof err);
+    if (!rs) die(err);
+    return rs;
+}
+
+static double error_of(const bench *b, const render_session *rs) {
+    size_t n = (size_t)b->w * (size_t)b->h * 3;
+    float *img = malloc(sizeof(float) * n);
+    film_resolve(session_film(rs), 1u << COMP_INDIRECT, img);
+    double e = metric_rel_l2(img, b->ref, n);
+    free(img);
+    return e;
+}
+
+/* Renders progressively, reading the error at each checkpoint of one run. */
+static void run_times(const bench *b, const char *label, render_params p, const double *times, int nt) {
+    render_session *rs = start(b, p);
+    double t0 = now();
+    printf("| %s |", label);
+    for (int k = 0; k < nt; k++) {
+        while (now() - t0 < times[k])
+            if (session_render_frame(rs) != 0) die(session_error(rs));
+        printf(" %.4f (%lld) |", error_of(b, rs), session_frames(rs));
+        fflush(stdout);
+    }
+    printf("\n");
+    session_destroy(rs);
+}
+
+static double run_for(const bench *b, render_params p, double seconds) {
+    render_session *rs = start(b, p);
+    double t0 = now();
+    while (now() - t0 < seconds || session_frames(rs) == 0)
+        if (session_render_frame(rs) != 0) die(session_error(rs));
+    double e = error_of(b, rs);
+    session_destroy(rs);
+    return e;
+}
+
+int main(int argc, char **argv) {
+    if (argc != 7) die("usage: bench_vsl SCENE|default REF.exr WxH REF_SECONDS T1,T2,... SWEEP_SECONDS");
+    char err[1024];
+    scene *s = strcmp(argv[1], "default") == 0 ? scene_load_default(NULL, NULL, err, sizeof err)
+                                               : scene_load(argv[1], NULL, NULL, err, sizeof err);
+    if (!s) die(err);
+    bench b = {.s = s};
+    if (sscanf(argv[3], "%dx%d", &b.w, &b.h) != 2) die("bad size");
+    b.cam = scene_camera(s, 0, (float)b.w / (float)b.h);
+    double ref_seconds = atof(argv[4]), sweep_seconds = atof(argv[6]);
+    double times[16];
+    int nt = 0;
+    for (char *t = strtok(argv[5], ","); t && nt < 16; t = strtok(NULL, ",")) times[nt++] = atof(t);
+
+    size_t n = (size_t)b.w * (size_t)b.h * 3;
+    b.ref = malloc(sizeof(float) * n);
+    exr_image ex;
+    if (exr_image_load(argv[2], &ex, err, sizeof err) == 0) {
+        if (ex.width != b.w || ex.height != b.h) die("reference size mismatch");
+        const float *c[3] = {exr_image_channel(&ex, "indirect.R"), exr_image_channel(&ex, "indirect.G"),
+                             exr_image_channel(&ex, "indirect.B")};
+        if (!c[0] || !c[1] || !c[2]) die("reference lacks the indirect layer");
+        for (size_t i = 0; i < n / 3; i++)
+            for (int k = 0; k < 3; k++) b.ref[3 * i + (size_t)k] = c[k][i];
+        exr_image_free(&ex);
+        fprintf(stderr, "bench_vsl: reference %s\n", argv[2]);
+    } else {
+        fprintf(stderr, "bench_vsl: rendering the PT reference for %.0f s\n", ref_seconds);
+        render_session *rs = start(&b, (render_params){.method = METHOD_PT, .seed = 12345});
+        double t0 = now();
+        while (now() - t0 < ref_seconds) session_render_frame(rs);
+        fprintf(stderr, "bench_vsl: reference %lld spp\n", session_frames(rs));
+        film_resolve(session_film(rs), 1u << COMP_INDIRECT, b.ref);
+        if (film_save_exr(session_film(rs), (1u << COMP_DIRECT) | (1u << COMP_INDIRECT), argv[2], WRITE_REPLACE, err,
+                          sizeof err) != 0)
+            die(err);
+        session_destroy(rs);
+    }
+
+    printf("### Equal time: relative L2 error of indirect light (frames in brackets), %dx%d\n\n", b.w, b.h);
+    printf("| method |");
+    for (int k = 0; k < nt; k++) printf(" %g s |", times[k]);
+    printf("\n|---|");
+    for (int k = 0; k < nt; k++) printf("---|");
+    printf("\n");
+    run_times(&b, "pt", (render_params){.method = METHOD_PT}, times, nt);
+    render_params vpl = {.method = METHOD_VPL};
+    run_times(&b, "vpl, clamped", vpl, times, nt);
+    render_params vsl = {.method = METHOD_VSL};
+    run_times(&b, "vsl", vsl, times, nt);
+    vsl.vl.radius_shrink = 0.7f;
+    run_times(&b, "vsl, radius shrink 0.7", vsl, times, nt);
+
+    printf("\n### Fig. 8 (right): error against the radius multiplier, %g s each\n\n| radius mult | rel. L2 |\n|---|---|\n",
+           sweep_seconds);
+    const float mults[] = {1, 2, 4, 8, 12, 16, 24};
+    for (size_t k = 0; k < sizeof mults / sizeof mults[0]; k++) {
+        render_params p = {.method = METHOD_VSL};
+        p.vl.radius_mult = mults[k];
+        printf("| %g | %.4f |\n", (double)mults[k], run_for(&b, p, sweep_seconds));
+        fflush(stdout);
+    }
+    printf("\n### Fig. 8 (left): error against the column count (matrix row-column sampling, 4096 lights,\n"
+           "300 rows), %g s each\n\n| columns | rel. L2 |\n|---|---|\n",
+           sweep_seconds);
+    const int cols[] = {64, 128, 256, 512, 1024};
+    for (size_t k = 0; k < sizeof cols / sizeof cols[0]; k++) {
+        render_params p = {.method = METHOD_VSL};
+        p.vl.count = 4096;
+        p.vl.columns = cols[k];
+        printf("| %d | %.4f |\n", cols[k], run_for(&b, p, sweep_seconds));
+        fflush(stdout);
+    }
+    free(b.ref);
+    scene_destroy(s);
+    return 0;
+}
