@@ -130,11 +130,11 @@ static vec3 ward_sample_h(const bsdf *b, vec2 u) {
 
 /* ---- Phong ---------------------------------------------------------------------------------- */
 
-/* Cosine between wi and the mirror direction of wo, from the chord |wi - r| so that sharp lobes
- * keep their precision near the peak. */
-static float phong_cos(vec3 wo, vec3 wi) {
+/* 1 - cos of the angle between wi and the mirror direction of wo, from the chord |wi - r|, so that
+ * sharp lobes keep their precision near the peak. */
+static float phong_one_minus_cos(vec3 wo, vec3 wi) {
     vec3 r = v3(-wo.x, -wo.y, wo.z);
-    return 1.0f - 0.5f * length_sq3(sub3(wi, r));
+    return 0.5f * length_sq3(sub3(wi, r));
 }
 
 /* ---- dispatch ------------------------------------------------------------------------------- */
@@ -147,9 +147,8 @@ static vec3 eval_glossy(const bsdf *b, vec3 wo, vec3 wi) {
         return scale3(schlick_fresnel(b->specular, dot3(wo, h)), dv);
     }
     case GLOSSY_PHONG: {
-        float c = phong_cos(wo, wi);
-        if (c <= 0.0f) return v3s(0.0f);
-        return scale3(b->specular, (b->exponent + 2.0f) * INV_2PI_F * powf(c, b->exponent));
+        float lobe = power_cosine(phong_one_minus_cos(wo, wi), b->exponent);
+        return scale3(b->specular, (b->exponent + 2.0f) * INV_2PI_F * lobe);
     }
     case GLOSSY_WARD: {
         /* ks (h.h) / (pi ax ay hz^4) exp(-tan^2 theta_h ...), h = wo + wi unnormalised. */
@@ -169,11 +168,13 @@ static float pdf_glossy(const bsdf *b, vec3 wo, vec3 wi) {
     case GLOSSY_GGX:
         return ggx_pdf(b, wo, normalize3(add3(wo, wi)));
     case GLOSSY_PHONG:
-        return pdf_power_cosine(phong_cos(wo, wi), b->exponent);
+        return pdf_power_cosine(phong_one_minus_cos(wo, wi), b->exponent);
     case GLOSSY_WARD: {
-        vec3 h = normalize3(add3(wo, wi));
-        float wo_h = dot3(wo, h);
-        return wo_h > 0.0f ? ward_pdf_h(b, h) / (4.0f * wo_h) : 0.0f;
+        /* wo . h_normalised = |wo + wi| / 2 exactly; the dot product itself cancels to noise (or
+         * the wrong sign) when wo and wi face each other at grazing angles, where eval does not. */
+        vec3 h = add3(wo, wi);
+        float wo_h = 0.5f * length3(h);
+        return wo_h > 0.0f ? ward_pdf_h(b, scale3(h, 0.5f / wo_h)) / (4.0f * wo_h) : 0.0f;
     }
     default:
         return 0.0f;
@@ -191,9 +192,14 @@ static int sample_glossy(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
         *wi = to_world(f, sample_power_cosine(u, b->exponent));
         break;
     }
-    case GLOSSY_WARD:
-        *wi = reflect3(wo, ward_sample_h(b, u));
+    case GLOSSY_WARD: {
+        /* Unlike visible-normal sampling, a Ward half vector can face away from wo; its
+         * reflection is not a direction pdf_glossy accounts for, so it is no sample. */
+        vec3 h = ward_sample_h(b, u);
+        if (dot3(wo, h) <= 0.0f) return 0;
+        *wi = reflect3(wo, h);
         break;
+    }
     default:
         return 0;
     }

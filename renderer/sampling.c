@@ -31,16 +31,23 @@ float cone_one_minus_cos(float s) {
 }
 
 vec3 sample_power_cosine(vec2 u, float exponent) {
-    /* cos(theta) = u^(1/(n+1)); computed through log so large exponents keep precision. */
-    float cos_t = expf(logf(fmaxf(1.0f - u.x, 1e-30f)) / (exponent + 1.0f));
-    float sin_t = safe_sqrtf(1.0f - cos_t * cos_t);
+    /* cos(theta) = (1 - u)^(1/(n+1)). Sharp lobes live where cos is within float epsilon of 1, so
+     * 1 - cos comes from expm1 and sin from (1 - cos)(1 + cos), as for tiny cones. */
+    float omc = -expm1f(logf(fmaxf(1.0f - u.x, 1e-30f)) / (exponent + 1.0f));
+    float cos_t = 1.0f - omc;
+    float sin_t = safe_sqrtf(omc * (2.0f - omc));
     float phi = 2.0f * PI_F * u.y;
     return v3(sin_t * cosf(phi), sin_t * sinf(phi), cos_t);
 }
 
-float pdf_power_cosine(float cos_theta, float exponent) {
-    if (cos_theta <= 0.0f) return 0.0f;
-    return (exponent + 1.0f) * INV_2PI_F * powf(cos_theta, exponent);
+float power_cosine(float one_minus_cos, float exponent) {
+    if (!(one_minus_cos < 1.0f)) return 0.0f;
+    if (one_minus_cos <= 0.0f) return 1.0f;
+    return expf(exponent * log1pf(-one_minus_cos));
+}
+
+float pdf_power_cosine(float one_minus_cos, float exponent) {
+    return (exponent + 1.0f) * INV_2PI_F * power_cosine(one_minus_cos, exponent);
 }
 
 vec2 sample_uniform_triangle(vec2 u) {

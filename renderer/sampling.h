@@ -27,9 +27,12 @@ static inline float pdf_uniform_cone(float one_minus_cos_max) { return INV_2PI_F
  * cancellation: s^2 / (1 + sqrt(1 - s^2)). Returns 1 (a hemisphere) when s >= 1: the point is inside. */
 float cone_one_minus_cos(float sin_theta_max);
 
-/* Power-cosine lobe around +z: pdf = (n + 1) / (2 pi) cos^n(theta) over the sphere's upper half. */
+/* Power-cosine lobe around +z: pdf = (n + 1) / (2 pi) cos^n(theta) over the sphere's upper half.
+ * Angles enter as 1 - cos(theta): sharp lobes (n ~ 1e6) live where cos(theta) rounds to 1 in float. */
 vec3 sample_power_cosine(vec2 u, float exponent);
-float pdf_power_cosine(float cos_theta, float exponent);
+float pdf_power_cosine(float one_minus_cos, float exponent);
+/* cos^n(theta) from 1 - cos(theta); 0 beyond 90 degrees. */
+float power_cosine(float one_minus_cos, float exponent);
 
 /* Uniform point on a triangle as barycentrics (b1, b2); b0 = 1 - b1 - b2. */
 vec2 sample_uniform_triangle(vec2 u);
@@ -39,8 +42,10 @@ vec2 sample_concentric_disk(vec2 u);
 
 /* Multiple importance sampling weights for strategy a against b (n samples each). */
 static inline float mis_balance(float pdf_a, float pdf_b) {
-    float s = pdf_a + pdf_b;
-    return s > 0.0f ? pdf_a / s : 0.0f;
+    /* As a ratio: the sum of two pdfs near FLT_MAX would overflow. */
+    if (pdf_a <= 0.0f) return 0.0f;
+    if (!(pdf_b > 0.0f)) return 1.0f;
+    return 1.0f / (1.0f + pdf_b / pdf_a);
 }
 static inline float mis_power(float pdf_a, float pdf_b) {
     /* Divide first: squaring a pdf of 1e20 would overflow float. */
