@@ -8,7 +8,7 @@ set -u
 glint=$1
 dir=$2/viewer
 keep_modules=${3:-}
-command -v xvfb-run >/dev/null || { echo "xvfb-run not installed: skipped"; exit 77; }
+command -v Xvfb >/dev/null || { echo "Xvfb not installed: skipped"; exit 77; }
 rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
@@ -22,8 +22,21 @@ asan=$(ldd "$glint" | sed -n 's/.*libasan[^ ]* => \([^ ]*\).*/\1/p')
 preload=
 if [ -n "$asan" ] && [ -n "$keep_modules" ]; then preload="$asan $keep_modules"; fi
 
+# One X server for the whole script, on a display it picks itself: xvfb-run per call would replace
+# the viewer's exit status with its own when its clean-up fails (exit 5), and costs a start each.
+Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp 3>display.txt 2>xvfb.log &
+xvfb_pid=$!
+trap 'kill $xvfb_pid 2>/dev/null; wait $xvfb_pid 2>/dev/null' EXIT
+tries=0
+until [ -s display.txt ]; do
+  tries=$((tries + 1))
+  [ $tries -le 300 ] && kill -0 $xvfb_pid 2>/dev/null || { echo "Xvfb did not start: $(cat xvfb.log)"; exit 1; }
+  sleep 0.1
+done
+export DISPLAY=":$(head -n 1 display.txt)"
+
 view() { # view ARGS... : runs the viewer headless, stdout to out.txt, stderr to err.txt
-  timeout 300 xvfb-run -a -s "-screen 0 1024x768x24" env LD_PRELOAD="$preload" "$glint" "$@" >out.txt 2>err.txt
+  timeout 300 env LD_PRELOAD="$preload" "$glint" "$@" >out.txt 2>err.txt
 }
 
 printf 'not a scene' >broken.gltf
