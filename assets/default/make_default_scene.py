@@ -122,7 +122,7 @@ MATERIALS = [
     {"name": "ceiling light", "emissiveFactor": [1.0, 0.93, 0.82],
      "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 12.0}},
      "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0, "roughnessFactor": 1}},
-    metal_rough("chrome", (0.95, 0.95, 0.95), metallic=1.0, roughness=0.04),
+    metal_rough("chrome", (0.95, 0.95, 0.95), metallic=1.0, roughness=0.15),
     metal_rough("gold", (1.0, 0.78, 0.34), metallic=1.0, roughness=0.22),
     # Brushed aluminium (anisotropic Ward), as on the VSL paper's kitchen appliances.
     metal_rough("brushed aluminium", (0.8, 0.8, 0.82), metallic=1.0, roughness=0.3,
