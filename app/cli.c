@@ -133,9 +133,11 @@ const char *cli_vl_help(void) {
              "  --rows R             matrix row-column sampling: sampled rows (pixels) [%d]\n"
              "  --columns C          ... and clusters; 0 = no clustering [0]\n"
              "  --per-pixel N|all    lights (cluster representatives) each pixel shades per frame,\n"
-             "                       picked by power (cluster norm) [%d; all with --columns]\n",
+             "                       picked by power (cluster norm) [%d; all with --columns]\n"
+             "  --candidates M       each of those is resampled from M candidates by its unshadowed\n"
+             "                       contribution at the pixel; 1 = plain sampling by power [%d]\n",
              VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_RADIUS_MULT, VL_DEFAULT_ROWS,
-             VL_DEFAULT_PER_PIXEL);
+             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES);
     return text;
 }
 
@@ -184,6 +186,9 @@ int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
         if (strcmp(value, "all") == 0) vl->per_pixel = -1;
         else if (cli_parse_int(option, value, 1, 1000000, &n)) return -1;
         else vl->per_pixel = (int)n;
+    } else if (strcmp(name, "candidates") == 0) {
+        if (cli_parse_int(option, value, 1, 4096, &n)) return -1;
+        vl->candidates = (int)n;
     } else {
         return 0;
     }
@@ -195,7 +200,7 @@ int cli_vl_option(int argc, char **argv, int *i, vl_params *vl) {
     if (strncmp(a, "--", 2) != 0) return 0;
     if (strcmp(a, "--vpl-glossy") == 0) return cli_set_vl_param("vpl-glossy", "on", vl);
     static const char *const names[] = {"vsl-count", "clamp", "clamp-value", "clamp-growth", "radius-mult",
-                                         "radius-shrink", "rows", "columns", "per-pixel"};
+                                         "radius-shrink", "rows", "columns", "per-pixel", "candidates"};
     int ours = 0;
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) ours |= strcmp(a + 2, names[k]) == 0;
     if (!ours) return 0;

@@ -383,6 +383,7 @@ static vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
     vl.count = c->vl_count;
     vl.columns = c->columns;
     vl.per_pixel = c->per_pixel;
+    vl.candidates = c->candidates;
     return vl;
 }
 
@@ -394,12 +395,13 @@ static void controls_from_vl(ui_controls *c, const vl_params *vl) {
     c->vl_count = vl->count > 0 ? vl->count : VL_DEFAULT_COUNT;
     c->columns = vl->columns;
     c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);
+    c->candidates = vl->candidates > 0 ? vl->candidates : VL_DEFAULT_CANDIDATES;
 }
 
 static int vl_controls_differ(const ui_controls *a, const ui_controls *b) {
     return a->clamp != b->clamp || a->clamp_value != b->clamp_value || a->radius_mult != b->radius_mult ||
            a->radius_shrink != b->radius_shrink || a->vl_count != b->vl_count || a->columns != b->columns ||
-           a->per_pixel != b->per_pixel;
+           a->per_pixel != b->per_pixel || a->candidates != b->candidates;
 }
 
 /* Sends the camera and estimator settings to the render thread; each call is a change that
@@ -485,11 +487,11 @@ static void request_load(ui_thread *u, int kind, const char *path) {
 static void print_stats(ui_thread *u) {
     printf("stats scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
-           "virtual_lights=%llu\n",
+           "candidates=%d virtual_lights=%llu\n",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
            u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
            method_name((render_method)u->ctl.method), u->rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
-           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->virtual_lights);
+           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.candidates, u->virtual_lights);
     fflush(stdout);
 }
 

@@ -67,6 +67,74 @@ static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *v
     return c;
 }
 
+/* One end's factor of the stand-in below: f cos toward the light's centre, raised to what a
+ * lobe sharper than the cone averages to over it when the lobe's axis falls inside the cone
+ * (its glossy reflectance over the cone's solid angle), so that sharp lobes aimed at a large
+ * sphere are not missed by the centre direction alone. */
+static float end_factor(const bsdf *b, frame3 f, vec3 wo_local, vec3 l_world, float cos_cone, float cone_solid_angle) {
+    vec3 l = to_local(f, l_world);
+    if (l.z <= 0.0f && cos_cone > 0.0f) return 0.0f;
+    float g = avg3(bsdf_eval(b, wo_local, l, BSDF_ALL)) * fmaxf(l.z, 0.0f);
+    if (b->model != GLOSSY_NONE) {
+        vec3 mirror = v3(-wo_local.x, -wo_local.y, wo_local.z);
+        if (dot3(mirror, l) >= cos_cone) g = fmaxf(g, avg3(b->specular) * mirror.z / cone_solid_angle);
+    }
+    return g;
+}
+
+/* A cheap stand-in for a light's contribution at x, for choosing lights per pixel: both ends'
+ * factors toward the light's centre, no visibility, the distance clamped at the radius as a VSL
+ * clamps it. The defensive terms keep it positive wherever the true contribution can be (a cone
+ * straddling a horizon, a lobe missing the centre), which resampling needs to stay unbiased. */
+static float target_of(const virtual_light *vl, const shading_point *x) {
+    vec3 d = sub3(vl->p, x->p);
+    float dist2 = length_sq3(d), r2 = vl->radius * vl->radius;
+    if (!(dist2 > 0.0f) && !(r2 > 0.0f)) return 0.0f;
+    vec3 l = dist2 > 0.0f ? scale3(d, 1.0f / sqrtf(dist2)) : x->frame.n;
+    /* The cone around the sphere (the whole sphere of directions when x is inside it). */
+    float cos_cone = -1.0f, solid_angle = 2.0f * PI_F;
+    if (dist2 > r2) {
+        float omc = cone_one_minus_cos(sqrtf(r2 / dist2));
+        cos_cone = 1.0f - omc;
+        solid_angle = fmaxf(2.0f * PI_F * omc, 1e-12f);
+    }
+    float gx = end_factor(&x->b, x->frame, x->wo, l, cos_cone, solid_angle);
+    float gv = end_factor(&vl->b, vl->frame, vl->wi, neg3(l), cos_cone, solid_angle);
+    const float floor = 0.05f * INV_PI_F;
+    return luminance3(vl->power) * (gx + floor) * (gv + floor) / fmaxf(dist2, r2);
+}
+
+/* Picks one entry for x: `candidates` draws by the frame's pick distribution, one of them chosen
+ * in proportion to target / pmf (resampled importance sampling, Talbot et al. 2005). Returns the
+ * weight that makes entry *e's contribution an unbiased estimate of the sum over all entries
+ * (its scale included), or 0 when nothing was drawn. */
+static float resample_entry(const manylight *m, const shading_point *x, rng_state *rng, int *e) {
+    float pmf;
+    if (m->candidates <= 1) {
+        *e = dist1d_sample_discrete(&m->pick, rng_float(rng), &pmf, NULL);
+        return pmf > 0.0f ? m->entries[*e].scale / pmf : 0.0f;
+    }
+    double w_sum = 0.0;
+    float chosen_target = 0.0f;
+    *e = -1;
+    for (int c = 0; c < m->candidates; c++) {
+        int cand = dist1d_sample_discrete(&m->pick, rng_float(rng), &pmf, NULL);
+        if (!(pmf > 0.0f)) continue;
+        const ml_entry *en = &m->entries[cand];
+        float t = target_of(&m->set.v[en->light], x) * en->scale;
+        if (!(t > 0.0f) || !isfinite(t)) continue;
+        double w = (double)t / (double)pmf;
+        w_sum += w;
+        /* Reservoir choice: keeps the candidate with probability w / w_sum, one pass. */
+        if ((double)rng_float(rng) * w_sum < w) {
+            *e = cand;
+            chosen_target = t;
+        }
+    }
+    if (*e < 0 || !(w_sum > 0.0)) return 0.0f;
+    return (float)(w_sum / (double)m->candidates / (double)chosen_target) * m->entries[*e].scale;
+}
+
 vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, rng_state *rng, render_stats *st) {
     vec3 sum = v3(0, 0, 0);
     if (m->num_entries == 0 || !bsdf_lobes(&x->b)) return sum;
@@ -78,11 +146,9 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
         return sum;
     }
     for (int k = 0; k < m->per_pixel; k++) {
-        float pmf;
-        int e = dist1d_sample_discrete(&m->pick, rng_float(rng), &pmf, NULL);
-        if (!(pmf > 0.0f)) continue;
-        vec3 c = shade_one(m, s, &m->set.v[m->entries[e].light], x, rng, st);
-        sum = madd3(sum, c, m->entries[e].scale / pmf);
+        int e;
+        float weight = resample_entry(m, x, rng, &e);
+        if (weight > 0.0f) sum = madd3(sum, shade_one(m, s, &m->set.v[m->entries[e].light], x, rng, st), weight);
     }
     return scale3(sum, 1.0f / (float)m->per_pixel);
 }
@@ -198,6 +264,7 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
 
     int clustering = vp->columns > 0 && vp->columns < m->set.count;
     m->per_pixel = vp->per_pixel > 0 ? vp->per_pixel : (clustering || vp->per_pixel < 0 ? 0 : VL_DEFAULT_PER_PIXEL);
+    m->candidates = vp->candidates > 0 ? vp->candidates : VL_DEFAULT_CANDIDATES;
     if (clustering) {
         if (cluster_lights(m, s, cam, p, frame, pool, st) != 0) return snprintf(err, errlen, "out of memory for the light clusters"), -1;
         m->clustered = 1;

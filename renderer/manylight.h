@@ -23,6 +23,7 @@ typedef struct {
     float clamp_bound;  /* this frame's bound */
     float radius_mult;  /* this frame's multiplier */
     int per_pixel;      /* 0: every entry */
+    int candidates;     /* resampling candidates per sampled entry (1: plain sampling by pick) */
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;

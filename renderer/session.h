@@ -36,6 +36,9 @@ typedef struct {
     int per_pixel;       /* lights (or cluster representatives) sampled per pixel per frame, by
                           * power (or cluster norm); -1: every one; 0: the default, which is
                           * VL_DEFAULT_PER_PIXEL without clustering and every representative with */
+    int candidates;      /* per sampled light: candidates drawn by power (or cluster norm) and
+                          * resampled by their unshadowed contribution at the pixel; 1: none
+                          * [VL_DEFAULT_CANDIDATES] */
     int highlights;      /* the highlight estimator owns glossy-glossy first-bounce paths */
 } vl_params;
 
@@ -47,6 +50,7 @@ enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
 #define VL_DEFAULT_RADIUS_MULT 1.0f
 #define VL_DEFAULT_ROWS 300
 #define VL_DEFAULT_PER_PIXEL 4
+#define VL_DEFAULT_CANDIDATES 4
 
 /* Zero means default for every field. */
 typedef struct {

@@ -195,6 +195,64 @@ static void test_outputs(void) {
     CHECK(rc == 0 && strstr(out_text, "triangles"), "glint info: %s%s", out_text, err_text);
 }
 
+/* The many-light options: listed in the help, bad values refused with a usage error, and the
+ * methods run with them, report their lights and clamping in the stats, and write finite images. */
+static void test_many_light_options(void) {
+    CHECK(run("render --help") == 0, "render --help exit code");
+    const char *options[] = {"--vsl-count", "--clamp ", "--clamp-value", "--clamp-growth", "--vpl-glossy", "--radius-mult",
+                             "--radius-shrink", "--rows", "--columns", "--per-pixel", "--candidates"};
+    for (size_t i = 0; i < sizeof options / sizeof options[0]; i++)
+        CHECK(strstr(out_text, options[i]) != NULL, "render help does not mention %s", options[i]);
+
+    expect_failure("render --method vsl --radius-mult -1", 2, "--radius-mult");
+    expect_failure("render --method vsl --radius-mult banana", 2, "--radius-mult");
+    expect_failure("render --method vsl --radius-shrink 1.5", 2, "--radius-shrink");
+    expect_failure("render --method vpl --clamp maybe", 2, "--clamp");
+    expect_failure("render --method vpl --clamp-value 0", 2, "--clamp-value");
+    expect_failure("render --method vsl --candidates 0", 2, "--candidates");
+    expect_failure("render --method vsl --per-pixel none", 2, "--per-pixel");
+    expect_failure("render --method vsl --vsl-count", 2, "--vsl-count");
+
+    char p[1024], json[8192], err[512];
+    /* A tiny clamp bound clamps; switching clamping off clamps nothing. */
+    int rc = run("render --method vpl --spp 2 --size 32x18 --vsl-count 64 --clamp-value 1e-4 --stats vpl.json --quiet");
+    CHECK(rc == 0, "vpl render: exit %d: %s", rc, err_text);
+    snprintf(p, sizeof p, "%s/vpl.json", tmp);
+    read_file(p, json, sizeof json);
+    const char *total = strstr(json, "\"virtual_lights_total\": ");
+    CHECK(strstr(json, "\"method\": \"vpl\"") && strstr(json, "\"virtual_lights_per_frame\": 64") && total &&
+              atol(total + 24) >= 128 && !strstr(json, "\"clamped\": 0,"),
+          "vpl stats json: %s", json);
+    rc = run("render --method vpl --spp 2 --size 32x18 --vsl-count 64 --clamp off --vpl-glossy --stats vpl2.json --quiet");
+    CHECK(rc == 0, "unclamped glossy vpl render: exit %d: %s", rc, err_text);
+    snprintf(p, sizeof p, "%s/vpl2.json", tmp);
+    read_file(p, json, sizeof json);
+    CHECK(strstr(json, "\"clamped\": 0,") != NULL, "clamping off still clamped: %s", json);
+
+    rc = run("render --method vsl --spp 2 --size 32x18 --vsl-count 256 --radius-mult 4 --candidates 2 --columns 32 "
+             "--rows 40 --out vsl.exr --stats vsl.json --quiet");
+    CHECK(rc == 0, "vsl render: exit %d: %s", rc, err_text);
+    snprintf(p, sizeof p, "%s/vsl.json", tmp);
+    read_file(p, json, sizeof json);
+    CHECK(strstr(json, "\"method\": \"vsl\"") && strstr(json, "\"columns\": 32") && !strstr(json, "\"vsl_samples\": 0,"),
+          "vsl stats json: %s", json);
+    snprintf(p, sizeof p, "%s/vsl.exr", tmp);
+    exr_image exr;
+    if (exr_image_load(p, &exr, err, sizeof err) == 0) {
+        const float *ind = exr_image_channel(&exr, "indirect.G");
+        double sum = 0.0;
+        int bad = 0;
+        for (int i = 0; ind && i < 32 * 18; i++) {
+            bad += !isfinite(ind[i]) || ind[i] < 0.0f;
+            sum += ind[i];
+        }
+        CHECK(ind && bad == 0 && sum > 0.0, "vsl indirect layer: %d bad pixels, sum %g", bad, sum);
+        exr_image_free(&exr);
+    } else {
+        CHECK(0, "vsl exr unreadable: %s", err);
+    }
+}
+
 int main(int argc, char **argv) {
     if (argc < 2) {
         fprintf(stderr, "usage: test_cli GLINT\n");
@@ -211,5 +269,6 @@ int main(int argc, char **argv) {
     test_usage();
     test_errors();
     test_outputs();
+    test_many_light_options();
     return check_exit("test_cli");
 }

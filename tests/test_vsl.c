@@ -397,6 +397,41 @@ static void test_glossy_box_energy(void) {
     scene_destroy(s);
 }
 
+/* Per-pixel light selection is unbiased: with the same light sets (same seed, so every frame
+ * traces the same lights), sampling a few lights per pixel, plainly by power or resampled from
+ * candidates, averages to the sum over every light; resampling gets there with less noise. */
+static void test_light_selection_unbiased(void) {
+    material m = material_default();
+    m.model = MATERIAL_PHONG;
+    m.kd = v3s(0.3f);
+    m.ks = v3s(0.6f);
+    m.exponent = 80.0f;
+    scene *s = closed_box(m, v3(0.3f, 0.5f, 0.2f));
+    camera cam = box_camera();
+    for (int method = METHOD_VPL; method <= METHOD_VSL; method++) {
+        const int frames = 200;
+        render_params p = vl_params_for((render_method)method, 256);
+        p.vl.clamp = VL_CLAMP_OFF;
+        float *all = ts_render_with(s, &cam, &p, frames, INDIRECT);
+        p.vl.per_pixel = 2;
+        p.vl.candidates = 1;
+        float *plain = ts_render_with(s, &cam, &p, frames, INDIRECT);
+        p.vl.candidates = 16;
+        float *ris = ts_render_with(s, &cam, &p, frames, INDIRECT);
+        double ma = image_mean(all, NPIX), e_plain = rel_l2(plain, all, NPIX), e_ris = rel_l2(ris, all, NPIX);
+        printf("light selection, %s: mean ratio plain %.4f, resampled %.4f; L2 to the exhaustive sum %.3f, %.3f\n",
+               method_name(p.method), image_mean(plain, NPIX) / ma, image_mean(ris, NPIX) / ma, e_plain, e_ris);
+        CHECK_NEAR(image_mean(plain, NPIX) / ma, 1.0, 0.03, "%s: plain sampling by power is biased", method_name(p.method));
+        CHECK_NEAR(image_mean(ris, NPIX) / ma, 1.0, 0.03, "%s: resampled selection is biased", method_name(p.method));
+        CHECK(e_ris < 0.8 * e_plain, "%s: resampling did not reduce the noise (%.3f vs %.3f)", method_name(p.method),
+              e_ris, e_plain);
+        free(all);
+        free(plain);
+        free(ris);
+    }
+    scene_destroy(s);
+}
+
 /* A point light on a wall and one a micrometre off it: thousands of frames, nothing non-finite. */
 static void test_lights_touching_surfaces(void) {
     material m = material_default();
@@ -437,6 +472,7 @@ int main(void) {
     test_degenerate();
     test_diffuse_box_against_pt();
     test_glossy_box_energy();
+    test_light_selection_unbiased();
     test_lights_touching_surfaces();
     return check_exit("test_vsl");
 }

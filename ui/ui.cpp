@@ -66,6 +66,8 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
                              ImGuiSliderFlags_Logarithmic);
             ImGui::SliderInt("lights/pixel", &c->per_pixel, -1, 256, c->per_pixel < 0 ? "all" : "%d");
             if (c->per_pixel == 0) c->per_pixel = 1;
+            ImGui::SliderInt("candidates", &c->candidates, 1, 64, c->candidates > 1 ? "%d" : "1 (by power)",
+                             ImGuiSliderFlags_Logarithmic);
         }
     }
 

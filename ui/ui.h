@@ -28,6 +28,7 @@ typedef struct {
     int vl_count;      /* virtual lights per frame */
     int columns;       /* clusters; 0: none */
     int per_pixel;     /* lights shaded per pixel per frame; -1: all */
+    int candidates;    /* resampling candidates per shaded light; 1: by power alone */
     /* display settings: a change never resets */
     float exposure;    /* stops */
     int show;          /* UI_SHOW_* */

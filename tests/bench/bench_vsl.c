@@ -127,6 +127,9 @@ int main(int argc, char **argv) {
     run_times(&b, "vpl, clamped", vpl, times, nt);
     render_params vsl = {.method = METHOD_VSL};
     run_times(&b, "vsl", vsl, times, nt);
+    render_params plain = vsl;
+    plain.vl.candidates = 1;
+    run_times(&b, "vsl, lights picked by power only", plain, times, nt);
     vsl.vl.radius_shrink = 0.7f;
     run_times(&b, "vsl, radius shrink 0.7", vsl, times, nt);
 
