@@ -13,7 +13,7 @@ int film_init(film *f, int width, int height) {
     size_t n = (size_t)width * (size_t)height;
     f->width = width;
     f->height = height;
-    int ok = (f->count = calloc(n, sizeof(double))) != NULL;
+    int ok = (f->rejected = calloc(n, sizeof(uint32_t))) != NULL;
     for (int c = 0; c < COMP_COUNT; c++) ok &= (f->sum[c] = calloc(3 * n, sizeof(double))) != NULL;
     if (!ok) {
         film_deinit(f);
@@ -24,14 +24,15 @@ int film_init(film *f, int width, int height) {
 
 void film_deinit(film *f) {
     for (int c = 0; c < COMP_COUNT; c++) free(f->sum[c]);
-    free(f->count);
+    free(f->rejected);
     memset(f, 0, sizeof *f);
 }
 
 void film_clear(film *f) {
     size_t n = (size_t)f->width * (size_t)f->height;
     for (int c = 0; c < COMP_COUNT; c++) memset(f->sum[c], 0, 3 * n * sizeof(double));
-    memset(f->count, 0, n * sizeof(double));
+    memset(f->rejected, 0, n * sizeof(uint32_t));
+    f->passes = 0;
 }
 
 void film_resolve(const film *f, unsigned mask, float *rgb) {
@@ -45,7 +46,8 @@ void film_resolve(const film *f, unsigned mask, float *rgb) {
             acc[1] += s[1];
             acc[2] += s[2];
         }
-        double inv = f->count[i] > 0.0 ? 1.0 / f->count[i] : 0.0;
+        long long count = f->passes - (long long)f->rejected[i];
+        double inv = count > 0 ? 1.0 / (double)count : 0.0;
         for (int k = 0; k < 3; k++) rgb[3 * i + (size_t)k] = (float)(acc[k] * inv);
     }
 }

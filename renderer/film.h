@@ -21,26 +21,36 @@ typedef enum {
 
 extern const char *const film_component_names[COMP_COUNT]; /* "direct", "indirect", "highlights" */
 
+/* Accumulated in passes: each pass gives every pixel one sample, added (film_add) or dropped
+ * (film_reject), then film_end_pass. So the per-pixel sample count is passes − rejected and
+ * needs no per-pixel store on the hot path. */
 typedef struct {
     int width, height;
     double *sum[COMP_COUNT]; /* 3 per pixel */
-    double *count;           /* samples per pixel */
+    uint32_t *rejected;      /* per pixel: dropped samples (NaN or Inf) */
+    long long passes;
 } film;
 
 int film_init(film *f, int width, int height); /* 0 or -1 (out of memory) */
 void film_deinit(film *f);
 void film_clear(film *f);
 
-/* Adds one sample (3 floats per component) to pixel i. */
+/* Adds one sample (3 floats per component) to pixel i. A component that is zero is not
+ * touched: the film is tens of megabytes, and a ray into the void or an unused component
+ * would otherwise cost a cache miss per buffer. */
 static inline void film_add(film *f, int i, const float rgb[COMP_COUNT][3]) {
     for (int c = 0; c < COMP_COUNT; c++) {
+        if (rgb[c][0] == 0.0f && rgb[c][1] == 0.0f && rgb[c][2] == 0.0f) continue;
         double *s = f->sum[c] + 3 * (size_t)i;
         s[0] += (double)rgb[c][0];
         s[1] += (double)rgb[c][1];
         s[2] += (double)rgb[c][2];
     }
-    f->count[i] += 1.0;
 }
+
+/* Pixel i's sample of this pass was dropped: the pixel's mean is over its good samples. */
+static inline void film_reject(film *f, int i) { f->rejected[i]++; }
+static inline void film_end_pass(film *f) { f->passes++; }
 
 /* Mean radiance of the components in mask (bit c = component c) into rgb (3 floats per pixel). */
 void film_resolve(const film *f, unsigned mask, float *rgb);

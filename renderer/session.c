@@ -89,14 +89,14 @@ static void render_tile(void *ctx, int tile, int worker) {
     int x0 = (tile % rs->tiles_x) * TILE, y0 = (tile / rs->tiles_x) * TILE;
     int x1 = x0 + TILE < p->width ? x0 + TILE : p->width;
     int y1 = y0 + TILE < p->height ? y0 + TILE : p->height;
-    float aspect = (float)p->width / (float)p->height;
+    float aspect = (float)p->width / (float)p->height, tan_half_fov = tanf(0.5f * rs->cam.yfov);
     for (int y = y0; y < y1; y++) {
         for (int x = x0; x < x1; x++) {
             int pixel = y * p->width + x;
             rng_state rng = rng_for((uint64_t)pixel, (uint64_t)rs->frames, p->seed);
             vec2 j = rng_vec2(&rng);
-            vec3 d = camera_ray_dir(&rs->cam, aspect, ((float)x + j.x) / (float)p->width,
-                                    ((float)y + j.y) / (float)p->height);
+            vec3 d = camera_ray_dir_tan(&rs->cam, tan_half_fov, aspect, ((float)x + j.x) / (float)p->width,
+                                        ((float)y + j.y) / (float)p->height);
             vec3 L[COMP_COUNT];
             if (p->method == METHOD_PT) {
                 pt_radiance(s, p->max_depth, rs->cam.position, d, &rng, L, st->rays);
@@ -117,10 +117,13 @@ static void render_tile(void *ctx, int tile, int worker) {
                 sample[c][1] = L[c].y;
                 sample[c][2] = L[c].z;
             }
-            /* A NaN or Inf never reaches the film: the sample is dropped (the pixel's count
-             * stays, so its mean is over the good samples) and counted. */
-            if (finite) film_add(&rs->film, pixel, (const float(*)[3])sample);
-            else st->rejected_samples++;
+            /* A NaN or Inf never reaches the film: the sample is dropped and counted. */
+            if (finite) {
+                film_add(&rs->film, pixel, (const float(*)[3])sample);
+            } else {
+                film_reject(&rs->film, pixel);
+                st->rejected_samples++;
+            }
         }
     }
 }
@@ -131,6 +134,7 @@ int session_render_frame(render_session *rs) {
                               sizeof rs->error) != 0)
         return -1;
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
+    film_end_pass(&rs->film);
     rs->frames++;
     int n = threadpool_size(rs->pool);
     for (int w = 0; w < n; w++) {

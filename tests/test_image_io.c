@@ -3,7 +3,8 @@
  * are a closed-form function of the pixel, a DWAB file and reference texels produced by OpenEXR's
  * C++ library, image sizes read from the files' own headers, and PNGs decoded by stb_image. Also
  * the atomic writer's guarantees (no replace, no partial file, no temporary left behind) and that
- * broken files fail with a message instead of crashing (this test runs under ASan/UBSan). */
+ * broken files fail with a message instead of crashing (this test runs under ASan/UBSan). And the
+ * film's running means. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <dirent.h>
@@ -18,6 +19,7 @@
 #include <stb/stb_image.h>
 
 #include "check.h"
+#include "film.h"
 #include "image_io.h"
 
 static char dir[1024]; /* this run's scratch directory */
@@ -1001,6 +1003,32 @@ static void test_errors(void) {
     expect_load_error(renamed, "not an OpenEXR");
 }
 
+/* The film's means: components sum, zero samples count, a dropped sample leaves the mean over
+ * the pixel's good samples, a clear starts over. Values chosen so the means are exact. */
+static void test_film_means(void) {
+    film f;
+    CHECK(film_init(&f, 2, 1) == 0, "film_init");
+    float a[COMP_COUNT][3] = {{1, 2, 4}, {0.5f, 0, 0}, {0, 0, 0}}, zero[COMP_COUNT][3] = {{0}};
+    film_add(&f, 0, (const float(*)[3])a);
+    film_add(&f, 1, (const float(*)[3])a);
+    film_end_pass(&f);
+    film_add(&f, 0, (const float(*)[3])zero);
+    film_reject(&f, 1);
+    film_end_pass(&f);
+    float rgb[6];
+    film_resolve(&f, COMP_MASK_ALL, rgb);
+    CHECK(rgb[0] == 0.75f && rgb[1] == 1.0f && rgb[2] == 2.0f, "pixel 0 mean (%g %g %g), expected (0.75 1 2)",
+          (double)rgb[0], (double)rgb[1], (double)rgb[2]);
+    CHECK(rgb[3] == 1.5f && rgb[4] == 2.0f && rgb[5] == 4.0f, "pixel 1 mean over its good sample (%g %g %g)",
+          (double)rgb[3], (double)rgb[4], (double)rgb[5]);
+    film_resolve(&f, 1u << COMP_INDIRECT, rgb);
+    CHECK(rgb[0] == 0.25f && rgb[3] == 0.5f, "indirect component alone: %g %g", (double)rgb[0], (double)rgb[3]);
+    film_clear(&f);
+    film_resolve(&f, COMP_MASK_ALL, rgb);
+    CHECK(rgb[0] == 0.0f && rgb[5] == 0.0f, "a cleared film is not black");
+    film_deinit(&f);
+}
+
 int main(void) {
     const char *base = getenv("GLINT_TEST_TMP");
     snprintf(dir, sizeof dir, "%s/test_image_io.%ld", base && base[0] ? base : "/tmp", (long)getpid());
@@ -1017,6 +1045,7 @@ int main(void) {
     test_png();
     test_shared_env_maps();
     test_errors();
+    test_film_means();
     CHECK(stray_temp_files(dir) == 0, "temporary files left behind");
     int status = check_exit("test_image_io");
     if (status == 0) remove_tree(dir); /* a failed run keeps its files to look at */
