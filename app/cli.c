@@ -119,7 +119,7 @@ int cli_check_output_dir(const char *option, const char *path) {
 /* ---- many-light parameters ------------------------------------------------------------------- */
 
 const char *cli_vl_help(void) {
-    static char text[2048];
+    static char text[4096];
     snprintf(text, sizeof text,
              "many-light methods (vpl, vsl):\n"
              "  --vsl-count N        virtual lights traced per frame [%d]\n"
@@ -135,9 +135,11 @@ const char *cli_vl_help(void) {
              "  --per-pixel N|all    lights (cluster representatives) each pixel shades per frame,\n"
              "                       picked by power (cluster norm) [%d; all with --columns]\n"
              "  --candidates M       each of those is resampled from M candidates by its unshadowed\n"
-             "                       contribution at the pixel; 1 = plain sampling by power [%d]\n",
+             "                       contribution at the pixel; 1 = plain sampling by power [%d]\n"
+             "  --trace-glossy A|off receivers' glossy lobes with roughness alpha below A are not\n"
+             "                       gathered from the lights: the path goes on through them [%g]\n",
              VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_RADIUS_MULT, VL_DEFAULT_ROWS,
-             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES);
+             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES, (double)VL_DEFAULT_TRACE_GLOSSY);
     return text;
 }
 
@@ -189,6 +191,10 @@ int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
     } else if (strcmp(name, "candidates") == 0) {
         if (cli_parse_int(option, value, 1, 4096, &n)) return -1;
         vl->candidates = (int)n;
+    } else if (strcmp(name, "trace-glossy") == 0) {
+        if (strcmp(value, "off") == 0) vl->trace_glossy = -1.0f;
+        else if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
+        else vl->trace_glossy = x > 0.0 ? (float)x : -1.0f; /* 0 is off too, not the default */
     } else {
         return 0;
     }
@@ -200,7 +206,8 @@ int cli_vl_option(int argc, char **argv, int *i, vl_params *vl) {
     if (strncmp(a, "--", 2) != 0) return 0;
     if (strcmp(a, "--vpl-glossy") == 0) return cli_set_vl_param("vpl-glossy", "on", vl);
     static const char *const names[] = {"vsl-count", "clamp", "clamp-value", "clamp-growth", "radius-mult",
-                                         "radius-shrink", "rows", "columns", "per-pixel", "candidates"};
+                                         "radius-shrink", "rows", "columns", "per-pixel", "candidates",
+                                         "trace-glossy"};
     int ours = 0;
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) ours |= strcmp(a + 2, names[k]) == 0;
     if (!ours) return 0;

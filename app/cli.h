@@ -27,7 +27,8 @@ const char *cli_value(int argc, char **argv, int *i);
 
 /* The many-light parameters, shared by glint render, the viewer's options and its script's `set`.
  * cli_set_vl_param takes a name without the leading "--" (vsl-count, clamp, clamp-value,
- * clamp-growth, vpl-glossy, radius-mult, radius-shrink, rows, columns, per-pixel, candidates) and
+ * clamp-growth, vpl-glossy, radius-mult, radius-shrink, rows, columns, per-pixel, candidates,
+ * trace-glossy) and
  * a value (vpl-glossy: on/off). Returns 1 when applied, 0 when name is not one of them, -1 on a
  * bad value (reported). cli_vl_option does the same for argv[*i] and its value, advancing *i. */
 int cli_set_vl_param(const char *name, const char *value, vl_params *vl);

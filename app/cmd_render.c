@@ -214,6 +214,7 @@ static int write_stats(const char *path, const render_options *o, const render_s
         fprintf(f, "  \"light_paths_total\": %llu,\n  \"connections\": %llu,\n  \"vsl_samples\": %llu,\n",
                 (unsigned long long)st.light_paths, (unsigned long long)st.vl_connections,
                 (unsigned long long)st.vsl_samples);
+        fprintf(f, "  \"glossy_bounces\": %llu,\n", (unsigned long long)st.glossy_bounces);
         fprintf(f, "  \"clamped\": %llu,\n  \"rows\": %d,\n  \"columns\": %d", (unsigned long long)st.clamped,
                 vp->columns > 0 ? (vp->rows > 0 ? vp->rows : VL_DEFAULT_ROWS) : 0, vp->columns);
     }

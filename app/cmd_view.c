@@ -384,6 +384,7 @@ static vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
     vl.columns = c->columns;
     vl.per_pixel = c->per_pixel;
     vl.candidates = c->candidates;
+    vl.trace_glossy = c->trace_glossy > 0.0f ? c->trace_glossy : -1.0f;
     return vl;
 }
 
@@ -396,12 +397,13 @@ static void controls_from_vl(ui_controls *c, const vl_params *vl) {
     c->columns = vl->columns;
     c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);
     c->candidates = vl->candidates > 0 ? vl->candidates : VL_DEFAULT_CANDIDATES;
+    c->trace_glossy = vl->trace_glossy > 0.0f ? vl->trace_glossy : vl->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
 }
 
 static int vl_controls_differ(const ui_controls *a, const ui_controls *b) {
     return a->clamp != b->clamp || a->clamp_value != b->clamp_value || a->radius_mult != b->radius_mult ||
            a->radius_shrink != b->radius_shrink || a->vl_count != b->vl_count || a->columns != b->columns ||
-           a->per_pixel != b->per_pixel || a->candidates != b->candidates;
+           a->per_pixel != b->per_pixel || a->candidates != b->candidates || a->trace_glossy != b->trace_glossy;
 }
 
 /* Sends the camera and estimator settings to the render thread; each call is a change that
@@ -487,11 +489,12 @@ static void request_load(ui_thread *u, int kind, const char *path) {
 static void print_stats(ui_thread *u) {
     printf("stats scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
-           "candidates=%d virtual_lights=%llu\n",
+           "candidates=%d trace_glossy=%g virtual_lights=%llu\n",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
            u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
            method_name((render_method)u->ctl.method), u->rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
-           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.candidates, u->virtual_lights);
+           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.candidates,
+           (double)u->ctl.trace_glossy, u->virtual_lights);
     fflush(stdout);
 }
 

@@ -66,6 +66,14 @@ int bsdf_lobes(const bsdf *b) {
     return lobes;
 }
 
+float bsdf_glossy_alpha(const bsdf *b) {
+    if (!(bsdf_lobes(b) & BSDF_GLOSSY)) return 0.0f;
+    /* Phong's cos^n and a Beckmann-like lobe of roughness alpha match for n = 2 / alpha^2 - 2
+     * (Walter et al. 2007). */
+    if (b->model == GLOSSY_PHONG) return sqrtf(2.0f / (b->exponent + 2.0f));
+    return sqrtf(b->alpha_x * b->alpha_y);
+}
+
 /* ---- GGX ------------------------------------------------------------------------------------ */
 
 static float ggx_d(const bsdf *b, vec3 h) {

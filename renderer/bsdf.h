@@ -71,6 +71,9 @@ int bsdf_sample(const bsdf *b, vec3 wo, int lobes, float u_lobe, vec2 u, bsdf_sa
 
 /* Which lobes are present (non-zero). */
 int bsdf_lobes(const bsdf *b);
+/* The glossy lobe's width as a microfacet roughness alpha (geometric mean of the two axes;
+ * Phong through its equivalent exponent); 0 without a glossy lobe. */
+float bsdf_glossy_alpha(const bsdf *b);
 /* Probability that bsdf_sample picks the glossy lobe for this wo (0 or 1 with one lobe). */
 float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes);
 

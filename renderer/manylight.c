@@ -241,6 +241,42 @@ static int cluster_lights(manylight *m, const scene *s, const camera *cam, const
     return status;
 }
 
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, int max_depth, rng_state *rng,
+                        render_stats *st) {
+    vec3 sum = v3(0, 0, 0), beta = v3s(1.0f);
+    shading_point x = *x0;
+    /* x is scattering event k: gathering there makes paths of k + 1 events or more. */
+    for (int k = 1; k + 1 <= max_depth; k++) {
+        int sharp = (bsdf_lobes(&x.b) & BSDF_GLOSSY) && bsdf_glossy_alpha(&x.b) < m->trace_alpha;
+        if (!sharp) return add3(sum, mul3(beta, manylight_shade(m, s, &x, rng, st)));
+        shading_point diffuse_only = x;
+        diffuse_only.b.model = GLOSSY_NONE;
+        sum = add3(sum, mul3(beta, manylight_shade(m, s, &diffuse_only, rng, st)));
+
+        float u_lobe = rng_float(rng);
+        vec2 u = rng_vec2(rng);
+        bsdf_sample_result bs;
+        if (!bsdf_sample(&x.b, x.wo, BSDF_GLOSSY, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) break;
+        vec3 wi = to_world(x.frame, bs.wi);
+        if (dot3(wi, x.ng) <= 0.0f) break;
+        beta = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
+        if (k >= 3) { /* Russian roulette, as the path tracer does */
+            float q = fminf(0.95f, max_comp3(beta));
+            if (rng_float(rng) >= q) break;
+            beta = scale3(beta, 1.0f / q);
+        }
+        if (is_black3(beta) || !is_finite3(beta)) break;
+        st->glossy_bounces++;
+        /* Emission at the next hit is the direct light at x, which the shared estimator has. */
+        surface_hit h;
+        vec3 direct;
+        if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, rng, &direct, &h, st->rays)) break;
+        sum = add3(sum, mul3(beta, direct));
+        x = shading_point_at(s, &h, wi);
+    }
+    return sum;
+}
+
 int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
                           threadpool *pool, render_stats *st, char *err, size_t errlen) {
     const vl_params *vp = &p->vl;
@@ -265,6 +301,7 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     int clustering = vp->columns > 0 && vp->columns < m->set.count;
     m->per_pixel = vp->per_pixel > 0 ? vp->per_pixel : (clustering || vp->per_pixel < 0 ? 0 : VL_DEFAULT_PER_PIXEL);
     m->candidates = vp->candidates > 0 ? vp->candidates : VL_DEFAULT_CANDIDATES;
+    m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : vp->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
     if (clustering) {
         if (cluster_lights(m, s, cam, p, frame, pool, st) != 0) return snprintf(err, errlen, "out of memory for the light clusters"), -1;
         m->clustered = 1;

@@ -24,6 +24,7 @@ typedef struct {
     float radius_mult;  /* this frame's multiplier */
     int per_pixel;      /* 0: every entry */
     int candidates;     /* resampling candidates per sampled entry (1: plain sampling by pick) */
+    float trace_alpha;  /* glossy lobes sharper than this are traced through, not gathered */
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;
@@ -38,8 +39,15 @@ void manylight_deinit(manylight *m);
 int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
                           threadpool *pool, render_stats *st, char *err, size_t errlen);
 
-/* Indirect light at x from this frame's virtual lights (visibility, clamping, scaling included). */
+/* Light at x from this frame's virtual lights (visibility, clamping, scaling included). */
 vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, rng_state *rng, render_stats *st);
+
+/* Indirect light at the camera hit x (scattering event 1 of at most max_depth): gathered from
+ * the virtual lights, except through a glossy lobe sharper than trace_alpha, where a handful of
+ * lights cannot represent the incoming light: that lobe is sampled, and the path picks up the
+ * direct light at the next hit and gathers there (the same rule again). */
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, int max_depth, rng_state *rng,
+                        render_stats *st);
 
 /* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
 shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);

@@ -8,10 +8,11 @@ static inline film_component component_of(int emitter_vertex) {
     return emitter_vertex <= 1 ? COMP_DIRECT : COMP_INDIRECT;
 }
 
-/* The path tracer; *first (optional) receives the camera ray's hit, and the return value says
- * whether there was one. */
+/* The path tracer; *first (optional) receives the first hit, and the return value says whether
+ * there was one. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
+ * first belongs to that path's direct light and is not counted. */
 static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
-                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first) {
+                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first, int continuation) {
     int hit_any = 0;
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
@@ -19,10 +20,10 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
     vec3 prev_p = o;
     for (int depth = 0;; depth++) {
         surface_hit h;
-        rays[depth == 0 ? RAY_CAMERA : RAY_BOUNCE]++;
+        rays[depth == 0 && !continuation ? RAY_CAMERA : RAY_BOUNCE]++;
         if (!scene_intersect(s, o, d, INFINITY, &h)) {
             vec3 le = env_eval(s, d);
-            if (!is_black3(le)) {
+            if (!is_black3(le) && (depth > 0 || !continuation)) {
                 float w = depth == 0 ? 1.0f : mis_power(prev_pdf, light_pdf_env(s, d));
                 out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
             }
@@ -33,7 +34,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
             if (first) *first = h;
         }
         vec3 le = material_emission(s, &h);
-        if (!is_black3(le)) {
+        if (!is_black3(le) && (depth > 0 || !continuation)) {
             float w = 1.0f;
             if (depth > 0) {
                 int li = s->tri_light[h.tri];
@@ -99,13 +100,21 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
 
 void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
                  uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, rng, out, rays, NULL);
+    trace_path(s, max_depth, o, d, rng, out, rays, NULL, 0);
 }
 
 int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
               uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
-    int hit = trace_path(s, 1, o, d, rng, out, rays, first);
+    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 0);
+    *direct = out[COMP_DIRECT];
+    return hit;
+}
+
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
+                        uint64_t rays[RAY_KIND_COUNT]) {
+    vec3 out[COMP_COUNT];
+    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 1);
     *direct = out[COMP_DIRECT];
     return hit;
 }

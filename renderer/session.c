@@ -106,7 +106,7 @@ static void render_tile(void *ctx, int tile, int worker) {
                 for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
                 if (pt_direct(s, rs->cam.position, d, &rng, &L[COMP_DIRECT], &h, st->rays) && p->max_depth > 1) {
                     shading_point sp = shading_point_at(s, &h, d);
-                    L[COMP_INDIRECT] = manylight_shade(&rs->ml, s, &sp, &rng, st);
+                    L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, p->max_depth, &rng, st);
                 }
             }
             float sample[COMP_COUNT][3];
@@ -145,6 +145,7 @@ int session_render_frame(render_session *rs) {
         t->vl_connections += st->vl_connections;
         t->vsl_samples += st->vsl_samples;
         t->clamped += st->clamped;
+        t->glossy_bounces += st->glossy_bounces;
         memset(st, 0, sizeof *st);
     }
     return 0;

@@ -39,6 +39,10 @@ typedef struct {
     int candidates;      /* per sampled light: candidates drawn by power (or cluster norm) and
                           * resampled by their unshadowed contribution at the pixel; 1: none
                           * [VL_DEFAULT_CANDIDATES] */
+    float trace_glossy;  /* a receiver's glossy lobe with roughness alpha below this is not
+                          * gathered from the lights: the camera path goes on through it (BSDF
+                          * sampling, direct light at the next hit, gathering there); < 0: never
+                          * [VL_DEFAULT_TRACE_GLOSSY] */
     int highlights;      /* the highlight estimator owns glossy-glossy first-bounce paths */
 } vl_params;
 
@@ -51,6 +55,7 @@ enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
 #define VL_DEFAULT_ROWS 300
 #define VL_DEFAULT_PER_PIXEL 4
 #define VL_DEFAULT_CANDIDATES 4
+#define VL_DEFAULT_TRACE_GLOSSY 0.2f
 
 /* Zero means default for every field. */
 typedef struct {
@@ -74,6 +79,7 @@ typedef struct {
     uint64_t vl_connections;   /* shading point - virtual light evaluations */
     uint64_t vsl_samples;      /* integration samples of the VSL integrals */
     uint64_t clamped;          /* contributions the clamp cut down */
+    uint64_t glossy_bounces;   /* camera paths continued through a sharp glossy lobe (--trace-glossy) */
 } render_stats;
 
 typedef struct render_session render_session;

@@ -200,7 +200,8 @@ static void test_outputs(void) {
 static void test_many_light_options(void) {
     CHECK(run("render --help") == 0, "render --help exit code");
     const char *options[] = {"--vsl-count", "--clamp ", "--clamp-value", "--clamp-growth", "--vpl-glossy", "--radius-mult",
-                             "--radius-shrink", "--rows", "--columns", "--per-pixel", "--candidates"};
+                             "--radius-shrink", "--rows", "--columns", "--per-pixel", "--candidates",
+                             "--trace-glossy"};
     for (size_t i = 0; i < sizeof options / sizeof options[0]; i++)
         CHECK(strstr(out_text, options[i]) != NULL, "render help does not mention %s", options[i]);
 
@@ -212,6 +213,7 @@ static void test_many_light_options(void) {
     expect_failure("render --method vsl --candidates 0", 2, "--candidates");
     expect_failure("render --method vsl --per-pixel none", 2, "--per-pixel");
     expect_failure("render --method vsl --vsl-count", 2, "--vsl-count");
+    expect_failure("render --method vsl --trace-glossy sharp", 2, "--trace-glossy");
 
     char p[1024], json[8192], err[512];
     /* A tiny clamp bound clamps; switching clamping off clamps nothing. */
@@ -234,8 +236,14 @@ static void test_many_light_options(void) {
     CHECK(rc == 0, "vsl render: exit %d: %s", rc, err_text);
     snprintf(p, sizeof p, "%s/vsl.json", tmp);
     read_file(p, json, sizeof json);
-    CHECK(strstr(json, "\"method\": \"vsl\"") && strstr(json, "\"columns\": 32") && !strstr(json, "\"vsl_samples\": 0,"),
+    /* The default scene's metals are sharper than the default --trace-glossy: paths go through. */
+    CHECK(strstr(json, "\"method\": \"vsl\"") && strstr(json, "\"columns\": 32") && !strstr(json, "\"vsl_samples\": 0,") &&
+              !strstr(json, "\"glossy_bounces\": 0,"),
           "vsl stats json: %s", json);
+    rc = run("render --method vsl --spp 1 --size 32x18 --vsl-count 64 --trace-glossy off --stats off.json --quiet");
+    snprintf(p, sizeof p, "%s/off.json", tmp);
+    read_file(p, json, sizeof json);
+    CHECK(rc == 0 && strstr(json, "\"glossy_bounces\": 0,"), "--trace-glossy off still traced: %s", json);
     snprintf(p, sizeof p, "%s/vsl.exr", tmp);
     exr_image exr;
     if (exr_image_load(p, &exr, err, sizeof err) == 0) {

@@ -89,6 +89,35 @@ grep -q 'broken.gltf' err.txt || fail "the bad scene file's error was not report
 head -c 2000 image.exr | grep -q 'direct.R' || fail "EXR export lacks the direct layer"
 ls | grep -q '\.tmp' && fail "temporary files left behind: $(ls)"
 
+# The many-light parameters change live: each change resets the accumulation and shows in the
+# stats; a bad value is reported with its line and leaves the last good value.
+cat >manylight.txt <<'EOF'
+set method vsl
+set vsl-count 128
+wait 1
+stats
+set radius-mult 4
+set candidates 8
+set trace-glossy 0.4
+wait 1
+stats
+set radius-mult -2
+stats
+quit
+EOF
+view --size 96x54 --script manylight.txt
+rc=$?
+[ $rc -eq 1 ] || fail "many-light session with a bad value: exit $rc, expected 1: $(cat err.txt)"
+grep -q 'manylight.txt:10:' err.txt || fail "bad radius multiplier not reported with its line: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 3 ] || fail "many-light session: expected 3 stats lines, got: $(cat out.txt)"
+[ "$(field 1 method)" = "vsl" ] && [ "$(field 1 vsl_count)" = "128" ] || fail "method or light count not applied"
+[ "$(field 1 virtual_lights)" -gt 0 ] || fail "vsl traced no virtual lights"
+[ "$(field 2 radius_mult)" = "4" ] && [ "$(field 2 candidates)" = "8" ] && [ "$(field 2 trace_glossy)" = "0.4" ] ||
+  fail "radius, candidates or trace-glossy not applied"
+[ "$(field 2 resets)" -gt "$(field 1 resets)" ] || fail "a many-light change did not reset the accumulation"
+[ "$(field 3 radius_mult)" = "4" ] || fail "a bad radius multiplier replaced the last good one"
+
 # A bad script line is reported with its line number, before any window opens.
 printf 'wait 1\nfrobnicate 3\n' >bad.txt
 view --script bad.txt

@@ -380,9 +380,11 @@ static void test_glossy_box_energy(void) {
     float *ref = ts_render(s, &cam, W, H, 2048, 8, 2, INDIRECT);
     render_params p = vl_params_for(METHOD_VPL, 1024);
     p.vl.clamp_value = 0.1f; /* a typical bound: below the brightest indirect radiance (~0.4) */
+    p.vl.trace_glossy = -1.0f; /* the paper's baseline: every lobe gathered */
     float *vpl = ts_render_with(s, &cam, &p, 16, INDIRECT);
     p = vl_params_for(METHOD_VSL, 1024);
     p.vl.radius_mult = 1.0f;
+    p.vl.trace_glossy = -1.0f; /* the VSL kernel itself gathers the glossy lobes, as in the paper */
     float *vsl = ts_render_with(s, &cam, &p, 16, INDIRECT);
     double r = image_mean(ref, NPIX), a = image_mean(vpl, NPIX) / r, b = image_mean(vsl, NPIX) / r;
     printf("glossy box: indirect energy vs path tracing: clamped VPL %.3f, VSL %.3f; L2 error VPL %.3f, VSL %.3f\n", a,
@@ -412,6 +414,7 @@ static void test_light_selection_unbiased(void) {
         const int frames = 200;
         render_params p = vl_params_for((render_method)method, 256);
         p.vl.clamp = VL_CLAMP_OFF;
+        p.vl.trace_glossy = -1.0f; /* every lobe gathered: the selection is all that differs */
         float *all = ts_render_with(s, &cam, &p, frames, INDIRECT);
         p.vl.per_pixel = 2;
         p.vl.candidates = 1;
@@ -432,6 +435,70 @@ static void test_light_selection_unbiased(void) {
     scene_destroy(s);
 }
 
+/* Receivers whose glossy lobe is sharper than --trace-glossy are traced through, not gathered.
+ * In a box of purely glossy walls below the threshold nothing is ever gathered, so the
+ * many-light methods' indirect light is path tracing through the lobes with direct light at each
+ * next hit: it must match the path tracer's within noise, at several depths. With the threshold
+ * below the walls' roughness, no path is continued and the light comes from the virtual lights. */
+static void test_trace_glossy_matches_pt(void) {
+    material m = material_default();
+    m.model = MATERIAL_PHONG;
+    m.kd = v3s(0.0f);
+    m.ks = v3s(0.8f);
+    m.exponent = 30.0f; /* alpha 0.25: broad enough that a few bright pixels do not make the mean */
+    camera cam = box_camera();
+    /* The point light's box; then the same walls lit by an emissive panel under the ceiling, whose
+     * emission the traced paths hit and must leave to the direct estimator. */
+    scene *boxes[2] = {closed_box(m, v3(0.3f, 0.5f, 0.2f)), ts_new("glossy box with a panel light")};
+    ts_box(boxes[1], v3(-1, -1, -1), v3(1, 1, 1), 1, ts_material(boxes[1], m));
+    ts_quad(boxes[1], v3(-0.3f, 0.98f, -0.3f), v3(0.3f, 0.98f, -0.3f), v3(0.3f, 0.98f, 0.3f), v3(-0.3f, 0.98f, 0.3f),
+            ts_lambert(boxes[1], v3s(0.0f), v3s(4.0f), 0));
+    ts_finalize(boxes[1]);
+    int depths[2] = {2, 5};
+    for (int k = 0; k < 2; k++) {
+        const scene *s = boxes[k];
+        float *ref = ts_render(s, &cam, W, H, 8192, depths[k], 5, INDIRECT);
+        float *pt = ts_render(s, &cam, W, H, 2048, depths[k], 6, INDIRECT);
+        render_params p = vl_params_for(METHOD_VSL, 64);
+        p.max_depth = depths[k];
+        p.vl.trace_glossy = 0.3f;
+        char err[256];
+        render_session *rs = session_create(s, &cam, &p, err, sizeof err);
+        for (int f = 0; f < 2048; f++) session_render_frame(rs);
+        float *traced = malloc(sizeof(float) * 3 * NPIX);
+        film_resolve(session_film(rs), INDIRECT, traced);
+        render_stats st = session_stats(rs);
+        session_destroy(rs);
+        double ratio = image_mean(traced, NPIX) / image_mean(ref, NPIX);
+        double e_traced = rel_l2(traced, ref, NPIX), e_pt = rel_l2(pt, ref, NPIX);
+        printf("traced glossy box %d, depth %d: mean ratio to PT %.4f, L2 %.4f (an equal PT render: %.4f, %.4f), %llu "
+               "bounces\n",
+               k, depths[k], ratio, e_traced, image_mean(pt, NPIX) / image_mean(ref, NPIX), e_pt,
+               (unsigned long long)st.glossy_bounces);
+        CHECK(fabs(ratio - 1.0) < 0.03, "depth %d: traced glossy indirect mean off by %+.4f", depths[k], ratio - 1.0);
+        CHECK(e_traced < 1.5 * e_pt + 0.01, "depth %d: traced glossy indirect L2 %.4f vs path tracing's %.4f", depths[k],
+              e_traced, e_pt);
+        CHECK(st.glossy_bounces >= (uint64_t)(0.95 * 2048 * NPIX), "depth %d: only %llu glossy bounces", depths[k],
+              (unsigned long long)st.glossy_bounces);
+        CHECK(st.vl_connections == 0, "depth %d: %llu virtual lights shaded where nothing is gathered", depths[k],
+              (unsigned long long)st.vl_connections);
+        free(ref);
+        free(pt);
+        free(traced);
+    }
+    render_params p = vl_params_for(METHOD_VSL, 64);
+    p.vl.trace_glossy = 0.2f; /* below the walls' alpha: gathered */
+    char err[256];
+    render_session *rs = session_create(boxes[0], &cam, &p, err, sizeof err);
+    session_render_frame(rs);
+    render_stats st = session_stats(rs);
+    CHECK(st.glossy_bounces == 0 && st.vl_connections > 0, "lobes above the threshold: %llu bounces, %llu connections",
+          (unsigned long long)st.glossy_bounces, (unsigned long long)st.vl_connections);
+    session_destroy(rs);
+    scene_destroy(boxes[0]);
+    scene_destroy(boxes[1]);
+}
+
 /* A point light on a wall and one a micrometre off it: thousands of frames, nothing non-finite. */
 static void test_lights_touching_surfaces(void) {
     material m = material_default();
@@ -443,8 +510,10 @@ static void test_lights_touching_surfaces(void) {
     for (int k = 0; k < 2; k++) {
         scene *s = closed_box(m, spots[k]);
         camera cam = box_camera();
-        for (int method = METHOD_VPL; method <= METHOD_VSL; method++) {
-            render_params p = {.width = 8, .height = 6, .method = (render_method)method, .max_depth = 6, .seed = 3};
+        for (int run = 0; run < 4; run++) { /* vpl, vsl; sharp lobes traced through, then gathered */
+            render_params p = {.width = 8, .height = 6, .method = (render_method)(METHOD_VPL + run / 2), .max_depth = 6,
+                               .seed = 3};
+            p.vl.trace_glossy = run % 2 ? -1.0f : 0.0f;
             p.vl.count = 32;
             p.vl.per_pixel = 4;
             p.vl.clamp = VL_CLAMP_OFF;
@@ -454,9 +523,9 @@ static void test_lights_touching_surfaces(void) {
             float img[8 * 6 * 3];
             film_resolve(session_film(rs), COMP_MASK_ALL, img);
             render_stats st = session_stats(rs);
-            CHECK(st.rejected_samples == 0, "light %d, %s: %llu samples were NaN or Inf", k, method_name(p.method),
+            CHECK(st.rejected_samples == 0, "light %d, %s, run %d: %llu samples were NaN or Inf", k, method_name(p.method), run,
                   (unsigned long long)st.rejected_samples);
-            CHECK(all_finite(img, 48), "light %d, %s: non-finite pixels", k, method_name(p.method));
+            CHECK(all_finite(img, 48), "light %d, %s, run %d: non-finite pixels", k, method_name(p.method), run);
             CHECK(st.virtual_lights >= 2000u * 32u, "light %d: virtual_lights_total %llu", k,
                   (unsigned long long)st.virtual_lights);
             session_destroy(rs);
@@ -473,6 +542,7 @@ int main(void) {
     test_diffuse_box_against_pt();
     test_glossy_box_energy();
     test_light_selection_unbiased();
+    test_trace_glossy_matches_pt();
     test_lights_touching_surfaces();
     return check_exit("test_vsl");
 }

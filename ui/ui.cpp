@@ -68,6 +68,8 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
             if (c->per_pixel == 0) c->per_pixel = 1;
             ImGui::SliderInt("candidates", &c->candidates, 1, 64, c->candidates > 1 ? "%d" : "1 (by power)",
                              ImGuiSliderFlags_Logarithmic);
+            ImGui::SliderFloat("trace glossy below", &c->trace_glossy, 0.0f, 1.0f,
+                               c->trace_glossy > 0.0f ? "alpha %.2f" : "never");
         }
     }
 

@@ -29,6 +29,7 @@ typedef struct {
     int columns;       /* clusters; 0: none */
     int per_pixel;     /* lights shaded per pixel per frame; -1: all */
     int candidates;    /* resampling candidates per shaded light; 1: by power alone */
+    float trace_glossy; /* glossy lobes with alpha below this are traced through; 0: never */
     /* display settings: a change never resets */
     float exposure;    /* stops */
     int show;          /* UI_SHOW_* */

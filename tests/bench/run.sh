@@ -3,9 +3,14 @@
 #   1. Path-tracing throughput against Embree's own `pathtracer` (embree-tools) on the same
 #      triangles, camera, point light, size, spp and path length.
 #   2. Load + BVH build time and peak memory for the 1.04 M-triangle sphere grid.
-# Usage: tests/bench/run.sh [SHARED_SCENES_DIR]
+#   3. With `vsl` first: the VSL paper's comparisons on the default scene (bench_vsl: equal-time
+#      error of pt, vpl and vsl against a 20-minute path-traced reference, cached in
+#      build/bench-cache, and the Fig. 8 sweeps), about 10 minutes plus the reference.
+# Usage: tests/bench/run.sh [vsl] [SHARED_SCENES_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
+mode=pt
+if [ "${1:-}" = vsl ]; then mode=vsl; shift; fi
 scenes=${1:-$root/../shared/scenes}
 build=$root/build
 source "$root/scripts/deps.sh"
@@ -14,6 +19,13 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DGLINT_TESTS=OFF >/dev/
 cmake --build "$build" -j"$(nproc)" >/dev/null
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+
+if [ "$mode" = vsl ]; then
+  mkdir -p "$build/bench-cache"
+  echo "## The VSL paper's comparisons, default scene ($(nproc) threads, $(date +%F))"
+  "$build/tests/bench/bench_vsl" default "$build/bench-cache/default-320x180-pt1200s.exr" 320x180 1200 10,60 10
+  exit 0
+fi
 
 seconds_of() { # wall seconds of a command, its output discarded
   local t0 t1
