@@ -55,7 +55,7 @@ enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
 #define VL_DEFAULT_ROWS 300
 #define VL_DEFAULT_PER_PIXEL 4
 #define VL_DEFAULT_CANDIDATES 1
-#define VL_DEFAULT_TRACE_GLOSSY 0.2f
+#define VL_DEFAULT_TRACE_GLOSSY 0.35f
 
 /* Zero means default for every field. */
 typedef struct {
