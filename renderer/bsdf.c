@@ -68,9 +68,10 @@ int bsdf_lobes(const bsdf *b) {
 
 float bsdf_glossy_alpha(const bsdf *b) {
     if (!(bsdf_lobes(b) & BSDF_GLOSSY)) return 0.0f;
-    /* Phong's cos^n and a Beckmann-like lobe of roughness alpha match for n = 2 / alpha^2 - 2
-     * (Walter et al. 2007). */
-    if (b->model == GLOSSY_PHONG) return sqrtf(2.0f / (b->exponent + 2.0f));
+    /* Blinn's cos^m of the half-vector angle matches a microfacet lobe of roughness alpha for
+     * m = 2 / alpha^2 - 2 (Walter et al. 2007); Phong's cos^n of the angle to the mirror direction,
+     * twice the half-vector angle near the peak, is Blinn's with m = 4n. */
+    if (b->model == GLOSSY_PHONG) return sqrtf(1.0f / (2.0f * b->exponent + 1.0f));
     return sqrtf(b->alpha_x * b->alpha_y);
 }
 

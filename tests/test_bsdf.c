@@ -300,6 +300,47 @@ static void test_traps(void) {
     CHECK_NEAR(hemisphere_integral(pdf_integrand, &ec, v3(0, 0, 1), 20000, 8), 1.0, 0.02, "Phong 1e6 pdf integral");
 }
 
+/* Median angle between sampled directions and the mirror direction at normal incidence. */
+static double median_reflected_angle(const bsdf *b, uint64_t seed) {
+    enum { N = 20001 };
+    static double angle[N];
+    rng_state rng = rng_make(seed, 4);
+    int n = 0;
+    for (int i = 0; i < N; i++) {
+        bsdf_sample_result s;
+        float u_lobe = rng_float(&rng);
+        vec2 u = rng_vec2(&rng);
+        if (bsdf_sample(b, v3(0, 0, 1), BSDF_GLOSSY, u_lobe, u, &s)) angle[n++] = acos(fmin(1.0, (double)s.wi.z));
+    }
+    for (int i = 1; i < n; i++) /* insertion sort is plenty here */
+        for (int j = i; j > 0 && angle[j - 1] > angle[j]; j--) {
+            double t = angle[j];
+            angle[j] = angle[j - 1];
+            angle[j - 1] = t;
+        }
+    return n ? angle[n / 2] : 0.0;
+}
+
+/* bsdf_glossy_alpha puts lobes of different models on one roughness scale: a GGX lobe of the
+ * alpha a Phong lobe reports spreads its reflections about as wide (median angle within 30%; the
+ * two shapes differ in their tails, and a slip by the factor of two between half-vector and
+ * mirror-direction angles would show as ~2.4). */
+static void test_glossy_alpha_scale(void) {
+    const float exponents[] = {30.0f, 300.0f, 3000.0f};
+    for (int k = 0; k < 3; k++) {
+        bsdf phong = make_bsdf_phong(v3s(0.0f), v3s(1.0f), exponents[k]);
+        float alpha = bsdf_glossy_alpha(&phong);
+        bsdf ggx = make_bsdf_gltf(v3s(1.0f), 1.0f, sqrtf(alpha), 0.0f);
+        CHECK(fabsf(bsdf_glossy_alpha(&ggx) - alpha) < 1e-4f * alpha + 1e-7f, "ggx alpha %g, expected %g",
+              (double)bsdf_glossy_alpha(&ggx), (double)alpha);
+        double a = median_reflected_angle(&phong, 70 + (uint64_t)k), b = median_reflected_angle(&ggx, 80 + (uint64_t)k);
+        CHECK(b / a > 1.0 / 1.3 && b / a < 1.3, "phong n=%g: median reflected angle %.4f, ggx of alpha %.4f: %.4f",
+              (double)exponents[k], a, (double)alpha, b);
+    }
+    bsdf lambert = make_bsdf_lambert(v3s(0.5f));
+    CHECK(bsdf_glossy_alpha(&lambert) == 0.0f, "a lobe-less bsdf has a glossy alpha");
+}
+
 int main(void) {
     const material mats[] = {
         {"lambert", make_bsdf_lambert(v3(0.8f, 0.6f, 0.4f)), 1},
@@ -328,5 +369,6 @@ int main(void) {
     test_ggx_reference();
     test_furnace();
     test_traps();
+    test_glossy_alpha_scale();
     return check_exit("test_bsdf");
 }

@@ -445,7 +445,7 @@ static void test_trace_glossy_matches_pt(void) {
     m.model = MATERIAL_PHONG;
     m.kd = v3s(0.0f);
     m.ks = v3s(0.8f);
-    m.exponent = 30.0f; /* alpha 0.25: broad enough that a few bright pixels do not make the mean */
+    m.exponent = 30.0f; /* alpha 0.13: broad enough that a few bright pixels do not make the mean */
     camera cam = box_camera();
     /* The point light's box; then the same walls lit by an emissive panel under the ceiling, whose
      * emission the traced paths hit and must leave to the direct estimator. */
@@ -487,7 +487,7 @@ static void test_trace_glossy_matches_pt(void) {
         free(traced);
     }
     render_params p = vl_params_for(METHOD_VSL, 64);
-    p.vl.trace_glossy = 0.2f; /* below the walls' alpha: gathered */
+    p.vl.trace_glossy = 0.1f; /* below the walls' alpha: gathered */
     char err[256];
     render_session *rs = session_create(boxes[0], &cam, &p, err, sizeof err);
     session_render_frame(rs);
