@@ -66,6 +66,15 @@ int bsdf_lobes(const bsdf *b) {
     return lobes;
 }
 
+vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo) {
+    if (!(bsdf_lobes(b) & BSDF_GLOSSY) || wo.z <= 0.0f) return v3s(0.0f);
+    /* A sharp lobe reflects about its mirror direction, where the half vector is the normal: GGX
+     * is Fresnel at wo; modified Phong (no cosine in f) is ks times the mirror's cosine, wo.z;
+     * Ward's normalisation keeps it at ks. */
+    if (b->model == GLOSSY_GGX) return schlick_fresnel(b->specular, wo.z);
+    return b->model == GLOSSY_PHONG ? scale3(b->specular, wo.z) : b->specular;
+}
+
 float bsdf_glossy_alpha(const bsdf *b) {
     if (!(bsdf_lobes(b) & BSDF_GLOSSY)) return 0.0f;
     /* Blinn's cos^m of the half-vector angle matches a microfacet lobe of roughness alpha for

@@ -74,6 +74,9 @@ int bsdf_lobes(const bsdf *b);
 /* The glossy lobe's width as a microfacet roughness alpha (geometric mean of the two axes;
  * Phong through its equivalent exponent); 0 without a glossy lobe. */
 float bsdf_glossy_alpha(const bsdf *b);
+/* The glossy lobe's directional albedo for wo, approximated for sharp lobes (the lobe's value at
+ * the mirror direction); 0 without a glossy lobe or with wo below. */
+vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo);
 /* Probability that bsdf_sample picks the glossy lobe for this wo (0 or 1 with one lobe). */
 float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes);
 
