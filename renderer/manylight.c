@@ -39,6 +39,14 @@ shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_di
 static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *vl, const shading_point *x,
                       rng_state *rng, render_stats *st) {
     st->vl_connections++;
+    /* Visibility is to the light's centre. A centre behind x's surface, or one x would see from
+     * behind the light's own surface, is blocked by that surface: the ray would start or end
+     * inside it. Within the ray offset of either plane counts as behind: offsetting the ends
+     * cannot tell the sides apart when both points lie in one plane (VSLs on the back of a thin
+     * panel lit x on its front). */
+    vec3 dir = sub3(vl->p, x->p);
+    if (!(dot3(dir, x->ng) > scene_offset_eps(s, x->p)) || !(dot3(dir, vl->ng) < -scene_offset_eps(s, vl->p)))
+        return v3(0, 0, 0);
     vec3 c;
     if (m->kernel == VL_KERNEL_VSL) {
         int n = 0;
@@ -48,7 +56,6 @@ static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *v
         c = vpl_contribution(vl, x, m->kernel == VL_KERNEL_VPL_GLOSSY, m->terms);
     }
     if (is_black3(c) || !is_finite3(c)) return v3(0, 0, 0);
-    vec3 dir = sub3(vl->p, x->p);
     vec3 org = offset_origin(s, x->p, x->ng, dir);
     vec3 target = offset_origin(s, vl->p, vl->ng, neg3(dir));
     vec3 span = sub3(target, org);

@@ -499,6 +499,46 @@ static void test_trace_glossy_matches_pt(void) {
     scene_destroy(boxes[1]);
 }
 
+/* A zero-thickness divider splits a closed box; the light is above it, the camera below. No
+ * light can reach the lower half, so its indirect light is exactly zero (the path tracer's is);
+ * virtual lights on the divider's upper side, in the same plane as the points below, must not
+ * leak through it, nor may lights whose spheres reach across. */
+static void test_no_leak_through_thin_walls(void) {
+    material m = material_default();
+    m.model = MATERIAL_PHONG;
+    m.kd = v3s(0.7f);
+    m.ks = v3s(0.0f);
+    scene *s = ts_new("divided box");
+    int mat = ts_material(s, m);
+    ts_box(s, v3(-1, -1, -1), v3(1, 1, 1), 1, mat);
+    /* the divider: one quad, lit on its upper side, seen on its lower side */
+    ts_quad(s, v3(-1, 0, -1), v3(1, 0, -1), v3(1, 0, 1), v3(-1, 0, 1), mat);
+    light l;
+    memset(&l, 0, sizeof l);
+    l.type = LIGHT_POINT;
+    l.color = v3s(1.0f);
+    l.position = v3(0.2f, 0.5f, 0.1f);
+    scene_add_light(s, &l);
+    ts_finalize(s);
+    camera cam = camera_look_at(v3(0.3f, -0.8f, 0.8f), v3(-0.5f, 0.0f, -0.5f), v3(0, 1, 0), 1.3f);
+    for (int method = METHOD_VPL; method <= METHOD_VSL; method++) {
+        render_params p = vl_params_for((render_method)method, 512);
+        p.vl.clamp = VL_CLAMP_OFF;
+        p.vl.radius_mult = 4.0f; /* spheres that reach well across the divider */
+        float *img = ts_render_with(s, &cam, &p, 8, INDIRECT);
+        int lit = 0;
+        for (int i = 0; i < 3 * NPIX; i++) lit += img[i] != 0.0f;
+        CHECK(lit == 0, "%s: %d pixel channels below the divider got light through it", method_name(p.method), lit);
+        free(img);
+    }
+    float *pt = ts_render(s, &cam, W, H, 64, 8, 1, INDIRECT);
+    int lit = 0;
+    for (int i = 0; i < 3 * NPIX; i++) lit += pt[i] != 0.0f;
+    CHECK(lit == 0, "path tracing: %d channels below the divider lit (the scene is not closed)", lit);
+    free(pt);
+    scene_destroy(s);
+}
+
 /* A point light on a wall and one a micrometre off it: thousands of frames, nothing non-finite. */
 static void test_lights_touching_surfaces(void) {
     material m = material_default();
@@ -543,6 +583,7 @@ int main(void) {
     test_glossy_box_energy();
     test_light_selection_unbiased();
     test_trace_glossy_matches_pt();
+    test_no_leak_through_thin_walls();
     test_lights_touching_surfaces();
     return check_exit("test_vsl");
 }
