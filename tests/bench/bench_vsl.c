@@ -132,9 +132,9 @@ int main(int argc, char **argv) {
     paper.vl.trace_glossy = -1.0f;
     run_times(&b, "vsl, every lobe gathered (the paper's)", paper, times, nt);
     run_times(&b, "vsl (sharp lobes traced through)", vsl, times, nt);
-    render_params plain = vsl;
-    plain.vl.candidates = 1;
-    run_times(&b, "vsl, lights picked by power only", plain, times, nt);
+    render_params ris = vsl;
+    ris.vl.candidates = 4;
+    run_times(&b, "vsl, lights resampled from 4 candidates", ris, times, nt);
     vsl.vl.radius_shrink = 0.7f;
     run_times(&b, "vsl, radius shrink 0.7", vsl, times, nt);
 
