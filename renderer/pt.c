@@ -8,14 +8,25 @@ static inline film_component component_of(int emitter_vertex) {
     return emitter_vertex <= 1 ? COMP_DIRECT : COMP_INDIRECT;
 }
 
+/* A contribution c of a path that reaches the light at its third vertex, whose part through the
+ * glossy lobes of both scattering vertices is hl: that part to the highlights, the rest indirect. */
+static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
+    out[COMP_HIGHLIGHTS] = add3(out[COMP_HIGHLIGHTS], hl);
+    vec3 rest = sub3(c, hl); /* >= 0 up to rounding: f >= its glossy lobe */
+    out[COMP_INDIRECT] = add3(out[COMP_INDIRECT], v3(fmaxf(rest.x, 0.0f), fmaxf(rest.y, 0.0f), fmaxf(rest.z, 0.0f)));
+}
+
 /* The path tracer; *first (optional) receives the first hit, and the return value says whether
  * there was one. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
- * first belongs to that path's direct light and is not counted. */
+ * first belongs to that path's direct light and is not counted. With split_highlights the paths
+ * camera - glossy - glossy - light go to COMP_HIGHLIGHTS: the product of the two vertices'
+ * glossy lobes, out of the same samples (the lobes add up to the BSDF). */
 static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
-                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first, int continuation) {
+                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first, int continuation, int split_highlights) {
     int hit_any = 0;
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
+    vec3 beta_hl = v3s(0.0f); /* the throughput through glossy lobes only (depths 1 and 2) */
     float prev_pdf = 0.0f; /* solid-angle pdf of the BSDF sample that produced the current ray */
     vec3 prev_p = o;
     for (int depth = 0;; depth++) {
@@ -25,7 +36,8 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (depth > 0 || !continuation)) {
                 float w = depth == 0 ? 1.0f : mis_power(prev_pdf, light_pdf_env(s, d));
-                out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+                if (split_highlights && depth == 2) add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
+                else out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
             }
             break;
         }
@@ -40,7 +52,8 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
                 int li = s->tri_light[h.tri];
                 w = mis_power(prev_pdf, li >= 0 ? light_pdf_triangle(s, li, prev_p, &h) : 0.0f);
             }
-            out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+            if (split_highlights && depth == 2) add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
+            else out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
         }
         if (depth >= max_depth) break;
 
@@ -69,7 +82,12 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
                 if (tmax > 0.0f && !scene_occluded(s, org, dir, tmax)) {
                     float w = ls.delta ? 1.0f : mis_power(ls.pdf, bsdf_pdf(&b, wo, wi, BSDF_ALL));
                     vec3 c = scale3(mul3(mul3(beta, f), ls.radiance), wi.z * w / ls.pdf);
-                    out[component_of(depth + 1)] = add3(out[component_of(depth + 1)], c);
+                    if (split_highlights && depth == 1) {
+                        vec3 fg = bsdf_eval(&b, wo, wi, BSDF_GLOSSY);
+                        add_split(out, c, scale3(mul3(mul3(beta_hl, fg), ls.radiance), wi.z * w / ls.pdf));
+                    } else {
+                        out[component_of(depth + 1)] = add3(out[component_of(depth + 1)], c);
+                    }
                 }
             }
         }
@@ -81,6 +99,10 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
         if (!bsdf_sample(&b, wo, BSDF_ALL, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
         vec3 wi = to_world(fr, bs.wi);
         if (dot3(wi, h.ng) <= 0.0f) break; /* below the geometric surface: no transmission */
+        if (split_highlights && depth <= 1) {
+            vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, BSDF_GLOSSY), bs.wi.z / bs.pdf);
+            beta_hl = depth == 0 ? fg : mul3(beta_hl, fg);
+        }
         beta = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
         if (is_black3(beta) || !is_finite3(beta)) break;
         prev_pdf = bs.pdf;
@@ -98,15 +120,15 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
     return hit_any;
 }
 
-void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
-                 uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, rng, out, rays, NULL, 0);
+void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, rng_state *rng,
+                 vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
+    trace_path(s, max_depth, o, d, rng, out, rays, NULL, 0, split_highlights);
 }
 
 int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
               uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
-    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 0);
+    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 0, 0);
     *direct = out[COMP_DIRECT];
     return hit;
 }
@@ -114,7 +136,7 @@ int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surf
 int pt_reflected_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
                         uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
-    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 1);
+    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 1, 0);
     *direct = out[COMP_DIRECT];
     return hit;
 }

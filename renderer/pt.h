@@ -11,9 +11,11 @@
 
 /* Radiance along the ray (o, d), split by path-space component: out[COMP_DIRECT] gets emission
  * seen directly and light arriving at the first hit directly from an emitter, out[COMP_INDIRECT]
- * the rest. Counts rays into rays[]. */
-void pt_radiance(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
-                 uint64_t rays[RAY_KIND_COUNT]);
+ * the rest; with split_highlights, the paths camera - glossy lobe - glossy lobe - light go to
+ * out[COMP_HIGHLIGHTS] instead (the highlight estimator's subset, DESIGN.md). Counts rays into
+ * rays[]. */
+void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, rng_state *rng,
+                 vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
 
 /* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
  * max depth 1, so every method shares one direct estimator), and that hit in *first. Returns 1

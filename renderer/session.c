@@ -99,7 +99,7 @@ static void render_tile(void *ctx, int tile, int worker) {
                                         ((float)y + j.y) / (float)p->height);
             vec3 L[COMP_COUNT];
             if (p->method == METHOD_PT) {
-                pt_radiance(s, p->max_depth, rs->cam.position, d, &rng, L, st->rays);
+                pt_radiance(s, p->max_depth, p->pt_highlights, rs->cam.position, d, &rng, L, st->rays);
             } else {
                 /* Many lights: the shared direct estimator, then the virtual lights at the hit. */
                 surface_hit h;

@@ -64,6 +64,7 @@ typedef struct {
     int max_depth;        /* scattering events per path; 0: DEFAULT_MAX_DEPTH; 1 is direct light only */
     uint64_t seed;
     int threads;          /* 0: one per core */
+    int pt_highlights;    /* pt: camera - glossy - glossy - light paths in their own component */
     vl_params vl;
 } render_params;
 

@@ -357,7 +357,75 @@ static material glossy_material(material_model model) {
     return m;
 }
 
+/* The path tracer's highlights layer (camera - glossy - glossy - light, the highlight
+ * estimator's paths). The same seed makes the same samples, so splitting must move light between
+ * layers without changing the sum; in a box of purely glossy walls at depth 2 every indirect path
+ * is a highlight, and in a diffuse box none is. Lit by a panel (its emission found by BSDF
+ * sampling, under MIS) and a point light (next-event only). */
+static void test_highlights_layer(void) {
+    enum { HW = 16, HH = 12, HN = HW * HH };
+    material mixed = material_default(), glossy, diffuse;
+    mixed.model = MATERIAL_PHONG;
+    mixed.kd = v3s(0.3f);
+    mixed.ks = v3s(0.6f);
+    mixed.exponent = 40.0f;
+    glossy = mixed;
+    glossy.kd = v3s(0.0f);
+    glossy.ks = v3s(0.9f);
+    diffuse = mixed;
+    diffuse.ks = v3s(0.0f);
+    diffuse.kd = v3s(0.8f);
+    const material *mats[3] = {&mixed, &glossy, &diffuse};
+    const char *names[3] = {"mixed", "glossy", "diffuse"};
+    camera cam = camera_look_at(v3(0.3f, 0.2f, 0.9f), v3(-1, -0.8f, -1), v3(0, 1, 0), 1.2f);
+    for (int k = 0; k < 3; k++) {
+        scene *s = ts_new("highlights box");
+        ts_box(s, v3(-1, -1, -1), v3(1, 1, 1), 1, ts_material(s, *mats[k]));
+        ts_quad(s, v3(-0.3f, 0.95f, -0.3f), v3(0.3f, 0.95f, -0.3f), v3(0.3f, 0.95f, 0.3f), v3(-0.3f, 0.95f, 0.3f),
+                ts_lambert(s, v3s(0.0f), v3s(3.0f), 0));
+        light pl = {.type = LIGHT_POINT, .color = v3s(0.5f), .position = v3(-0.4f, 0.3f, 0.2f)};
+        scene_add_light(s, &pl);
+        ts_finalize(s);
+        int depth = k == 1 ? 2 : 6;
+        render_params p = {.width = HW, .height = HH, .max_depth = depth, .seed = 21};
+        float *ind = ts_render_with(s, &cam, &p, 64, 1u << COMP_INDIRECT);
+        p.pt_highlights = 1;
+        float *ind_split = ts_render_with(s, &cam, &p, 64, 1u << COMP_INDIRECT);
+        float *hl = ts_render_with(s, &cam, &p, 64, 1u << COMP_HIGHLIGHTS);
+        float *dir0 = ts_render_with(s, &cam, &p, 64, 1u << COMP_DIRECT);
+        p.pt_highlights = 0;
+        float *dir1 = ts_render_with(s, &cam, &p, 64, 1u << COMP_DIRECT);
+        int bad_sum = 0, negative = 0, direct_changed = 0;
+        double hl_total = 0.0, ind_total = 0.0, rest_total = 0.0;
+        for (int i = 0; i < 3 * HN; i++) {
+            if (!(fabsf(ind[i] - (ind_split[i] + hl[i])) <= 1e-4f * ind[i] + 1e-7f)) bad_sum++;
+            negative += hl[i] < 0.0f || ind_split[i] < 0.0f;
+            direct_changed += dir0[i] != dir1[i];
+            hl_total += hl[i];
+            ind_total += ind[i];
+            rest_total += ind_split[i];
+        }
+        printf("highlights layer, %s box: highlights %.4f of indirect %.4f\n", names[k], hl_total / ind_total, ind_total);
+        CHECK(bad_sum == 0 && negative == 0, "%s: indirect != split indirect + highlights at %d channels, %d negative",
+              names[k], bad_sum, negative);
+        CHECK(direct_changed == 0, "%s: the split changed the direct light at %d channels", names[k], direct_changed);
+        CHECK(ind_total > 0.0, "%s: no indirect light", names[k]);
+        if (k == 0) CHECK(hl_total > 0.05 * ind_total && rest_total > 0.05 * ind_total, "mixed: highlights share %.3f",
+                          hl_total / ind_total);
+        if (k == 1) CHECK(rest_total <= 1e-6 * ind_total, "glossy, depth 2: %.3g of the indirect is not highlights",
+                          rest_total / ind_total);
+        if (k == 2) CHECK(hl_total == 0.0, "diffuse: highlights %g", hl_total);
+        free(ind);
+        free(ind_split);
+        free(hl);
+        free(dir0);
+        free(dir1);
+        scene_destroy(s);
+    }
+}
+
 int main(void) {
+    test_highlights_layer();
     test_furnace_box(0.5f, 64);
     test_furnace_box(0.8f, 200);
     test_furnace_box(0.8f, 3); /* truncation at max_depth is exact too */
