@@ -47,6 +47,8 @@ static void print_render_help(void) {
            "  --seed S             random seed; runs with the same seed reproduce [0]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
            "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers [none]\n"
+           "  --highlights-layer   pt: camera-glossy-glossy-light paths (the highlight estimator's\n"
+           "                       share) go to their own highlights.* layer, not indirect.*\n"
            "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
            "  --exposure EV        exposure for the PNG, in stops [0]\n"
            "  --stats FILE.json    statistics: frames, spp, seconds, rays by kind, rejected samples [none]\n"
@@ -78,6 +80,8 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
             return 1;
         } else if (strcmp(a, "--quiet") == 0) {
             o->quiet = 1;
+        } else if (strcmp(a, "--highlights-layer") == 0) {
+            o->params.pt_highlights = 1;
         } else if (strcmp(a, "--method") == 0) {
             VALUE();
             int m = method_from_name(v);
@@ -140,6 +144,8 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
 #undef VALUE
     }
     if (spp_given && time_given) return cli_error("--spp and --time exclude each other"), -1;
+    if (o->params.pt_highlights && o->params.method != METHOD_PT)
+        return cli_error("--highlights-layer: only the path tracer (--method pt) splits highlights so far"), -1;
     if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
     return 0;
 }
@@ -231,8 +237,9 @@ static int write_stats(const char *path, const render_options *o, const render_s
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, double seconds) {
     const film *fm = session_film(rs);
     char err[1024];
-    /* Highlights are a layer of their own only once an estimator produces them. */
-    const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT);
+    /* Highlights are a layer of their own when they are split off (--highlights-layer). */
+    const unsigned layers =
+        (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (o->params.pt_highlights ? 1u << COMP_HIGHLIGHTS : 0u);
     if (o->out_exr && film_save_exr(fm, layers, o->out_exr, WRITE_REPLACE, err, sizeof err) != 0) {
         cli_error("%s", err);
         return -1;

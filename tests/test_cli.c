@@ -214,6 +214,7 @@ static void test_many_light_options(void) {
     expect_failure("render --method vsl --per-pixel none", 2, "--per-pixel");
     expect_failure("render --method vsl --vsl-count", 2, "--vsl-count");
     expect_failure("render --method vsl --trace-glossy sharp", 2, "--trace-glossy");
+    expect_failure("render --method vsl --highlights-layer", 2, "--highlights-layer");
 
     char p[1024], json[8192], err[512];
     /* A tiny clamp bound clamps; switching clamping off clamps nothing. */
@@ -261,6 +262,33 @@ static void test_many_light_options(void) {
     }
 }
 
+/* --highlights-layer: the EXR gains highlights.* and the layers still add up to the image. */
+static void test_highlights_layer(void) {
+    int rc = run("render --spp 4 --size 32x18 --max-depth 4 --highlights-layer --out hl.exr --quiet");
+    CHECK(rc == 0, "render --highlights-layer: exit %d: %s", rc, err_text);
+    char p[1024], err[512];
+    snprintf(p, sizeof p, "%s/hl.exr", tmp);
+    exr_image exr;
+    if (exr_image_load(p, &exr, err, sizeof err) != 0) {
+        CHECK(0, "highlights exr unreadable: %s", err);
+        return;
+    }
+    const float *all = exr_image_channel(&exr, "G"), *d = exr_image_channel(&exr, "direct.G"),
+                *ind = exr_image_channel(&exr, "indirect.G"), *hl = exr_image_channel(&exr, "highlights.G");
+    CHECK(all && d && ind && hl, "the exr lacks a layer (highlights.G?)");
+    if (all && d && ind && hl) {
+        int bad = 0;
+        double hl_sum = 0.0;
+        for (int i = 0; i < 32 * 18; i++) {
+            bad += !(fabsf(all[i] - (d[i] + ind[i] + hl[i])) <= 1e-5f * fabsf(all[i]) + 1e-7f) || hl[i] < 0.0f;
+            hl_sum += hl[i];
+        }
+        CHECK(bad == 0 && hl_sum > 0.0, "highlights layer: %d pixels off the sum, total %g (the default scene has "
+              "glossy-glossy light)", bad, hl_sum);
+    }
+    exr_image_free(&exr);
+}
+
 int main(int argc, char **argv) {
     if (argc < 2) {
         fprintf(stderr, "usage: test_cli GLINT\n");
@@ -278,5 +306,6 @@ int main(int argc, char **argv) {
     test_errors();
     test_outputs();
     test_many_light_options();
+    test_highlights_layer();
     return check_exit("test_cli");
 }
