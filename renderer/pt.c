@@ -16,6 +16,14 @@ static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
     out[COMP_INDIRECT] = add3(out[COMP_INDIRECT], v3(fmaxf(rest.x, 0.0f), fmaxf(rest.y, 0.0f), fmaxf(rest.z, 0.0f)));
 }
 
+/* Emission le reached at vertex `depth` with MIS weight w: to its component, split into
+ * highlights for the paths that reach the light at their third vertex. */
+static void add_emission(vec3 out[COMP_COUNT], int depth, int split_highlights, vec3 beta, vec3 beta_hl, vec3 le,
+                         float w) {
+    if (split_highlights && depth == 2) add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
+    else out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+}
+
 /* The path tracer; *first (optional) receives the first hit, and the return value says whether
  * there was one. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
  * first belongs to that path's direct light and is not counted. With split_highlights the paths
@@ -36,8 +44,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (depth > 0 || !continuation)) {
                 float w = depth == 0 ? 1.0f : mis_power(prev_pdf, light_pdf_env(s, d));
-                if (split_highlights && depth == 2) add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
-                else out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+                add_emission(out, depth, split_highlights, beta, beta_hl, le, w);
             }
             break;
         }
@@ -52,8 +59,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
                 int li = s->tri_light[h.tri];
                 w = mis_power(prev_pdf, li >= 0 ? light_pdf_triangle(s, li, prev_p, &h) : 0.0f);
             }
-            if (split_highlights && depth == 2) add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
-            else out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+            add_emission(out, depth, split_highlights, beta, beta_hl, le, w);
         }
         if (depth >= max_depth) break;
 

@@ -26,10 +26,13 @@ double vmf_eval(vmf v, vec3 s) {
     return eval_one_minus_cos(v.kappa, 0.5 * (dx * dx + dy * dy + dz * dz));
 }
 
+/* 1 - cos theta below which a fraction u of a vMF's mass lies: its inverse cdf. */
+static double quantile_one_minus_cos(double kappa, double u) {
+    return kappa < 1e-8 ? 2.0 * u : -log1p(u * expm1(-2.0 * kappa)) / kappa;
+}
+
 vec3 vmf_sample(vmf v, vec2 u) {
-    double k = v.kappa, omw; /* 1 - cos theta */
-    if (k < 1e-8) omw = 2.0 * (double)u.x;
-    else omw = -log1p((double)u.x * expm1(-2.0 * k)) / k; /* inverts the cdf of cos theta */
+    double omw = quantile_one_minus_cos(v.kappa, (double)u.x); /* 1 - cos theta */
     if (!(omw >= 0.0)) omw = 0.0;
     if (omw > 2.0) omw = 2.0;
     double sin_t = sqrt(omw * (2.0 - omw)), phi = 2.0 * PI_D * (double)u.y;
@@ -93,11 +96,6 @@ double vmf_convolve_kappa(double ka, double kb) {
     return vmf_kappa_from_rbar(vmf_rbar_from_kappa(ka) * vmf_rbar_from_kappa(kb));
 }
 
-/* 1 - cos of the median angle of a vMF (half its mass is closer to mu). */
-static double median_one_minus_cos(double kappa) {
-    return kappa < 1e-8 ? 1.0 : -log1p(0.5 * expm1(-2.0 * kappa)) / kappa;
-}
-
 int vmf_fit_glossy(const bsdf *b, vec3 wo, vmf *lobe, vec3 *albedo) {
     if (!(bsdf_lobes(b) & BSDF_GLOSSY) || !(wo.z > 0.0f)) return 0;
     /* Width matched by the median angle to the mirror direction, not the mean cosine: GGX's long
@@ -125,7 +123,7 @@ int vmf_fit_glossy(const bsdf *b, vec3 wo, vmf *lobe, vec3 *albedo) {
         double lo = -12.0, hi = log(log(2.0) / 0.25) + 1.0;
         for (int i = 0; i < 48; i++) {
             double mid = 0.5 * (lo + hi);
-            if (median_one_minus_cos(exp(mid)) > t) lo = mid;
+            if (quantile_one_minus_cos(exp(mid), 0.5) > t) lo = mid; /* the median */
             else hi = mid;
         }
         kappa = exp(0.5 * (lo + hi));
