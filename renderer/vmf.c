@@ -96,6 +96,26 @@ double vmf_convolve_kappa(double ka, double kb) {
     return vmf_kappa_from_rbar(vmf_rbar_from_kappa(ka) * vmf_rbar_from_kappa(kb));
 }
 
+/* The kappa whose median 1 - cos theta is t: m(kappa) = -log1p(expm1(-2 kappa) / 2) / kappa = t,
+ * by Newton's method kept inside a bracket. m falls from 1 (kappa = 0) and m(kappa) <= ln 2 / kappa,
+ * so the root lies in [0, ln 2 / t]. This runs for every secondary hit of the highlight estimator:
+ * a handful of iterations, not a bisection's fifty. */
+static double kappa_of_median(double t) {
+    if (t >= 1.0) return 0.0;
+    double lo = 0.0, hi = log(2.0) / t, k = hi;
+    for (int i = 0; i < 30; i++) {
+        double e = exp(-2.0 * k), m = -log1p(0.5 * (e - 1.0)) / k;
+        double dm = (2.0 / (1.0 / e + 1.0) - m) / k; /* (L' k - L) / k^2 with L = m k, L' = 2 / (e^{2k} + 1) */
+        if (m > t) lo = k; /* m decreases: the root is above k */
+        else hi = k;
+        double next = dm < 0.0 ? k - (m - t) / dm : 0.5 * (lo + hi);
+        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+        if (fabs(next - k) <= 1e-10 * k) return next;
+        k = next;
+    }
+    return k;
+}
+
 int vmf_fit_glossy(const bsdf *b, vec3 wo, vmf *lobe, vec3 *albedo) {
     if (!(bsdf_lobes(b) & BSDF_GLOSSY) || !(wo.z > 0.0f)) return 0;
     /* Width matched by the median angle to the mirror direction, not the mean cosine: GGX's long
@@ -113,20 +133,14 @@ int vmf_fit_glossy(const bsdf *b, vec3 wo, vmf *lobe, vec3 *albedo) {
         t = 2.0 * a2 / (1.0 + a2) * (double)wo.z;
     }
     /* The vMF's median 1 - cos is ln 2 / kappa once e^{-2 kappa} is negligible; broader lobes by
-     * bisection on log kappa. */
+     * Newton's method (kappa_of_median). */
     double kappa;
     if (t <= 0.0) {
         kappa = VMF_MAX_KAPPA;
     } else if (t < 0.25) {
         kappa = fmin(log(2.0) / t, VMF_MAX_KAPPA);
     } else {
-        double lo = -12.0, hi = log(log(2.0) / 0.25) + 1.0;
-        for (int i = 0; i < 48; i++) {
-            double mid = 0.5 * (lo + hi);
-            if (quantile_one_minus_cos(exp(mid), 0.5) > t) lo = mid; /* the median */
-            else hi = mid;
-        }
-        kappa = exp(0.5 * (lo + hi));
+        kappa = kappa_of_median(t);
     }
     lobe->mu = v3(-wo.x, -wo.y, wo.z);
     lobe->kappa = (float)kappa;
@@ -159,22 +173,32 @@ vmf vmf_merge(const vmf *lobes, const float *weights, const int *members, int nu
 typedef struct {
     double alpha;
     vmf lobe;
+    double log_scale; /* log alpha + log c(kappa) + kappa: the score's part that is the same for every direction */
 } em_cluster;
+
+static void em_set(em_cluster *c, double alpha, float kappa) {
+    c->alpha = alpha;
+    c->lobe.kappa = kappa;
+    c->log_scale = log(alpha) + log_norm_plus_kappa(kappa);
+}
 
 static double em_score(const em_cluster *c, vec3 s) {
     double dx = (double)c->lobe.mu.x - (double)s.x, dy = (double)c->lobe.mu.y - (double)s.y, dz = (double)c->lobe.mu.z - (double)s.z;
-    return log(c->alpha) + log_norm_plus_kappa(c->lobe.kappa) - (double)c->lobe.kappa * 0.5 * (dx * dx + dy * dy + dz * dz);
+    return c->log_scale - (double)c->lobe.kappa * 0.5 * (dx * dx + dy * dy + dz * dz);
 }
 
 int vmf_em(const vec3 *dirs, const float *weights, int n, int k, int *assign) {
     if (n <= 0) return 0;
     if (k > n) k = n;
     if (k < 1) k = 1;
-    em_cluster *c = malloc(sizeof(em_cluster) * (size_t)k);
-    double *sum = malloc(sizeof(double) * 4 * (size_t)k);
+    /* The highlight estimator calls this per camera hit with k <= 8: no allocation for small k. */
+    em_cluster c_small[16];
+    double sum_small[4 * 16];
+    int small = k <= 16;
+    em_cluster *c = small ? c_small : malloc(sizeof(em_cluster) * (size_t)k);
+    double *sum = small ? sum_small : malloc(sizeof(double) * 4 * (size_t)k);
     if (!c || !sum) { /* no memory: one cluster */
-        free(c);
-        free(sum);
+        if (!small) free(c), free(sum);
         for (int i = 0; i < n; i++) assign[i] = 0;
         return 1;
     }
@@ -204,7 +228,7 @@ int vmf_em(const vec3 *dirs, const float *weights, int n, int k, int *assign) {
         if (best < 0) break;
         c[m++].lobe.mu = dirs[best];
     }
-    for (int j = 0; j < m; j++) c[j].alpha = 1.0 / m, c[j].lobe.kappa = 1.0f; /* first E-step: nearest centre */
+    for (int j = 0; j < m; j++) em_set(&c[j], 1.0 / m, 1.0f); /* first E-step: nearest centre */
 
     for (int iter = 0; iter < 50; iter++) {
         int changed = 0;
@@ -236,10 +260,9 @@ int vmf_em(const vec3 *dirs, const float *weights, int n, int k, int *assign) {
                 c[j].alpha = 0.0;
                 continue;
             }
-            c[j].alpha = s[3] / all;
             double len = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
             if (len > 1e-12 * s[3]) c[j].lobe.mu = v3((float)(s[0] / len), (float)(s[1] / len), (float)(s[2] / len));
-            c[j].lobe.kappa = (float)vmf_kappa_estimate(len / s[3]);
+            em_set(&c[j], s[3] / all, (float)vmf_kappa_estimate(len / s[3]));
         }
     }
 #undef WEIGHT
@@ -250,7 +273,6 @@ int vmf_em(const vec3 *dirs, const float *weights, int n, int k, int *assign) {
         if (remap[assign[i]] < 0) remap[assign[i]] = used++;
         assign[i] = remap[assign[i]];
     }
-    free(c);
-    free(sum);
+    if (!small) free(c), free(sum);
     return used;
 }

@@ -224,10 +224,17 @@ static void test_fit_glossy(void) {
     bsdf lambert = make_bsdf_lambert(v3s(0.5f));
     CHECK(!vmf_fit_glossy(&lambert, v3(0, 0, 1), &lobe, &albedo), "a lambert bsdf has no glossy lobe to fit");
     CHECK(!vmf_fit_glossy(&cases[0].b, v3(0, 0.6f, -0.8f), &lobe, &albedo), "wo below the surface was fitted");
-    /* Rough lobes get broad but finite fits. */
+    /* Rough lobes get broad but finite fits: at roughness 1 the median angle is 90 degrees, the
+     * uniform sphere's (kappa 0); a little less rough, a small kappa with that median. */
     bsdf rough = make_bsdf_gltf(v3s(1.0f), 1.0f, 1.0f, 0.0f);
-    CHECK(vmf_fit_glossy(&rough, v3(0, 0, 1), &lobe, &albedo) && lobe.kappa > 0.0f && lobe.kappa < 5.0f,
+    CHECK(vmf_fit_glossy(&rough, v3(0, 0, 1), &lobe, &albedo) && lobe.kappa >= 0.0f && lobe.kappa < 0.01f,
           "roughness 1: kappa %g", (double)lobe.kappa);
+    rough = make_bsdf_gltf(v3s(1.0f), 1.0f, 0.9f, 0.0f);
+    CHECK(vmf_fit_glossy(&rough, v3(0, 0, 1), &lobe, &albedo) && lobe.kappa > 0.0f && lobe.kappa < 5.0f,
+          "roughness 0.9: kappa %g", (double)lobe.kappa);
+    double a2 = 0.81 * 0.81, t = 2.0 * a2 / (1.0 + a2); /* alpha = roughness^2 */
+    CHECK_NEAR(-log1p(0.5 * expm1(-2.0 * (double)lobe.kappa)) / (double)lobe.kappa, t, 1e-5,
+               "roughness 0.9: the fit's median 1 - cos");
 }
 
 static void test_merge(void) {
