@@ -137,9 +137,16 @@ const char *cli_vl_help(void) {
              "  --candidates M       each of those is resampled from M candidates by its unshadowed\n"
              "                       contribution at the pixel; 1 = plain sampling by power [%d]\n"
              "  --trace-glossy A|off receivers' glossy lobes with roughness alpha below A are not\n"
-             "                       gathered from the lights: the path goes on through them [%g]\n",
+             "                       gathered from the lights: the path goes on through them [%g]\n"
+             "indirect highlights (vsl+hl):\n"
+             "  --secondary-rays N   rays sampled from a camera hit's glossy lobe, 1..%d [%d]\n"
+             "  --clusters K         merged vMF lobes per camera hit, 1..%d [%d]\n"
+             "  --merge on|off|trace off: every secondary hit's own vMF lobe is lit by itself (the\n"
+             "                       paper's comparison); trace: no vMFs, each hit's true glossy lobe\n"
+             "                       (the path tracer's answer for the same paths) [on]\n",
              VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_RADIUS_MULT, VL_DEFAULT_ROWS,
-             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES, (double)VL_DEFAULT_TRACE_GLOSSY);
+             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES, (double)VL_DEFAULT_TRACE_GLOSSY,
+             HL_MAX_SECONDARY_RAYS, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_CLUSTERS, HL_DEFAULT_CLUSTERS);
     return text;
 }
 
@@ -195,6 +202,16 @@ int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
         if (strcmp(value, "off") == 0) vl->trace_glossy = -1.0f;
         else if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
         else vl->trace_glossy = x > 0.0 ? (float)x : -1.0f; /* 0 is off too, not the default */
+    } else if (strcmp(name, "secondary-rays") == 0) {
+        if (cli_parse_int(option, value, 1, HL_MAX_SECONDARY_RAYS, &n)) return -1;
+        vl->secondary_rays = (int)n;
+    } else if (strcmp(name, "clusters") == 0) {
+        if (cli_parse_int(option, value, 1, HL_MAX_CLUSTERS, &n)) return -1;
+        vl->clusters = (int)n;
+    } else if (strcmp(name, "merge") == 0) {
+        if (strcmp(value, "trace") == 0) vl->merge = HL_MERGE_TRACE;
+        else if (on_off(option, value, &b)) return -1;
+        else vl->merge = b ? HL_MERGE_ON : HL_MERGE_OFF;
     } else {
         return 0;
     }
@@ -207,7 +224,7 @@ int cli_vl_option(int argc, char **argv, int *i, vl_params *vl) {
     if (strcmp(a, "--vpl-glossy") == 0) return cli_set_vl_param("vpl-glossy", "on", vl);
     static const char *const names[] = {"vsl-count", "clamp", "clamp-value", "clamp-growth", "radius-mult",
                                          "radius-shrink", "rows", "columns", "per-pixel", "candidates",
-                                         "trace-glossy"};
+                                         "trace-glossy", "secondary-rays", "clusters", "merge"};
     int ours = 0;
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) ours |= strcmp(a + 2, names[k]) == 0;
     if (!ours) return 0;

@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "film.h"
+#include "highlights.h"
 #include "image_io.h"
 #include "session.h"
 
@@ -36,7 +37,8 @@ static void print_render_help(void) {
            "\n"
            "options (default in brackets):\n"
            "  --method NAME        estimator: pt (path tracing, the reference), vpl (clamped virtual\n"
-           "                       point lights), vsl (virtual spherical lights) [pt]\n"
+           "                       point lights), vsl (virtual spherical lights), vsl+hl (VSLs plus\n"
+           "                       vMF-merged indirect highlights, in a highlights.* layer) [pt]\n"
            "  --spp N              samples per pixel (frames) [%d]\n"
            "  --time SECONDS       render until this much time has passed instead of --spp\n"
            "  --size WxH           image size [960x540]\n"
@@ -47,8 +49,8 @@ static void print_render_help(void) {
            "  --seed S             random seed; runs with the same seed reproduce [0]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
            "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers [none]\n"
-           "  --highlights-layer   pt: camera-glossy-glossy-light paths (the highlight estimator's\n"
-           "                       share) go to their own highlights.* layer, not indirect.*\n"
+           "  --highlights-layer   camera-glossy-glossy-light paths (the highlight estimator's share)\n"
+           "                       go to their own highlights.* layer, not indirect.*: pt, vsl+hl\n"
            "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
            "  --exposure EV        exposure for the PNG, in stops [0]\n"
            "  --stats FILE.json    statistics: frames, spp, seconds, rays by kind, rejected samples [none]\n"
@@ -85,7 +87,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         } else if (strcmp(a, "--method") == 0) {
             VALUE();
             int m = method_from_name(v);
-            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl)", v), -1;
+            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", v), -1;
             o->params.method = (render_method)m;
         } else if (strcmp(a, "--spp") == 0) {
             VALUE();
@@ -144,8 +146,9 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
 #undef VALUE
     }
     if (spp_given && time_given) return cli_error("--spp and --time exclude each other"), -1;
-    if (o->params.pt_highlights && o->params.method != METHOD_PT)
-        return cli_error("--highlights-layer: only the path tracer (--method pt) splits highlights so far"), -1;
+    if (o->params.pt_highlights && o->params.method != METHOD_PT && o->params.method != METHOD_VSL_HL)
+        return cli_error("--highlights-layer: only pt and vsl+hl split highlights off (vpl and vsl count them "
+                         "as indirect)"), -1;
     if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
     return 0;
 }
@@ -224,6 +227,14 @@ static int write_stats(const char *path, const render_options *o, const render_s
         fprintf(f, "  \"clamped\": %llu,\n  \"rows\": %d,\n  \"columns\": %d", (unsigned long long)st.clamped,
                 vp->columns > 0 ? (vp->rows > 0 ? vp->rows : VL_DEFAULT_ROWS) : 0, vp->columns);
     }
+    if (p->method == METHOD_VSL_HL) {
+        hl_setup hl = hl_setup_from(s, &p->vl, NULL);
+        fprintf(f, ",\n  \"highlights\": {\"secondary_rays\": %d, \"clusters\": %d, \"merge\": %s, ", hl.secondary_rays,
+                hl.clusters, hl.mode == HL_MERGED ? "\"on\"" : hl.mode == HL_UNMERGED ? "\"off\"" : "\"trace\"");
+        fprintf(f, "\"points\": %llu, \"secondary_rays_total\": %llu, \"lobes_lit\": %llu, \"merge_seconds\": %.6f}",
+                (unsigned long long)st.hl_points, (unsigned long long)st.hl_secondary_rays,
+                (unsigned long long)st.hl_lobes, 1e-9 * (double)st.hl_merge_ns);
+    }
     fprintf(f, "\n}\n");
     fclose(f);
     char err[1024];
@@ -237,9 +248,9 @@ static int write_stats(const char *path, const render_options *o, const render_s
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, double seconds) {
     const film *fm = session_film(rs);
     char err[1024];
-    /* Highlights are a layer of their own when they are split off (--highlights-layer). */
-    const unsigned layers =
-        (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (o->params.pt_highlights ? 1u << COMP_HIGHLIGHTS : 0u);
+    /* Highlights are a layer of their own when they are split off (vsl+hl, --highlights-layer). */
+    int split = o->params.pt_highlights || o->params.method == METHOD_VSL_HL;
+    const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (split ? 1u << COMP_HIGHLIGHTS : 0u);
     if (o->out_exr && film_save_exr(fm, layers, o->out_exr, WRITE_REPLACE, err, sizeof err) != 0) {
         cli_error("%s", err);
         return -1;

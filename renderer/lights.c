@@ -1,6 +1,8 @@
 /* Lights: building the list, sampling for next-event estimation, pdfs for MIS, the environment. */
 #include "lights.h"
 
+#include "envfilter.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -62,6 +64,7 @@ env_map *env_map_create(image_rgb *image, float rotation, char *err, size_t errl
     }
     env->image = *image;
     *image = (image_rgb){0};
+    pthread_mutex_init(&env->filter_lock, NULL);
     env->rotation = rotation;
     /* Sampling density: luminance times sin(theta) (the equirectangular Jacobian), each texel
      * dilated to the maximum of its neighbours so that wherever bilinear lookup is non-zero the
@@ -97,7 +100,18 @@ void env_map_destroy(env_map *env) {
     if (!env) return;
     image_rgb_free(&env->image);
     dist2d_deinit(&env->dist);
+    env_vmf_filter_destroy(env->filter);
+    pthread_mutex_destroy(&env->filter_lock);
     free(env);
+}
+
+const struct env_vmf_filter *env_map_vmf_filter(const env_map *env, char *err, size_t errlen) {
+    env_map *e = (env_map *)env; /* the cache is built lazily behind a lock; the map itself stays */
+    pthread_mutex_lock(&e->filter_lock);
+    if (!e->filter) e->filter = env_vmf_filter_create(env, err, errlen);
+    const struct env_vmf_filter *f = e->filter;
+    pthread_mutex_unlock(&e->filter_lock);
+    return f;
 }
 
 vec3 env_eval(const scene *s, vec3 d) {
@@ -247,11 +261,23 @@ static surface_hit triangle_point(const scene *s, int t, vec2 u, vec3 *q, vec3 *
     return h;
 }
 
+static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light_sample *out);
+
 int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out) {
     if (s->num_lights == 0) return 0;
     float pmf;
     int li = dist1d_sample_discrete(&s->light_dist, u_select, &pmf, NULL);
     if (!(pmf > 0.0f)) return 0;
+    return sample_light(s, li, pmf, p, u, out);
+}
+
+int light_sample_one(const scene *s, int li, vec3 p, vec2 u, light_sample *out) {
+    if (li < 0 || li >= s->num_lights) return 0;
+    return sample_light(s, li, 1.0f, p, u, out);
+}
+
+/* Light li chosen with probability pmf: the sample's pdf includes it. */
+static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light_sample *out) {
     const light *l = &s->lights[li];
     out->light = li;
     out->delta = 0;
@@ -319,6 +345,21 @@ int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sa
     }
     }
     return 0;
+}
+
+int light_sample_visible(const scene *s, vec3 p, vec3 ng, const light_sample *ls, uint64_t *shadow_rays) {
+    vec3 org = offset_origin(s, p, ng, ls->wi);
+    vec3 dir = ls->wi;
+    float tmax = INFINITY;
+    if (isfinite(ls->dist)) {
+        vec3 target = ls->delta ? ls->p_light : offset_origin(s, ls->p_light, ls->n_light, neg3(ls->wi));
+        vec3 span = sub3(target, org);
+        tmax = length3(span);
+        if (!(tmax > 0.0f)) return 0;
+        dir = scale3(span, 1.0f / tmax);
+    }
+    ++*shadow_rays;
+    return !scene_occluded(s, org, dir, tmax);
 }
 
 float light_pdf_triangle(const scene *s, int li, vec3 p, const surface_hit *h) {

@@ -23,6 +23,15 @@ typedef struct {
  * a spot cone, zero pdf). */
 int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out);
 
+/* The same for one given light (index into scene.lights), as if it were always chosen: the pdf
+ * has no selection probability in it. */
+int light_sample_one(const scene *s, int light, vec3 p, vec2 u, light_sample *out);
+
+/* Whether the sampled light reaches p (geometric normal ng): one shadow ray, offset off p's
+ * surface toward the light, ending short of the sampled point (off the emitter) or unbounded for
+ * directional and environment light. Counts the ray into *shadow_rays. */
+int light_sample_visible(const scene *s, vec3 p, vec3 ng, const light_sample *ls, uint64_t *shadow_rays);
+
 /* A ray leaving a light, for light tracing (virtual lights). */
 typedef struct {
     vec3 o, d;      /* origin and unit direction */
@@ -51,6 +60,10 @@ int scene_build_lights(scene *s, char *err, size_t errlen);
 /* Environment maps. */
 env_map *env_map_create(image_rgb *image, float rotation, char *err, size_t errlen); /* takes the image */
 void env_map_destroy(env_map *env);
+/* The map prefiltered for vMF lobes (envfilter.h), built on the first call (thread-safe) and kept
+ * with the map. NULL with err set when it cannot be built. */
+struct env_vmf_filter;
+const struct env_vmf_filter *env_map_vmf_filter(const env_map *env, char *err, size_t errlen);
 vec3 env_direction(const env_map *env, vec2 uv);
 vec2 env_uv(const env_map *env, vec3 d);
 

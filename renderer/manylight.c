@@ -277,7 +277,9 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         /* Emission at the next hit is the direct light at x, which the shared estimator has. */
         surface_hit h;
         vec3 direct;
-        if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, rng, &direct, &h, st->rays)) break;
+        /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (DESIGN.md). */
+        int lobes = k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS ? BSDF_DIFFUSE : BSDF_ALL;
+        if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, lobes, rng, &direct, &h, st->rays)) break;
         sum = add3(sum, mul3(beta, direct));
         x = shading_point_at(s, &h, wi);
     }
@@ -288,8 +290,9 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
                           threadpool *pool, render_stats *st, char *err, size_t errlen) {
     const vl_params *vp = &p->vl;
     long long i = frame + 1;
-    m->kernel = p->method == METHOD_VSL ? VL_KERNEL_VSL : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
-    m->terms = vp->highlights ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
+    m->kernel = p->method == METHOD_VSL || p->method == METHOD_VSL_HL ? VL_KERNEL_VSL
+                : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
+    m->terms = p->method == METHOD_VSL_HL ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
     m->clamp = vp->clamp == VL_CLAMP_ON || (vp->clamp == VL_CLAMP_DEFAULT && p->method == METHOD_VPL);
     m->clamp_bound = vpl_clamp_at(vp->clamp_value > 0.0f ? vp->clamp_value : VL_DEFAULT_CLAMP, vp->clamp_growth, i);
     m->radius_mult = vsl_radius_mult_at(vp->radius_mult > 0.0f ? vp->radius_mult : VL_DEFAULT_RADIUS_MULT,

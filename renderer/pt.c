@@ -30,7 +30,8 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int split_highlights, 
  * camera - glossy - glossy - light go to COMP_HIGHLIGHTS: the product of the two vertices'
  * glossy lobes, out of the same samples (the lobes add up to the BSDF). */
 static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
-                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first, int continuation, int split_highlights) {
+                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first, int continuation, int split_highlights,
+                      int first_lobes) {
     int hit_any = 0;
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
@@ -66,6 +67,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
         frame3 fr;
         bsdf b = material_bsdf(s, &h, &fr);
         vec3 wo = to_local(fr, neg3(d));
+        int lobes = depth == 0 ? first_lobes : BSDF_ALL;
 
         /* Next-event estimation. */
         light_sample ls;
@@ -73,20 +75,10 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
         vec2 u_light = rng_vec2(rng);
         if (light_sample_direct(s, h.p, u_sel, u_light, &ls) && dot3(ls.wi, h.ng) > 0.0f) {
             vec3 wi = to_local(fr, ls.wi);
-            vec3 f = wi.z > 0.0f ? bsdf_eval(&b, wo, wi, BSDF_ALL) : v3(0, 0, 0);
+            vec3 f = wi.z > 0.0f ? bsdf_eval(&b, wo, wi, lobes) : v3(0, 0, 0);
             if (!is_black3(f)) {
-                vec3 org = offset_origin(s, h.p, h.ng, ls.wi);
-                vec3 dir = ls.wi;
-                float tmax = INFINITY;
-                if (isfinite(ls.dist)) {
-                    vec3 target = ls.delta ? ls.p_light : offset_origin(s, ls.p_light, ls.n_light, neg3(ls.wi));
-                    vec3 span = sub3(target, org);
-                    tmax = length3(span);
-                    dir = tmax > 0.0f ? scale3(span, 1.0f / tmax) : ls.wi;
-                }
-                rays[RAY_SHADOW]++;
-                if (tmax > 0.0f && !scene_occluded(s, org, dir, tmax)) {
-                    float w = ls.delta ? 1.0f : mis_power(ls.pdf, bsdf_pdf(&b, wo, wi, BSDF_ALL));
+                if (light_sample_visible(s, h.p, h.ng, &ls, &rays[RAY_SHADOW])) {
+                    float w = ls.delta ? 1.0f : mis_power(ls.pdf, bsdf_pdf(&b, wo, wi, lobes));
                     vec3 c = scale3(mul3(mul3(beta, f), ls.radiance), wi.z * w / ls.pdf);
                     if (split_highlights && depth == 1) {
                         vec3 fg = bsdf_eval(&b, wo, wi, BSDF_GLOSSY);
@@ -102,7 +94,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
         float u_lobe = rng_float(rng);
         vec2 u_dir = rng_vec2(rng);
         bsdf_sample_result bs;
-        if (!bsdf_sample(&b, wo, BSDF_ALL, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
+        if (!bsdf_sample(&b, wo, lobes, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
         vec3 wi = to_world(fr, bs.wi);
         if (dot3(wi, h.ng) <= 0.0f) break; /* below the geometric surface: no transmission */
         if (split_highlights && depth <= 1) {
@@ -128,21 +120,21 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
 
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, rng_state *rng,
                  vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, rng, out, rays, NULL, 0, split_highlights);
+    trace_path(s, max_depth, o, d, rng, out, rays, NULL, 0, split_highlights, BSDF_ALL);
 }
 
 int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
               uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
-    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 0, 0);
+    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 0, 0, BSDF_ALL);
     *direct = out[COMP_DIRECT];
     return hit;
 }
 
-int pt_reflected_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, int lobes, rng_state *rng, vec3 *direct, surface_hit *first,
                         uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
-    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 1, 0);
+    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 1, 0, lobes);
     *direct = out[COMP_DIRECT];
     return hit;
 }

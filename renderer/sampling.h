@@ -41,6 +41,17 @@ vec2 sample_uniform_triangle(vec2 u);
 vec2 sample_concentric_disk(vec2 u);
 
 /* Multiple importance sampling weights for strategy a against b (n samples each). */
+/* Point k of the R2 sequence (Roberts 2018: additive recurrence on the plastic number) shifted by
+ * u mod 1: N of them cover [0,1)^2 evenly for any N, and the shift keeps each unbiased. */
+static inline vec2 sample_r2(int k, vec2 u) {
+    double x = (double)u.x + 0.7548776662466927 * (double)k, y = (double)u.y + 0.5698402909980532 * (double)k;
+    vec2 r = v2((float)(x - floor(x)), (float)(y - floor(y)));
+    /* float rounding can land on 1 */
+    if (r.x >= 1.0f) r.x = 0.0f;
+    if (r.y >= 1.0f) r.y = 0.0f;
+    return r;
+}
+
 static inline float mis_balance(float pdf_a, float pdf_b) {
     /* As a ratio: the sum of two pdfs near FLT_MAX would overflow. */
     if (pdf_a <= 0.0f) return 0.0f;

@@ -7,6 +7,7 @@
 #ifndef GLINT_SCENE_H
 #define GLINT_SCENE_H
 
+#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -110,6 +111,10 @@ typedef struct {
     dist2d dist;        /* over (u, v), luminance * sin(theta), dilated for bilinear lookups */
     float rotation;     /* radians about +Y */
     float mean_luminance;
+    /* The map prefiltered for vMF lobes (the highlight estimator), built on first use: a scene
+     * that never asks for it never pays for it. env_map_vmf_filter() guards it. */
+    pthread_mutex_t filter_lock;
+    struct env_vmf_filter *filter;
 } env_map;
 
 /* ---- the scene ----------------------------------------------------------------------------- */

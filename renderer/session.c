@@ -5,12 +5,14 @@
 #include <string.h>
 
 #include "camera.h"
+#include "highlights.h"
+#include "lights.h"
 #include "manylight.h"
 #include "pt.h"
 #include "rng.h"
 #include "threadpool.h"
 
-static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl"};
+static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl", "vsl+hl"};
 const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
 
 const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? method_names[m] : "?"; }
@@ -39,7 +41,8 @@ struct render_session {
     worker_stats *workers;
     render_stats totals;
     int tiles_x, tiles_y;
-    manylight ml; /* vpl, vsl: this frame's virtual lights */
+    manylight ml; /* vpl, vsl, vsl+hl: this frame's virtual lights */
+    hl_setup hl;  /* vsl+hl: this frame's highlight settings */
     char error[256];
 };
 
@@ -107,6 +110,7 @@ static void render_tile(void *ctx, int tile, int worker) {
                 if (pt_direct(s, rs->cam.position, d, &rng, &L[COMP_DIRECT], &h, st->rays) && p->max_depth > 1) {
                     shading_point sp = shading_point_at(s, &h, d);
                     L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, p->max_depth, &rng, st);
+                    if (p->method == METHOD_VSL_HL && p->max_depth > 2) L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &rng, st);
                 }
             }
             float sample[COMP_COUNT][3];
@@ -129,6 +133,11 @@ static void render_tile(void *ctx, int tile, int worker) {
 }
 
 int session_render_frame(render_session *rs) {
+    if (rs->params.method == METHOD_VSL_HL) {
+        const struct env_vmf_filter *envf = NULL;
+        if (rs->scene->env && !(envf = env_map_vmf_filter(rs->scene->env, rs->error, sizeof rs->error))) return -1;
+        rs->hl = hl_setup_from(rs->scene, &rs->params.vl, envf);
+    }
     if (rs->params.method != METHOD_PT &&
         manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, rs->frames, rs->pool, &rs->totals, rs->error,
                               sizeof rs->error) != 0)
@@ -146,6 +155,10 @@ int session_render_frame(render_session *rs) {
         t->vsl_samples += st->vsl_samples;
         t->clamped += st->clamped;
         t->glossy_bounces += st->glossy_bounces;
+        t->hl_points += st->hl_points;
+        t->hl_secondary_rays += st->hl_secondary_rays;
+        t->hl_lobes += st->hl_lobes;
+        t->hl_merge_ns += st->hl_merge_ns;
         memset(st, 0, sizeof *st);
     }
     return 0;

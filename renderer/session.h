@@ -14,16 +14,17 @@ typedef enum {
     METHOD_PT = 0, /* unbiased path tracing: the reference */
     METHOD_VPL,    /* virtual point lights (instant radiosity), clamped */
     METHOD_VSL,    /* virtual spherical lights */
+    METHOD_VSL_HL, /* virtual spherical lights plus vMF-merged indirect highlights */
     METHOD_COUNT
 } render_method;
 
-/* "pt", "vpl", "vsl"; method_from_name returns -1 for an unknown name. */
+/* "pt", "vpl", "vsl", "vsl+hl"; method_from_name returns -1 for an unknown name. */
 const char *method_name(render_method m);
 int method_from_name(const char *name);
 
 #define DEFAULT_MAX_DEPTH 16
 
-/* The many-light methods (vpl, vsl). Zero means default for every field but the switches. */
+/* The many-light methods (vpl, vsl, vsl+hl). Zero means default for every field but the switches. */
 typedef struct {
     int count;           /* virtual lights per frame [VL_DEFAULT_COUNT] */
     int clamp;           /* VL_CLAMP_*: clamp each light's contribution [on for vpl, off for vsl] */
@@ -43,7 +44,10 @@ typedef struct {
                           * gathered from the lights: the camera path goes on through it (BSDF
                           * sampling, direct light at the next hit, gathering there); < 0: never
                           * [VL_DEFAULT_TRACE_GLOSSY] */
-    int highlights;      /* the highlight estimator owns glossy-glossy first-bounce paths */
+    /* vsl+hl: the highlight estimator (which owns the camera - glossy - glossy - light paths) */
+    int secondary_rays;  /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
+    int clusters;        /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
+    int merge;           /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
 } vl_params;
 
 enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
@@ -56,6 +60,13 @@ enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
 #define VL_DEFAULT_PER_PIXEL 4
 #define VL_DEFAULT_CANDIDATES 1
 #define VL_DEFAULT_TRACE_GLOSSY 0.35f
+/* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the
+ * path tracer's estimate of the same paths, to see what the approximation costs) */
+enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };
+#define HL_DEFAULT_SECONDARY_RAYS 32
+#define HL_DEFAULT_CLUSTERS 2
+#define HL_MAX_CLUSTERS 8
+#define HL_MAX_SECONDARY_RAYS 256 /* the paper uses 32-64; per-hit records live on the stack */
 
 /* Zero means default for every field. */
 typedef struct {
@@ -81,6 +92,10 @@ typedef struct {
     uint64_t vsl_samples;      /* integration samples of the VSL integrals */
     uint64_t clamped;          /* contributions the clamp cut down */
     uint64_t glossy_bounces;   /* camera paths continued through a sharp glossy lobe (--trace-glossy) */
+    uint64_t hl_points;        /* camera hits the highlight estimator worked at */
+    uint64_t hl_secondary_rays;/* rays sampled from their glossy lobes */
+    uint64_t hl_lobes;         /* lobes lit (merged, or one per secondary hit without merging) */
+    uint64_t hl_merge_ns;      /* thread time spent clustering and merging (the paper's Table 1, C) */
 } render_stats;
 
 typedef struct render_session render_session;

@@ -6,11 +6,15 @@
 #   3. With `vsl` first: the VSL paper's comparisons on the default scene (bench_vsl: equal-time
 #      error of pt, vpl and vsl against a 20-minute path-traced reference, cached in
 #      build/bench-cache, and the Fig. 8 sweeps), about 10 minutes plus the reference.
-# Usage: tests/bench/run.sh [vsl] [SHARED_SCENES_DIR]
+#   4. With `hl` first: the highlight paper's comparison on the default scene (bench_hl: the
+#      highlight component alone at equal time, path tracing its paths vs no merging vs merging
+#      into K lobes, N secondary rays, against a 10-minute reference cached in build/bench-cache;
+#      and the share of time spent merging), about 8 minutes plus the reference.
+# Usage: tests/bench/run.sh [vsl|hl] [SHARED_SCENES_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 mode=pt
-if [ "${1:-}" = vsl ]; then mode=vsl; shift; fi
+if [ "${1:-}" = vsl ] || [ "${1:-}" = hl ]; then mode=$1; shift; fi
 scenes=${1:-$root/../shared/scenes}
 build=$root/build
 source "$root/scripts/deps.sh"
@@ -24,6 +28,13 @@ if [ "$mode" = vsl ]; then
   mkdir -p "$build/bench-cache"
   echo "## The VSL paper's comparisons, default scene ($(nproc) threads, $(date +%F))"
   "$build/tests/bench/bench_vsl" default "$build/bench-cache/default-320x180-pt1200s.exr" 320x180 1200 10,60 10
+  exit 0
+fi
+
+if [ "$mode" = hl ]; then
+  mkdir -p "$build/bench-cache"
+  echo "## The highlight paper's comparison, default scene ($(nproc) threads, $(date +%F))"
+  "$build/tests/bench/bench_hl" default "$build/bench-cache/default-320x180-hl-trace600s.exr" 320x180 600 30
   exit 0
 fi
 

@@ -1,0 +1,43 @@
+/* glint — indirect highlights by vMF merging (Laurijssen et al. 2010, DESIGN.md): the paths
+ * camera - glossy(x) - glossy(q) - light. At a camera hit x, N secondary rays sample x's glossy
+ * lobe; each hit q_i with a glossy lobe contributes that lobe, fitted as a vMF about the mirror of
+ * the direction back to x and weighted by its albedo and x's sample weight. The lobes are merged
+ * into at most K vMFs (spherical hard EM on their directions, Eq. 5 per cluster, the clusters'
+ * energies summing to the members', Eq. 10), and each merged lobe is lit once from its members'
+ * mean position: every punctual light by a shadow ray, area lights by one light sample and one
+ * lobe sample (multiple importance sampling), the environment through its vMF-prefiltered map and
+ * one ray along the lobe's mean. */
+#ifndef GLINT_HIGHLIGHTS_H
+#define GLINT_HIGHLIGHTS_H
+
+#include "rng.h"
+#include "session.h"
+#include "vsl.h"
+
+struct env_vmf_filter;
+
+typedef enum {
+    HL_MERGED = 0, /* the paper's estimator */
+    HL_UNMERGED,   /* every secondary hit's own vMF lobe lit from that hit (the paper's Fig. 4 top) */
+    HL_TRACED,     /* every secondary hit lit through its true glossy BSDF lobe, light sampling and
+                    * lobe sampling with MIS: the path tracer's estimate of the same paths, for
+                    * tests and benchmarks (no vMF approximation, no shared position) */
+} hl_mode;
+
+typedef struct {
+    hl_mode mode;
+    int secondary_rays; /* N, 1..HL_MAX_SECONDARY_RAYS */
+    int clusters;       /* K, 1..HL_MAX_CLUSTERS */
+    const struct env_vmf_filter *env_filter; /* the scene's environment, prefiltered; NULL: none */
+    int num_punctual;   /* the scene's point, spot and directional lights (first in its list) */
+    int area_lights;    /* whether it has emissive triangles */
+} hl_setup;
+
+/* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */
+hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf_filter *env_filter);
+
+/* The highlights at camera hit x: light along camera - glossy(x) - glossy(q) - light, reflected
+ * toward the camera. Zero when x has no glossy lobe. Counts work into st. */
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_state *rng, render_stats *st);
+
+#endif
