@@ -68,6 +68,8 @@ typedef struct {
     double reset_at, frame_ms, rays_per_second;
     unsigned long long rejected;
     unsigned long long virtual_lights;
+    unsigned long long hl_points, hl_lobes; /* the last full-resolution frame's (vsl+hl) */
+    double hl_merge_share;   /* its thread time spent merging, as a fraction */
     char message[1200];
     uint64_t message_serial;
     scene_info info;
@@ -155,8 +157,11 @@ static void handle_load(viewer *v, int kind, const char *path, const camera *cam
     }
 }
 
-static void publish(viewer *v, render_session *rs, int preview, double frame_ms, uint64_t resets_seen, uint64_t gen,
-                    unsigned mask) {
+/* before: the session's statistics before the frame, so the frame's own work is the difference.
+ * The film is resolved with the components shown now, not when the frame started: a frame after a
+ * display change shows that change. */
+static void publish(viewer *v, render_session *rs, int preview, double frame_ms, const render_stats *before,
+                    uint64_t resets_seen, uint64_t gen) {
     const film *f = session_film(rs);
     if (v->back.width != f->width || v->back.height != f->height) {
         free(v->back.rgb);
@@ -165,11 +170,16 @@ static void publish(viewer *v, render_session *rs, int preview, double frame_ms,
         v->back.height = v->back.rgb ? f->height : 0;
         if (!v->back.rgb) return;
     }
+    pthread_mutex_lock(&v->sh.lock);
+    unsigned mask = v->sh.show_mask;
+    pthread_mutex_unlock(&v->sh.lock);
     film_resolve(f, mask, v->back.rgb);
     v->back.preview = preview;
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
     for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st.rays[k];
+    double thread_ns = 1e6 * frame_ms * (double)session_params(rs)->threads;
+    double merge_share = thread_ns > 0.0 ? (double)(st.hl_merge_ns - before->hl_merge_ns) / thread_ns : 0.0;
     pthread_mutex_lock(&v->sh.lock);
     if (v->sh.resets == resets_seen) { /* drop a frame of a state already replaced */
         image_buf t = v->sh.image;
@@ -185,7 +195,12 @@ static void publish(viewer *v, render_session *rs, int preview, double frame_ms,
         double secs = seconds_since(v->sh.reset_at);
         v->sh.rays_per_second = secs > 0.0 && !preview ? (double)rays / secs : 0.0;
         v->sh.rejected = st.rejected_samples;
-        if (!preview) v->sh.virtual_lights = st.virtual_lights;
+        if (!preview) {
+            v->sh.virtual_lights = st.virtual_lights;
+            v->sh.hl_points = st.hl_points - before->hl_points;
+            v->sh.hl_lobes = st.hl_lobes - before->hl_lobes;
+            v->sh.hl_merge_share = merge_share;
+        }
     }
     pthread_mutex_unlock(&v->sh.lock);
 }
@@ -201,7 +216,10 @@ static void *render_main(void *arg) {
             snprintf(path, sizeof path, "%s", v->sh.export_path);
             v->sh.export_pending = 0;
             pthread_mutex_unlock(&v->sh.lock);
-            const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT);
+            /* Highlights are a layer of their own when the film has them split off (as glint render). */
+            const render_params *fp = session_params(v->full);
+            int split = fp->pt_highlights || fp->method == METHOD_VSL_HL;
+            const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (split ? 1u << COMP_HIGHLIGHTS : 0u);
             if (film_save_exr(session_film(v->full), layers, path, WRITE_NO_REPLACE, err, sizeof err) != 0) {
                 cli_error("%s", err);
                 set_message(v, "%s%s", err, "");
@@ -233,7 +251,6 @@ static void *render_main(void *arg) {
         camera cam = v->sh.cam;
         render_params params = v->sh.params;
         int preview = seconds_since(v->sh.changed_at) < PREVIEW_HOLD_SECONDS;
-        unsigned mask = v->sh.show_mask;
         int rw = v->sh.render_w, rh = v->sh.render_h;
         if (gen != applied || resize) {
             v->sh.resets++;
@@ -254,9 +271,10 @@ static void *render_main(void *arg) {
             applied = gen;
         }
         render_session *rs = preview ? v->preview : v->full;
+        render_stats before = session_stats(rs);
         double t0 = cli_now();
         session_render_frame(rs);
-        publish(v, rs, preview, 1e3 * seconds_since(t0), resets_seen, gen, mask);
+        publish(v, rs, preview, 1e3 * seconds_since(t0), &before, resets_seen, gen);
         pthread_mutex_lock(&v->sh.lock);
     }
     pthread_mutex_unlock(&v->sh.lock);
@@ -340,6 +358,8 @@ typedef struct {
     double reset_at, frame_ms, rays_per_second;
     unsigned long long rejected;
     unsigned long long virtual_lights;
+    unsigned long long hl_points, hl_lobes;
+    double hl_merge_share;
     /* input */
     double mouse_x, mouse_y;
     double scroll;
@@ -385,6 +405,9 @@ static vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
     vl.per_pixel = c->per_pixel;
     vl.candidates = c->candidates;
     vl.trace_glossy = c->trace_glossy > 0.0f ? c->trace_glossy : -1.0f;
+    vl.secondary_rays = c->secondary_rays;
+    vl.clusters = c->clusters;
+    vl.merge = c->merge == 1 ? HL_MERGE_OFF : c->merge == 2 ? HL_MERGE_TRACE : HL_MERGE_ON;
     return vl;
 }
 
@@ -398,12 +421,16 @@ static void controls_from_vl(ui_controls *c, const vl_params *vl) {
     c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);
     c->candidates = vl->candidates > 0 ? vl->candidates : VL_DEFAULT_CANDIDATES;
     c->trace_glossy = vl->trace_glossy > 0.0f ? vl->trace_glossy : vl->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
+    c->secondary_rays = vl->secondary_rays > 0 ? vl->secondary_rays : HL_DEFAULT_SECONDARY_RAYS;
+    c->clusters = vl->clusters > 0 ? vl->clusters : HL_DEFAULT_CLUSTERS;
+    c->merge = vl->merge == HL_MERGE_OFF ? 1 : vl->merge == HL_MERGE_TRACE ? 2 : 0;
 }
 
 static int vl_controls_differ(const ui_controls *a, const ui_controls *b) {
     return a->clamp != b->clamp || a->clamp_value != b->clamp_value || a->radius_mult != b->radius_mult ||
            a->radius_shrink != b->radius_shrink || a->vl_count != b->vl_count || a->columns != b->columns ||
-           a->per_pixel != b->per_pixel || a->candidates != b->candidates || a->trace_glossy != b->trace_glossy;
+           a->per_pixel != b->per_pixel || a->candidates != b->candidates || a->trace_glossy != b->trace_glossy ||
+           a->secondary_rays != b->secondary_rays || a->clusters != b->clusters || a->merge != b->merge;
 }
 
 /* Sends the camera and estimator settings to the render thread; each call is a change that
@@ -454,8 +481,14 @@ static void request_export(ui_thread *u, const char *name) {
     pthread_mutex_unlock(&sh->lock);
 }
 
+static void tonemap_and_upload(ui_thread *u);
+
 static void take_screenshot(ui_thread *u, const char *name) {
     char path[1024], err[1200];
+    if (u->need_tonemap) { /* a newer image or exposure than the one drawn last: save what is current */
+        tonemap_and_upload(u);
+        u->need_tonemap = 0;
+    }
     if (!u->front.rgb || !u->pixels) {
         snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
         cli_error("%s", u->message);
@@ -489,12 +522,13 @@ static void request_load(ui_thread *u, int kind, const char *path) {
 static void print_stats(ui_thread *u) {
     printf("stats scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
-           "candidates=%d trace_glossy=%g virtual_lights=%llu\n",
+           "candidates=%d trace_glossy=%g virtual_lights=%llu secondary_rays=%d clusters=%d merge=%s hl_lobes=%llu\n",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
            u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
            method_name((render_method)u->ctl.method), u->rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
            u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.candidates,
-           (double)u->ctl.trace_glossy, u->virtual_lights);
+           (double)u->ctl.trace_glossy, u->virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
+           u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->hl_lobes);
     fflush(stdout);
 }
 
@@ -730,6 +764,9 @@ static int fetch(ui_thread *u) {
     u->rays_per_second = sh->rays_per_second;
     u->rejected = sh->rejected;
     u->virtual_lights = sh->virtual_lights;
+    u->hl_points = sh->hl_points;
+    u->hl_lobes = sh->hl_lobes;
+    u->hl_merge_share = sh->hl_merge_share;
     if (sh->message_serial != u->message_serial) {
         snprintf(u->message, sizeof u->message, "%s", sh->message);
         u->message_serial = sh->message_serial;
@@ -811,7 +848,7 @@ static void print_view_help(void) {
            "\n"
            "options:\n"
            "  --size WxH           window and render size [960x540]\n"
-           "  --method NAME        estimator: pt, vpl, vsl [pt]\n"
+           "  --method NAME        estimator: pt, vpl, vsl, vsl+hl [pt]\n"
            "  --max-depth D        scattering events per path [%d]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
            "  --camera INDEX       start from the scene's camera INDEX\n"
@@ -845,7 +882,7 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         } else if (strcmp(a, "--method") == 0) {
             if (!(v = cli_value(argc, argv, &i))) return -1;
             int m = method_from_name(v);
-            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl)", v), -1;
+            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", v), -1;
             o->params.method = (render_method)m;
         } else if ((vl = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
             if (vl < 0) return -1;
@@ -969,6 +1006,7 @@ int cmd_view(int argc, char **argv) {
     v.sh.render_h = fh > 0 ? fh : o.height;
     v.sh.show_mask = COMP_MASK_ALL;
     v.sh.changed_at = -1e9;
+    v.sh.reset_at = cli_now(); /* the first accumulation starts now, not at the clock's origin */
     if (make_sessions(&v, v.sh.render_w, v.sh.render_h, &v.sh.cam, &o.params) != 0) {
         cli_error("%s", v.sh.message);
         ui_shutdown();
@@ -1003,6 +1041,12 @@ int cmd_view(int argc, char **argv) {
                        .rejected_samples = u.rejected,
                        .many_light = u.ctl.method != METHOD_PT,
                        .virtual_lights = u.virtual_lights,
+                       .highlights = u.ctl.method == METHOD_VSL_HL,
+                       .max_secondary_rays = HL_MAX_SECONDARY_RAYS,
+                       .max_clusters = HL_MAX_CLUSTERS,
+                       .hl_points = u.hl_points,
+                       .hl_lobes = u.hl_lobes,
+                       .hl_merge_share = u.hl_merge_share,
                        .width = u.front.width,
                        .height = u.front.height,
                        .previewing = u.front.preview,

@@ -1,8 +1,9 @@
 #!/bin/sh
 # The viewer in a real window under Xvfb, driven by --script: it opens on the default scene,
-# display-only changes keep the accumulated frames, estimator and camera changes reset them,
-# screenshots and EXR exports appear (numbered, never overwriting), a bad file leaves the viewer
-# running, a bad script line is reported with its line number.
+# display-only changes keep the accumulated frames, estimator and camera changes reset them (the
+# many-light and vsl+hl highlight parameters included), screenshots and EXR exports appear
+# (numbered, never overwriting; vsl+hl's with a highlights layer), a bad file leaves the viewer
+# running, a bad script line or value is reported with its line number.
 # Usage: test_viewer.sh GLINT TMPDIR [KEEP_MODULES_LIB]
 set -u
 glint=$1
@@ -90,7 +91,8 @@ head -c 2000 image.exr | grep -q 'direct.R' || fail "EXR export lacks the direct
 ls | grep -q '\.tmp' && fail "temporary files left behind: $(ls)"
 
 # The many-light parameters change live: each change resets the accumulation and shows in the
-# stats; a bad value is reported with its line and leaves the last good value.
+# stats; a bad value is reported with its line and leaves the last good value. Then the same for
+# vsl+hl's highlight parameters, whose component the display can show alone and the export holds.
 cat >manylight.txt <<'EOF'
 set method vsl
 set vsl-count 128
@@ -103,20 +105,66 @@ wait 1
 stats
 set radius-mult -2
 stats
+set method vsl+hl
+set secondary-rays 8
+wait 1
+stats
+set show highlights
+wait 1
+stats
+screenshot highlights.png
+export highlights.exr
+set secondary-rays 4
+wait 1
+stats
+set clusters 4
+wait 1
+stats
+set merge off
+wait 1
+stats
+set merge trace
+wait 1
+stats
+set merge on
+wait 1
+stats
+set clusters 99
+stats
 quit
 EOF
-view --size 96x54 --script manylight.txt
+view --size 48x27 --script manylight.txt # tiny: the run time is per pixel
 rc=$?
-[ $rc -eq 1 ] || fail "many-light session with a bad value: exit $rc, expected 1: $(cat err.txt)"
+[ $rc -eq 1 ] || fail "many-light session with bad values: exit $rc, expected 1: $(cat err.txt)"
 grep -q 'manylight.txt:10:' err.txt || fail "bad radius multiplier not reported with its line: $(cat err.txt)"
+grep -q 'manylight.txt:36:' err.txt || fail "bad cluster count not reported with its line: $(cat err.txt)"
 grep '^stats ' out.txt >stats.txt
-[ "$(wc -l <stats.txt)" -eq 3 ] || fail "many-light session: expected 3 stats lines, got: $(cat out.txt)"
+[ "$(wc -l <stats.txt)" -eq 11 ] || fail "many-light session: expected 11 stats lines, got: $(cat out.txt)"
 [ "$(field 1 method)" = "vsl" ] && [ "$(field 1 vsl_count)" = "128" ] || fail "method or light count not applied"
 [ "$(field 1 virtual_lights)" -gt 0 ] || fail "vsl traced no virtual lights"
 [ "$(field 2 radius_mult)" = "4" ] && [ "$(field 2 candidates)" = "8" ] && [ "$(field 2 trace_glossy)" = "0.4" ] ||
   fail "radius, candidates or trace-glossy not applied"
 [ "$(field 2 resets)" -gt "$(field 1 resets)" ] || fail "a many-light change did not reset the accumulation"
 [ "$(field 3 radius_mult)" = "4" ] || fail "a bad radius multiplier replaced the last good one"
+# stats lines 4 on: vsl+hl (with fewer secondary rays than the default 32, to save time), then shown
+# as highlights only, then N, K and merge changed
+[ "$(field 1 secondary_rays)" = "32" ] && [ "$(field 1 clusters)" = "2" ] && [ "$(field 1 merge)" = "on" ] ||
+  fail "highlight parameters do not start at their defaults: $(sed -n 1p stats.txt)"
+[ "$(field 4 method)" = "vsl+hl" ] && [ "$(field 4 secondary_rays)" = "8" ] || fail "vsl+hl not applied: $(sed -n 4p stats.txt)"
+[ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "switching to vsl+hl did not reset the accumulation"
+[ "$(field 4 hl_lobes)" -gt 0 ] || fail "vsl+hl lit no highlight lobes"
+[ "$(field 5 show)" = "3" ] || fail "show highlights not applied"
+[ "$(field 5 resets)" = "$(field 4 resets)" ] || fail "showing the highlights reset the accumulation"
+[ "$(field 5 frames)" -gt "$(field 4 frames)" ] || fail "frames did not keep accumulating when showing the highlights"
+for change in "6 secondary_rays 4" "7 clusters 4" "8 merge off" "9 merge trace" "10 merge on"; do
+  set -- $change
+  [ "$(field "$1" "$2")" = "$3" ] || fail "$2 $3 not applied: $(sed -n "$1p" stats.txt)"
+  [ "$(field "$1" resets)" -gt "$(field $(($1 - 1)) resets)" ] || fail "$2 $3 did not reset the accumulation"
+done
+[ "$(field 11 clusters)" = "4" ] || fail "a bad cluster count replaced the last good one"
+[ -s highlights.png ] || fail "vsl+hl screenshot missing"
+[ -s highlights.exr ] || fail "vsl+hl EXR export missing"
+head -c 2000 highlights.exr | grep -q 'highlights.R' || fail "the vsl+hl export lacks the highlights layer"
 
 # A bad script line is reported with its line number, before any window opens.
 printf 'wait 1\nfrobnicate 3\n' >bad.txt

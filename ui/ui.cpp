@@ -73,6 +73,14 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
         }
     }
 
+    if (s->highlights && ImGui::CollapsingHeader("Highlights", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::SliderInt("secondary rays", &c->secondary_rays, 1, s->max_secondary_rays, "%d",
+                         ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+        ImGui::SliderInt("clusters (K)", &c->clusters, 1, s->max_clusters, "%d", ImGuiSliderFlags_AlwaysClamp);
+        static const char *merges[3] = {"on", "off", "trace"};
+        ImGui::Combo("merge", &c->merge, merges, 3);
+    }
+
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::SliderFloat("exposure", &c->exposure, -8.0f, 8.0f, "%.1f stops");
         static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights"};
@@ -111,6 +119,15 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
         ImGui::Text("%.2f M rays/s", s->rays_per_second * 1e-6);
         if (s->rejected_samples) ImGui::Text("rejected samples %llu", s->rejected_samples);
         if (s->many_light) ImGui::Text("virtual lights %llu", s->virtual_lights);
+        if (s->highlights) { /* always two lines, so the panel's height does not jump */
+            if (s->hl_points > 0) {
+                ImGui::Text("lobes lit %llu/frame (%.2f/hit)", s->hl_lobes, (double)s->hl_lobes / (double)s->hl_points);
+                ImGui::Text("merging %.1f%% of render time", 100.0 * s->hl_merge_share);
+            } else {
+                ImGui::TextUnformatted("lobes lit -");
+                ImGui::TextUnformatted("merging -");
+            }
+        }
     }
     ImGui::End();
 }

@@ -30,6 +30,10 @@ typedef struct {
     int per_pixel;     /* lights shaded per pixel per frame; -1: all */
     int candidates;    /* resampling candidates per shaded light; 1: by power alone */
     float trace_glossy; /* glossy lobes with alpha below this are traced through; 0: never */
+    /* indirect highlights (method vsl+hl), as glint render's options */
+    int secondary_rays; /* rays sampled from a camera hit's glossy lobe */
+    int clusters;       /* merged vMF lobes per camera hit (K) */
+    int merge;          /* 0: on, 1: off (each hit's own lobe), 2: trace (no vMFs) */
     /* display settings: a change never resets */
     float exposure;    /* stops */
     int show;          /* UI_SHOW_* */
@@ -54,6 +58,11 @@ typedef struct {
     int num_methods;
     int many_light;            /* the current method uses virtual lights: show their settings */
     unsigned long long virtual_lights; /* deposited since the last reset */
+    int highlights;            /* the current method is vsl+hl: show the highlight settings */
+    int max_secondary_rays, max_clusters; /* the highlight settings' upper bounds */
+    /* the last full-resolution frame's highlight work (vsl+hl) */
+    unsigned long long hl_points, hl_lobes; /* camera hits worked at, lobes lit */
+    double hl_merge_share;     /* of the frame's thread time spent clustering and merging */
     const char *message;       /* last export path or error, shown until replaced */
 } ui_stats;
 
