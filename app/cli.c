@@ -69,6 +69,13 @@ int cli_parse_float(const char *option, const char *text, double lo, double hi, 
     return 0;
 }
 
+int cli_parse_plan(const char *option, const char *text, int *plan) {
+    if (strcmp(text, "auto") == 0) *plan = PLAN_AUTO;
+    else if (strcmp(text, "full") == 0) *plan = PLAN_FULL;
+    else return cli_error("%s: expected auto or full, got '%s'", option, text), -1;
+    return 0;
+}
+
 int cli_parse_size(const char *option, const char *text, int *width, int *height) {
     char *end = NULL;
     errno = 0;

@@ -7,20 +7,38 @@
 #include "commands.h"
 
 static void print_info_help(void) {
-    printf("usage: glint info [SCENE] [--env FILE]\n"
+    printf("usage: glint info [SCENE] [--env FILE] [--method NAME] [--max-depth D] [--plan auto|full]\n"
            "\n"
            "Prints a summary of SCENE (default: the built-in scene): geometry, materials, lights,\n"
-           "cameras, size.\n");
+           "cameras, size; then what the scene calls for (material classes, emitters, whether\n"
+           "indirect and glossy-to-glossy transport exist) and the passes method NAME would run\n"
+           "(default vsl+hl, which has them all), each with its reason.\n");
 }
 
 int cmd_info(int argc, char **argv) {
     const char *path = NULL, *env = NULL;
+    int method = METHOD_VSL_HL, max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             print_info_help();
             return EXIT_OK;
         } else if (strcmp(argv[i], "--env") == 0) {
             if (!(env = cli_value(argc, argv, &i))) return EXIT_USAGE;
+        } else if (strcmp(argv[i], "--method") == 0) {
+            const char *v = cli_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if ((method = method_from_name(v)) < 0) {
+                cli_error("--method: expected pt, vpl, vsl or vsl+hl, got '%s'", v);
+                return EXIT_USAGE;
+            }
+        } else if (strcmp(argv[i], "--max-depth") == 0) {
+            const char *v = cli_value(argc, argv, &i);
+            long long n;
+            if (!v || cli_parse_int("--max-depth", v, 1, 10000, &n)) return EXIT_USAGE;
+            max_depth = (int)n;
+        } else if (strcmp(argv[i], "--plan") == 0) {
+            const char *v = cli_value(argc, argv, &i);
+            if (!v || cli_parse_plan("--plan", v, &plan_mode)) return EXIT_USAGE;
         } else if (argv[i][0] == '-') {
             cli_error("unknown option '%s' (see glint info --help)", argv[i]);
             return EXIT_USAGE;
@@ -61,6 +79,17 @@ int cmd_info(int argc, char **argv) {
     /* Load includes parsing, flattening, the light list and the BVH build; ru_maxrss is in KiB. */
     printf("load:       %.3f s, peak memory %.1f MiB\n", load_seconds, (double)ru.ru_maxrss / 1024.0);
     if (s->num_warnings) printf("warnings:   %d (printed above)\n", s->num_warnings);
+    scene_analysis a;
+    char err[256];
+    if (scene_analyse(s, &a, err, sizeof err) != 0) {
+        cli_error("%s: %s", s->path, err);
+        scene_destroy(s);
+        return EXIT_FAILURE_;
+    }
+    effect_plan plan = plan_make(&a, method, max_depth, plan_mode);
+    printf("method:     %s\n", method_name(method));
+    plan_print(stdout, s, &a, &plan);
+    scene_analysis_free(&a);
     scene_destroy(s);
     return EXIT_OK;
 }

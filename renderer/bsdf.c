@@ -66,6 +66,16 @@ int bsdf_lobes(const bsdf *b) {
     return lobes;
 }
 
+int bsdf_highlight_lobe(const bsdf *b) {
+    return (bsdf_lobes(b) & BSDF_GLOSSY) && bsdf_glossy_alpha(b) < BSDF_HIGHLIGHT_ALPHA ? BSDF_GLOSSY : 0;
+}
+
+float bsdf_glossy_aspect(const bsdf *b) {
+    if (!(bsdf_lobes(b) & BSDF_GLOSSY) || (b->model != GLOSSY_GGX && b->model != GLOSSY_WARD)) return 1.0f;
+    float ax = fmaxf(b->alpha_x, BSDF_MIN_ALPHA), ay = fmaxf(b->alpha_y, BSDF_MIN_ALPHA);
+    return fmaxf(ax, ay) / fminf(ax, ay);
+}
+
 vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo) {
     if (!(bsdf_lobes(b) & BSDF_GLOSSY) || wo.z <= 0.0f) return v3s(0.0f);
     /* A sharp lobe reflects about its mirror direction, where the half vector is the normal: GGX

@@ -15,8 +15,15 @@ extern "C" {
 #endif
 
 
-/* Lobe masks: estimators that split path space ask for one lobe or both. */
-enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_ALL = 3 };
+/* Lobe masks: estimators that split path space ask for one lobe or both. BSDF_NOT_HIGHLIGHT,
+ * for estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe. */
+enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_ALL = 3, BSDF_NOT_HIGHLIGHT = 4 };
+
+/* The path-space split (DESIGN.md): camera - glossy - glossy - light paths belong to the
+ * highlight estimator when both glossy lobes are sharper than this roughness (microfacet alpha).
+ * A rougher lobe reflects much like a diffuse one: it stays with the many-light estimators, costs
+ * no highlight rays, and cone sampling integrates it well (the effect plan's diffuse kernel). */
+#define BSDF_HIGHLIGHT_ALPHA 0.5f
 
 typedef enum {
     GLOSSY_NONE = 0,
@@ -74,6 +81,11 @@ int bsdf_lobes(const bsdf *b);
 /* The glossy lobe's width as a microfacet roughness alpha (geometric mean of the two axes;
  * Phong through its equivalent exponent); 0 without a glossy lobe. */
 float bsdf_glossy_alpha(const bsdf *b);
+/* BSDF_GLOSSY when b's glossy lobe is sharper than BSDF_HIGHLIGHT_ALPHA, else 0. */
+int bsdf_highlight_lobe(const bsdf *b);
+/* How anisotropic the glossy lobe is: its larger roughness over its smaller (GGX, Ward); 1 for an
+ * isotropic lobe or none. */
+float bsdf_glossy_aspect(const bsdf *b);
 /* The glossy lobe's directional albedo for wo, approximated for sharp lobes (the lobe's value at
  * the mirror direction); 0 without a glossy lobe or with wo below. */
 vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo);

@@ -37,7 +37,7 @@ shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_di
 /* One light's contribution to x: kernel, then visibility (only when there is something to
  * block), then the clamp. */
 static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *vl, const shading_point *x,
-                      rng_state *rng, render_stats *st) {
+                      vl_terms terms, rng_state *rng, render_stats *st) {
     st->vl_connections++;
     /* Visibility is to the light's centre. A centre behind x's surface, or one x would see from
      * behind the light's own surface, is blocked by that surface: the ray would start or end
@@ -50,10 +50,10 @@ static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *v
     vec3 c;
     if (m->kernel == VL_KERNEL_VSL) {
         int n = 0;
-        c = vsl_contribution(vl, x, m->terms, rng, &n);
+        c = vsl_contribution(vl, x, terms, m->all_strategies, rng, &n);
         st->vsl_samples += (uint64_t)n;
     } else {
-        c = vpl_contribution(vl, x, m->kernel == VL_KERNEL_VPL_GLOSSY, m->terms);
+        c = vpl_contribution(vl, x, m->kernel == VL_KERNEL_VPL_GLOSSY, terms);
     }
     if (is_black3(c) || !is_finite3(c)) return v3(0, 0, 0);
     vec3 org = offset_origin(s, x->p, x->ng, dir);
@@ -142,12 +142,13 @@ static float resample_entry(const manylight *m, const shading_point *x, rng_stat
     return (float)(w_sum / (double)m->candidates / (double)chosen_target) * m->entries[*e].scale;
 }
 
-vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, rng_state *rng, render_stats *st) {
+vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, vl_terms terms, rng_state *rng,
+                     render_stats *st) {
     vec3 sum = v3(0, 0, 0);
     if (m->num_entries == 0 || !bsdf_lobes(&x->b)) return sum;
     if (m->per_pixel == 0) {
         for (int e = 0; e < m->num_entries; e++) {
-            vec3 c = shade_one(m, s, &m->set.v[m->entries[e].light], x, rng, st);
+            vec3 c = shade_one(m, s, &m->set.v[m->entries[e].light], x, terms, rng, st);
             sum = madd3(sum, c, m->entries[e].scale);
         }
         return sum;
@@ -155,7 +156,7 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
     for (int k = 0; k < m->per_pixel; k++) {
         int e;
         float weight = resample_entry(m, x, rng, &e);
-        if (weight > 0.0f) sum = madd3(sum, shade_one(m, s, &m->set.v[m->entries[e].light], x, rng, st), weight);
+        if (weight > 0.0f) sum = madd3(sum, shade_one(m, s, &m->set.v[m->entries[e].light], x, terms, rng, st), weight);
     }
     return scale3(sum, 1.0f / (float)m->per_pixel);
 }
@@ -196,7 +197,8 @@ static void compute_row(void *ctx, int r, int worker) {
     if (!scene_intersect(job->s, job->cam->position, d, INFINITY, &h)) return;
     shading_point sp = shading_point_at(job->s, &h, d);
     if (!bsdf_lobes(&sp.b)) return;
-    for (int j = 0; j < n; j++) row[j] = luminance3(shade_one(job->m, job->s, &job->m->set.v[j], &sp, &rng, st));
+    for (int j = 0; j < n; j++)
+        row[j] = luminance3(shade_one(job->m, job->s, &job->m->set.v[j], &sp, job->m->terms, &rng, st));
 }
 
 static void add_stats(render_stats *to, const render_stats *from) {
@@ -254,11 +256,13 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
     shading_point x = *x0;
     /* x is scattering event k: gathering there makes paths of k + 1 events or more. */
     for (int k = 1; k + 1 <= max_depth; k++) {
+        /* Only at the camera hit do the highlights own part of the gathered paths. */
+        vl_terms terms = k == 1 ? m->terms : VL_TERMS_ALL;
         int sharp = (bsdf_lobes(&x.b) & BSDF_GLOSSY) && bsdf_glossy_alpha(&x.b) < m->trace_alpha;
-        if (!sharp) return add3(sum, mul3(beta, manylight_shade(m, s, &x, rng, st)));
+        if (!sharp) return add3(sum, mul3(beta, manylight_shade(m, s, &x, terms, rng, st)));
         shading_point diffuse_only = x;
         diffuse_only.b.model = GLOSSY_NONE;
-        sum = add3(sum, mul3(beta, manylight_shade(m, s, &diffuse_only, rng, st)));
+        sum = add3(sum, mul3(beta, manylight_shade(m, s, &diffuse_only, terms, rng, st)));
 
         float u_lobe = rng_float(rng);
         vec2 u = rng_vec2(rng);
@@ -277,8 +281,9 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         /* Emission at the next hit is the direct light at x, which the shared estimator has. */
         surface_hit h;
         vec3 direct;
-        /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (DESIGN.md). */
-        int lobes = k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS ? BSDF_DIFFUSE : BSDF_ALL;
+        /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (DESIGN.md) when both
+         * lobes are highlight lobes. */
+        int lobes = k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT : BSDF_ALL;
         if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, lobes, rng, &direct, &h, st->rays)) break;
         sum = add3(sum, mul3(beta, direct));
         x = shading_point_at(s, &h, wi);
@@ -286,13 +291,15 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
     return sum;
 }
 
-int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
-                          threadpool *pool, render_stats *st, char *err, size_t errlen) {
+int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p,
+                          const effect_plan *plan, long long frame, threadpool *pool, render_stats *st, char *err,
+                          size_t errlen) {
     const vl_params *vp = &p->vl;
     long long i = frame + 1;
     m->kernel = p->method == METHOD_VSL || p->method == METHOD_VSL_HL ? VL_KERNEL_VSL
                 : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
-    m->terms = p->method == METHOD_VSL_HL ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
+    m->terms = plan->highlights ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
+    m->all_strategies = plan->vsl_all_strategies;
     m->clamp = vp->clamp == VL_CLAMP_ON || (vp->clamp == VL_CLAMP_DEFAULT && p->method == METHOD_VPL);
     m->clamp_bound = vpl_clamp_at(vp->clamp_value > 0.0f ? vp->clamp_value : VL_DEFAULT_CLAMP, vp->clamp_growth, i);
     m->radius_mult = vsl_radius_mult_at(vp->radius_mult > 0.0f ? vp->radius_mult : VL_DEFAULT_RADIUS_MULT,
@@ -300,7 +307,7 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     m->num_entries = 0;
     m->clustered = 0;
     int count = vp->count > 0 ? vp->count : VL_DEFAULT_COUNT;
-    if (vlights_trace(s, count, p->max_depth, p->seed, (uint64_t)frame, &m->set, &st->rays[RAY_BOUNCE]) != 0)
+    if (vlights_trace(s, count, plan->max_depth, p->seed, (uint64_t)frame, &m->set, &st->rays[RAY_BOUNCE]) != 0)
         return snprintf(err, errlen, "out of memory for %d virtual lights", count), -1;
     st->virtual_lights += (uint64_t)m->set.count;
     st->light_paths += (uint64_t)m->set.paths;

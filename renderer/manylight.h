@@ -19,6 +19,7 @@ typedef struct {
 typedef struct {
     vl_kernel kernel;
     vl_terms terms;
+    int all_strategies; /* the three-strategy VSL integral for every pair (the plan's choice) */
     int clamp;          /* on for this method? */
     float clamp_bound;  /* this frame's bound */
     float radius_mult;  /* this frame's multiplier */
@@ -34,13 +35,17 @@ typedef struct {
 
 void manylight_deinit(manylight *m);
 
-/* Prepares frame `frame` (0 = first of the running mean) of method p->method. Uses the pool for
+/* Prepares frame `frame` (0 = first of the running mean) of method p->method as the plan says
+ * (its depth, whether highlights own the glossy-glossy paths, the VSL kernel). Uses the pool for
  * the sampled rows of the reduced matrix. Returns 0, or -1 with err set (out of memory). */
-int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
-                          threadpool *pool, render_stats *st, char *err, size_t errlen);
+int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p,
+                          const effect_plan *plan, long long frame, threadpool *pool, render_stats *st, char *err,
+                          size_t errlen);
 
-/* Light at x from this frame's virtual lights (visibility, clamping, scaling included). */
-vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, rng_state *rng, render_stats *st);
+/* Light at x from this frame's virtual lights (visibility, clamping, scaling included), the paths
+ * in `terms` (the frame's m->terms at the camera hit, VL_TERMS_ALL beyond). */
+vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, vl_terms terms, rng_state *rng,
+                     render_stats *st);
 
 /* Indirect light at the camera hit x (scattering event 1 of at most max_depth): gathered from
  * the virtual lights, except through a glossy lobe sharper than trace_alpha, where a handful of

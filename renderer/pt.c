@@ -9,7 +9,8 @@ static inline film_component component_of(int emitter_vertex) {
 }
 
 /* A contribution c of a path that reaches the light at its third vertex, whose part through the
- * glossy lobes of both scattering vertices is hl: that part to the highlights, the rest indirect. */
+ * highlight lobes (bsdf_highlight_lobe) of both scattering vertices is hl: that part to the
+ * highlights, the rest indirect. */
 static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
     out[COMP_HIGHLIGHTS] = add3(out[COMP_HIGHLIGHTS], hl);
     vec3 rest = sub3(c, hl); /* >= 0 up to rounding: f >= its glossy lobe */
@@ -28,7 +29,7 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int split_highlights, 
  * there was one. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
  * first belongs to that path's direct light and is not counted. With split_highlights the paths
  * camera - glossy - glossy - light go to COMP_HIGHLIGHTS: the product of the two vertices'
- * glossy lobes, out of the same samples (the lobes add up to the BSDF). */
+ * highlight lobes, out of the same samples (the lobes add up to the BSDF). */
 static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
                       uint64_t rays[RAY_KIND_COUNT], surface_hit *first, int continuation, int split_highlights,
                       int first_lobes) {
@@ -67,7 +68,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
         frame3 fr;
         bsdf b = material_bsdf(s, &h, &fr);
         vec3 wo = to_local(fr, neg3(d));
-        int lobes = depth == 0 ? first_lobes : BSDF_ALL;
+        int lobes = depth > 0 ? BSDF_ALL : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~bsdf_highlight_lobe(&b) : first_lobes;
 
         /* Next-event estimation. */
         light_sample ls;
@@ -81,7 +82,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
                     float w = ls.delta ? 1.0f : mis_power(ls.pdf, bsdf_pdf(&b, wo, wi, lobes));
                     vec3 c = scale3(mul3(mul3(beta, f), ls.radiance), wi.z * w / ls.pdf);
                     if (split_highlights && depth == 1) {
-                        vec3 fg = bsdf_eval(&b, wo, wi, BSDF_GLOSSY);
+                        vec3 fg = bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b));
                         add_split(out, c, scale3(mul3(mul3(beta_hl, fg), ls.radiance), wi.z * w / ls.pdf));
                     } else {
                         out[component_of(depth + 1)] = add3(out[component_of(depth + 1)], c);
@@ -98,7 +99,7 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
         vec3 wi = to_world(fr, bs.wi);
         if (dot3(wi, h.ng) <= 0.0f) break; /* below the geometric surface: no transmission */
         if (split_highlights && depth <= 1) {
-            vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, BSDF_GLOSSY), bs.wi.z / bs.pdf);
+            vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, bsdf_highlight_lobe(&b)), bs.wi.z / bs.pdf);
             beta_hl = depth == 0 ? fg : mul3(beta_hl, fg);
         }
         beta = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));

@@ -25,8 +25,8 @@ int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surf
 
 /* The same without the emission at the hit (nor the environment when the ray escapes): only
  * light that reaches the hit directly from an emitter and is reflected back along the ray by the
- * hit's BSDF lobes in the mask (BSDF_ALL, or BSDF_DIFFUSE where the glossy lobe's share belongs to
- * the highlight estimator). For estimators that continue a path and must not count the emission
+ * hit's BSDF lobes in the mask (BSDF_ALL, or BSDF_NOT_HIGHLIGHT where the highlight lobe's share
+ * belongs to the highlight estimator). For estimators that continue a path and must not count the emission
  * their direct light has. */
 int pt_reflected_direct(const scene *s, vec3 o, vec3 d, int lobes, rng_state *rng, vec3 *direct, surface_hit *first,
                         uint64_t rays[RAY_KIND_COUNT]);

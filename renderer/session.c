@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L
 #include "session.h"
 
 #include <stdio.h>
@@ -5,6 +6,7 @@
 #include <string.h>
 
 #include "camera.h"
+#include "clock.h"
 #include "highlights.h"
 #include "lights.h"
 #include "manylight.h"
@@ -14,6 +16,7 @@
 
 static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl", "vsl+hl"};
 const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
+const char *const pass_names[PASS_COUNT] = {"paths", "direct", "virtual_lights", "gather", "highlights"};
 
 const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? method_names[m] : "?"; }
 
@@ -43,6 +46,8 @@ struct render_session {
     int tiles_x, tiles_y;
     manylight ml; /* vpl, vsl, vsl+hl: this frame's virtual lights */
     hl_setup hl;  /* vsl+hl: this frame's highlight settings */
+    scene_analysis analysis;
+    effect_plan plan;
     char error[256];
 };
 
@@ -70,6 +75,11 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         return snprintf(err, errlen, "cannot start render threads"), NULL;
     }
     p->threads = threadpool_size(rs->pool); /* report what runs, not what was asked */
+    if (scene_analyse(s, &rs->analysis, err, errlen) != 0) {
+        session_destroy(rs);
+        return NULL;
+    }
+    rs->plan = plan_make(&rs->analysis, p->method, p->max_depth, p->plan);
     rs->tiles_x = (p->width + TILE - 1) / TILE;
     rs->tiles_y = (p->height + TILE - 1) / TILE;
     return rs;
@@ -79,6 +89,7 @@ void session_destroy(render_session *rs) {
     if (!rs) return;
     threadpool_destroy(rs->pool);
     manylight_deinit(&rs->ml);
+    scene_analysis_free(&rs->analysis);
     free(rs->workers);
     film_deinit(&rs->film);
     free(rs);
@@ -93,6 +104,7 @@ static void render_tile(void *ctx, int tile, int worker) {
     int x1 = x0 + TILE < p->width ? x0 + TILE : p->width;
     int y1 = y0 + TILE < p->height ? y0 + TILE : p->height;
     float aspect = (float)p->width / (float)p->height, tan_half_fov = tanf(0.5f * rs->cam.yfov);
+    uint64_t tile_start = clock_ns();
     for (int y = y0; y < y1; y++) {
         for (int x = x0; x < x1; x++) {
             int pixel = y * p->width + x;
@@ -101,16 +113,30 @@ static void render_tile(void *ctx, int tile, int worker) {
             vec3 d = camera_ray_dir_tan(&rs->cam, tan_half_fov, aspect, ((float)x + j.x) / (float)p->width,
                                         ((float)y + j.y) / (float)p->height);
             vec3 L[COMP_COUNT];
+            int depth = rs->plan.max_depth;
             if (p->method == METHOD_PT) {
-                pt_radiance(s, p->max_depth, p->pt_highlights, rs->cam.position, d, &rng, L, st->rays);
+                pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, &rng, L, st->rays);
             } else {
-                /* Many lights: the shared direct estimator, then the virtual lights at the hit. */
+                /* Many lights: the shared direct estimator, then the virtual lights at the hit and
+                 * the highlights, each pass timed. */
                 surface_hit h;
                 for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
-                if (pt_direct(s, rs->cam.position, d, &rng, &L[COMP_DIRECT], &h, st->rays) && p->max_depth > 1) {
+                uint64_t t0 = clock_ns();
+                int hit = pt_direct(s, rs->cam.position, d, &rng, &L[COMP_DIRECT], &h, st->rays);
+                uint64_t t1 = clock_ns();
+                st->pass_ns[PASS_DIRECT] += t1 - t0;
+                if (hit && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
                     shading_point sp = shading_point_at(s, &h, d);
-                    L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, p->max_depth, &rng, st);
-                    if (p->method == METHOD_VSL_HL && p->max_depth > 2) L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &rng, st);
+                    if (rs->plan.virtual_lights) {
+                        L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, &rng, st);
+                        uint64_t t2 = clock_ns();
+                        st->pass_ns[PASS_GATHER] += t2 - t1;
+                        t1 = t2;
+                    }
+                    if (rs->plan.highlights) {
+                        L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &rng, st);
+                        st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
+                    }
                 }
             }
             float sample[COMP_COUNT][3];
@@ -130,18 +156,22 @@ static void render_tile(void *ctx, int tile, int worker) {
             }
         }
     }
+    if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;
 }
 
 int session_render_frame(render_session *rs) {
-    if (rs->params.method == METHOD_VSL_HL) {
+    if (rs->plan.highlights) {
         const struct env_vmf_filter *envf = NULL;
-        if (rs->scene->env && !(envf = env_map_vmf_filter(rs->scene->env, rs->error, sizeof rs->error))) return -1;
+        if (rs->plan.env_prefilter && !(envf = env_map_vmf_filter(rs->scene->env, rs->error, sizeof rs->error))) return -1;
         rs->hl = hl_setup_from(rs->scene, &rs->params.vl, envf);
     }
-    if (rs->params.method != METHOD_PT &&
-        manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, rs->frames, rs->pool, &rs->totals, rs->error,
-                              sizeof rs->error) != 0)
-        return -1;
+    if (rs->plan.virtual_lights) {
+        uint64_t t0 = clock_ns();
+        if (manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, &rs->plan, rs->frames, rs->pool, &rs->totals,
+                                  rs->error, sizeof rs->error) != 0)
+            return -1;
+        rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
+    }
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
     film_end_pass(&rs->film);
     rs->frames++;
@@ -159,6 +189,7 @@ int session_render_frame(render_session *rs) {
         t->hl_secondary_rays += st->hl_secondary_rays;
         t->hl_lobes += st->hl_lobes;
         t->hl_merge_ns += st->hl_merge_ns;
+        for (int k = 0; k < PASS_COUNT; k++) t->pass_ns[k] += st->pass_ns[k];
         memset(st, 0, sizeof *st);
     }
     return 0;
@@ -184,6 +215,7 @@ void session_set_params(render_session *rs, const render_params *params) {
     if (p.max_depth <= 0) p.max_depth = DEFAULT_MAX_DEPTH;
     if ((unsigned)p.method >= METHOD_COUNT) p.method = METHOD_PT;
     rs->params = p;
+    rs->plan = plan_make(&rs->analysis, p.method, p.max_depth, p.plan);
     session_reset(rs);
 }
 
@@ -191,3 +223,5 @@ long long session_frames(const render_session *rs) { return rs->frames; }
 const film *session_film(const render_session *rs) { return &rs->film; }
 const render_params *session_params(const render_session *rs) { return &rs->params; }
 render_stats session_stats(const render_session *rs) { return rs->totals; }
+const scene_analysis *session_analysis(const render_session *rs) { return &rs->analysis; }
+const effect_plan *session_plan(const render_session *rs) { return &rs->plan; }

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "film.h"
+#include "plan.h"
 #include "scene.h"
 
 typedef enum {
@@ -76,12 +77,19 @@ typedef struct {
     uint64_t seed;
     int threads;          /* 0: one per core */
     int pt_highlights;    /* pt: camera - glossy - glossy - light paths in their own component */
+    int plan;             /* PLAN_AUTO: only the passes the scene calls for; PLAN_FULL: all */
     vl_params vl;
 } render_params;
 
 /* Work done, by kind of ray; summed over the session's frames. */
 typedef enum { RAY_CAMERA = 0, RAY_SHADOW, RAY_BOUNCE, RAY_KIND_COUNT } ray_kind;
 extern const char *const ray_kind_names[RAY_KIND_COUNT];
+
+/* The passes a frame runs, each timed (thread time; the virtual lights' preparation wall time):
+ * path tracing (pt), or the camera rays with the direct light, the virtual lights' tracing and
+ * clustering, gathering from them, and the highlights. */
+typedef enum { PASS_PATHS = 0, PASS_DIRECT, PASS_VIRTUAL_LIGHTS, PASS_GATHER, PASS_HIGHLIGHTS, PASS_COUNT } pass_kind;
+extern const char *const pass_names[PASS_COUNT];
 
 typedef struct {
     uint64_t rays[RAY_KIND_COUNT];
@@ -96,6 +104,7 @@ typedef struct {
     uint64_t hl_secondary_rays;/* rays sampled from their glossy lobes */
     uint64_t hl_lobes;         /* lobes lit (merged, or one per secondary hit without merging) */
     uint64_t hl_merge_ns;      /* thread time spent clustering and merging (the paper's Table 1, C) */
+    uint64_t pass_ns[PASS_COUNT];
 } render_stats;
 
 typedef struct render_session render_session;
@@ -121,5 +130,8 @@ long long session_frames(const render_session *rs);
 const film *session_film(const render_session *rs);
 const render_params *session_params(const render_session *rs);
 render_stats session_stats(const render_session *rs);
+/* What the scene calls for (analysed when the session is created) and the passes it runs. */
+const scene_analysis *session_analysis(const render_session *rs);
+const effect_plan *session_plan(const render_session *rs);
 
 #endif

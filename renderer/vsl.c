@@ -4,12 +4,14 @@
 
 #define PI_D 3.14159265358979323846
 
-/* f_x(wo, lx) f_j(wi_j, lj) with the path-space split applied (both directions local, above). */
+/* f_x(wo, lx) f_j(wi_j, lj) with the path-space split applied (both directions local, above):
+ * the highlights' part is the product of both ends' highlight lobes. */
 static vec3 bsdf_pair(const virtual_light *vl, const shading_point *x, vec3 lx, vec3 lj, int lobes_j, vl_terms terms) {
     if (terms == VL_TERMS_ALL || vl->depth != 1)
         return terms == VL_TERMS_HIGHLIGHTS ? v3(0, 0, 0)
                                             : mul3(bsdf_eval(&x->b, x->wo, lx, BSDF_ALL), bsdf_eval(&vl->b, vl->wi, lj, lobes_j));
-    vec3 gg = mul3(bsdf_eval(&x->b, x->wo, lx, BSDF_GLOSSY), bsdf_eval(&vl->b, vl->wi, lj, lobes_j & BSDF_GLOSSY));
+    vec3 gg = mul3(bsdf_eval(&x->b, x->wo, lx, bsdf_highlight_lobe(&x->b)),
+                   bsdf_eval(&vl->b, vl->wi, lj, lobes_j & bsdf_highlight_lobe(&vl->b)));
     if (terms == VL_TERMS_HIGHLIGHTS) return gg;
     vec3 all = mul3(bsdf_eval(&x->b, x->wo, lx, BSDF_ALL), bsdf_eval(&vl->b, vl->wi, lj, lobes_j));
     return max3(sub3(all, gg), v3(0, 0, 0)); /* exact up to rounding; never below zero */
@@ -84,7 +86,8 @@ vec3 vsl_integrand(const virtual_light *vl, const shading_point *x, vl_terms ter
     return in_omega(&o, x, l) ? integrand(vl, x, terms, l, &lx, &lj) : v3(0, 0, 0);
 }
 
-vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms terms, rng_state *rng, int *samples) {
+vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
+                  int *samples) {
     solid_angle o = omega_of(vl, x);
     /* Proportional to |Omega| = 2 pi (1 - cos theta_max): 100 at the hemisphere, at least 1. */
     int n = o.inside ? VSL_MAX_SAMPLES : (int)ceilf((float)VSL_MAX_SAMPLES * o.omc);
@@ -92,10 +95,12 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
     if (samples) *samples = n;
     float pdf_cone_uniform = o.inside ? 0.0f : pdf_uniform_cone(o.omc);
     /* The strategies take turns from a random start, so each sample's strategy is uniform: the
-     * one-sample model, weights (1/3) p_t. */
-    unsigned strategy = (unsigned)(rng_float(rng) * 3.0f);
+     * one-sample model, weights (1/3) p_t. Where neither lobe is glossy the integrand is smooth
+     * over the cone and cone sampling alone does (the effect plan's diffuse kernel). */
+    int strategies = all_strategies || bsdf_highlight_lobe(&x->b) || bsdf_highlight_lobe(&vl->b) ? 3 : 1;
+    unsigned strategy = strategies == 3 ? (unsigned)(rng_float(rng) * 3.0f) : 0u;
     double sum[3] = {0.0, 0.0, 0.0}; /* double: a razor-sharp lobe over a tiny pdf must not overflow */
-    for (int k = 0; k < n; k++, strategy = (strategy + 1) % 3) {
+    for (int k = 0; k < n; k++, strategy = (strategy + 1) % (unsigned)strategies) {
         vec2 u = rng_vec2(rng);
         float u_lobe = rng_float(rng);
         vec3 l;
@@ -115,9 +120,10 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
         vec3 g = integrand(vl, x, terms, l, &lx, &lj);
         if (is_black3(g)) continue;
         float p_cone = o.inside ? pdf_cosine_hemisphere(lx) : pdf_cone_uniform;
-        float p_sum = p_cone + bsdf_pdf(&x->b, x->wo, lx, BSDF_ALL) + bsdf_pdf(&vl->b, vl->wi, lj, BSDF_ALL);
+        float p_sum = strategies == 1 ? p_cone
+                                      : p_cone + bsdf_pdf(&x->b, x->wo, lx, BSDF_ALL) + bsdf_pdf(&vl->b, vl->wi, lj, BSDF_ALL);
         if (!(p_sum > 0.0f)) continue;
-        double w = 3.0 / (double)p_sum;
+        double w = (double)strategies / (double)p_sum;
         sum[0] += (double)g.x * w;
         sum[1] += (double)g.y * w;
         sum[2] += (double)g.z * w;
@@ -126,9 +132,10 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
                                   (float)fmin(sum[2], VL_MAX_CONTRIBUTION)), 1.0 / n);
 }
 
-vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, rng_state *rng, int *samples) {
+vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
+                      int *samples) {
     if (!(vl->radius > 0.0f)) return vpl_contribution(vl, x, 1, terms); /* the limit r -> 0 */
-    vec3 i = vsl_integral(vl, x, terms, rng, samples);
+    vec3 i = vsl_integral(vl, x, terms, all_strategies, rng, samples);
     if (is_black3(i)) return i;
     return saturate(vl->power, i, 1.0 / (PI_D * (double)vl->radius * (double)vl->radius));
 }

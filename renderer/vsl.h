@@ -14,7 +14,8 @@ typedef enum {
 } vl_kernel;
 
 /* Which part of path space: with the highlight estimator on, the paths glossy(x) -> glossy(p_j)
- * with p_j a first bounce from a light belong to it, and the many-light estimators skip them. */
+ * with p_j a first bounce from a light belong to it (both lobes sharper than
+ * BSDF_HIGHLIGHT_ALPHA), and the many-light estimators skip them at the camera hit x. */
 typedef enum {
     VL_TERMS_ALL = 0,
     VL_TERMS_NO_HIGHLIGHTS, /* drop glossy(x) x glossy(p_j) for depth-1 lights */
@@ -39,11 +40,14 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
 /* Phi_j / (pi r_j^2) x the integral over the cone Omega_j of Eq. 5, no visibility: uniform cone
  * sampling (cosine-weighted hemisphere when x is inside the sphere), BSDF sampling at x and BSDF
  * sampling at the light, one sample model with the balance heuristic; ceil(100 |Omega|/2pi)
- * samples, at least 1. *samples (optional) receives the count used. */
-vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, rng_state *rng, int *samples);
+ * samples, at least 1. Unless all_strategies, a pair without a glossy lobe sharper than
+ * BSDF_HIGHLIGHT_ALPHA uses cone sampling alone. *samples (optional) receives the count used. */
+vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
+                      int *samples);
 
 /* The integral of Eq. 5 alone (without Phi / (pi r^2)), for tests. */
-vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms terms, rng_state *rng, int *samples);
+vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
+                  int *samples);
 
 /* The Eq. 5 integrand at direction l (world, from x): f_x cos_x f_j cos_j with the term split,
  * zero outside Omega_j. Exposed for brute-force checks. */

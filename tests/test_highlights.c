@@ -15,15 +15,6 @@
 #define IND (1u << COMP_INDIRECT)
 #define DIR (1u << COMP_DIRECT)
 
-static material phong(vec3 kd, vec3 ks, float n) {
-    material m = material_default();
-    m.model = MATERIAL_PHONG;
-    m.kd = kd;
-    m.ks = ks;
-    m.exponent = n;
-    return m;
-}
-
 static double channel_sum(const float *img, int n, int c) {
     double s = 0.0;
     for (int i = 0; i < n; i++) s += img[3 * i + c];
@@ -63,10 +54,10 @@ static render_params hl_params(int merge, int clusters, int rays) {
  * sky; 2: by the sky alone): the camera sees the wall's highlights in the floor. The lights sit at distance `far` from
  * the wall, up behind the camera where the two mirrors send the view rays; far from the wall
  * (far >> the floor-wall distance) the merged lobes' shared position costs little. */
-static scene *floor_and_wall(float exponent, int with_env, float far) {
+static scene *floor_and_wall_of(float exponent, int with_env, float far, const material *wall) {
     scene *s = ts_new("floor and wall");
-    int floor_m = ts_material(s, phong(v3(0.15f, 0.1f, 0.1f), v3(0.7f, 0.75f, 0.8f), exponent));
-    int wall_m = ts_material(s, phong(v3(0.1f, 0.15f, 0.1f), v3(0.8f, 0.7f, 0.6f), exponent));
+    int floor_m = ts_material(s, ts_phong(v3(0.15f, 0.1f, 0.1f), v3(0.7f, 0.75f, 0.8f), exponent));
+    int wall_m = ts_material(s, wall ? *wall : ts_phong(v3(0.1f, 0.15f, 0.1f), v3(0.8f, 0.7f, 0.6f), exponent));
     ts_quad(s, v3(-2, 0, -2), v3(-2, 0, 3), v3(2, 0, 3), v3(2, 0, -2), floor_m);
     ts_quad(s, v3(-2, 0, -1), v3(2, 0, -1), v3(2, 2, -1), v3(-2, 2, -1), wall_m);
     if (with_env != 2) {
@@ -103,6 +94,10 @@ static scene *floor_and_wall(float exponent, int with_env, float far) {
     return s;
 }
 
+static scene *floor_and_wall(float exponent, int with_env, float far) {
+    return floor_and_wall_of(exponent, with_env, far, NULL);
+}
+
 static camera floor_camera(void) { return camera_look_at(v3(0, 0.6f, 2.2f), v3(0, 0.05f, 0), v3(0, 1, 0), 0.9f); }
 
 /* --merge trace lights every secondary hit through its true lobe: the same paths as the path
@@ -131,11 +126,13 @@ static void test_trace_matches_path_tracer(void) {
 
 /* The vMF modes approximate each secondary hit's lobe by a vMF, and merging shares a position:
  * sharp lobes far from the lights keep both small. Against the exact mode. */
-/* ... lit by the lights, or by the sky alone (the prefiltered map looked up by each lobe). */
-static void vmf_modes_close_to_exact(int env) {
-    scene *s = floor_and_wall(400.0f, env, 12.0f);
+/* ... lit by the lights, or by the sky alone (the prefiltered map looked up by each lobe); wall:
+ * a brushed (anisotropic Ward) wall, whose lobes no vMF can follow and which is lit through its
+ * own BSDF (with a vMF: relative L2 0.39). */
+static void vmf_modes_close_to_exact(int env, const material *wall) {
+    scene *s = floor_and_wall_of(400.0f, env, 12.0f, wall);
     camera cam = floor_camera();
-    printf("%s:\n", env ? "sky" : "lights");
+    printf("%s%s:\n", env ? "sky" : "lights", wall ? ", brushed wall" : "");
     render_params p = hl_params(HL_MERGE_TRACE, 0, 32);
     float *exact = ts_render_with(s, &cam, &p, 96, HL);
     const int merges[3] = {HL_MERGE_OFF, HL_MERGE_ON, HL_MERGE_ON};
@@ -145,9 +142,13 @@ static void vmf_modes_close_to_exact(int env) {
         float *img = ts_render_with(s, &cam, &p, 48, HL);
         double bias = total(img, NPIX) / total(exact, NPIX) - 1.0, err = rel_l2(img, exact, NPIX);
         printf("merge %s, K=%d: bias %+.3f, relative L2 %.3f\n", merges[k] == HL_MERGE_OFF ? "off" : "on", ks[k], bias, err);
-        /* Measured: biases within 1%, L2 0.024 unmerged and 0.09 merged (the shared position) */
-        CHECK(fabs(bias) < 0.04, "merge %d K=%d: highlights off by %+.3f", merges[k], ks[k], bias);
-        CHECK(err < (merges[k] == HL_MERGE_OFF ? 0.06 : 0.15), "merge %d K=%d: relative L2 %.3f", merges[k], ks[k], err);
+        /* Measured: biases within 1%, L2 0.024 unmerged and 0.09 merged (the shared position).
+         * The brushed wall's lobe is a streak: its secondary hits spread along the floor, and one
+         * merged lobe at their mean position errs more (+6%, 0.19; two lobes +5%, 0.09). */
+        double bias_tol = wall && merges[k] == HL_MERGE_ON ? 0.1 : 0.04;
+        double err_tol = merges[k] == HL_MERGE_OFF ? 0.06 : wall && ks[k] == 1 ? 0.25 : 0.15;
+        CHECK(fabs(bias) < bias_tol, "merge %d K=%d: highlights off by %+.3f", merges[k], ks[k], bias);
+        CHECK(err < err_tol, "merge %d K=%d: relative L2 %.3f", merges[k], ks[k], err);
         CHECK(all_finite(img, NPIX), "non-finite pixels");
         free(img);
     }
@@ -162,9 +163,9 @@ static void vmf_modes_close_to_exact(int env) {
  * keep them apart. */
 static scene *fig6_corner(float far) {
     scene *s = ts_new("fig 6 corner");
-    int floor_m = ts_material(s, phong(v3s(0.05f), v3s(0.9f), 300.0f));
-    int red = ts_material(s, phong(v3(0.1f, 0.0f, 0.0f), v3(0.9f, 0.1f, 0.1f), 300.0f));
-    int green = ts_material(s, phong(v3(0.0f, 0.1f, 0.0f), v3(0.1f, 0.9f, 0.1f), 300.0f));
+    int floor_m = ts_material(s, ts_phong(v3s(0.05f), v3s(0.9f), 300.0f));
+    int red = ts_material(s, ts_phong(v3(0.1f, 0.0f, 0.0f), v3(0.9f, 0.1f, 0.1f), 300.0f));
+    int green = ts_material(s, ts_phong(v3(0.0f, 0.1f, 0.0f), v3(0.1f, 0.9f, 0.1f), 300.0f));
     ts_quad(s, v3(0, 0, 0), v3(0, 0, 3), v3(3, 0, 3), v3(3, 0, 0), floor_m);
     ts_quad(s, v3(0, 0, 0), v3(0, 1.2f, 0), v3(0, 1.2f, 3), v3(0, 0, 3), red);     /* x = 0, facing +x */
     ts_quad(s, v3(0, 0, 0), v3(3, 0, 0), v3(3, 1.2f, 0), v3(0, 1.2f, 0), green);   /* z = 0, facing +z */
@@ -322,8 +323,8 @@ static void add_sphere(scene *s, vec3 c, float r, int mat) {
  * at 10^4 but 0.0069 at 10^6; merged 0.0221 (K=1) and 0.0212 (K=8) at 10^6). */
 static scene *hard_scene(float floor_exponent) {
     scene *s = ts_new("hard cases");
-    int floor_m = ts_material(s, phong(v3s(0.1f), v3s(0.85f), floor_exponent));
-    int ball = ts_material(s, phong(v3(0.1f, 0.05f, 0.0f), v3(0.8f, 0.6f, 0.3f), 120.0f));
+    int floor_m = ts_material(s, ts_phong(v3s(0.1f), v3s(0.85f), floor_exponent));
+    int ball = ts_material(s, ts_phong(v3(0.1f, 0.05f, 0.0f), v3(0.8f, 0.6f, 0.3f), 120.0f));
     ts_quad(s, v3(-3, 0, -3), v3(-3, 0, 3), v3(3, 0, 3), v3(3, 0, -3), floor_m);
     add_sphere(s, v3(0, 0.5f, 0), 0.5f, ball);
     light touching_ball = {.type = LIGHT_POINT, .color = v3s(0.5f), .position = v3(0.0f, 1.0f + 1e-6f, 0.0f)};
@@ -373,7 +374,14 @@ static void test_hard_cases(void) {
 }
 
 static void test_vmf_modes_close_to_exact(void) {
-    for (int env = 0; env <= 2; env += 2) vmf_modes_close_to_exact(env);
+    for (int env = 0; env <= 2; env += 2) vmf_modes_close_to_exact(env, NULL);
+    material brushed = material_default();
+    brushed.model = MATERIAL_WARD;
+    brushed.kd = v3s(0.02f);
+    brushed.ks = v3(0.78f, 0.78f, 0.8f);
+    brushed.alpha_x = 0.05f;
+    brushed.alpha_y = 0.3f;
+    vmf_modes_close_to_exact(0, &brushed);
 }
 
 int main(void) {

@@ -31,6 +31,16 @@ static inline int ts_lambert(scene *s, vec3 albedo, vec3 emission, int double_si
 
 static inline int ts_material(scene *s, material m) { return scene_add_material(s, &m); }
 
+/* Lambert kd plus modified Phong with ks and exponent n. */
+static inline material ts_phong(vec3 kd, vec3 ks, float n) {
+    material m = material_default();
+    m.model = MATERIAL_PHONG;
+    m.kd = kd;
+    m.ks = ks;
+    m.exponent = n;
+    return m;
+}
+
 /* Quad p0 p1 p2 p3 (counter-clockwise seen from its front), flat-shaded. */
 static inline void ts_quad(scene *s, vec3 p0, vec3 p1, vec3 p2, vec3 p3, int mat) {
     float pos[12] = {p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y, p2.z, p3.x, p3.y, p3.z};

@@ -89,13 +89,16 @@ static double single_strategy(const virtual_light *vl, const shading_point *x, i
     return mean;
 }
 
+/* Whether estimate() asks for the three strategies everywhere (else the effect plan's choice). */
+static int all_strategies = 1;
+
 /* Mean of `runs` calls of vsl_integral and its standard error; checks every value is finite. */
 static double estimate(const virtual_light *vl, const shading_point *x, int runs, double *sem, const char *name) {
     rng_state rng = rng_make(1234, 5);
     double s = 0.0, s2 = 0.0;
     int bad = 0;
     for (int k = 0; k < runs; k++) {
-        vec3 c = vsl_integral(vl, x, VL_TERMS_ALL, &rng, NULL);
+        vec3 c = vsl_integral(vl, x, VL_TERMS_ALL, all_strategies, &rng, NULL);
         bad += !is_finite3(c) || c.x < 0.0f || c.y < 0.0f || c.z < 0.0f;
         double v = avg(c);
         s += v;
@@ -188,6 +191,34 @@ static void test_integral_against_brute_force(void) {
     }
 }
 
+/* Pairs without a glossy lobe (Lambert, or GGX rough enough to count as diffuse) take cone
+ * sampling alone unless all strategies are asked for: both must match the quadrature. */
+static void test_diffuse_kernel(void) {
+    bsdf diffuse = make_bsdf_lambert(v3s(0.7f));
+    bsdf rough = make_bsdf_gltf(v3(0.8f, 0.6f, 0.4f), 0.0f, 0.9f, 0.0f); /* alpha 0.81 */
+    CHECK(!bsdf_highlight_lobe(&diffuse) && !bsdf_highlight_lobe(&rough), "the pair must count as diffuse");
+    CHECK(bsdf_highlight_lobe(&(bsdf){.model = GLOSSY_GGX, .specular = v3s(0.04f), .alpha_x = 0.3f, .alpha_y = 0.3f}),
+          "GGX at alpha 0.3 must count as glossy");
+    for (int mode = 0; mode < 2; mode++) {
+        all_strategies = mode;
+        double sem, ref;
+        char name[64];
+        virtual_light vl = make_vl(v3(0.3f, 0, 0.3f), v3(-1, 0, 0), v3(-1, 0, 1), diffuse, 1.0f, 2);
+        shading_point x = make_x(v3(0, 0, 0), v3(0, 0, 1), v3(0, 0.3f, 1), rough);
+        ref = quadrature_omega(&vl, &x, 600, 600);
+        snprintf(name, sizeof name, "diffuse pair inside, all strategies %d", mode);
+        double got = estimate(&vl, &x, 4000, &sem, name);
+        agree(name, got, sem, ref, 0.0, 2e-3);
+        vl = make_vl(v3(2, 0.5f, 1.5f), v3(-1, 0, -0.5f), v3(0, 0, -1), rough, 0.6f, 2);
+        x = make_x(v3(0, 0, 0), v3(0, 0, 1), v3(-1, 0.2f, 1), diffuse);
+        ref = quadrature_omega(&vl, &x, 600, 600);
+        snprintf(name, sizeof name, "diffuse pair outside, all strategies %d", mode);
+        got = estimate(&vl, &x, 4000, &sem, name);
+        agree(name, got, sem, ref, 0.0, 2e-3);
+    }
+    all_strategies = 1;
+}
+
 /* As the radius goes to zero the VSL becomes the (unclamped) VPL with the light's full BSDF. */
 static void test_zero_radius_limit(void) {
     bsdf phong = make_bsdf_phong(v3s(0.4f), v3s(0.4f), 20.0f);
@@ -201,7 +232,7 @@ static void test_zero_radius_limit(void) {
         rng_state rng = rng_make(77, 1);
         double s = 0.0;
         int runs = 30000;
-        for (int k = 0; k < runs; k++) s += avg(vsl_contribution(&vl, &x, VL_TERMS_ALL, &rng, NULL));
+        for (int k = 0; k < runs; k++) s += avg(vsl_contribution(&vl, &x, VL_TERMS_ALL, 1, &rng, NULL));
         double err = fabs(s / runs - avg(vpl)) / avg(vpl);
         if (r < 2e-3f) CHECK(err < 0.02, "r = %g: VSL %.6g vs VPL %.6g", (double)r, s / runs, avg(vpl));
         prev_err = fmin(prev_err, err);
@@ -209,7 +240,7 @@ static void test_zero_radius_limit(void) {
     CHECK(prev_err < 0.02, "the VSL never approached the VPL (best relative error %.3g)", prev_err);
     vl.radius = 0.0f;
     rng_state rng = rng_make(1, 1);
-    vec3 c = vsl_contribution(&vl, &x, VL_TERMS_ALL, &rng, NULL);
+    vec3 c = vsl_contribution(&vl, &x, VL_TERMS_ALL, 1, &rng, NULL);
     CHECK(avg(c) == avg(vpl), "r = 0 is the VPL exactly");
 }
 
@@ -223,9 +254,9 @@ static void test_terms_split(void) {
         double all = 0, split = 0, hl = 0;
         for (int k = 0; k < 2000; k++) {
             rng_state r1 = rng_make((uint64_t)k, 3), r2 = r1, r3 = r1;
-            all += avg(vsl_contribution(&vl, &x, VL_TERMS_ALL, &r1, NULL));
-            split += avg(vsl_contribution(&vl, &x, VL_TERMS_NO_HIGHLIGHTS, &r2, NULL));
-            hl += avg(vsl_contribution(&vl, &x, VL_TERMS_HIGHLIGHTS, &r3, NULL));
+            all += avg(vsl_contribution(&vl, &x, VL_TERMS_ALL, 1, &r1, NULL));
+            split += avg(vsl_contribution(&vl, &x, VL_TERMS_NO_HIGHLIGHTS, 1, &r2, NULL));
+            hl += avg(vsl_contribution(&vl, &x, VL_TERMS_HIGHLIGHTS, 1, &r3, NULL));
         }
         CHECK_NEAR(split + hl, all, 1e-4 * all, "depth %d: without + only highlights = all", depth);
         if (depth == 1) CHECK(hl > 0.05 * all, "depth 1: the glossy-glossy part is missing (%.3g of %.3g)", hl, all);
@@ -253,8 +284,8 @@ static void test_degenerate(void) {
                     float d = dists[di], t = tilts[ti];
                     virtual_light vl = make_vl(v3(d, 0, d * t), v3(-1, 0, t), v3(-1, t, t), mats[m & 3], radii[ri], 1);
                     shading_point x = make_x(v3(0, 0, 0), v3(0, 0, 1), v3(1, 0, t), mats[m >> 2]);
-                    vec3 c[3] = {vsl_contribution(&vl, &x, VL_TERMS_ALL, &rng, NULL),
-                                 vsl_contribution(&vl, &x, VL_TERMS_NO_HIGHLIGHTS, &rng, NULL),
+                    vec3 c[3] = {vsl_contribution(&vl, &x, VL_TERMS_ALL, 1, &rng, NULL),
+                                 vsl_contribution(&vl, &x, VL_TERMS_NO_HIGHLIGHTS, 1, &rng, NULL),
                                  vpl_contribution(&vl, &x, 1, VL_TERMS_ALL)};
                     for (int k = 0; k < 3; k++) {
                         total++;
@@ -576,6 +607,7 @@ static void test_lights_touching_surfaces(void) {
 
 int main(void) {
     test_integral_against_brute_force();
+    test_diffuse_kernel();
     test_zero_radius_limit();
     test_terms_split();
     test_degenerate();
