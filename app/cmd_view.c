@@ -5,9 +5,15 @@
  * buffers under a lock held only for the swap. The UI thread owns the window: it handles input
  * and scripts, tone-maps and draws the newest image, and never waits for a frame.
  *
- * While the camera moves, frames come from a preview session at a fraction of the resolution so
- * the image follows the input; once things rest, the full-resolution session accumulates. */
+ * While the camera moves, frames come from a preview session at a fraction of the resolution
+ * (coarser while its frames are slow) so the image follows the input; once things rest, the
+ * full-resolution session accumulates.
+ *
+ * Lights are edited the same way: the UI keeps the wanted offset and intensity of every light and
+ * sends them with each change; the render thread applies the difference to the scene between
+ * frames, when nothing reads it. */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -20,13 +26,19 @@
 #include "camera.h"
 #include "cli.h"
 #include "commands.h"
+#include "metrics.h"
 #include "session.h"
 #include "ui.h"
 #include "view_script.h"
 
-#define PREVIEW_DIVISOR 3      /* preview resolution = full / 3 on each axis */
+#define PREVIEW_DIVISOR 3      /* preview resolution = full / 3 on each axis, or coarser... */
+#define PREVIEW_MAX_DIVISOR 8
+#define PREVIEW_TARGET_MS 70.0 /* ...so that a preview frame takes about this long */
 #define PREVIEW_HOLD_SECONDS 0.3
 #define MAX_VIEW_CAMERAS 32
+#define MAX_LIGHT_GROUPS 64    /* lights the viewer lists and edits; more are rendered, not listed */
+#define MAX_CURVES 6           /* error curves kept for comparison */
+#define MAX_CURVE_POINTS 512   /* per curve; halved (every other point) when full */
 
 /* ---- shared state --------------------------------------------------------------------------- */
 
@@ -42,6 +54,8 @@ typedef struct {
     camera cameras[MAX_VIEW_CAMERAS];
     bounds3 bounds;
     float diag;
+    int num_lights;
+    light_group lights[MAX_LIGHT_GROUPS]; /* as loaded */
 } scene_info;
 
 typedef struct {
@@ -58,6 +72,11 @@ typedef struct {
     char load_path[1024];
     int load_kind;           /* 0 none, 1 scene, 2 environment map */
     int quit;
+    uint64_t lights_scene;   /* the scene (info_serial) the light requests below refer to */
+    vec3 light_offset[MAX_LIGHT_GROUPS]; /* wanted offset from the loaded position */
+    float light_gain[MAX_LIGHT_GROUPS];  /* wanted intensity multiplier */
+    image_rgb reference_new; /* a new reference for the error, handed over (the render thread frees it) */
+    int reference_pending;
     /* results: render thread -> UI */
     image_buf image;
     uint64_t image_serial;
@@ -70,6 +89,10 @@ typedef struct {
     unsigned long long virtual_lights;
     unsigned long long hl_points, hl_lobes; /* the last full-resolution frame's (vsl+hl) */
     double hl_merge_share;   /* its thread time spent merging, as a fraction */
+    double rel_error;        /* the last full-resolution frame's against the reference */
+    double rel_error_at;     /* ... and its seconds since the reset */
+    uint64_t rel_error_serial, rel_error_resets;
+    uint64_t preview_frames; /* reduced-resolution frames published, ever */
     char message[1200];
     uint64_t message_serial;
     scene_info info;
@@ -81,6 +104,12 @@ typedef struct {
     scene *scene;                       /* render thread */
     render_session *full, *preview;     /* render thread */
     image_buf back;                     /* render thread */
+    vec3 light_applied[MAX_LIGHT_GROUPS]; /* render thread: the edits the scene has */
+    float gain_applied[MAX_LIGHT_GROUPS];
+    image_rgb reference;                /* render thread: for the error of each frame */
+    float *combined;                    /* render thread: the whole image when another part is shown */
+    size_t combined_len;
+    int preview_divisor;                /* render thread */
 } viewer;
 
 static double seconds_since(double t) { return cli_now() - t; }
@@ -93,6 +122,16 @@ static void fill_info(scene_info *info, const scene *s) {
     for (int i = 0; i < info->num_cameras; i++) info->cameras[i] = s->cameras[i];
     info->bounds = s->bounds;
     info->diag = s->diag;
+    int n = scene_light_groups(s, info->lights, MAX_LIGHT_GROUPS); /* -1 (out of memory): none listed */
+    info->num_lights = n < 0 ? 0 : n < MAX_LIGHT_GROUPS ? n : MAX_LIGHT_GROUPS;
+}
+
+/* The scene as loaded: no light edits. */
+static void clear_light_edits(vec3 *offset, float *gain) {
+    for (int g = 0; g < MAX_LIGHT_GROUPS; g++) {
+        offset[g] = v3(0, 0, 0);
+        gain[g] = 1.0f;
+    }
 }
 
 static void set_message(viewer *v, const char *fmt, const char *a, const char *b) {
@@ -100,6 +139,16 @@ static void set_message(viewer *v, const char *fmt, const char *a, const char *b
     snprintf(v->sh.message, sizeof v->sh.message, fmt, a, b);
     v->sh.message_serial++;
     pthread_mutex_unlock(&v->sh.lock);
+}
+
+/* A preview session at the full session's size / divisor. NULL with err set on failure. */
+static render_session *create_preview(viewer *v, int divisor, const camera *cam, const render_params *params, char *err,
+                                      size_t errlen) {
+    const render_params *fp = session_params(v->full);
+    render_params p = *params;
+    p.width = fp->width / divisor > 0 ? fp->width / divisor : 1;
+    p.height = fp->height / divisor > 0 ? fp->height / divisor : 1;
+    return session_create(v->scene, cam, &p, err, errlen);
 }
 
 /* (Re)creates both sessions for the current scene at w x h. Returns 0 or -1 (message set). */
@@ -112,14 +161,30 @@ static int make_sessions(viewer *v, int w, int h, const camera *cam, const rende
     p.width = w;
     p.height = h;
     v->full = session_create(v->scene, cam, &p, err, sizeof err);
-    p.width = w / PREVIEW_DIVISOR > 0 ? w / PREVIEW_DIVISOR : 1;
-    p.height = h / PREVIEW_DIVISOR > 0 ? h / PREVIEW_DIVISOR : 1;
-    if (v->full) v->preview = session_create(v->scene, cam, &p, err, sizeof err);
+    if (v->preview_divisor < PREVIEW_DIVISOR) v->preview_divisor = PREVIEW_DIVISOR;
+    if (v->full) v->preview = create_preview(v, v->preview_divisor, cam, params, err, sizeof err);
     if (!v->full || !v->preview) {
         set_message(v, "%s%s", err, "");
         return -1;
     }
     return 0;
+}
+
+/* Coarser previews when their frames are slow (a large window, a costly method, a busy
+ * machine), finer again when they are quick, so the image follows motion at about 10 frames a
+ * second or more. The thresholds leave room: one step changes the time by a factor of 0.56 to
+ * 0.77, less than their ratio. */
+static void adapt_preview(viewer *v, double frame_ms, const camera *cam, const render_params *params) {
+    int d = v->preview_divisor;
+    if (frame_ms > 1.3 * PREVIEW_TARGET_MS && d < PREVIEW_MAX_DIVISOR) d++;
+    else if (frame_ms < 0.45 * PREVIEW_TARGET_MS && d > PREVIEW_DIVISOR) d--;
+    if (d == v->preview_divisor) return;
+    char err[512];
+    render_session *p = create_preview(v, d, cam, params, err, sizeof err);
+    if (!p) return; /* keep the one there is */
+    session_destroy(v->preview);
+    v->preview = p;
+    v->preview_divisor = d;
 }
 
 static void handle_load(viewer *v, int kind, const char *path, const camera *cam, const render_params *params) {
@@ -138,6 +203,7 @@ static void handle_load(viewer *v, int kind, const char *path, const camera *cam
         v->full = v->preview = NULL;
         scene_destroy(v->scene);
         v->scene = s;
+        clear_light_edits(v->light_applied, v->gain_applied);
         camera c = scene_camera(s, -1, (float)w / (float)h);
         make_sessions(v, w, h, &c, params);
         pthread_mutex_lock(&v->sh.lock);
@@ -155,6 +221,43 @@ static void handle_load(viewer *v, int kind, const char *path, const camera *cam
         session_set_camera(v->preview, cam);
         set_message(v, "environment %s%s", path, "");
     }
+}
+
+/* Brings the scene's lights to the wanted offsets and gains (render thread, between frames). */
+static void apply_light_edits(viewer *v, const vec3 *offset, const float *gain) {
+    char err[512];
+    for (int g = 0; g < MAX_LIGHT_GROUPS; g++) {
+        vec3 d = sub3(offset[g], v->light_applied[g]);
+        int failed = !is_black3(d) && scene_move_light(v->scene, g, d, err, sizeof err) != 0;
+        failed = failed || (gain[g] != v->gain_applied[g] && scene_set_light_gain(v->scene, g, gain[g], err, sizeof err) != 0);
+        if (failed) {
+            cli_error("%s", err);
+            set_message(v, "%s%s", err, "");
+        }
+        /* Taken as applied either way: a failed edit is reported once, not every frame. */
+        v->light_applied[g] = offset[g];
+        v->gain_applied[g] = gain[g];
+    }
+}
+
+/* The relative L2 error of the whole image (every component, whatever is shown) against the
+ * reference; -1 without a reference of this size. shown is the image resolved with mask. */
+static double frame_error(viewer *v, const film *f, unsigned mask, const float *shown) {
+    const image_rgb *ref = &v->reference;
+    if (!ref->rgb || ref->width != f->width || ref->height != f->height) return -1.0;
+    size_t n = 3 * (size_t)f->width * (size_t)f->height;
+    const float *img = shown;
+    if (mask != COMP_MASK_ALL) {
+        if (v->combined_len != n) {
+            free(v->combined);
+            v->combined = malloc(sizeof(float) * n);
+            v->combined_len = v->combined ? n : 0;
+            if (!v->combined) return -1.0;
+        }
+        film_resolve(f, COMP_MASK_ALL, v->combined);
+        img = v->combined;
+    }
+    return metric_rel_l2(img, ref->rgb, n);
 }
 
 /* before: the session's statistics before the frame, so the frame's own work is the difference.
@@ -175,6 +278,7 @@ static void publish(viewer *v, render_session *rs, int preview, double frame_ms,
     pthread_mutex_unlock(&v->sh.lock);
     film_resolve(f, mask, v->back.rgb);
     v->back.preview = preview;
+    double rel_error = preview ? -1.0 : frame_error(v, f, mask, v->back.rgb);
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
     for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st.rays[k];
@@ -195,6 +299,13 @@ static void publish(viewer *v, render_session *rs, int preview, double frame_ms,
         double secs = seconds_since(v->sh.reset_at);
         v->sh.rays_per_second = secs > 0.0 && !preview ? (double)rays / secs : 0.0;
         v->sh.rejected = st.rejected_samples;
+        if (preview) v->sh.preview_frames++;
+        if (!preview && rel_error >= 0.0) {
+            v->sh.rel_error = rel_error;
+            v->sh.rel_error_at = secs;
+            v->sh.rel_error_resets = v->sh.resets;
+            v->sh.rel_error_serial++;
+        }
         if (!preview) {
             v->sh.virtual_lights = st.virtual_lights;
             v->sh.hl_points = st.hl_points - before->hl_points;
@@ -252,6 +363,20 @@ static void *render_main(void *arg) {
         render_params params = v->sh.params;
         int preview = seconds_since(v->sh.changed_at) < PREVIEW_HOLD_SECONDS;
         int rw = v->sh.render_w, rh = v->sh.render_h;
+        /* Light requests made for a scene since replaced are stale: the new one starts as loaded. */
+        int edit_lights = gen != applied && v->sh.lights_scene == v->sh.info_serial;
+        vec3 light_offset[MAX_LIGHT_GROUPS];
+        float light_gain[MAX_LIGHT_GROUPS];
+        if (edit_lights) {
+            memcpy(light_offset, v->sh.light_offset, sizeof light_offset);
+            memcpy(light_gain, v->sh.light_gain, sizeof light_gain);
+        }
+        if (v->sh.reference_pending) {
+            image_rgb_free(&v->reference);
+            v->reference = v->sh.reference_new;
+            v->sh.reference_new = (image_rgb){0};
+            v->sh.reference_pending = 0;
+        }
         if (gen != applied || resize) {
             v->sh.resets++;
             v->sh.reset_at = cli_now();
@@ -260,6 +385,7 @@ static void *render_main(void *arg) {
         uint64_t resets_seen = v->sh.resets;
         pthread_mutex_unlock(&v->sh.lock);
 
+        if (edit_lights) apply_light_edits(v, light_offset, light_gain);
         if (resize) {
             if (make_sessions(v, rw, rh, &cam, &params) != 0) break;
             applied = gen;
@@ -274,7 +400,9 @@ static void *render_main(void *arg) {
         render_stats before = session_stats(rs);
         double t0 = cli_now();
         session_render_frame(rs);
-        publish(v, rs, preview, 1e3 * seconds_since(t0), &before, resets_seen, gen);
+        double ms = 1e3 * seconds_since(t0);
+        publish(v, rs, preview, ms, &before, resets_seen, gen);
+        if (preview) adapt_preview(v, ms, &cam, &params);
         pthread_mutex_lock(&v->sh.lock);
     }
     pthread_mutex_unlock(&v->sh.lock);
@@ -335,7 +463,16 @@ typedef struct {
     render_params params;
     int camera;
     double exposure;
+    int tonemap;
+    const char *reference_path;
 } view_options;
+
+/* Relative error against seconds since a reset, for one method and setting. */
+typedef struct {
+    char label[96];
+    int n;
+    float seconds[MAX_CURVE_POINTS], error[MAX_CURVE_POINTS];
+} error_curve;
 
 typedef struct {
     viewer *v;
@@ -360,6 +497,31 @@ typedef struct {
     unsigned long long virtual_lights;
     unsigned long long hl_points, hl_lobes;
     double hl_merge_share;
+    uint64_t preview_frames;
+    int preview_w, preview_h; /* the last preview frame's size */
+    double started_at;
+    /* lights: the wanted offset and intensity of each, sent with every change */
+    vec3 light_offset[MAX_LIGHT_GROUPS];
+    float light_gain[MAX_LIGHT_GROUPS];
+    char light_labels[MAX_LIGHT_GROUPS][96];
+    const char *light_label_ptrs[MAX_LIGHT_GROUPS];
+    float light_xy[2 * MAX_LIGHT_GROUPS]; /* window positions, NaN off screen */
+    int left_was_down, dragging_light;
+    /* camera bookmarks 1-9 of this scene, and their file */
+    cam_ctl bookmarks[10];
+    int bookmark_set[10];
+    char bookmarks_path[1100];
+    char bookmarks_text[1200];
+    /* the reference image and the error against it */
+    image_rgb reference;
+    char reference_path[1024];
+    double rel_error;
+    uint64_t rel_error_serial, curve_resets;
+    error_curve curves[MAX_CURVES];
+    int num_curves, current_curve;
+    ui_curve ui_curves[MAX_CURVES];
+    /* a scripted continuous orbit */
+    double spin_rate, spin_until; /* degrees per second, until when */
     /* input */
     double mouse_x, mouse_y;
     double scroll;
@@ -442,6 +604,9 @@ static void send_change(ui_thread *u) {
     sh->params.max_depth = u->ctl.max_depth;
     sh->params.method = (render_method)u->ctl.method;
     sh->params.vl = vl_from_controls(&u->ctl, sh->params.vl);
+    memcpy(sh->light_offset, u->light_offset, sizeof sh->light_offset);
+    memcpy(sh->light_gain, u->light_gain, sizeof sh->light_gain);
+    sh->lights_scene = u->info_serial;
     u->sent_generation = ++sh->generation;
     sh->changed_at = cli_now();
     pthread_mutex_unlock(&sh->lock);
@@ -458,14 +623,298 @@ static void apply_controls(ui_thread *u, int camera_changed) {
     if (u->ctl.method != u->applied_ctl.method || u->ctl.max_depth != u->applied_ctl.max_depth ||
         vl_controls_differ(&u->ctl, &u->applied_ctl))
         camera_changed = 1;
+    /* Picking another light shows its intensity; changing the intensity changes the light. */
+    if (u->ctl.light < 0 || u->ctl.light >= u->info.num_lights) u->ctl.light = -1;
+    if (u->ctl.light != u->applied_ctl.light) {
+        u->ctl.light_gain = u->ctl.light >= 0 ? u->light_gain[u->ctl.light] : 1.0f;
+    } else if (u->ctl.light >= 0 && u->ctl.light_gain != u->applied_ctl.light_gain) {
+        u->light_gain[u->ctl.light] = u->ctl.light_gain;
+        camera_changed = 1;
+    }
     if (camera_changed) send_change(u);
-    if (u->ctl.exposure != u->applied_ctl.exposure) u->need_tonemap = 1;
+    if (u->ctl.exposure != u->applied_ctl.exposure || u->ctl.tonemap != u->applied_ctl.tonemap) u->need_tonemap = 1;
     if (u->ctl.show != u->applied_ctl.show) {
         pthread_mutex_lock(&u->v->sh.lock);
         u->v->sh.show_mask = show_mask_of(u->ctl.show);
         pthread_mutex_unlock(&u->v->sh.lock);
+        u->need_tonemap = 1;
     }
     u->applied_ctl = u->ctl;
+}
+
+/* ---- lights (UI thread) ------------------------------------------------------------------------ */
+
+static vec3 light_position(const ui_thread *u, int g) {
+    return add3(u->info.lights[g].center, u->light_offset[g]);
+}
+
+static int light_movable(const ui_thread *u, int g) {
+    return g >= 0 && g < u->info.num_lights && u->info.lights[g].type != LIGHT_DIRECTIONAL;
+}
+
+/* World units per window pixel at distance z in front of the camera. */
+static float pixel_footprint(const ui_thread *u, float z) {
+    int wh;
+    glfwGetWindowSize(u->win, NULL, &wh);
+    return 2.0f * z * tanf(0.5f * u->cam.yfov) / (float)(wh > 0 ? wh : 1);
+}
+
+/* Where each light appears in the window (for markers and picking). */
+static void update_light_screen(ui_thread *u) {
+    int ww, wh;
+    glfwGetWindowSize(u->win, &ww, &wh);
+    camera c = ctl_camera(&u->cam);
+    float t = tanf(0.5f * c.yfov), aspect = wh > 0 ? (float)ww / (float)wh : 1.0f;
+    for (int g = 0; g < u->info.num_lights; g++) {
+        vec3 d = sub3(light_position(u, g), c.position);
+        float z = dot3(d, c.forward);
+        u->light_xy[2 * g] = u->light_xy[2 * g + 1] = NAN;
+        if (!light_movable(u, g) || !(z > 1e-6f)) continue;
+        float x = dot3(d, c.right) / (z * t * aspect), y = dot3(d, c.up) / (z * t);
+        u->light_xy[2 * g] = 0.5f * (x + 1.0f) * (float)ww;
+        u->light_xy[2 * g + 1] = 0.5f * (1.0f - y) * (float)wh;
+    }
+}
+
+/* The light drawn nearest to window position (x, y), within a few pixels; -1 for none. */
+static int pick_light(ui_thread *u, double x, double y) {
+    update_light_screen(u);
+    int best = -1;
+    double best_d2 = 24.0 * 24.0;
+    for (int g = 0; g < u->info.num_lights; g++) {
+        double dx = (double)u->light_xy[2 * g] - x, dy = (double)u->light_xy[2 * g + 1] - y;
+        double d2 = dx * dx + dy * dy;
+        if (d2 < best_d2) best_d2 = d2, best = g;
+    }
+    return best;
+}
+
+/* Moves light g by delta (world units); the caller sends the change. Returns 0, or -1 with a
+ * message when g has no position. */
+static int move_light(ui_thread *u, int g, vec3 delta, char *err, size_t errlen) {
+    if (g < 0 || g >= u->info.num_lights)
+        return snprintf(err, errlen, "no light %d (the scene has %d)", g, u->info.num_lights), -1;
+    if (!light_movable(u, g))
+        return snprintf(err, errlen, "light %d (%s) is directional: it has no position", g, u->info.lights[g].name), -1;
+    if (!is_finite3(delta) || length3(delta) > 1e3f * u->info.diag)
+        return snprintf(err, errlen, "light %d: move too large", g), -1;
+    u->light_offset[g] = add3(u->light_offset[g], delta);
+    return 0;
+}
+
+/* A new scene: its lights as loaded, the first one selected. */
+static void reset_lights(ui_thread *u) {
+    clear_light_edits(u->light_offset, u->light_gain);
+    static const char *const kinds[] = {"point", "spot", "directional", "area", "environment"};
+    for (int g = 0; g < u->info.num_lights; g++) {
+        const light_group *lg = &u->info.lights[g];
+        snprintf(u->light_labels[g], sizeof u->light_labels[g], "%d: %.60s (%s)", g, lg->name,
+                 (unsigned)lg->type < 5 ? kinds[lg->type] : "?");
+        u->light_label_ptrs[g] = u->light_labels[g];
+    }
+    u->ctl.light = u->applied_ctl.light = u->info.num_lights > 0 ? 0 : -1;
+    u->ctl.light_gain = u->applied_ctl.light_gain = 1.0f;
+}
+
+/* ---- camera bookmarks (UI thread) -------------------------------------------------------------- */
+
+/* Beside the scene file; the built-in scene has none, so the current directory. */
+static void bookmarks_load(ui_thread *u) {
+    memset(u->bookmark_set, 0, sizeof u->bookmark_set);
+    if (strcmp(u->info.name, "<default>") == 0) snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "default.glint-bookmarks");
+    else snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.bookmarks", u->info.name);
+    FILE *f = fopen(u->bookmarks_path, "r");
+    if (!f) {
+        if (errno != ENOENT) {
+            snprintf(u->message, sizeof u->message, "%s: %s; no bookmarks", u->bookmarks_path, strerror(errno));
+            cli_warning("%s", u->message);
+        }
+        return;
+    }
+    cam_ctl marks[10];
+    int set[10] = {0}, bad = 0, lineno = 0;
+    char line[512];
+    while (!bad && fgets(line, sizeof line, f)) {
+        lineno++;
+        size_t len = strlen(line);
+        if (len == sizeof line - 1 && line[len - 1] != '\n') bad = lineno; /* too long to be ours */
+        const char *p = line + strspn(line, " \t");
+        if (bad || *p == '#' || *p == '\n' || *p == '\r' || *p == 0) continue;
+        int slot, used = 0;
+        float x, y, z, yaw, pitch, dist, yfov;
+        if (sscanf(p, "%d %f %f %f %f %f %f %f %n", &slot, &x, &y, &z, &yaw, &pitch, &dist, &yfov, &used) != 8 ||
+            p[used] != 0 || slot < 1 || slot > 9 || !is_finite3(v3(x, y, z)) || !isfinite(yaw) || !isfinite(pitch) ||
+            !(dist > 0.0f && dist < 1e30f) || !(yfov > 0.0f && yfov < 3.1f)) {
+            bad = lineno;
+            continue;
+        }
+        marks[slot] = (cam_ctl){v3(x, y, z), yaw, clampf(pitch, -1.55f, 1.55f), dist, yfov};
+        set[slot] = 1;
+    }
+    fclose(f);
+    if (bad) {
+        snprintf(u->message, sizeof u->message, "%s:%d: not a bookmark line (N x y z yaw pitch distance fov); file ignored",
+                 u->bookmarks_path, bad);
+        cli_warning("%s", u->message);
+        return;
+    }
+    for (int i = 1; i <= 9; i++)
+        if (set[i]) u->bookmarks[i] = marks[i], u->bookmark_set[i] = 1;
+}
+
+/* Saves the current view as bookmark slot (1-9), rewriting the file atomically. Returns 0 or -1. */
+static int bookmark_save(ui_thread *u, int slot) {
+    u->bookmarks[slot] = u->cam;
+    u->bookmark_set[slot] = 1;
+    char buf[2048], err[1200];
+    int len = snprintf(buf, sizeof buf,
+                       "# glint camera bookmarks: N, position x y z, yaw and pitch (radians), orbit distance, "
+                       "vertical fov (radians)\n");
+    for (int i = 1; i <= 9; i++) {
+        const cam_ctl *c = &u->bookmarks[i];
+        if (u->bookmark_set[i] && len < (int)sizeof buf)
+            len += snprintf(buf + len, sizeof buf - (size_t)len, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", i, (double)c->pos.x,
+                            (double)c->pos.y, (double)c->pos.z, (double)c->yaw, (double)c->pitch, (double)c->dist, (double)c->yfov);
+    }
+    if (len >= (int)sizeof buf || write_file_atomic(u->bookmarks_path, buf, (size_t)len, WRITE_REPLACE, err, sizeof err) != 0) {
+        if (len >= (int)sizeof buf) snprintf(err, sizeof err, "%s: bookmarks too long", u->bookmarks_path);
+        snprintf(u->message, sizeof u->message, "%s", err);
+        cli_error("%s", err);
+        return -1;
+    }
+    snprintf(u->message, sizeof u->message, "bookmark %d saved to %s", slot, u->bookmarks_path);
+    return 0;
+}
+
+/* Returns 0, or -1 (message set) when the slot is empty. */
+static int bookmark_restore(ui_thread *u, int slot) {
+    if (!u->bookmark_set[slot]) {
+        snprintf(u->message, sizeof u->message, "no bookmark %d (%s)", slot, u->bookmarks_path);
+        return -1;
+    }
+    u->cam = u->bookmarks[slot];
+    u->ctl.camera = u->applied_ctl.camera = -1; /* a free camera, not the scene's */
+    send_change(u);
+    snprintf(u->message, sizeof u->message, "bookmark %d", slot);
+    return 0;
+}
+
+static void describe_bookmarks(ui_thread *u) {
+    int len = 0;
+    for (int i = 1; i <= 9; i++)
+        if (u->bookmark_set[i]) len += snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%d ", i);
+    snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%s(%s)", len ? "" : "none ", u->bookmarks_path);
+}
+
+/* ---- the reference image and the error plot (UI thread) ---------------------------------------- */
+
+/* Loads a reference for the error view and plot: it must match the render size. Returns 0, or -1
+ * with the message shown (the previous reference stays). */
+static int load_reference(ui_thread *u, const char *path) {
+    image_rgb img;
+    char err[1200];
+    if (image_rgb_load(path, &img, err, sizeof err) != 0) {
+        snprintf(u->message, sizeof u->message, "%s", err);
+        cli_error("%s", err);
+        return -1;
+    }
+    shared_state *sh = &u->v->sh;
+    pthread_mutex_lock(&sh->lock);
+    int w = sh->render_w, h = sh->render_h;
+    pthread_mutex_unlock(&sh->lock);
+    image_rgb copy = {img.width, img.height, NULL};
+    size_t bytes = sizeof(float) * 3 * (size_t)img.width * (size_t)img.height;
+    if (img.width != w || img.height != h) {
+        snprintf(u->message, sizeof u->message, "%s: the reference is %dx%d but the render is %dx%d; not used", path,
+                 img.width, img.height, w, h);
+    } else if (!(copy.rgb = malloc(bytes))) {
+        snprintf(u->message, sizeof u->message, "%s: out of memory", path);
+    }
+    if (!copy.rgb) {
+        cli_error("%s", u->message);
+        image_rgb_free(&img);
+        return -1;
+    }
+    memcpy(copy.rgb, img.rgb, bytes);
+    pthread_mutex_lock(&sh->lock);
+    image_rgb_free(&sh->reference_new);
+    sh->reference_new = copy; /* the render thread's own copy, for the error of each frame */
+    sh->reference_pending = 1;
+    pthread_mutex_unlock(&sh->lock);
+    image_rgb_free(&u->reference);
+    u->reference = img;
+    snprintf(u->reference_path, sizeof u->reference_path, "%s", path);
+    u->rel_error = -1.0;
+    u->num_curves = 0; /* errors against another image do not compare */
+    u->current_curve = -1;
+    u->need_tonemap = 1;
+    snprintf(u->message, sizeof u->message, "reference %s", path);
+    return 0;
+}
+
+/* The plot's name for the current method and settings. */
+static void curve_label(const ui_thread *u, char *out, size_t n) {
+    const ui_controls *c = &u->ctl;
+    int len = snprintf(out, n, "%s, depth %d", method_name((render_method)c->method), c->max_depth);
+    if (c->method != METHOD_PT && len < (int)n)
+        len += snprintf(out + len, n - (size_t)len, ", %d lights, radius x%g", c->vl_count, (double)c->radius_mult);
+    if (c->method == METHOD_VSL_HL && len < (int)n)
+        snprintf(out + len, n - (size_t)len, ", N %d, K %d", c->secondary_rays, c->clusters);
+}
+
+/* A new error measurement. A new accumulation starts its curve afresh, replacing an earlier one of
+ * the same settings, so switching between methods leaves one curve for each side by side. */
+static void add_error_point(ui_thread *u, double seconds, double error, uint64_t resets) {
+    if (u->current_curve < 0 || resets != u->curve_resets) {
+        char label[96];
+        curve_label(u, label, sizeof label);
+        int c = -1;
+        for (int i = 0; i < u->num_curves; i++)
+            if (strcmp(u->curves[i].label, label) == 0) c = i;
+        if (c < 0 && u->num_curves == MAX_CURVES) { /* forget the oldest */
+            memmove(&u->curves[0], &u->curves[1], sizeof(error_curve) * (MAX_CURVES - 1));
+            c = MAX_CURVES - 1;
+        } else if (c < 0) {
+            c = u->num_curves++;
+        }
+        snprintf(u->curves[c].label, sizeof u->curves[c].label, "%s", label);
+        u->curves[c].n = 0;
+        u->current_curve = c;
+        u->curve_resets = resets;
+    }
+    error_curve *k = &u->curves[u->current_curve];
+    if (k->n == MAX_CURVE_POINTS) { /* keep the whole time span at half the density */
+        for (int i = 0; i < MAX_CURVE_POINTS / 2; i++) {
+            k->seconds[i] = k->seconds[2 * i + 1];
+            k->error[i] = k->error[2 * i + 1];
+        }
+        k->n = MAX_CURVE_POINTS / 2;
+    }
+    k->seconds[k->n] = (float)seconds;
+    k->error[k->n] = (float)error;
+    k->n++;
+    u->rel_error = error;
+}
+
+/* Per-pixel relative error |I - R| / (|R| + eps) as colours on a log scale: blue 1%, green 10%,
+ * red 100% and more. eps, a hundredth of the mean reference, keeps black pixels from glaring. */
+static void false_colour_error(const float *img, const float *ref, int num_pixels, unsigned char *out) {
+    size_t n = 3 * (size_t)num_pixels;
+    double mean = 0.0;
+    for (size_t i = 0; i < n; i++) mean += (double)ref[i];
+    float eps = (float)(0.01 * mean / (double)(n ? n : 1)) + 1e-20f;
+    for (int i = 0; i < num_pixels; i++) {
+        const float *a = img + 3 * (size_t)i, *r = ref + 3 * (size_t)i;
+        float d2 = 0.0f, r2 = 0.0f;
+        for (int k = 0; k < 3; k++) {
+            d2 += (a[k] - r[k]) * (a[k] - r[k]);
+            r2 += r[k] * r[k];
+        }
+        float e = sqrtf(d2) / (sqrtf(r2) + eps);
+        float t = isfinite(e) ? clampf(0.5f * (log10f(fmaxf(e, 1e-6f)) + 2.0f), 0.0f, 1.0f) : 1.0f;
+        float rgb[3] = {clampf(2.0f * t - 1.0f, 0.0f, 1.0f), 1.0f - fabsf(2.0f * t - 1.0f), clampf(1.0f - 2.0f * t, 0.0f, 1.0f)};
+        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+    }
 }
 
 static void request_export(ui_thread *u, const char *name) {
@@ -520,7 +969,30 @@ static void request_load(ui_thread *u, int kind, const char *path) {
 }
 
 static void print_stats(ui_thread *u) {
-    printf("stats scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
+    /* the mean luminance of the image shown: light edits must move it */
+    double mean = 0.0;
+    int np = u->front.rgb ? u->front.width * u->front.height : 0;
+    for (int i = 0; i < np; i++) {
+        const float *c = u->front.rgb + 3 * (size_t)i;
+        mean += (double)luminance3(v3(c[0], c[1], c[2]));
+    }
+    mean = np > 0 ? mean / np : 0.0;
+    vec3 lp = u->ctl.light >= 0 ? light_position(u, u->ctl.light) : v3(0, 0, 0);
+    update_light_screen(u);
+    float lx = u->ctl.light >= 0 ? u->light_xy[2 * u->ctl.light] : NAN;
+    float ly = u->ctl.light >= 0 ? u->light_xy[2 * u->ctl.light + 1] : NAN;
+    int nb = 0;
+    char marks[16];
+    for (int i = 1; i <= 9; i++)
+        if (u->bookmark_set[i]) marks[nb++] = (char)('0' + i);
+    marks[nb] = 0;
+    printf("stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
+           "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
+           u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z, (double)lx, (double)ly,
+           tonemap_names[u->ctl.tonemap], mean, u->rel_error, (unsigned long long)u->preview_frames, u->preview_w, u->preview_h,
+           seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
+           nb ? marks : "-");
+    printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
            "candidates=%d trace_glossy=%g virtual_lights=%llu secondary_rays=%d clusters=%d merge=%s hl_lobes=%llu\n",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
@@ -558,12 +1030,24 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
         if (cli_parse_float(opt, value, -30, 30, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
         u->ctl.exposure = (float)x;
     } else if (strcmp(name, "show") == 0) {
-        static const char *names[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights"};
+        static const char *names[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
         int found = -1;
         for (int i = 0; i < UI_SHOW_COUNT; i++)
             if (strcmp(value, names[i]) == 0) found = i;
-        if (found < 0) return snprintf(err, errlen, "show: one of all, direct, indirect, highlights"), -1;
+        if (found < 0) return snprintf(err, errlen, "show: one of all, direct, indirect, highlights, error"), -1;
+        if (found == UI_SHOW_ERROR && !u->reference.rgb) return snprintf(err, errlen, "show error: no reference loaded"), -1;
         u->ctl.show = found;
+    } else if (strcmp(name, "tonemap") == 0) {
+        int t = tonemap_from_name(value);
+        if (t < 0) return snprintf(err, errlen, "tonemap: one of reinhard, clamp, exponential"), -1;
+        u->ctl.tonemap = t;
+    } else if (strcmp(name, "light") == 0) {
+        if (cli_parse_int(opt, value, 0, u->info.num_lights - 1, &n) != 0) return snprintf(err, errlen, "no light %s", value), -1;
+        u->ctl.light = (int)n;
+    } else if (strcmp(name, "light-intensity") == 0) {
+        if (u->ctl.light < 0) return snprintf(err, errlen, "light-intensity: no light selected"), -1;
+        if (cli_parse_float(opt, value, 1e-3, 1e3, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        u->ctl.light_gain = (float)x;
     } else if (strcmp(name, "camera") == 0) {
         if (cli_parse_int(opt, value, -1, u->info.num_cameras - 1, &n) != 0)
             return snprintf(err, errlen, "no camera %s", value), -1;
@@ -577,11 +1061,16 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     return 0;
 }
 
-static void press_key(ui_thread *u, int key) {
-    if (key >= 0 && key <= GLFW_KEY_LAST) u->keys_pressed[key] = 1;
+/* keys_pressed holds 1 + the modifier bits of each press since the last frame. */
+static void press_key(ui_thread *u, int key, int mods) {
+    if (key >= 0 && key <= GLFW_KEY_LAST) u->keys_pressed[key] = 1 + mods;
 }
 
-static int key_from_name(const char *name) {
+/* A key by name, with "ctrl+" or "shift+" in front for the modifier (into *mods). */
+static int key_from_name(const char *name, int *mods) {
+    *mods = 0;
+    if (strncmp(name, "ctrl+", 5) == 0) *mods = GLFW_MOD_CONTROL, name += 5;
+    else if (strncmp(name, "shift+", 6) == 0) *mods = GLFW_MOD_SHIFT, name += 6;
     if (strcmp(name, "r") == 0) return GLFW_KEY_R;
     if (strcmp(name, "f11") == 0) return GLFW_KEY_F11;
     if (strcmp(name, "f12") == 0) return GLFW_KEY_F12;
@@ -632,20 +1121,51 @@ static void run_script(ui_thread *u) {
             send_change(u);
             break;
         case ACT_KEY: {
-            int k = key_from_name(a->name);
+            int mods, k = key_from_name(a->name, &mods);
             if (k < 0) {
                 cli_error("%s:%d: unknown key '%s'", u->script_path_for_errors, a->line, a->name);
                 u->script_errors++;
             } else {
-                press_key(u, k);
+                press_key(u, k, mods);
             }
             break;
         }
+        case ACT_MOVE_LIGHT:
+            if (move_light(u, (int)a->a, v3((float)a->b, (float)a->c, (float)a->d), err, sizeof err) != 0) {
+                cli_error("%s:%d: %s", u->script_path_for_errors, a->line, err);
+                u->script_errors++;
+            } else {
+                u->ctl.light = (int)a->a;
+                apply_controls(u, 1);
+            }
+            break;
+        case ACT_SAVE_BOOKMARK:
+            if (bookmark_save(u, (int)a->a) != 0) u->script_errors++;
+            break;
+        case ACT_RESTORE_BOOKMARK:
+            if (bookmark_restore(u, (int)a->a) != 0) {
+                cli_error("%s:%d: %s", u->script_path_for_errors, a->line, u->message);
+                u->script_errors++;
+            }
+            break;
+        case ACT_REFERENCE: load_reference(u, a->text); break;
+        case ACT_SPIN:
+            if (!u->script_waiting) {
+                u->script_waiting = 1;
+                u->spin_rate = a->a;
+                u->spin_until = cli_now() + a->b;
+            }
+            if (cli_now() < u->spin_until) return;
+            u->script_waiting = 0;
+            break;
         case ACT_SCREENSHOT: take_screenshot(u, a->text); break;
         case ACT_EXPORT: request_export(u, a->text); break;
         case ACT_LOAD: request_load(u, 1, a->text); break;
         case ACT_ENV: request_load(u, 2, a->text); break;
-        case ACT_WINDOW_SHOT: snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text); break;
+        case ACT_WINDOW_SHOT: /* taken after this frame's draw: later actions wait for it */
+            snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text);
+            u->script_pos++;
+            return;
         case ACT_STATS: print_stats(u); break;
         case ACT_QUIT: u->quit = 1; break;
         }
@@ -657,9 +1177,8 @@ static void run_script(ui_thread *u) {
 
 static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods) {
     (void)scancode;
-    (void)mods;
     ui_thread *u = glfwGetWindowUserPointer(win);
-    if (action == GLFW_PRESS && !ui_wants_keyboard()) press_key(u, key);
+    if (action == GLFW_PRESS && !ui_wants_keyboard()) press_key(u, key, mods);
 }
 
 static void on_scroll(GLFWwindow *win, double dx, double dy) {
@@ -694,17 +1213,55 @@ static int handle_input(ui_thread *u, double dt) {
             u->cam.pos = madd3(u->cam.pos, normalize3(move), speed * (float)dt);
             changed = 1;
         }
+        /* The selected light: arrows along the view plane, PageUp/PageDown along the view. */
+        vec3 lmove = v3s(0.0f);
+        if (glfwGetKey(u->win, GLFW_KEY_RIGHT) == GLFW_PRESS) lmove = add3(lmove, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_LEFT) == GLFW_PRESS) lmove = sub3(lmove, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_UP) == GLFW_PRESS) lmove = add3(lmove, c.up);
+        if (glfwGetKey(u->win, GLFW_KEY_DOWN) == GLFW_PRESS) lmove = sub3(lmove, c.up);
+        if (glfwGetKey(u->win, GLFW_KEY_PAGE_UP) == GLFW_PRESS) lmove = add3(lmove, c.forward);
+        if (glfwGetKey(u->win, GLFW_KEY_PAGE_DOWN) == GLFW_PRESS) lmove = sub3(lmove, c.forward);
+        char err[256];
+        if (!is_black3(lmove) && light_movable(u, u->ctl.light) &&
+            move_light(u, u->ctl.light, scale3(normalize3(lmove), speed * (float)dt), err, sizeof err) == 0)
+            changed = 1;
+    }
+    if (cli_now() < u->spin_until) { /* a scripted drag */
+        ctl_orbit(&u->cam, (float)(u->spin_rate * dt * 3.14159265358979 / 180.0), 0.0f);
+        changed = 1;
     }
     double x, y;
     glfwGetCursorPos(u->win, &x, &y);
     double dx = x - u->mouse_x, dy = y - u->mouse_y;
     u->mouse_x = x;
     u->mouse_y = y;
-    if (!ui_wants_mouse() && (dx != 0.0 || dy != 0.0)) {
+    /* Ctrl + left button: a click picks the light drawn nearest, a drag moves the selected one
+     * with the cursor (at the light's depth, so it stays under the cursor). */
+    int left = glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    int ctrl = glfwGetKey(u->win, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+               glfwGetKey(u->win, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
+    if (left && !u->left_was_down && ctrl && !ui_wants_mouse()) {
+        int g = pick_light(u, x, y);
+        if (g >= 0) u->ctl.light = g;
+        u->dragging_light = 1;
+    }
+    if (!left) u->dragging_light = 0;
+    u->left_was_down = left;
+    if (u->dragging_light) {
+        int g = u->ctl.light;
+        if ((dx != 0.0 || dy != 0.0) && light_movable(u, g)) {
+            camera c = ctl_camera(&u->cam);
+            float z = dot3(sub3(light_position(u, g), c.position), c.forward);
+            float px = pixel_footprint(u, fmaxf(z, 0.01f * u->info.diag));
+            vec3 d = add3(scale3(c.right, (float)dx * px), scale3(c.up, (float)-dy * px));
+            char err[256];
+            if (move_light(u, g, d, err, sizeof err) == 0) changed = 1;
+        }
+    } else if (!ui_wants_mouse() && (dx != 0.0 || dy != 0.0)) {
         int wh;
         glfwGetWindowSize(u->win, NULL, &wh);
         float scale = 1.0f / (float)(wh > 0 ? wh : 1);
-        if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+        if (left) {
             ctl_orbit(&u->cam, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
             changed = 1;
         } else if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
@@ -723,8 +1280,15 @@ static int handle_input(ui_thread *u, double dt) {
     if (u->keys_pressed[GLFW_KEY_F11]) u->ctl.export_exr = 1;
     if (u->keys_pressed[GLFW_KEY_TAB]) u->ctl.show_panel = !u->ctl.show_panel;
     if (u->keys_pressed[GLFW_KEY_ESCAPE]) u->quit = 1;
-    for (int k = 1; k <= 9; k++)
-        if (u->keys_pressed[GLFW_KEY_0 + k] && k - 1 < u->info.num_cameras) u->ctl.camera = k - 1;
+    /* 1-9 the scene's cameras; with ctrl, save bookmark N; with shift, restore it. */
+    for (int k = 1; k <= 9; k++) {
+        int pressed = u->keys_pressed[GLFW_KEY_0 + k];
+        int mods = pressed - 1;
+        if (!pressed) continue;
+        if (mods & GLFW_MOD_CONTROL) bookmark_save(u, k);
+        else if (mods & GLFW_MOD_SHIFT) bookmark_restore(u, k);
+        else if (k - 1 < u->info.num_cameras) u->ctl.camera = k - 1;
+    }
     memset(u->keys_pressed, 0, sizeof u->keys_pressed);
 
     if (u->ctl.camera != u->applied_ctl.camera) u->ctl.reset_view = 1;
@@ -737,7 +1301,8 @@ static int handle_input(ui_thread *u, double dt) {
     if (u->ctl.export_exr) request_export(u, "glint-export.exr");
     if (u->ctl.load_scene) request_load(u, 1, u->ctl.path);
     if (u->ctl.load_env) request_load(u, 2, u->ctl.path);
-    u->ctl.screenshot = u->ctl.export_exr = u->ctl.load_scene = u->ctl.load_env = 0;
+    if (u->ctl.load_reference) load_reference(u, u->ctl.path);
+    u->ctl.screenshot = u->ctl.export_exr = u->ctl.load_scene = u->ctl.load_env = u->ctl.load_reference = 0;
     return changed;
 }
 
@@ -754,6 +1319,7 @@ static int fetch(ui_thread *u) {
         sh->image = t;
         u->image_serial = sh->image_serial;
         fresh = 1;
+        if (u->front.preview) u->preview_w = u->front.width, u->preview_h = u->front.height;
     }
     u->frames = sh->frames;
     u->frames_total = sh->frames_total;
@@ -767,6 +1333,11 @@ static int fetch(ui_thread *u) {
     u->hl_points = sh->hl_points;
     u->hl_lobes = sh->hl_lobes;
     u->hl_merge_share = sh->hl_merge_share;
+    u->preview_frames = sh->preview_frames;
+    int new_error = sh->rel_error_serial != u->rel_error_serial;
+    double rel_error = sh->rel_error, rel_error_at = sh->rel_error_at;
+    uint64_t rel_error_resets = sh->rel_error_resets;
+    u->rel_error_serial = sh->rel_error_serial;
     if (sh->message_serial != u->message_serial) {
         snprintf(u->message, sizeof u->message, "%s", sh->message);
         u->message_serial = sh->message_serial;
@@ -777,10 +1348,13 @@ static int fetch(ui_thread *u) {
         new_info = 1;
     }
     pthread_mutex_unlock(&sh->lock);
-    if (new_info) { /* a new scene: its own view */
+    if (new_error && u->reference.rgb) add_error_point(u, rel_error_at, rel_error, rel_error_resets);
+    if (new_info) { /* a new scene: its own view, lights and bookmarks */
         u->ctl.camera = -1;
         u->applied_ctl.camera = -1;
         u->ctl.reset_view = 1;
+        reset_lights(u);
+        bookmarks_load(u);
     }
     return fresh;
 }
@@ -794,8 +1368,13 @@ static void tonemap_and_upload(ui_thread *u) {
         u->pixels_cap = u->pixels ? w * h : 0;
         if (!u->pixels) return;
     }
-    tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f};
-    tonemap_reinhard(u->front.rgb, w * h, &tp, u->pixels);
+    const image_rgb *ref = &u->reference;
+    if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
+        false_colour_error(u->front.rgb, ref->rgb, w * h, u->pixels);
+    } else { /* also the preview while moving in the error view: it has another size */
+        tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f, (tonemap_op)u->ctl.tonemap};
+        tonemap_apply(u->front.rgb, w * h, &tp, u->pixels);
+    }
     if (!u->texture) {
         GLuint t;
         glGenTextures(1, &t);
@@ -854,12 +1433,16 @@ static void print_view_help(void) {
            "  --camera INDEX       start from the scene's camera INDEX\n"
            "  --seed S             random seed [0]\n"
            "  --exposure STOPS     display exposure [0]\n"
+           "  --tonemap NAME       display tone mapper: reinhard, clamp, exponential [reinhard]\n"
+           "  --reference FILE.exr an image of the render's size: error view and plot\n"
            "  --script FILE        replay a script of viewer actions (see README)\n"
            "\n"
            "%s"
            "\n"
            "controls: left drag orbit, right/middle drag pan, wheel zoom, WASD/QE fly, R reset view,\n"
-           "1-9 scene cameras, F12 screenshot (PNG), F11 export (EXR), Tab panel, Esc quit.\n"
+           "1-9 scene cameras, ctrl+1-9 save and shift+1-9 restore a camera bookmark, arrows and\n"
+           "PageUp/PageDown move the selected light, ctrl+click picks a light, ctrl+drag moves it,\n"
+           "F12 screenshot (PNG), F11 export (EXR), Tab panel, Esc quit.\n"
            "Drop a .gltf/.glb on the window to open it, an .exr/.hdr to light the scene with it.\n",
            DEFAULT_MAX_DEPTH, cli_vl_help());
 }
@@ -898,6 +1481,12 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
             if (!(v = cli_value(argc, argv, &i)) || cli_parse_u64(a, v, &o->params.seed)) return -1;
         } else if (strcmp(a, "--exposure") == 0) {
             if (!(v = cli_value(argc, argv, &i)) || cli_parse_float(a, v, -30, 30, &o->exposure)) return -1;
+        } else if (strcmp(a, "--tonemap") == 0) {
+            if (!(v = cli_value(argc, argv, &i))) return -1;
+            if ((o->tonemap = tonemap_from_name(v)) < 0)
+                return cli_error("--tonemap: unknown tone mapper '%s' (available: reinhard, clamp, exponential)", v), -1;
+        } else if (strcmp(a, "--reference") == 0) {
+            if (!(o->reference_path = cli_value(argc, argv, &i))) return -1;
         } else if (strcmp(a, "--script") == 0) {
             if (!(o->script_path = cli_value(argc, argv, &i))) return -1;
         } else if (a[0] == '-') {
@@ -993,10 +1582,18 @@ int cmd_view(int argc, char **argv) {
                           .max_depth = o.params.max_depth,
                           .camera = o.camera,
                           .exposure = (float)o.exposure,
+                          .tonemap = o.tonemap,
                           .show = UI_SHOW_ALL,
                           .show_panel = 1};
     controls_from_vl(&u.ctl, &o.params.vl);
     u.applied_ctl = u.ctl;
+    reset_lights(&u);
+    clear_light_edits(v.sh.light_offset, v.sh.light_gain);
+    clear_light_edits(v.light_applied, v.gain_applied);
+    bookmarks_load(&u);
+    u.rel_error = -1.0;
+    u.current_curve = -1;
+    u.started_at = cli_now();
     int fw, fh;
     glfwGetFramebufferSize(win, &fw, &fh);
     reset_view(&u);
@@ -1018,6 +1615,7 @@ int cmd_view(int argc, char **argv) {
     }
     pthread_t render_thread;
     pthread_create(&render_thread, NULL, render_main, &v);
+    if (o.reference_path) load_reference(&u, o.reference_path); /* a bad one is shown; the viewer runs on */
 
     glfwGetCursorPos(win, &u.mouse_x, &u.mouse_y);
     u.last_time = cli_now();
@@ -1032,6 +1630,13 @@ int cmd_view(int argc, char **argv) {
 
         ui_begin_frame();
         ui_draw_image(u.texture);
+        if (u.ctl.show_panel) {
+            update_light_screen(&u);
+            ui_draw_lights(u.light_xy, u.info.num_lights, u.ctl.light);
+        }
+        for (int c = 0; c < u.num_curves; c++)
+            u.ui_curves[c] = (ui_curve){u.curves[c].label, u.curves[c].seconds, u.curves[c].error, u.curves[c].n};
+        describe_bookmarks(&u);
         ui_stats st = {.scene_name = u.info.name,
                        .frames = u.frames,
                        .spp = (double)u.frames,
@@ -1051,6 +1656,16 @@ int cmd_view(int argc, char **argv) {
                        .height = u.front.height,
                        .previewing = u.front.preview,
                        .num_cameras = u.info.num_cameras,
+                       .tonemap_names = tonemap_names,
+                       .num_tonemaps = TONEMAP_COUNT,
+                       .light_names = u.light_label_ptrs,
+                       .num_lights = u.info.num_lights,
+                       .light_movable = light_movable(&u, u.ctl.light),
+                       .reference = u.reference.rgb ? u.reference_path : NULL,
+                       .rel_error = u.rel_error,
+                       .curves = u.ui_curves,
+                       .num_curves = u.num_curves,
+                       .bookmarks = u.bookmarks_text,
                        .message = u.message};
         const char *methods[METHOD_COUNT];
         for (int m = 0; m < METHOD_COUNT; m++) methods[m] = method_name((render_method)m);
@@ -1104,6 +1719,10 @@ int cmd_view(int argc, char **argv) {
     session_destroy(v.preview);
     scene_destroy(v.scene);
     free(v.back.rgb);
+    free(v.combined);
+    image_rgb_free(&v.reference);
+    image_rgb_free(&v.sh.reference_new);
+    image_rgb_free(&u.reference);
     free(v.sh.image.rgb);
     free(u.front.rgb);
     free(u.pixels);

@@ -38,8 +38,8 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
     snprintf(buf, sizeof buf, "%s", line);
     char *hash = strchr(buf, '#');
     if (hash) *hash = 0;
-    char *w[4];
-    int n = split_words(buf, w, 3);
+    char *w[5];
+    int n = split_words(buf, w, 5);
     if (n == 0) return 0;
     memset(out, 0, sizeof *out);
     static const struct {
@@ -47,12 +47,26 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
         script_action_kind kind;
         int args; /* words after the command */
         int numbers; /* how many of them are numbers */
+        int path;    /* the one argument is a path */
     } commands[] = {
-        {"wait", ACT_WAIT, 1, 1},         {"set", ACT_SET, 2, 0},     {"orbit", ACT_ORBIT, 2, 2},
-        {"pan", ACT_PAN, 2, 2},           {"zoom", ACT_ZOOM, 1, 1},   {"key", ACT_KEY, 1, 0},
-        {"screenshot", ACT_SCREENSHOT, 1, 0}, {"export", ACT_EXPORT, 1, 0}, {"load", ACT_LOAD, 1, 0},
-        {"env", ACT_ENV, 1, 0},           {"window-shot", ACT_WINDOW_SHOT, 1, 0},           {"stats", ACT_STATS, 0, 0},
-        {"quit", ACT_QUIT, 0, 0},
+        {"wait", ACT_WAIT, 1, 1, 0},
+        {"set", ACT_SET, 2, 0, 0},
+        {"orbit", ACT_ORBIT, 2, 2, 0},
+        {"pan", ACT_PAN, 2, 2, 0},
+        {"zoom", ACT_ZOOM, 1, 1, 0},
+        {"key", ACT_KEY, 1, 0, 0},
+        {"screenshot", ACT_SCREENSHOT, 1, 0, 1},
+        {"export", ACT_EXPORT, 1, 0, 1},
+        {"load", ACT_LOAD, 1, 0, 1},
+        {"env", ACT_ENV, 1, 0, 1},
+        {"window-shot", ACT_WINDOW_SHOT, 1, 0, 1},
+        {"reference", ACT_REFERENCE, 1, 0, 1},
+        {"move-light", ACT_MOVE_LIGHT, 4, 4, 0},
+        {"save-bookmark", ACT_SAVE_BOOKMARK, 1, 1, 0},
+        {"restore-bookmark", ACT_RESTORE_BOOKMARK, 1, 1, 0},
+        {"spin", ACT_SPIN, 2, 2, 0},
+        {"stats", ACT_STATS, 0, 0, 0},
+        {"quit", ACT_QUIT, 0, 0, 0},
     };
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
         if (strcmp(w[0], commands[i].name) != 0) continue;
@@ -61,7 +75,7 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
                             commands[i].args == 1 ? "" : "s"),
                    -1;
         out->kind = commands[i].kind;
-        double *nums[2] = {&out->a, &out->b};
+        double *nums[4] = {&out->a, &out->b, &out->c, &out->d};
         for (int k = 0; k < commands[i].numbers; k++)
             if (parse_number(w[1 + k], nums[k]) != 0)
                 return snprintf(err, errlen, "'%s': '%s' is not a number", w[0], w[1 + k]), -1;
@@ -69,9 +83,16 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
             return snprintf(err, errlen, "'wait' needs a whole number of frames (0 to 1000000)"), -1;
         if (out->kind == ACT_ZOOM && !(out->a > 0))
             return snprintf(err, errlen, "'zoom' needs a positive factor"), -1;
+        if (out->kind == ACT_MOVE_LIGHT && (out->a < 0 || out->a > 1e6 || out->a != floor(out->a)))
+            return snprintf(err, errlen, "'move-light' needs a light index (0, 1, ...)"), -1;
+        if ((out->kind == ACT_SAVE_BOOKMARK || out->kind == ACT_RESTORE_BOOKMARK) &&
+            (out->a < 1 || out->a > 9 || out->a != floor(out->a)))
+            return snprintf(err, errlen, "'%s' needs a bookmark number 1 to 9", w[0]), -1;
+        if (out->kind == ACT_SPIN && !(out->b >= 0 && out->b <= 3600))
+            return snprintf(err, errlen, "'spin' needs 0 to 3600 seconds"), -1;
         if (out->kind == ACT_SET || out->kind == ACT_KEY) snprintf(out->name, sizeof out->name, "%s", w[1]);
         if (out->kind == ACT_SET) snprintf(out->text, sizeof out->text, "%s", w[2]);
-        if (out->kind >= ACT_SCREENSHOT && out->kind <= ACT_WINDOW_SHOT) snprintf(out->text, sizeof out->text, "%s", w[1]);
+        if (commands[i].path) snprintf(out->text, sizeof out->text, "%s", w[1]);
         return 1;
     }
     return snprintf(err, errlen, "unknown action '%s'", w[0]), -1;

@@ -5,11 +5,16 @@
  *   orbit DX_DEG DY_DEG       pan DX DY              zoom FACTOR
  *   key NAME                  screenshot FILE.png    export FILE.exr
  *   load SCENE                env MAP.exr|MAP.hdr    window-shot FILE.png
- *   stats                     quit
+ *   move-light INDEX DX DY DZ save-bookmark N        restore-bookmark N
+ *   reference FILE.exr        spin DEG_PER_S SECONDS stats
+ *   quit
  *
- * `window-shot` captures the window as drawn, panel included (for documentation).
- * `wait` waits for FRAMES new full-resolution frames; `stats` prints one line of the viewer's
- * counters to stdout; `key` presses a named key (r, f11, f12, tab, 1-9). */
+ * `window-shot` captures the window as drawn, panel included (for documentation); the actions
+ * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
+ * prints one line of the viewer's counters to stdout; `key` presses a named key (r, f11, f12,
+ * tab, escape, 1-9, ctrl+N, shift+N). `move-light` moves light INDEX (as the panel lists them)
+ * by a world-space offset and selects it; `spin` orbits continuously, a little every drawn
+ * frame, as a held mouse drag would. */
 #ifndef GLINT_VIEW_SCRIPT_H
 #define GLINT_VIEW_SCRIPT_H
 
@@ -27,6 +32,11 @@ typedef enum {
     ACT_LOAD,
     ACT_ENV,
     ACT_WINDOW_SHOT, /* the whole window, panel included */
+    ACT_REFERENCE,
+    ACT_MOVE_LIGHT,
+    ACT_SAVE_BOOKMARK,
+    ACT_RESTORE_BOOKMARK,
+    ACT_SPIN,
     ACT_STATS,
     ACT_QUIT,
 } script_action_kind;
@@ -34,9 +44,9 @@ typedef enum {
 typedef struct {
     script_action_kind kind;
     int line;
-    double a, b;     /* numbers: frames, degrees, offsets, factor */
+    double a, b, c, d; /* numbers: frames, degrees, offsets, factor, light index and offset */
     char name[64];   /* set: parameter; key: key name */
-    char text[1024]; /* set: value; screenshot, export, load, env: path */
+    char text[1024]; /* set: value; screenshot, export, load, env, window-shot, reference: path */
 } script_action;
 
 typedef struct {

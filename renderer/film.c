@@ -87,6 +87,33 @@ void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p,
     }
 }
 
+const char *const tonemap_names[TONEMAP_COUNT] = {"reinhard", "clamp", "exponential"};
+
+int tonemap_from_name(const char *name) {
+    for (int i = 0; i < TONEMAP_COUNT; i++)
+        if (strcmp(name, tonemap_names[i]) == 0) return i;
+    return -1;
+}
+
+/* The exposure-only operators: a fixed curve per channel. */
+static void tonemap_curve(const float *rgb, int num_pixels, float exposure, int exponential, uint8_t *out) {
+    float scale = exp2f(exposure);
+    for (size_t i = 0; i < 3 * (size_t)num_pixels; i++) {
+        float x = rgb[i] * scale;
+        if (!isfinite(x)) x = 0.0f;
+        float v = srgb_encode(exponential ? 1.0f - expf(-x) : x);
+        out[i] = (uint8_t)(v * 255.0f + 0.5f);
+    }
+}
+
+void tonemap_apply(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *out) {
+    switch (p->op) {
+    case TONEMAP_CLAMP: tonemap_curve(rgb, num_pixels, p->exposure, 0, out); break;
+    case TONEMAP_EXPONENTIAL: tonemap_curve(rgb, num_pixels, p->exposure, 1, out); break;
+    default: tonemap_reinhard(rgb, num_pixels, p, out); break;
+    }
+}
+
 int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen) {
     size_t n = 3 * (size_t)f->width * (size_t)f->height;
     float *planes[1 + COMP_COUNT] = {0};
@@ -118,7 +145,7 @@ int film_save_png(const film *f, unsigned mask, const tonemap_params *tp, const 
         snprintf(err, errlen, "%s: out of memory", path);
     } else {
         film_resolve(f, mask, rgb);
-        tonemap_reinhard(rgb, (int)n, tp, px);
+        tonemap_apply(rgb, (int)n, tp, px);
         status = png_save_rgb8(path, f->width, f->height, px, mode, err, errlen);
     }
     free(rgb);

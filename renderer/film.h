@@ -1,6 +1,6 @@
 /* glint — the film: per-component sums and per-pixel sample counts in double (thousands of
- * frames accumulate without drift), resolved to means on demand; Reinhard's global tone
- * operator and sRGB encoding for display. */
+ * frames accumulate without drift), resolved to means on demand; global tone operators and
+ * sRGB encoding for display. */
 #ifndef GLINT_FILM_H
 #define GLINT_FILM_H
 
@@ -55,12 +55,27 @@ static inline void film_end_pass(film *f) { f->passes++; }
 /* Mean radiance of the components in mask (bit c = component c) into rgb (3 floats per pixel). */
 void film_resolve(const film *f, unsigned mask, float *rgb);
 
+/* Global tone operators, all followed by the sRGB transfer function to 8 bits. */
+typedef enum {
+    TONEMAP_REINHARD = 0, /* Reinhard et al. 2002: key / log-average luminance, L/(1+L), hue kept */
+    TONEMAP_CLAMP,        /* radiance x 2^exposure, clipped at 1: what the numbers say */
+    TONEMAP_EXPONENTIAL,  /* 1 - exp(-radiance x 2^exposure) per channel: a soft shoulder, no
+                           * image statistics, so brightness never shifts while noise settles */
+    TONEMAP_COUNT
+} tonemap_op;
+
+extern const char *const tonemap_names[TONEMAP_COUNT]; /* "reinhard", "clamp", "exponential" */
+int tonemap_from_name(const char *name);               /* -1 when unknown */
+
 typedef struct {
     float exposure; /* stops: the scaled luminance is multiplied by 2^exposure */
     float key;      /* Reinhard's key value a (0 = 0.18) */
     float white;    /* smallest scaled luminance mapped to white (0 = infinity: L/(1+L)) */
+    tonemap_op op;  /* 0: Reinhard */
 } tonemap_params;
 
+/* Tone-maps with p->op. */
+void tonemap_apply(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *srgb8);
 /* Reinhard et al. 2002, global operator: scale by key / log-average luminance, compress
  * luminance, keep chromaticity; then the sRGB transfer function to 8 bits. */
 void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *srgb8);
@@ -68,7 +83,7 @@ float srgb_encode(float linear);
 
 /* Exports (atomic; see image_io.h for write_mode). The EXR holds R,G,B (the sum of the
  * components) plus one layer per component in layers_mask ("direct.R", ...). The PNG is the sum,
- * tone-mapped. Return 0, or -1 with err = "PATH: problem". */
+ * tone-mapped with tp->op. Return 0, or -1 with err = "PATH: problem". */
 int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen);
 int film_save_png(const film *f, unsigned mask, const tonemap_params *tp, const char *path, write_mode mode, char *err,
                   size_t errlen);

@@ -15,10 +15,15 @@ typedef struct {
     void *user;
 } warn_sink;
 
-/* The warning sink lives beside the scene; kept out of the public struct. */
+/* The warning sink and the light edits live beside the scene; kept out of the public struct. */
 typedef struct {
     scene s;
     warn_sink warn;
+    /* Per light group, made on the first change of intensity: the multiplier and what it
+     * multiplies (the colour or emission as loaded), so gains are exact, never compounded. */
+    int num_gains;
+    float *gains;
+    vec3 *gain_bases;
 } scene_box;
 
 scene *scene_create(scene_warn_fn warn, void *warn_user) {
@@ -66,6 +71,8 @@ void scene_destroy(scene *s) {
     free(s->cameras);
     env_map_destroy(s->env);
     dist1d_deinit(&s->light_dist);
+    free(((scene_box *)s)->gains);
+    free(((scene_box *)s)->gain_bases);
     free((scene_box *)s);
 }
 
@@ -331,15 +338,23 @@ static void embree_error(void *user, enum RTCError code, const char *str) {
     fprintf(stderr, "glint: error: embree: %s (code %d)\n", str ? str : "unknown error", (int)code);
 }
 
-int scene_finalize(scene *s, char *err, size_t errlen) {
-    if (s->num_triangles == 0) return snprintf(err, errlen, "%s: no triangles to render", s->path), -1;
+/* The scene's size from its triangles: bounds, diagonal, and the ray offset that scales with it.
+ * Returns 0, or -1 when the scene has no (finite) extent. */
+static int update_extent(scene *s) {
     bounds3 b = bounds_empty();
     for (int t = 0; t < s->num_triangles; t++)
         for (int c = 0; c < 3; c++) b = bounds_add(b, s->positions[s->indices[3 * t + c]]);
+    float diag = bounds_diagonal(b);
+    if (!(diag > 0.0f) || !isfinite(diag)) return -1;
     s->bounds = b;
-    s->diag = bounds_diagonal(b);
-    if (!(s->diag > 0.0f) || !isfinite(s->diag)) return snprintf(err, errlen, "%s: scene has no extent", s->path), -1;
-    s->ray_eps = 1e-5f * s->diag;
+    s->diag = diag;
+    s->ray_eps = 1e-5f * diag;
+    return 0;
+}
+
+int scene_finalize(scene *s, char *err, size_t errlen) {
+    if (s->num_triangles == 0) return snprintf(err, errlen, "%s: no triangles to render", s->path), -1;
+    if (update_extent(s) != 0) return snprintf(err, errlen, "%s: scene has no extent", s->path), -1;
 
     /* Pad the vertex array for Embree (the slot exists: positions has one spare element). */
     s->positions[s->num_vertices] = v3(0, 0, 0);
@@ -362,6 +377,153 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
     if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE)
         return snprintf(err, errlen, "%s: building the BVH failed", s->path), -1;
     return 0;
+}
+
+/* ---- editing lights ------------------------------------------------------------------------ */
+
+static int is_punctual(light_type t) { return t == LIGHT_POINT || t == LIGHT_SPOT || t == LIGHT_DIRECTIONAL; }
+
+static float group_gain(const scene *s, int g) {
+    const scene_box *box = (const scene_box *)s;
+    return g < box->num_gains ? box->gains[g] : 1.0f;
+}
+
+int scene_light_groups(const scene *s, light_group *out, int max) {
+    int n = 0;
+    for (int i = 0; i < s->num_lights; i++) {
+        const light *l = &s->lights[i];
+        if (!is_punctual(l->type)) continue;
+        if (n < max) {
+            light_group *g = &out[n];
+            memset(g, 0, sizeof *g);
+            if (l->name[0]) snprintf(g->name, sizeof g->name, "%s", l->name);
+            else snprintf(g->name, sizeof g->name, "light %d", i);
+            g->type = l->type;
+            g->index = i;
+            g->center = l->type == LIGHT_DIRECTIONAL ? v3(0, 0, 0) : l->position;
+            g->gain = group_gain(s, n);
+        }
+        n++;
+    }
+    /* Emissive materials with triangles, with their area-weighted centroids, from one scan of the
+     * triangles: per material its area, then centroid x area. */
+    double *acc = calloc(4 * (size_t)s->num_materials + 1, sizeof(double));
+    if (!acc) return -1;
+    for (int t = 0; t < s->num_triangles; t++) {
+        int m = s->tri_material[t];
+        if (!(max_comp3(s->materials[m].emission) > 0.0f)) continue;
+        const uint32_t *v = &s->indices[3 * t];
+        vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
+        double a = 0.5 * (double)length3(cross3(sub3(p1, p0), sub3(p2, p0)));
+        vec3 mid = scale3(add3(add3(p0, p1), p2), 1.0f / 3.0f);
+        double *k = acc + 4 * (size_t)m;
+        k[0] += a;
+        k[1] += a * (double)mid.x;
+        k[2] += a * (double)mid.y;
+        k[3] += a * (double)mid.z;
+    }
+    for (int m = 0; m < s->num_materials; m++) {
+        const double *k = acc + 4 * (size_t)m;
+        if (!(k[0] > 0.0)) continue;
+        if (n < max) {
+            light_group *g = &out[n];
+            memset(g, 0, sizeof *g);
+            if (s->materials[m].name[0]) snprintf(g->name, sizeof g->name, "%s", s->materials[m].name);
+            else snprintf(g->name, sizeof g->name, "emissive material %d", m);
+            g->type = LIGHT_TRIANGLE;
+            g->index = m;
+            g->center = v3((float)(k[1] / k[0]), (float)(k[2] / k[0]), (float)(k[3] / k[0]));
+            g->gain = group_gain(s, n);
+        }
+        n++;
+    }
+    free(acc);
+    return n;
+}
+
+/* Group g, or -1 with err set. */
+static int find_group(const scene *s, int g, light_group *out, char *err, size_t errlen) {
+    int n = scene_light_groups(s, NULL, 0);
+    if (n < 0) return snprintf(err, errlen, "out of memory"), -1;
+    if (g < 0 || g >= n) return snprintf(err, errlen, "no light %d (the scene has %d)", g, n), -1;
+    /* Punctual groups come first and are cheap; an area group needs the list up to it. */
+    light_group *all = malloc(sizeof(light_group) * (size_t)(g + 1));
+    int status = all && scene_light_groups(s, all, g + 1) > g ? 0 : -1;
+    if (status == 0) *out = all[g];
+    else snprintf(err, errlen, "out of memory");
+    free(all);
+    return status;
+}
+
+int scene_move_light(scene *s, int g, vec3 delta, char *err, size_t errlen) {
+    light_group lg;
+    if (find_group(s, g, &lg, err, errlen) != 0) return -1;
+    /* Beyond a thousand scene sizes, float positions lose the scene's detail: a typo, not a move. */
+    if (!is_finite3(delta) || length3(delta) > 1e3f * s->diag)
+        return snprintf(err, errlen, "light %d: move too large or not finite", g), -1;
+    if (lg.type == LIGHT_DIRECTIONAL)
+        return snprintf(err, errlen, "light %d (%s) is directional: it has no position", g, lg.name), -1;
+    if (lg.type != LIGHT_TRIANGLE) {
+        s->lights[lg.index].position = add3(s->lights[lg.index].position, delta);
+        return 0; /* a punctual light's power does not depend on where it is */
+    }
+    /* The material's vertices, each once (triangles share them). No other material's triangle
+     * uses them: every mesh brings its own vertices and has one material. */
+    uint8_t *moved = calloc((size_t)s->num_vertices, 1);
+    if (!moved) return snprintf(err, errlen, "out of memory"), -1;
+    for (int t = 0; t < s->num_triangles; t++) {
+        if (s->tri_material[t] != lg.index) continue;
+        for (int c = 0; c < 3; c++) {
+            uint32_t v = s->indices[3 * t + c];
+            if (!moved[v]) s->positions[v] = add3(s->positions[v], delta);
+            moved[v] = 1;
+        }
+    }
+    free(moved);
+    update_extent(s); /* cannot fail: the moved triangles keep their (non-zero) areas */
+    /* The vertex buffer is shared with Embree: mark it changed and rebuild the BVH. */
+    RTCGeometry geom = rtcGetGeometry(s->rtc, 0);
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+    rtcCommitScene(s->rtc);
+    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) return snprintf(err, errlen, "rebuilding the BVH failed"), -1;
+    /* Bounds feed the directional and environment powers: the selection distribution follows. */
+    return scene_build_lights(s, err, errlen);
+}
+
+int scene_set_light_gain(scene *s, int g, float gain, char *err, size_t errlen) {
+    light_group lg;
+    if (find_group(s, g, &lg, err, errlen) != 0) return -1;
+    if (!(gain >= 1e-6f && gain <= 1e6f))
+        return snprintf(err, errlen, "light %d: intensity %g out of range", g, (double)gain), -1;
+    scene_box *box = (scene_box *)s;
+    if (!box->gains) {
+        int n = scene_light_groups(s, NULL, 0); /* more than g (find_group found it), or -1 */
+        light_group *all = n > g ? malloc(sizeof(light_group) * (size_t)n) : NULL;
+        box->gains = n > g ? malloc(sizeof(float) * (size_t)n) : NULL;
+        box->gain_bases = n > g ? malloc(sizeof(vec3) * (size_t)n) : NULL;
+        if (!all || !box->gains || !box->gain_bases || scene_light_groups(s, all, n) != n) {
+            free(all);
+            free(box->gains);
+            free(box->gain_bases);
+            box->gains = NULL;
+            box->gain_bases = NULL;
+            return snprintf(err, errlen, "out of memory"), -1;
+        }
+        for (int i = 0; i < n; i++) {
+            box->gains[i] = 1.0f;
+            const light_group *gi = &all[i];
+            box->gain_bases[i] = gi->type == LIGHT_TRIANGLE ? s->materials[gi->index].emission : s->lights[gi->index].color;
+        }
+        box->num_gains = n;
+        free(all);
+    }
+    vec3 value = scale3(box->gain_bases[g], gain);
+    if (lg.type == LIGHT_TRIANGLE) s->materials[lg.index].emission = value;
+    else s->lights[lg.index].color = value;
+    box->gains[g] = gain;
+    /* Powers and the selection distribution follow the new intensity. */
+    return scene_build_lights(s, err, errlen);
 }
 
 /* ---- loading ------------------------------------------------------------------------------- */

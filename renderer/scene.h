@@ -208,6 +208,30 @@ material material_default(void);
 /* Builds what rendering needs: light list and selection, scale, the BVH. Returns 0 or -1. */
 int scene_finalize(scene *s, char *err, size_t errlen);
 
+/* ---- editing lights (between frames: nothing may be rendering the scene) ------------------ */
+
+/* What a user moves and dims as one light: a punctual light, or every emissive triangle of one
+ * material (an area light is many triangles; the user means the lamp). Numbered punctual lights
+ * first, in light order, then emissive materials, in material order; moving and dimming never
+ * add or remove one, so the numbers hold while the scene lives. */
+typedef struct {
+    char name[64];
+    light_type type; /* LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL, or LIGHT_TRIANGLE (area) */
+    int index;       /* punctual: into lights; area: into materials */
+    vec3 center;     /* position, or the area-weighted centroid; directional: the origin */
+    float gain;      /* intensity multiplier against the scene as loaded */
+} light_group;
+
+/* Fills out[0 .. min(count, max) - 1] (out may be NULL when max is 0); returns the count, or -1
+ * when out of memory. */
+int scene_light_groups(const scene *s, light_group *out, int max);
+/* Translates group g by delta, world units: a punctual light's position, or an area light's
+ * vertices (then the BVH and the scene's bounds). Returns 0, or -1 with err set (no such group,
+ * a directional light, a non-finite delta, out of memory). */
+int scene_move_light(scene *s, int g, vec3 delta, char *err, size_t errlen);
+/* Sets group g's intensity to gain (1e-6 .. 1e6) times its loaded value. Returns 0 or -1. */
+int scene_set_light_gain(scene *s, int g, float gain, char *err, size_t errlen);
+
 /* ---- queries during rendering (thread-safe, read-only) ------------------------------------ */
 
 typedef struct {

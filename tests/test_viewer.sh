@@ -4,6 +4,9 @@
 # many-light and vsl+hl highlight parameters included), screenshots and EXR exports appear
 # (numbered, never overwriting; vsl+hl's with a highlights layer), a bad file leaves the viewer
 # running, a bad script line or value is reported with its line number.
+# Lights move and dim live, camera bookmarks round-trip through their file (a malformed one is
+# reported and ignored), tone mappers switch without a reset, a reference image gives the error
+# and its false-colour view (one of another size is refused).
 # Usage: test_viewer.sh GLINT TMPDIR [KEEP_MODULES_LIB]
 set -u
 glint=$1
@@ -165,6 +168,108 @@ done
 [ -s highlights.png ] || fail "vsl+hl screenshot missing"
 [ -s highlights.exr ] || fail "vsl+hl EXR export missing"
 head -c 2000 highlights.exr | grep -q 'highlights.R' || fail "the vsl+hl export lacks the highlights layer"
+
+# Lights: dimming and moving the ceiling light (light 1; light 0 is the spot) reset the
+# accumulation and change the image; a tone mapper change does not reset; a camera bookmark
+# saved, the view moved, the bookmark restored gives the saved view back.
+cat >edits.txt <<'EOF'
+wait 2
+stats
+set light 1
+set light-intensity 0.25
+wait 2
+stats
+export ref.exr
+move-light 1 0 -1 0
+wait 2
+stats
+set tonemap clamp
+wait 1
+stats
+save-bookmark 1
+orbit 30 0
+wait 1
+stats
+restore-bookmark 1
+wait 1
+stats
+move-light 7 0 1 0
+key ctrl+2
+key shift+1
+wait 1
+stats
+quit
+EOF
+view --size 96x54 --script edits.txt
+rc=$?
+[ $rc -eq 1 ] || fail "light session: exit $rc, expected 1 (a bad light index): $(cat err.txt)"
+grep -q 'edits.txt:21: no light 7' err.txt || fail "a bad light index not reported with its line: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 7 ] || fail "light session: expected 7 stats lines, got: $(cat out.txt)"
+[ "$(field 1 lights)" = "2" ] || fail "the default scene should list 2 lights: $(sed -n 1p stats.txt)"
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.4f", a / b }'; }
+below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; } # below A B: A < B
+[ "$(field 2 light)" = "1" ] && [ "$(field 2 light_intensity)" = "0.25" ] || fail "light intensity not applied: $(sed -n 2p stats.txt)"
+[ "$(field 2 resets)" -gt "$(field 1 resets)" ] || fail "a light intensity change did not reset the accumulation"
+below "$(ratio "$(field 2 mean)" "$(field 1 mean)")" 0.6 || fail "dimming the ceiling light did not darken the image: $(field 1 mean) -> $(field 2 mean)"
+[ "$(field 3 resets)" -gt "$(field 2 resets)" ] || fail "moving a light did not reset the accumulation"
+y2=$(field 2 light_pos | cut -d, -f2)
+y3=$(field 3 light_pos | cut -d, -f2)
+below "$(awk -v a="$y2" -v b="$y3" 'BEGIN { d = a - b - 1; print d < 0 ? -d : d }')" 0.001 || fail "the light did not move down by 1: $y2 -> $y3"
+r=$(ratio "$(field 3 mean)" "$(field 2 mean)")
+below 1.05 "$r" || below "$r" 0.95 || fail "moving the light did not change the image (mean ratio $r)"
+[ "$(field 4 tonemap)" = "clamp" ] || fail "tone mapper not applied"
+[ "$(field 4 resets)" = "$(field 3 resets)" ] || fail "a tone mapper change reset the accumulation"
+[ "$(field 4 frames)" -gt "$(field 3 frames)" ] || fail "frames did not keep accumulating across a tone mapper change"
+[ "$(field 5 cam)" != "$(field 4 cam)" ] || fail "orbit did not move the camera"
+[ "$(field 6 cam)" = "$(field 4 cam)" ] || fail "restoring a bookmark did not restore the view: $(field 4 cam) vs $(field 6 cam)"
+[ "$(field 6 bookmarks)" = "1" ] || fail "bookmark 1 not listed: $(field 6 bookmarks)"
+[ "$(field 7 bookmarks)" = "12" ] || fail "ctrl+2 did not save bookmark 2: $(field 7 bookmarks)"
+grep -q '^1 ' default.glint-bookmarks && grep -q '^2 ' default.glint-bookmarks ||
+  fail "the bookmark file lacks bookmark 1 or 2: $(cat default.glint-bookmarks)"
+saved_cam=$(field 4 cam)
+
+# The bookmark file, read back by a new session; then a malformed one: one message, ignored.
+printf 'restore-bookmark 1\nwait 1\nstats\nquit\n' >restore.txt
+view --size 96x54 --script restore.txt
+rc=$?
+[ $rc -eq 0 ] || fail "restoring a saved bookmark: exit $rc: $(cat err.txt)"
+[ "$(grep '^stats ' out.txt | tr ' ' '\n' | sed -n 's/^cam=//p')" = "$saved_cam" ] || fail "the bookmark file did not restore the view"
+printf '1 0 1 2 0.1 nonsense\n' >default.glint-bookmarks
+view --size 96x54 --script restore.txt
+rc=$?
+[ $rc -eq 1 ] || fail "restoring from a malformed bookmark file: exit $rc, expected 1"
+grep -q 'default.glint-bookmarks:1: not a bookmark line' err.txt || fail "malformed bookmark file not reported: $(cat err.txt)"
+[ "$(grep -c 'bookmark' err.txt)" -eq 2 ] || fail "expected one message for the file and one for the restore: $(cat err.txt)"
+grep -q '^stats ' out.txt || fail "the viewer did not keep running after a malformed bookmark file"
+
+# A reference image (of the dimmed light, so the error cannot be zero): the error is measured,
+# shown in false colour (a display change: no reset); a reference of another size is refused
+# with a message and the viewer keeps running.
+cat >reference.txt <<'EOF'
+wait 2
+stats
+set show error
+wait 1
+stats
+screenshot error.png
+reference highlights.exr
+wait 1
+stats
+quit
+EOF
+view --size 96x54 --reference ref.exr --script reference.txt
+rc=$?
+[ $rc -eq 0 ] || fail "reference session: exit $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 3 ] || fail "reference session: expected 3 stats lines, got: $(cat out.txt)"
+below 0.05 "$(field 1 rel_error)" && below "$(field 1 rel_error)" 100 || fail "no plausible error against the reference: $(field 1 rel_error)"
+[ "$(field 2 show)" = "4" ] || fail "the error view not shown"
+[ "$(field 2 resets)" = "$(field 1 resets)" ] || fail "the error view reset the accumulation"
+[ -s error.png ] || fail "no screenshot of the error view"
+grep -q 'highlights.exr: the reference is 48x27 but the render is 96x54' err.txt ||
+  fail "a reference of another size not reported: $(cat err.txt)"
+[ "$(field 3 frames)" -gt "$(field 2 frames)" ] || fail "the viewer stopped after a reference of another size"
 
 # A bad script line is reported with its line number, before any window opens.
 printf 'wait 1\nfrobnicate 3\n' >bad.txt

@@ -7,8 +7,10 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 
 extern "C" int ui_init(GLFWwindow *window) {
     IMGUI_CHECKVERSION();
@@ -36,6 +38,72 @@ extern "C" void ui_draw_image(unsigned texture) {
     if (!texture) return;
     ImVec2 size = ImGui::GetIO().DisplaySize;
     ImGui::GetBackgroundDrawList()->AddImage((ImTextureID)(intptr_t)texture, ImVec2(0, 0), size);
+}
+
+extern "C" void ui_draw_lights(const float *xy, int n, int selected) {
+    ImDrawList *dl = ImGui::GetBackgroundDrawList();
+    for (int i = 0; i < n; i++) {
+        float x = xy[2 * i], y = xy[2 * i + 1];
+        if (!std::isfinite(x) || !std::isfinite(y)) continue;
+        ImU32 col = i == selected ? IM_COL32(255, 210, 60, 255) : IM_COL32(255, 255, 255, 140);
+        dl->AddCircle(ImVec2(x, y), i == selected ? 9.0f : 6.0f, IM_COL32(0, 0, 0, 160), 0, 3.5f);
+        dl->AddCircle(ImVec2(x, y), i == selected ? 9.0f : 6.0f, col, 0, 1.5f);
+    }
+}
+
+static const ImU32 curve_colours[6] = {IM_COL32(255, 200, 60, 255), IM_COL32(90, 200, 255, 255),
+                                       IM_COL32(140, 255, 120, 255), IM_COL32(255, 110, 110, 255),
+                                       IM_COL32(210, 140, 255, 255), IM_COL32(230, 230, 230, 255)};
+
+// Relative error against time since the reset, log scale, one polyline per method and setting.
+static void error_plot(const ui_stats *s) {
+    float tmax = 0.0f, emin = INFINITY, emax = 0.0f;
+    for (int c = 0; c < s->num_curves; c++)
+        for (int i = 0; i < s->curves[c].n; i++) {
+            float e = s->curves[c].error[i];
+            if (!(e > 0.0f) || !std::isfinite(e)) continue;
+            tmax = std::fmax(tmax, s->curves[c].seconds[i]);
+            emin = std::fmin(emin, e);
+            emax = std::fmax(emax, e);
+        }
+    if (!(emax > 0.0f)) {
+        ImGui::TextUnformatted("error plot: no full-resolution frame yet");
+        return;
+    }
+    float lo = std::floor(std::log10(emin)), hi = std::ceil(std::log10(emax));
+    if (hi <= lo) hi = lo + 1.0f;
+    if (!(tmax > 0.0f)) tmax = 1.0f;
+    ImVec2 p0 = ImGui::GetCursorScreenPos();
+    float w = std::fmax(ImGui::GetContentRegionAvail().x, 50.0f), h = 110.0f;
+    ImGui::Dummy(ImVec2(w, h));
+    ImDrawList *dl = ImGui::GetWindowDrawList();
+    dl->AddRectFilled(p0, ImVec2(p0.x + w, p0.y + h), IM_COL32(15, 15, 20, 255));
+    for (float d = lo + 1.0f; d < hi; d += 1.0f) { // decade lines
+        float y = p0.y + h * (1.0f - (d - lo) / (hi - lo));
+        dl->AddLine(ImVec2(p0.x, y), ImVec2(p0.x + w, y), IM_COL32(60, 60, 70, 255));
+    }
+    ImVector<ImVec2> pts;
+    for (int c = 0; c < s->num_curves; c++) {
+        pts.resize(0);
+        for (int i = 0; i < s->curves[c].n; i++) {
+            float e = s->curves[c].error[i];
+            if (!(e > 0.0f) || !std::isfinite(e)) continue;
+            float x = p0.x + w * s->curves[c].seconds[i] / tmax;
+            float y = p0.y + h * (1.0f - (std::log10(e) - lo) / (hi - lo));
+            pts.push_back(ImVec2(x, y));
+        }
+        if (pts.Size == 1) dl->AddCircleFilled(pts[0], 2.0f, curve_colours[c % 6]);
+        else if (pts.Size > 1) dl->AddPolyline(pts.Data, pts.Size, curve_colours[c % 6], 0, 1.5f);
+    }
+    char label[32];
+    std::snprintf(label, sizeof label, "1e%+.0f", (double)hi);
+    dl->AddText(ImVec2(p0.x + 2, p0.y + 1), IM_COL32(200, 200, 200, 255), label);
+    std::snprintf(label, sizeof label, "1e%+.0f", (double)lo);
+    dl->AddText(ImVec2(p0.x + 2, p0.y + h - 15), IM_COL32(200, 200, 200, 255), label);
+    std::snprintf(label, sizeof label, "%.1f s", (double)tmax);
+    dl->AddText(ImVec2(p0.x + w - 8.0f * (float)std::strlen(label), p0.y + h - 15), IM_COL32(200, 200, 200, 255), label);
+    for (int c = 0; c < s->num_curves; c++)
+        ImGui::TextColored(ImColor(curve_colours[c % 6]), "%s", s->curves[c].label);
 }
 
 extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
@@ -81,10 +149,33 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
         ImGui::Combo("merge", &c->merge, merges, 3);
     }
 
+    if (s->num_lights > 0 && ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) {
+        int l = c->light;
+        if (ImGui::Combo("light", &l, s->light_names, s->num_lights)) c->light = l;
+        if (c->light >= 0) {
+            ImGui::SliderFloat("intensity", &c->light_gain, 0.01f, 100.0f, "x %.3g",
+                               ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+            ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+            ImGui::TextWrapped(s->light_movable ? "move: arrows, PageUp/PageDown, ctrl+drag; ctrl+click picks"
+                                                : "directional: no position; ctrl+click picks");
+            ImGui::PopStyleColor();
+        }
+    }
+
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::SliderFloat("exposure", &c->exposure, -8.0f, 8.0f, "%.1f stops");
-        static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights"};
-        ImGui::Combo("show", &c->show, shows, UI_SHOW_COUNT);
+        if (s->num_tonemaps > 0) ImGui::Combo("tone mapper", &c->tonemap, s->tonemap_names, s->num_tonemaps);
+        static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
+        ImGui::Combo("show", &c->show, shows, s->reference ? UI_SHOW_COUNT : UI_SHOW_ERROR);
+        if (c->show == UI_SHOW_ERROR)
+            ImGui::TextUnformatted("per-pixel relative error:\nblue 1%, green 10%, red 100% and more");
+    }
+
+    if (s->reference && ImGui::CollapsingHeader("Reference", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::TextWrapped("%s", s->reference);
+        if (s->rel_error >= 0.0) ImGui::Text("relative L2 error %.4f", s->rel_error);
+        else ImGui::TextUnformatted("relative L2 error -");
+        error_plot(s);
     }
 
     if (ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) {
@@ -99,6 +190,7 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
             ImGui::EndCombo();
         }
         if (ImGui::Button("reset view (R)")) c->reset_view = 1;
+        if (s->bookmarks) ImGui::TextWrapped("bookmarks (ctrl+N saves, shift+N restores): %s", s->bookmarks);
     }
 
     if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
@@ -109,6 +201,8 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
         if (ImGui::Button("load scene")) c->load_scene = 1;
         ImGui::SameLine();
         if (ImGui::Button("load environment")) c->load_env = 1;
+        ImGui::SameLine();
+        if (ImGui::Button("load reference")) c->load_reference = 1;
         if (s->message && s->message[0]) ImGui::TextWrapped("%s", s->message);
     }
 

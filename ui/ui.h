@@ -12,8 +12,9 @@ extern "C" {
 
 struct GLFWwindow;
 
-/* Components the display can show (film components plus their sum). */
-enum { UI_SHOW_ALL = 0, UI_SHOW_DIRECT, UI_SHOW_INDIRECT, UI_SHOW_HIGHLIGHTS, UI_SHOW_COUNT };
+/* What the display shows: film components, their sum, or the sum's error against a reference
+ * in false colour. */
+enum { UI_SHOW_ALL = 0, UI_SHOW_DIRECT, UI_SHOW_INDIRECT, UI_SHOW_HIGHLIGHTS, UI_SHOW_ERROR, UI_SHOW_COUNT };
 
 typedef struct {
     /* estimator settings: a change resets the accumulation */
@@ -34,14 +35,25 @@ typedef struct {
     int secondary_rays; /* rays sampled from a camera hit's glossy lobe */
     int clusters;       /* merged vMF lobes per camera hit (K) */
     int merge;          /* 0: on, 1: off (each hit's own lobe), 2: trace (no vMFs) */
+    /* the selected light and its intensity: a change of intensity resets */
+    int light;         /* light group, -1 for none */
+    float light_gain;  /* its intensity multiplier */
     /* display settings: a change never resets */
     float exposure;    /* stops */
+    int tonemap;       /* index into the tone mapper names given to ui_panel */
     int show;          /* UI_SHOW_* */
     int show_panel;
     /* one-shot actions, set by the panel, cleared by the viewer */
-    int screenshot, export_exr, reset_view, load_scene, load_env;
+    int screenshot, export_exr, reset_view, load_scene, load_env, load_reference;
     char path[1024];   /* the panel's path field for loading */
 } ui_controls;
+
+/* One curve of the error plot: relative L2 error against seconds since a reset. */
+typedef struct {
+    const char *label; /* the method and settings it was measured with */
+    const float *seconds, *error;
+    int n;
+} ui_curve;
 
 typedef struct {
     const char *scene_name;
@@ -63,6 +75,16 @@ typedef struct {
     /* the last full-resolution frame's highlight work (vsl+hl) */
     unsigned long long hl_points, hl_lobes; /* camera hits worked at, lobes lit */
     double hl_merge_share;     /* of the frame's thread time spent clustering and merging */
+    const char *const *tonemap_names;
+    int num_tonemaps;
+    const char *const *light_names; /* the scene's light groups, "name (type)" */
+    int num_lights;
+    int light_movable;         /* the selected light has a position */
+    const char *reference;     /* the reference image's path, NULL without one */
+    double rel_error;          /* of the full-resolution image against it; < 0: none yet */
+    const ui_curve *curves;    /* the error plot, one curve per method and setting */
+    int num_curves;
+    const char *bookmarks;     /* which of bookmarks 1-9 are set, e.g. "1 3", and where they live */
     const char *message;       /* last export path or error, shown until replaced */
 } ui_stats;
 
@@ -72,6 +94,9 @@ void ui_shutdown(void);
 void ui_begin_frame(void);
 /* The image fills the window (a textured quad behind the panel). texture 0 draws nothing. */
 void ui_draw_image(unsigned texture);
+/* Markers over the image at the lights' window positions (2 floats per light; NaN: off
+ * screen); the selected one stands out. */
+void ui_draw_lights(const float *xy, int n, int selected);
 void ui_panel(ui_controls *c, const ui_stats *s);
 void ui_end_frame(void);
 /* Whether the panel has the mouse or keyboard (the viewer then ignores them for the camera). */
