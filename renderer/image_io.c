@@ -1192,6 +1192,20 @@ void image_rgb_free(image_rgb *img) {
 
 /* ---- OpenEXR: writing ------------------------------------------------------------------------ */
 
+/* OpenEXR 3.1's ZIP encoder keeps its zlib output when that is exactly as long as the raw chunk,
+ * and every reader then takes it for raw pixels (OpenEXR issue #2306): noisy renders hit this.
+ * In that case the raw bytes are stored instead, as the format prescribes when compression does
+ * not pay. The library's own compressor is called first; it is the same for every chunk. */
+static _Thread_local exr_result_t (*exr_zip_compress)(exr_encode_pipeline_t *);
+
+static exr_result_t exr_zip_compress_or_store(exr_encode_pipeline_t *enc) {
+    exr_result_t rv = exr_zip_compress(enc);
+    if (rv == EXR_ERR_SUCCESS && enc->compressed_bytes == enc->packed_bytes && enc->compressed_buffer &&
+        enc->packed_buffer && enc->compressed_buffer != enc->packed_buffer)
+        memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
+    return rv;
+}
+
 /* Encodes the layers as a ZIP-compressed scanline EXR into buf. */
 static int exr_encode(const char *path, int width, int height, const exr_layer *layers, int num_layers, char **names,
                       membuf *buf, char *err, size_t errlen) {
@@ -1247,6 +1261,10 @@ static int exr_encode(const char *path, int width, int height, const exr_layer *
             ch->user_line_stride = 3 * 4 * width;
         }
         if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+        if (rv == EXR_ERR_SUCCESS && enc.compress_fn && enc.compress_fn != exr_zip_compress_or_store) {
+            exr_zip_compress = enc.compress_fn;
+            enc.compress_fn = exr_zip_compress_or_store;
+        }
         if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctx, part, &enc);
     }
     if (have_enc) exr_encoding_destroy(ctx, &enc);
