@@ -12,6 +12,7 @@
 #include "film.h"
 #include "highlights.h"
 #include "image_io.h"
+#include "reference.h"
 #include "session.h"
 
 typedef struct {
@@ -43,12 +44,16 @@ static void print_render_help(void) {
            "  --time SECONDS       render until this much time has passed instead of --spp\n"
            "  --size WxH           image size [960x540]\n"
            "  --max-depth D        scattering events per path; 1 = direct light only [%d]\n"
+           "  --plan auto|full     auto: only the passes the scene calls for (glint info shows\n"
+           "                       them); full: every pass, for comparison [auto]\n"
            "  --env FILE           environment map, equirectangular .exr or .hdr [none]\n"
            "  --env-rotation DEG   rotate the environment about +Y [0]\n"
            "  --camera INDEX       glTF camera to render from [0; a framing view without cameras]\n"
            "  --seed S             random seed; runs with the same seed reproduce [0]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
-           "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers [none]\n"
+           "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers, and beside it\n"
+           "                       FILE.exr.json (scene hash, camera, size, spp, noise): a reference\n"
+           "                       for glint bench [none]\n"
            "  --highlights-layer   camera-glossy-glossy-light paths (the highlight estimator's share)\n"
            "                       go to their own highlights.* layer, not indirect.*: pt, vsl+hl\n"
            "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
@@ -104,6 +109,9 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
             VALUE();
             if (cli_parse_int(a, v, 1, 10000, &n)) return -1;
             o->params.max_depth = (int)n;
+        } else if (strcmp(a, "--plan") == 0) {
+            VALUE();
+            if (cli_parse_plan(a, v, &o->params.plan)) return -1;
         } else if (strcmp(a, "--env") == 0) {
             VALUE();
             o->env_path = v;
@@ -181,18 +189,6 @@ static void progress_update(progress *pg, const render_options *o, long long fra
     pg->last = now;
 }
 
-/* JSON string escaping for paths. */
-static void json_string(FILE *f, const char *s) {
-    fputc('"', f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
-        else if (c < 0x20) fprintf(f, "\\u%04x", c);
-        else fputc(c, f);
-    }
-    fputc('"', f);
-}
-
 static int write_stats(const char *path, const render_options *o, const render_session *rs, const scene *s,
                        double seconds) {
     char *buf = NULL;
@@ -205,7 +201,7 @@ static int write_stats(const char *path, const render_options *o, const render_s
     uint64_t total = 0;
     for (int k = 0; k < RAY_KIND_COUNT; k++) total += st.rays[k];
     fprintf(f, "{\n  \"method\": \"%s\",\n  \"scene\": ", method_name(p->method));
-    json_string(f, s->path);
+    reference_json_string(f, s->path);
     fprintf(f, ",\n  \"width\": %d,\n  \"height\": %d,\n  \"frames\": %lld,\n  \"spp\": %lld,\n", p->width, p->height,
             frames, frames);
     fprintf(f, "  \"seconds\": %.6f,\n  \"max_depth\": %d,\n  \"seed\": %llu,\n  \"threads\": %d,\n", seconds,
@@ -235,6 +231,17 @@ static int write_stats(const char *path, const render_options *o, const render_s
                 (unsigned long long)st.hl_points, (unsigned long long)st.hl_secondary_rays,
                 (unsigned long long)st.hl_lobes, 1e-9 * (double)st.hl_merge_ns);
     }
+    /* The effect plan and what each pass cost: a skipped pass shows zero seconds. */
+    const effect_plan *plan = session_plan(rs);
+    fprintf(f, ",\n  \"plan\": {\"mode\": \"%s\", \"max_depth\": %d, \"virtual_lights\": %s, "
+               "\"vsl_all_strategies\": %s, \"highlights\": %s, \"env_prefilter\": %s},\n",
+            plan->full ? "full" : "auto", plan->max_depth, plan->virtual_lights ? "true" : "false",
+            plan->vsl_all_strategies ? "true" : "false", plan->highlights ? "true" : "false",
+            plan->env_prefilter ? "true" : "false");
+    fprintf(f, "  \"pass_seconds\": {");
+    for (int k = 0; k < PASS_COUNT; k++)
+        fprintf(f, "%s\"%s\": %.6f", k ? ", " : "", pass_names[k], 1e-9 * (double)st.pass_ns[k]);
+    fprintf(f, "}");
     fprintf(f, "\n}\n");
     fclose(f);
     char err[1024];
@@ -245,7 +252,26 @@ static int write_stats(const char *path, const render_options *o, const render_s
     return status;
 }
 
-static int write_outputs(const render_options *o, const render_session *rs, const scene *s, double seconds) {
+/* The reference sidecar beside the EXR (reference.h): what glint bench checks a reference by. */
+static int write_sidecar(const render_options *o, const render_session *rs, const scene *s, double seconds,
+                         reference_noise *rn) {
+    char err[1024], path[4200];
+    reference_info info;
+    const render_params *p = session_params(rs);
+    if (reference_sidecar_path(o->out_exr, path, sizeof path) != 0)
+        return cli_error("%s: file name too long for its sidecar", o->out_exr), -1;
+    if (reference_describe(&info, o->scene_path, o->env_path, o->env_rotation_deg, s, (int)o->camera_index, p, err,
+                           sizeof err) != 0)
+        return cli_error("%s", err), -1;
+    info.spp = session_frames(rs);
+    info.seconds = seconds;
+    reference_noise_finish(rn, rs, &info);
+    if (reference_save(path, &info, err, sizeof err) != 0) return cli_error("%s", err), -1;
+    return 0;
+}
+
+static int write_outputs(const render_options *o, const render_session *rs, const scene *s, double seconds,
+                         reference_noise *rn) {
     const film *fm = session_film(rs);
     char err[1024];
     /* Highlights are a layer of their own when they are split off (vsl+hl, --highlights-layer). */
@@ -255,6 +281,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
         cli_error("%s", err);
         return -1;
     }
+    if (o->out_exr && write_sidecar(o, rs, s, seconds, rn) != 0) return -1;
     const char *png = o->out_png;
     char fallback[4096];
     if (!o->out_exr && !o->out_png && !o->out_stats) {
@@ -265,7 +292,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
         png = fallback;
     }
     if (png) {
-        tonemap_params tp = {(float)o->exposure, 0.0f, 0.0f};
+        tonemap_params tp = {(float)o->exposure, 0.0f, 0.0f, TONEMAP_REINHARD};
         if (film_save_png(fm, COMP_MASK_ALL, &tp, png, png == fallback ? WRITE_NO_REPLACE : WRITE_REPLACE, err,
                           sizeof err) != 0) {
             cli_error("%s", err);
@@ -320,6 +347,10 @@ int cmd_render(int argc, char **argv) {
         return EXIT_FAILURE_;
     }
 
+    /* Only a reference (an EXR) pays for the noise estimate's snapshots. */
+    reference_noise rn = {0};
+    if (o.out_exr && reference_noise_init(&rn, p.width, p.height) != 0)
+        cli_warning("%s: out of memory for the noise estimate; the sidecar will lack it", o.out_exr);
     progress pg = {!o.quiet, isatty(STDERR_FILENO), cli_now(), 0.0};
     pg.last = pg.start;
     double elapsed = 0.0;
@@ -327,19 +358,22 @@ int cmd_render(int argc, char **argv) {
         if (o.spp > 0 ? frame >= o.spp : (frame > 0 && elapsed >= o.seconds)) break;
         if (session_render_frame(rs) != 0) {
             cli_error("%s: %s", s->path, session_error(rs));
+            reference_noise_deinit(&rn);
             session_destroy(rs);
             scene_destroy(s);
             return EXIT_FAILURE_;
         }
         double now = cli_now();
         elapsed = now - pg.start;
+        reference_noise_frame(&rn, rs);
         progress_update(&pg, &o, frame + 1, now, 0);
     }
     progress_update(&pg, &o, session_frames(rs), cli_now(), 1);
     render_stats st = session_stats(rs);
     if (st.rejected_samples) cli_warning("%llu NaN/Inf samples were rejected", (unsigned long long)st.rejected_samples);
 
-    int status = write_outputs(&o, rs, s, elapsed);
+    int status = write_outputs(&o, rs, s, elapsed, &rn);
+    reference_noise_deinit(&rn);
     session_destroy(rs);
     scene_destroy(s);
     return status == 0 ? EXIT_OK : EXIT_FAILURE_;

@@ -7,6 +7,8 @@
 
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
+/* Error against time per method and setting, against a reference (cmd_bench.c). */
+int cmd_bench(int argc, char **argv);
 /* The interactive viewer. */
 int cmd_view(int argc, char **argv);
 

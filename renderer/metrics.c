@@ -22,3 +22,63 @@ double metric_relmse(const float *img, const float *ref, size_t n) {
     }
     return sum / (double)n;
 }
+
+double metric_mean_variance_halves(const float *first, const float *all, size_t n, long long m, long long total,
+                                   double *rel_noise) {
+    if (rel_noise) *rel_noise = 0.0;
+    if (n == 0 || m <= 0 || m >= total) return 0.0;
+    double dm = (double)m, dt = (double)total, rest = dt - dm;
+    /* E[(first - second)^2] = sigma^2 (1/m + 1/rest); the final mean's variance is sigma^2 / total. */
+    double scale = 1.0 / ((1.0 / dm + 1.0 / rest) * dt);
+    double var = 0.0, norm = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double a = (double)first[i], mean = (double)all[i];
+        double second = (dt * mean - dm * a) / rest;
+        double d = a - second;
+        var += d * d * scale;
+        norm += mean * mean;
+    }
+    if (rel_noise) *rel_noise = norm > 0.0 ? sqrt(var / norm) : 0.0;
+    return var / (double)n;
+}
+
+static int usable(double x, double y) { return x > 0.0 && isfinite(x) && y > 0.0 && isfinite(y); }
+
+double metric_loglog_slope(const double *x, const double *y, int n) {
+    double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        if (!usable(x[i], y[i])) continue;
+        double lx = log(x[i]), ly = log(y[i]);
+        sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
+        k++;
+    }
+    if (k < 2) return (double)NAN;
+    double den = (double)k * sxx - sx * sx;
+    if (!(fabs(den) > 1e-12 * (double)k * sxx)) return (double)NAN;
+    return ((double)k * sxy - sx * sy) / den;
+}
+
+double metric_loglog_at(const double *x, const double *y, int n, double x0) {
+    for (int i = 0; i + 1 < n; i++) {
+        if (!usable(x[i], y[i]) || !usable(x[i + 1], y[i + 1])) continue;
+        if (x0 < x[i] || x0 > x[i + 1]) continue;
+        if (x[i + 1] == x[i]) return y[i];
+        double t = log(x0 / x[i]) / log(x[i + 1] / x[i]);
+        return exp(log(y[i]) + t * log(y[i + 1] / y[i]));
+    }
+    if (n >= 1 && usable(x[n - 1], y[n - 1]) && x0 == x[n - 1]) return y[n - 1];
+    return (double)NAN;
+}
+
+double metric_loglog_reach(const double *x, const double *y, int n, double y0) {
+    if (!(y0 > 0.0)) return (double)NAN;
+    if (n >= 1 && usable(x[0], y[0]) && y[0] <= y0) return x[0];
+    for (int i = 0; i + 1 < n; i++) {
+        if (!usable(x[i], y[i]) || !usable(x[i + 1], y[i + 1])) continue;
+        if (!(y[i] > y0 && y[i + 1] <= y0)) continue;
+        double t = log(y0 / y[i]) / log(y[i + 1] / y[i]);
+        return exp(log(x[i]) + t * log(x[i + 1] / x[i]));
+    }
+    return (double)NAN;
+}

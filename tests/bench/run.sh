@@ -10,11 +10,16 @@
 #      highlight component alone at equal time, path tracing its paths vs no merging vs merging
 #      into K lobes, N secondary rays, against a 10-minute reference cached in build/bench-cache;
 #      and the share of time spent merging), about 8 minutes plus the reference.
-# Usage: tests/bench/run.sh [vsl|hl] [SHARED_SCENES_DIR]
+#   5. With `bench` first: `glint bench` on the default scene, the headline comparison (pt,
+#      clamped vpl, vsl, vsl+hl; budgets 1 to 64 s, about 5 minutes) and the Fig. 8 sweeps (radius
+#      multiplier and column count, every lobe gathered, 10 s each, about 2 minutes), against a
+#      path-traced reference with its sidecar, rendered once into build/bench-cache
+#      (REF_SECONDS, default 1200). Results (CSV, plots, report.md) go to build/bench-results/.
+# Usage: tests/bench/run.sh [vsl|hl|bench] [SHARED_SCENES_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 mode=pt
-if [ "${1:-}" = vsl ] || [ "${1:-}" = hl ]; then mode=$1; shift; fi
+if [ "${1:-}" = vsl ] || [ "${1:-}" = hl ] || [ "${1:-}" = bench ]; then mode=$1; shift; fi
 scenes=${1:-$root/../shared/scenes}
 build=$root/build
 source "$root/scripts/deps.sh"
@@ -28,6 +33,25 @@ if [ "$mode" = vsl ]; then
   mkdir -p "$build/bench-cache"
   echo "## The VSL paper's comparisons, default scene ($(nproc) threads, $(date +%F))"
   "$build/tests/bench/bench_vsl" default "$build/bench-cache/default-320x180-pt1200s.exr" 320x180 1200 10,60 10
+  exit 0
+fi
+
+if [ "$mode" = bench ]; then
+  glint=$build/app/glint
+  ref=$build/bench-cache/default-320x180-pt-ref.exr
+  mkdir -p "$build/bench-cache" "$build/bench-results"
+  if [ ! -f "$ref.json" ]; then
+    echo "rendering the path-traced reference for ${REF_SECONDS:-1200} s"
+    "$glint" render --method pt --time "${REF_SECONDS:-1200}" --size 320x180 --seed 12345 --out "$ref"
+  fi
+  stamp=$(date +%Y%m%d-%H%M%S)
+  "$glint" bench --reference "$ref" --methods pt,vpl,vsl,vsl+hl --times 1,2,4,8,16,32,64 \
+    --out "$build/bench-results/headline-$stamp"
+  # Fig. 8: the paper's estimator (every lobe gathered), 4096 lights a frame, both sweeps in one run.
+  "$glint" bench --reference "$ref" --methods vsl --trace-glossy off --vsl-count 4096 --times 5,10 \
+    --sweep radius-mult=1,2,4,8,12,16,24 --sweep columns=64,128,256,512,1024 \
+    --out "$build/bench-results/fig8-$stamp"
+  cat "$build/bench-results/headline-$stamp/report.md" "$build/bench-results/fig8-$stamp/report.md"
   exit 0
 fi
 

@@ -1,0 +1,363 @@
+/* glint — reference sidecars: content hashes, the JSON beside a reference EXR, the noise of a
+ * progressive mean from two halves, and the match check glint bench runs. */
+#define _POSIX_C_SOURCE 200809L
+#include "reference.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera.h"
+#include "metrics.h"
+
+/* The built-in scene, embedded by the renderer's build (renderer/CMakeLists.txt). */
+extern const unsigned char glint_default_scene_gltf[];
+extern const size_t glint_default_scene_gltf_size;
+
+static int fail(char *err, size_t errlen, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static int fail(char *err, size_t errlen, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static uint64_t fnv1a64(uint64_t h, const unsigned char *p, size_t n) {
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+#define FNV_OFFSET 0xcbf29ce484222325ull
+
+int reference_hash_file(const char *path, char out[64], char *err, size_t errlen) {
+    if (!path) {
+        uint64_t h = fnv1a64(FNV_OFFSET, glint_default_scene_gltf, glint_default_scene_gltf_size);
+        snprintf(out, 64, "builtin:default:fnv1a64:%016llx", (unsigned long long)h);
+        return 0;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f) return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+    uint64_t h = FNV_OFFSET;
+    unsigned char buf[1 << 16];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) h = fnv1a64(h, buf, n);
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) return fail(err, errlen, "%s: read error", path);
+    snprintf(out, 64, "fnv1a64:%016llx", (unsigned long long)h);
+    return 0;
+}
+
+int reference_describe(reference_info *r, const char *scene_path, const char *env_path, double env_rotation_deg,
+                       const scene *s, int camera_index, const render_params *p, char *err, size_t errlen) {
+    memset(r, 0, sizeof *r);
+    snprintf(r->scene, sizeof r->scene, "%s", scene_path ? scene_path : "<default>");
+    if (reference_hash_file(scene_path, r->scene_hash, err, errlen)) return -1;
+    if (env_path) {
+        snprintf(r->env, sizeof r->env, "%s", env_path);
+        if (reference_hash_file(env_path, r->env_hash, err, errlen)) return -1;
+        r->env_rotation = env_rotation_deg;
+    }
+    /* -1 renders the first camera when there is one: record that, so both spellings match. */
+    r->camera_index = camera_index < 0 && s->num_cameras > 0 ? 0 : camera_index;
+    r->cam = scene_camera(s, camera_index, (float)p->width / (float)p->height);
+    r->width = p->width;
+    r->height = p->height;
+    r->max_depth = p->max_depth > 0 ? p->max_depth : DEFAULT_MAX_DEPTH;
+    r->seed = p->seed;
+    r->threads = p->threads;
+    snprintf(r->method, sizeof r->method, "%s", method_name(p->method));
+    r->highlights_layer = p->pt_highlights || p->method == METHOD_VSL_HL;
+    return 0;
+}
+
+int reference_sidecar_path(const char *exr_path, char *out, size_t outlen) {
+    int n = snprintf(out, outlen, "%s.json", exr_path);
+    return n < 0 || (size_t)n >= outlen ? -1 : 0;
+}
+
+/* ---- writing --------------------------------------------------------------------------------- */
+
+void reference_json_string(FILE *f, const char *s) {
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+        else if (c < 0x20) fprintf(f, "\\u%04x", c);
+        else fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void json_vec3(FILE *f, const char *key, vec3 v) {
+    fprintf(f, "\"%s\": [%.9g, %.9g, %.9g]", key, (double)v.x, (double)v.y, (double)v.z);
+}
+
+int reference_save(const char *path, const reference_info *r, char *err, size_t errlen) {
+    char *buf = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&buf, &size);
+    if (!f) return fail(err, errlen, "%s: out of memory", path);
+    fprintf(f, "{\n  \"glint_reference\": 1,\n  \"scene\": ");
+    reference_json_string(f, r->scene);
+    fprintf(f, ",\n  \"scene_hash\": \"%s\",\n  \"env\": ", r->scene_hash);
+    reference_json_string(f, r->env);
+    fprintf(f, ",\n  \"env_hash\": \"%s\",\n  \"env_rotation\": %.9g,\n", r->env_hash, r->env_rotation);
+    fprintf(f, "  \"camera\": {\"index\": %d, ", r->camera_index);
+    json_vec3(f, "position", r->cam.position);
+    fputs(", ", f);
+    json_vec3(f, "right", r->cam.right);
+    fputs(", ", f);
+    json_vec3(f, "up", r->cam.up);
+    fputs(", ", f);
+    json_vec3(f, "forward", r->cam.forward);
+    fprintf(f, ", \"yfov\": %.9g},\n", (double)r->cam.yfov);
+    fprintf(f, "  \"width\": %d,\n  \"height\": %d,\n  \"method\": \"%s\",\n  \"highlights_layer\": %s,\n", r->width,
+            r->height, r->method, r->highlights_layer ? "true" : "false");
+    fprintf(f, "  \"spp\": %lld,\n  \"frames\": %lld,\n  \"seconds\": %.6f,\n  \"max_depth\": %d,\n", r->spp, r->spp,
+            r->seconds, r->max_depth);
+    fprintf(f, "  \"seed\": %llu,\n  \"threads\": %d,\n", (unsigned long long)r->seed, r->threads);
+    if (r->has_noise)
+        fprintf(f, "  \"variance\": {\"mean_pixel_variance\": %.9g, \"rel_l2_noise\": %.9g, "
+                   "\"estimate\": \"two halves of the frames\"}\n}\n",
+                r->mean_variance, r->rel_l2_noise);
+    else
+        fprintf(f, "  \"variance\": null\n}\n");
+    fclose(f);
+    int status = write_file_atomic(path, buf, size, WRITE_REPLACE, err, errlen);
+    free(buf);
+    return status;
+}
+
+/* ---- reading: only our own flat format; every key name is unique in the file ---------------- */
+
+/* The value after "key": (skipping white space), or NULL. */
+static const char *json_value(const char *text, const char *key) {
+    char pat[80];
+    snprintf(pat, sizeof pat, "\"%s\"", key);
+    for (const char *p = strstr(text, pat); p; p = strstr(p + 1, pat)) {
+        const char *q = p + strlen(pat);
+        while (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r') q++;
+        if (*q != ':') continue;
+        q++;
+        while (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r') q++;
+        return q;
+    }
+    return NULL;
+}
+
+static int json_number(const char *text, const char *key, double *out) {
+    const char *v = json_value(text, key);
+    if (!v) return -1;
+    char *end;
+    errno = 0;
+    double x = strtod(v, &end);
+    if (end == v || errno || !isfinite(x)) return -1;
+    *out = x;
+    return 0;
+}
+
+static int json_int(const char *text, const char *key, long long lo, long long hi, long long *out) {
+    double x;
+    if (json_number(text, key, &x) || x != floor(x) || x < (double)lo || x > (double)hi) return -1;
+    *out = (long long)x;
+    return 0;
+}
+
+/* A string as reference_json_string writes it: \" and \\ unescaped, \u00XX read as "?". */
+static int json_str(const char *text, const char *key, char *out, size_t outlen) {
+    const char *v = json_value(text, key);
+    if (!v || *v != '"') return -1;
+    size_t k = 0;
+    for (v++; *v && *v != '"'; v++) {
+        if (*v == '\\') {
+            v++;
+            if (*v == 'u') { /* control characters: never in a name we compare; keep a marker */
+                if (strlen(v) < 5) return -1;
+                v += 4;
+                if (k + 1 < outlen) out[k++] = '?';
+                continue;
+            }
+            if (!*v) return -1;
+        }
+        if (k + 1 >= outlen) return -1;
+        out[k++] = *v;
+    }
+    if (*v != '"') return -1;
+    out[k] = '\0';
+    return 0;
+}
+
+static int json_vec(const char *text, const char *key, vec3 *out) {
+    const char *v = json_value(text, key);
+    if (!v || *v != '[') return -1;
+    float c[3];
+    v++;
+    for (int k = 0; k < 3; k++) {
+        char *end;
+        errno = 0;
+        double x = strtod(v, &end);
+        if (end == v || errno || !isfinite(x)) return -1;
+        c[k] = (float)x;
+        v = end;
+        while (*v == ' ' || *v == '\n') v++;
+        if (*v != (k < 2 ? ',' : ']')) return -1;
+        v++;
+    }
+    *out = (vec3){c[0], c[1], c[2]};
+    return 0;
+}
+
+int reference_load(const char *path, reference_info *r, char *err, size_t errlen) {
+    memset(r, 0, sizeof *r);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        if (errno == ENOENT) return 1;
+        return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+    }
+    enum { CAP = 1 << 20 };
+    char *text = malloc(CAP + 1);
+    if (!text) {
+        fclose(f);
+        return fail(err, errlen, "%s: out of memory", path);
+    }
+    size_t n = fread(text, 1, CAP + 1, f);
+    int bad_read = ferror(f);
+    fclose(f);
+    if (bad_read || n > CAP) {
+        free(text);
+        return fail(err, errlen, "%s: %s", path, bad_read ? "read error" : "too large for a reference sidecar");
+    }
+    text[n] = '\0';
+    if (memchr(text, '\0', n)) {
+        free(text);
+        return fail(err, errlen, "%s: not a glint reference sidecar (binary data)", path);
+    }
+    const char *missing = NULL;
+    long long ll = 0;
+    double x = 0.0;
+#define NEED(ok, key) \
+    if (!missing && !(ok)) missing = key
+    NEED(json_value(text, "glint_reference") != NULL, "glint_reference");
+    NEED(json_str(text, "scene", r->scene, sizeof r->scene) == 0, "scene");
+    NEED(json_str(text, "scene_hash", r->scene_hash, sizeof r->scene_hash) == 0, "scene_hash");
+    NEED(json_str(text, "env", r->env, sizeof r->env) == 0, "env");
+    NEED(json_str(text, "env_hash", r->env_hash, sizeof r->env_hash) == 0, "env_hash");
+    NEED(json_number(text, "env_rotation", &r->env_rotation) == 0, "env_rotation");
+    NEED(json_int(text, "index", -1, 1000000, &ll) == 0, "camera index");
+    r->camera_index = (int)ll;
+    NEED(json_vec(text, "position", &r->cam.position) == 0, "camera position");
+    NEED(json_vec(text, "right", &r->cam.right) == 0, "camera right");
+    NEED(json_vec(text, "up", &r->cam.up) == 0, "camera up");
+    NEED(json_vec(text, "forward", &r->cam.forward) == 0, "camera forward");
+    NEED(json_number(text, "yfov", &x) == 0, "camera yfov");
+    r->cam.yfov = (float)x;
+    NEED(json_int(text, "width", 1, 16384, &ll) == 0, "width");
+    r->width = (int)ll;
+    NEED(json_int(text, "height", 1, 16384, &ll) == 0, "height");
+    r->height = (int)ll;
+    NEED(json_str(text, "method", r->method, sizeof r->method) == 0, "method");
+    const char *hl = json_value(text, "highlights_layer");
+    NEED(hl && (strncmp(hl, "true", 4) == 0 || strncmp(hl, "false", 5) == 0), "highlights_layer");
+    r->highlights_layer = hl && strncmp(hl, "true", 4) == 0;
+    NEED(json_int(text, "spp", 0, (long long)1 << 50, &r->spp) == 0, "spp");
+    NEED(json_number(text, "seconds", &r->seconds) == 0, "seconds");
+    NEED(json_int(text, "max_depth", 1, 10000, &ll) == 0, "max_depth");
+    r->max_depth = (int)ll;
+    NEED(json_number(text, "seed", &x) == 0, "seed");
+    r->seed = (uint64_t)strtoull(json_value(text, "seed") ? json_value(text, "seed") : "0", NULL, 10);
+    r->has_noise = json_number(text, "mean_pixel_variance", &r->mean_variance) == 0 &&
+                   json_number(text, "rel_l2_noise", &r->rel_l2_noise) == 0;
+#undef NEED
+    free(text);
+    if (missing) return fail(err, errlen, "%s: not a glint reference sidecar (missing or bad \"%s\")", path, missing);
+    return 0;
+}
+
+/* ---- noise of the reference ------------------------------------------------------------------ */
+
+int reference_noise_init(reference_noise *rn, int width, int height) {
+    memset(rn, 0, sizeof *rn);
+    rn->n = (size_t)width * (size_t)height * 3;
+    rn->snap[0] = malloc(sizeof(float) * rn->n);
+    rn->snap[1] = malloc(sizeof(float) * rn->n);
+    rn->scratch = malloc(sizeof(float) * rn->n);
+    if (!rn->snap[0] || !rn->snap[1] || !rn->scratch) {
+        reference_noise_deinit(rn);
+        return -1;
+    }
+    return 0;
+}
+
+void reference_noise_deinit(reference_noise *rn) {
+    free(rn->snap[0]);
+    free(rn->snap[1]);
+    free(rn->scratch);
+    memset(rn, 0, sizeof *rn);
+}
+
+void reference_noise_frame(reference_noise *rn, const render_session *rs) {
+    long long frames = session_frames(rs);
+    if (!rn->scratch || frames <= 0 || (frames & (frames - 1)) != 0) return;
+    float *t = rn->snap[0];
+    rn->snap[0] = rn->snap[1];
+    rn->snap_frames[0] = rn->snap_frames[1];
+    rn->snap[1] = t;
+    rn->snap_frames[1] = frames;
+    film_resolve(session_film(rs), COMP_MASK_ALL, t);
+}
+
+void reference_noise_finish(reference_noise *rn, const render_session *rs, reference_info *info) {
+    info->has_noise = 0;
+    long long total = session_frames(rs);
+    if (!rn->scratch || total < 2) return;
+    /* Of the snapshots taken before the end, the one whose split is closest to even. */
+    int best = -1;
+    for (int k = 0; k < 2; k++) {
+        long long m = rn->snap_frames[k];
+        if (m <= 0 || m >= total) continue;
+        if (best < 0 || llabs(2 * m - total) < llabs(2 * rn->snap_frames[best] - total)) best = k;
+    }
+    if (best < 0) return;
+    film_resolve(session_film(rs), COMP_MASK_ALL, rn->scratch);
+    info->mean_variance =
+        metric_mean_variance_halves(rn->snap[best], rn->scratch, rn->n, rn->snap_frames[best], total, &info->rel_l2_noise);
+    info->has_noise = 1;
+}
+
+/* ---- matching -------------------------------------------------------------------------------- */
+
+static int near(float a, float b) { return fabsf(a - b) <= 1e-5f * (1.0f + fmaxf(fabsf(a), fabsf(b))); }
+static int near3(vec3 a, vec3 b) { return near(a.x, b.x) && near(a.y, b.y) && near(a.z, b.z); }
+
+int reference_check(const char *ref, const reference_info *have, const reference_info *want, char *err, size_t errlen) {
+    if (strcmp(have->scene_hash, want->scene_hash) != 0)
+        return fail(err, errlen, "%s: rendered from another scene ('%s', %s), not '%s' (%s)", ref, have->scene,
+                    have->scene_hash, want->scene, want->scene_hash);
+    if (strcmp(have->env_hash, want->env_hash) != 0)
+        return fail(err, errlen, "%s: rendered with environment %s%s%s, not %s%s%s", ref,
+                    have->env[0] ? "'" : "", have->env[0] ? have->env : "none", have->env[0] ? "'" : "",
+                    want->env[0] ? "'" : "", want->env[0] ? want->env : "none", want->env[0] ? "'" : "");
+    if (fabs(have->env_rotation - want->env_rotation) > 1e-6)
+        return fail(err, errlen, "%s: rendered with --env-rotation %g, not %g", ref, have->env_rotation,
+                    want->env_rotation);
+    if (have->width != want->width || have->height != want->height)
+        return fail(err, errlen, "%s: rendered at %dx%d, not %dx%d", ref, have->width, have->height, want->width,
+                    want->height);
+    if (have->camera_index != want->camera_index)
+        return fail(err, errlen, "%s: rendered from camera %d, not %d", ref, have->camera_index, want->camera_index);
+    const camera *a = &have->cam, *b = &want->cam;
+    if (!near3(a->position, b->position) || !near3(a->right, b->right) || !near3(a->up, b->up) ||
+        !near3(a->forward, b->forward) || !near(a->yfov, b->yfov))
+        return fail(err, errlen, "%s: camera %d has moved since the reference was rendered (position %g %g %g, "
+                                 "now %g %g %g)", ref, have->camera_index, (double)a->position.x,
+                    (double)a->position.y, (double)a->position.z, (double)b->position.x, (double)b->position.y,
+                    (double)b->position.z);
+    return 0;
+}

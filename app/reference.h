@@ -1,0 +1,82 @@
+/* glint — what makes a reference image trustworthy and reusable: the JSON sidecar that glint
+ * render writes beside its EXR (OUT.exr.json) and glint bench reads to refuse a reference of
+ * another scene, camera or size. */
+#ifndef GLINT_REFERENCE_H
+#define GLINT_REFERENCE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "session.h"
+
+typedef struct {
+    char scene[1024];      /* as given on the command line, "<default>" for the built-in scene */
+    char scene_hash[64];   /* "fnv1a64:..." of the file's bytes, "builtin:default:fnv1a64:..." */
+    char env[1024];        /* "" without an environment map */
+    char env_hash[64];
+    double env_rotation;   /* degrees */
+    int camera_index;      /* -1: the scene's first camera or the framing view */
+    camera cam;            /* the camera actually rendered from */
+    int width, height;
+    char method[16];
+    int highlights_layer;  /* the EXR has a highlights.* layer */
+    long long spp;         /* = frames: one sample per pixel per frame */
+    double seconds;
+    int max_depth;
+    uint64_t seed;
+    int threads;
+    /* Noise of the reference itself, from two halves of its frames (reference_noise()); has_noise
+     * is 0 when it rendered a single frame. */
+    int has_noise;
+    double mean_variance;  /* mean over pixels and channels of the variance of the pixel mean */
+    double rel_l2_noise;   /* expected relative L2 error of the reference against the truth */
+} reference_info;
+
+/* The content hash of a scene or environment file (FNV-1a 64 of its bytes; NULL path: the
+ * built-in scene). Returns 0, or -1 with err = "PATH: problem". */
+int reference_hash_file(const char *path, char out[64], char *err, size_t errlen);
+
+/* Fills what identifies a rendering of scene s (loaded from scene_path, NULL: built-in; env_path
+ * may be NULL) from camera_index (-1: the default view, recorded as 0 when the scene has cameras)
+ * at the size in p: paths, content hashes, camera, size, max depth, seed, threads. The method
+ * and the results (spp, seconds, noise) are left to the caller. Returns 0, or -1 with err set
+ * (a file unreadable for hashing). */
+int reference_describe(reference_info *info, const char *scene_path, const char *env_path, double env_rotation_deg,
+                       const struct scene *s, int camera_index, const render_params *p, char *err, size_t errlen);
+
+/* Writes s as a JSON string (quotes, escapes); shared with glint render's --stats. */
+void reference_json_string(FILE *f, const char *s);
+
+/* The sidecar path of an EXR: "OUT.exr.json". Returns 0, or -1 when out is too small. */
+int reference_sidecar_path(const char *exr_path, char *out, size_t outlen);
+
+/* Writes info as JSON to path, atomically (replacing: it belongs to an EXR the user named). */
+int reference_save(const char *path, const reference_info *info, char *err, size_t errlen);
+/* Reads a sidecar. Returns 0, 1 when the file does not exist, -1 when it is unreadable or
+ * malformed (err = "PATH: problem"). */
+int reference_load(const char *path, reference_info *info, char *err, size_t errlen);
+
+/* Tracks two halves of a progressive render for the noise estimate: call reference_noise_frame
+ * after every frame, reference_noise_finish at the end. Snapshots of the mean are taken at
+ * power-of-two frame counts, so the finish uses a split of the frames between 1/2 and 3/4 (no
+ * cost on the hot path: log2(frames) resolves). */
+typedef struct {
+    float *snap[2];        /* the last two snapshots, at frames snap_frames[k] */
+    long long snap_frames[2];
+    float *scratch;
+    size_t n;
+} reference_noise;
+
+int reference_noise_init(reference_noise *rn, int width, int height); /* 0, or -1 out of memory */
+void reference_noise_frame(reference_noise *rn, const render_session *rs);
+void reference_noise_finish(reference_noise *rn, const render_session *rs, reference_info *info);
+void reference_noise_deinit(reference_noise *rn);
+
+/* Compares what a bench renders (want) with a reference's sidecar (have), field by field: scene
+ * and environment hashes, camera index and parameters, size. Returns 0 when they match, else -1
+ * with err naming the first difference ("REF.exr: ..."). */
+int reference_check(const char *ref_path, const reference_info *have, const reference_info *want, char *err,
+                    size_t errlen);
+
+#endif

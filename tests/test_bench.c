@@ -1,0 +1,324 @@
+/* glint bench and reference sidecars, run as a user would: the sidecar beside a reference EXR,
+ * a bench whose CSV parses (header, monotone time, pt's error falling), whose SVG and PNG plots
+ * and report appear, sweeps, the highlights component; mismatched references (size, camera,
+ * scene, no or broken sidecar) refused with one error line; nothing ever overwritten.
+ * Usage: test_bench PATH_TO_GLINT */
+#define _POSIX_C_SOURCE 200809L
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <stb_image.h>
+
+#include "check.h"
+#include "image_io.h"
+
+static const char *glint;
+static char tmp[512];
+static char out_text[65536], err_text[65536];
+
+static const char *const header = "method,params,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,direct_relmse,"
+                                  "indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse";
+
+static size_t read_file(const char *name, char *buf, size_t cap) {
+    char p[1024];
+    snprintf(p, sizeof p, "%s/%s", tmp, name);
+    buf[0] = 0;
+    FILE *f = fopen(p, "rb");
+    if (!f) return 0;
+    size_t n = fread(buf, 1, cap - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    return n;
+}
+
+/* Runs glint with the given arguments in directory tmp; returns the exit status (-1: a crash). */
+static int run(const char *args) {
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >stdout.txt 2>stderr.txt </dev/null", tmp, glint, args);
+    int status = system(cmd);
+    read_file("stdout.txt", out_text, sizeof out_text);
+    read_file("stderr.txt", err_text, sizeof err_text);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static int count_lines(const char *s) {
+    int n = 0;
+    for (; *s; s++) n += *s == '\n';
+    return n;
+}
+
+/* A non-zero exit and stderr exactly one "glint: error: ..." line containing needle. */
+static void expect_refusal(const char *args, const char *needle) {
+    int rc = run(args);
+    CHECK(rc > 0, "'%s': exit %d, expected a failure", args, rc);
+    CHECK(strncmp(err_text, "glint: error: ", 14) == 0 && count_lines(err_text) == 1,
+          "'%s': stderr is not one error line: '%s'", args, err_text);
+    CHECK(strstr(err_text, needle) != NULL, "'%s': error '%s' lacks '%s'", args, err_text, needle);
+}
+
+static int exists(const char *name) {
+    char p[1024];
+    snprintf(p, sizeof p, "%s/%s", tmp, name);
+    struct stat st;
+    return stat(p, &st) == 0;
+}
+
+static void write_text(const char *name, const char *text) {
+    char p[1024];
+    snprintf(p, sizeof p, "%s/%s", tmp, name);
+    FILE *f = fopen(p, "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+/* One parsed results.csv row. */
+typedef struct {
+    char method[16], params[64];
+    double seconds, rel_l2, highlights_rel_l2;
+    long long frames;
+    int fields, has_highlights;
+} row;
+
+/* Parses results.csv: the header must be exact; returns the number of rows (-1: bad header). */
+static int parse_csv(const char *name, row *rows, int cap) {
+    static char text[1 << 16];
+    read_file(name, text, sizeof text);
+    char *line = text, *nl = strchr(line, '\n');
+    if (!nl) return -1;
+    *nl = 0;
+    if (strcmp(line, header) != 0) return -1;
+    int n = 0;
+    for (line = nl + 1; *line && n < cap; line = nl + 1) {
+        nl = strchr(line, '\n');
+        if (!nl) break;
+        *nl = 0;
+        row *r = &rows[n++];
+        memset(r, 0, sizeof *r);
+        char *field[32];
+        int k = 0;
+        for (char *p = line;; p++) { /* empty fields count: no strtok */
+            if (k < 32) field[k++] = p;
+            p = strchr(p, ',');
+            if (!p) break;
+            *p = 0;
+        }
+        r->fields = k;
+        if (k != 14) continue;
+        snprintf(r->method, sizeof r->method, "%s", field[0]);
+        snprintf(r->params, sizeof r->params, "%s", field[1]);
+        r->seconds = atof(field[2]);
+        r->frames = atoll(field[3]);
+        r->rel_l2 = field[6][0] ? atof(field[6]) : NAN;
+        r->has_highlights = field[12][0] != 0;
+        r->highlights_rel_l2 = r->has_highlights ? atof(field[12]) : NAN;
+    }
+    return n;
+}
+
+static const char *const other_scene =
+    "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/octet-stream;base64,"
+    "AACAvwAAAAAAAIC/AACAPwAAAAAAAIC/AACAPwAAAAAAAIA/AACAvwAAAAAAAIA/AAACAAEAAAADAAIA\"}],\"bufferViews\":[{\"buffer\":"
+    "0,\"byteOffset\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],\"accessors\":[{"
+    "\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\",\"min\":[-1,0,-1],\"max\":[1,0,1]},{"
+    "\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],\"meshes\":[{\"primitives\":[{"
+    "\"attributes\":{\"POSITION\":0},\"indices\":1}]}],\"extensionsUsed\":[\"KHR_lights_punctual\"],\"extensions\":{"
+    "\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\",\"intensity\":5}]}},\"cameras\":[{\"type\":"
+    "\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.01}}],\"nodes\":[{\"mesh\":0},{\"light\":0,"
+    "\"translation\":[0,1,0]},{\"camera\":0,\"translation\":[0,1,3]}],\"scenes\":[{\"nodes\":[0,1,2]}],\"scene\":0}\n";
+
+static void test_sidecar(void) {
+    /* 1024 spp: the reference's own noise must stay below pt's error at the bench's budgets. */
+    int rc = run("render --spp 1024 --size 24x16 --max-depth 3 --seed 7 --out ref.exr --quiet");
+    CHECK(rc == 0, "reference render: exit %d: %s", rc, err_text);
+    char json[8192];
+    read_file("ref.exr.json", json, sizeof json);
+    CHECK(strstr(json, "\"scene_hash\": \"builtin:default:fnv1a64:") && strstr(json, "\"spp\": 1024") &&
+              strstr(json, "\"width\": 24") && strstr(json, "\"height\": 16") && strstr(json, "\"max_depth\": 3") &&
+              strstr(json, "\"seed\": 7") && strstr(json, "\"index\": 0") && strstr(json, "\"method\": \"pt\"") &&
+              strstr(json, "\"mean_pixel_variance\": "),
+          "sidecar: %s", json);
+    const char *noise = strstr(json, "\"rel_l2_noise\": ");
+    double rel = noise ? atof(noise + 16) : -1.0;
+    CHECK(rel > 0.0 && rel < 1.0, "the reference's relative noise %g", rel);
+    /* A reference with the highlights split off, for the highlights component. */
+    rc = run("render --spp 64 --size 24x16 --max-depth 3 --seed 7 --highlights-layer --out refhl.exr --quiet");
+    CHECK(rc == 0, "highlights reference render: exit %d: %s", rc, err_text);
+    read_file("refhl.exr.json", json, sizeof json);
+    CHECK(strstr(json, "\"highlights_layer\": true") != NULL, "highlights sidecar: %s", json);
+    /* A reference of another scene. */
+    write_text("other.gltf", other_scene);
+    rc = run("render other.gltf --spp 16 --size 24x16 --max-depth 3 --out other.exr --quiet");
+    CHECK(rc == 0, "other scene render: exit %d: %s", rc, err_text);
+    read_file("other.exr.json", json, sizeof json);
+    CHECK(strstr(json, "\"scene_hash\": \"fnv1a64:") && strstr(json, "\"scene\": \"other.gltf\""), "other: %s", json);
+}
+
+static void test_bench_run(void) {
+    int rc = run("bench --reference ref.exr --methods pt,vsl --vsl-count 64 --times 0.01,0.3,1 --threads 2 --out b1");
+    CHECK(rc == 0, "bench: exit %d: %s", rc, err_text);
+    row rows[64];
+    int n = parse_csv("b1/results.csv", rows, 64);
+    CHECK(n == 6, "results.csv: %d rows (-1: bad header), expected 6", n);
+    for (int i = 0; i < n; i++) {
+        CHECK(rows[i].fields == 14, "row %d has %d fields", i, rows[i].fields);
+        CHECK(isfinite(rows[i].rel_l2) && rows[i].rel_l2 > 0.0 && !rows[i].has_highlights,
+              "row %d: rel_l2 %g, highlights column filled without a highlights layer", i, rows[i].rel_l2);
+        if (i % 3 > 0)
+            CHECK(rows[i].seconds > rows[i - 1].seconds && rows[i].frames >= rows[i - 1].frames &&
+                      strcmp(rows[i].method, rows[i - 1].method) == 0,
+                  "row %d: seconds %g after %g, not monotone within one run", i, rows[i].seconds, rows[i - 1].seconds);
+    }
+    if (n == 6) {
+        CHECK(strcmp(rows[0].method, "pt") == 0 && strcmp(rows[3].method, "vsl") == 0, "methods in order");
+        CHECK(rows[0].seconds >= 0.01 && rows[2].seconds >= 1.0, "budgets met: %g, %g", rows[0].seconds, rows[2].seconds);
+        /* By frames (seed 8): 1.39 at 2, 0.65 at 10, 0.29 at 44, 0.25 at 200, 0.19 at 700; one
+         * firefly can raise the curve a little, so only a clear fall counts. */
+        CHECK(rows[2].rel_l2 < 0.6 * rows[0].rel_l2, "pt's error does not fall: %g at %g s, %g at %g s", rows[0].rel_l2,
+              rows[0].seconds, rows[2].rel_l2, rows[2].seconds);
+    }
+    char svg[1 << 16];
+    read_file("b1/error-vs-time.svg", svg, sizeof svg);
+    CHECK(strncmp(svg, "<svg", 4) == 0 && strstr(svg, "</svg>") && strstr(svg, "<polyline") && strstr(svg, ">pt<") &&
+              strstr(svg, ">vsl<") && strstr(svg, "equal time"),
+          "error-vs-time.svg is not the plot");
+    char p[1024];
+    snprintf(p, sizeof p, "%s/b1/error-vs-time.png", tmp);
+    int w = 0, h = 0, c = 0;
+    unsigned char *png = stbi_load(p, &w, &h, &c, 3);
+    CHECK(png && w > 100 && h > 100, "error-vs-time.png does not decode (%dx%d)", w, h);
+    if (png) {
+        long dark = 0;
+        for (long i = 0; i < (long)w * h * 3; i++) dark += png[i] < 128;
+        CHECK(dark > 1000, "the png is blank (%ld dark values)", dark);
+    }
+    stbi_image_free(png);
+    char md[1 << 16];
+    read_file("b1/report.md", md, sizeof md);
+    CHECK(strstr(md, "| pt |") && strstr(md, "| vsl |") && strstr(md, "## Convergence") && strstr(md, "## Equal error") &&
+              strstr(md, "| 1 s |"),
+          "report.md: %s", md);
+
+    /* Nothing is overwritten: the same --out is refused, the files stay as they were. */
+    char before[1 << 16], after[1 << 16];
+    read_file("b1/results.csv", before, sizeof before);
+    expect_refusal("bench --reference ref.exr --methods pt --times 0.05 --out b1", "results.csv");
+    read_file("b1/results.csv", after, sizeof after);
+    CHECK(strcmp(before, after) == 0, "results.csv changed");
+    /* Without --out: bench, then bench-1. */
+    CHECK(run("bench --reference ref.exr --methods pt --times 0.05 --quiet") == 0 && exists("bench/results.csv"),
+          "default output directory: %s", err_text);
+    CHECK(run("bench --reference ref.exr --methods pt --times 0.05 --quiet") == 0 && exists("bench-1/results.csv"),
+          "second default output directory: %s", err_text);
+}
+
+static void test_sweeps_and_highlights(void) {
+    int rc = run("bench --reference ref.exr --methods pt,vsl --vsl-count 64 --sweep radius-mult=1,4 --sweep "
+                 "columns=0,16 --times 0.05,0.1 --quiet --out b2");
+    CHECK(rc == 0, "sweep bench: exit %d: %s", rc, err_text);
+    row rows[64];
+    int n = parse_csv("b2/results.csv", rows, 64);
+    CHECK(n == 10, "sweep results: %d rows, expected 2 (pt) + 4 settings x 2 (vsl)", n);
+    int found = 0;
+    for (int i = 0; i < n; i++) found += strcmp(rows[i].method, "vsl") == 0 && strcmp(rows[i].params, "radius-mult=4") == 0;
+    CHECK(found == 2, "no vsl radius-mult=4 rows");
+    CHECK(exists("b2/sweep-radius-mult.svg") && exists("b2/sweep-columns.png"), "sweep plots missing");
+    char md[1 << 16];
+    read_file("b2/report.md", md, sizeof md);
+    CHECK(strstr(md, "## Sweep: radius-mult") && strstr(md, "## Sweep: columns"), "report lacks the sweeps");
+
+    rc = run("bench --reference refhl.exr --methods pt,vsl+hl --vsl-count 64 --secondary-rays 4 --component highlights "
+             "--times 0.05,0.1 --quiet --out b3");
+    CHECK(rc == 0, "highlights bench: exit %d: %s", rc, err_text);
+    n = parse_csv("b3/results.csv", rows, 64);
+    CHECK(n == 4, "highlights results: %d rows", n);
+    for (int i = 0; i < n; i++)
+        CHECK(rows[i].has_highlights && isfinite(rows[i].highlights_rel_l2), "row %d lacks its highlights error", i);
+}
+
+static void test_refusals(void) {
+    CHECK(run("bench --help") == 0 && strstr(out_text, "--reference") && strstr(out_text, "--sweep") &&
+              strstr(out_text, "--component"),
+          "bench --help: %s", out_text);
+    CHECK(run("--help") == 0 && strstr(out_text, "glint bench"), "glint --help lacks bench");
+    expect_refusal("bench --reference ref.exr --size 32x16 --times 0.05 --out r1", "24x16");
+    expect_refusal("bench --reference ref.exr --camera 1 --times 0.05 --out r2", "camera");
+    expect_refusal("bench --reference other.exr --times 0.05 --out r3", "another scene");
+    expect_refusal("bench other.gltf --reference ref.exr --times 0.05 --out r4", "another scene");
+    expect_refusal("bench --reference ref.exr --seed 7 --times 0.05 --out r5", "seed");
+    expect_refusal("bench --reference ref.exr --component highlights --times 0.05 --out r6", "highlights");
+    expect_refusal("bench --reference missing.exr --times 0.05 --out r7", "missing.exr");
+    expect_refusal("bench --times 0.05 --out r8", "--reference");
+    expect_refusal("bench --reference ref.exr --times 2,1 --out r9", "--times");
+    expect_refusal("bench --reference ref.exr --sweep bogus=1,2 --out r10", "bogus");
+    expect_refusal("bench --reference ref.exr --sweep radius-mult=1,x --out r11", "--radius-mult");
+    expect_refusal("bench --reference ref.exr --methods pt,nope --out r12", "nope");
+    CHECK(!exists("r1") && !exists("r2") && !exists("r3"), "a refused bench created its directory");
+    /* Without a sidecar: refused unless --force; a broken sidecar is refused always. */
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "cp '%s/ref.exr' '%s/bare.exr' && cp '%s/ref.exr' '%s/broken.exr'", tmp, tmp, tmp, tmp);
+    CHECK(system(cmd) == 0, "copying the reference");
+    expect_refusal("bench --reference bare.exr --times 0.05 --out r13", "sidecar");
+    CHECK(run("bench --reference bare.exr --force --methods pt --times 0.05 --quiet --out r14") == 0 &&
+              exists("r14/results.csv"),
+          "--force: %s", err_text);
+    write_text("broken.exr.json", "{\"glint_reference\": 1, \"scene\": \"x\"");
+    expect_refusal("bench --reference broken.exr --times 0.05 --out r15", "broken.exr.json");
+}
+
+/* References must read back exactly. OpenEXR 3.1's ZIP encoder kept zlib output exactly as long
+ * as the raw chunk, which readers take for raw pixels (OpenEXR issue #2306); partly compressible
+ * chunks of every length between all-zero and all-random meet that length now and then. */
+static void test_exr_round_trip(void) {
+    enum { W = 16, H = 2, N = 3 * W * H };
+    float rgb[N];
+    uint32_t x = 12345u;
+    int bad = 0, cases = 0;
+    char path[1024], err[1024];
+    snprintf(path, sizeof path, "%s/roundtrip.exr", tmp);
+    for (int seed = 0; seed < 4; seed++)
+        for (int k = 0; k <= N; k++, cases++) {
+            for (int i = 0; i < N; i++) {
+                x = x * 1664525u + 1013904223u;
+                /* the first k values random in [0, 2), the rest repeat a constant */
+                rgb[i] = i < k ? (float)(x >> 8) * (1.0f / 8388608.0f) : 0.25f;
+            }
+            exr_layer layer = {"", rgb};
+            exr_image ex;
+            if (exr_save_layers(path, W, H, &layer, 1, WRITE_REPLACE, err, sizeof err) != 0 ||
+                exr_image_load(path, &ex, err, sizeof err) != 0) {
+                bad++;
+                continue;
+            }
+            const float *c[3] = {exr_image_channel(&ex, "R"), exr_image_channel(&ex, "G"), exr_image_channel(&ex, "B")};
+            int same = c[0] && c[1] && c[2];
+            for (int i = 0; same && i < W * H; i++)
+                for (int j = 0; j < 3; j++) same &= memcmp(&c[j][i], &rgb[3 * i + j], sizeof(float)) == 0;
+            bad += !same;
+            exr_image_free(&ex);
+        }
+    CHECK(bad == 0, "%d of %d EXR round trips differ", bad, cases);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_bench GLINT\n");
+        return 2;
+    }
+    glint = argv[1];
+    const char *t = getenv("GLINT_TEST_TMP");
+    snprintf(tmp, sizeof tmp, "%s/bench", t ? t : "/tmp");
+    char cmd[1100];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", tmp, tmp);
+    if (system(cmd) != 0) return 1;
+    test_exr_round_trip();
+    test_sidecar();
+    test_bench_run();
+    test_sweeps_and_highlights();
+    test_refusals();
+    return check_exit("test_bench");
+}
