@@ -87,6 +87,8 @@ typedef struct {
     double reset_at, frame_ms, rays_per_second;
     unsigned long long rejected;
     unsigned long long virtual_lights;
+    char plan[1200];         /* the full-resolution session's effect plan, one pass a line */
+    int plan_highlights;
     unsigned long long hl_points, hl_lobes; /* the last full-resolution frame's (vsl+hl) */
     double hl_merge_share;   /* its thread time spent merging, as a fraction */
     double rel_error;        /* the last full-resolution frame's against the reference */
@@ -307,6 +309,8 @@ static void publish(viewer *v, render_session *rs, int preview, double frame_ms,
             v->sh.rel_error_serial++;
         }
         if (!preview) {
+            plan_summary(session_plan(rs), v->sh.plan, sizeof v->sh.plan);
+            v->sh.plan_highlights = session_plan(rs)->highlights;
             v->sh.virtual_lights = st.virtual_lights;
             v->sh.hl_points = st.hl_points - before->hl_points;
             v->sh.hl_lobes = st.hl_lobes - before->hl_lobes;
@@ -495,6 +499,8 @@ typedef struct {
     double reset_at, frame_ms, rays_per_second;
     unsigned long long rejected;
     unsigned long long virtual_lights;
+    char plan[1200];
+    int plan_highlights;
     unsigned long long hl_points, hl_lobes;
     double hl_merge_share;
     uint64_t preview_frames;
@@ -994,13 +1000,14 @@ static void print_stats(ui_thread *u) {
            nb ? marks : "-");
     printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
-           "candidates=%d trace_glossy=%g virtual_lights=%llu secondary_rays=%d clusters=%d merge=%s hl_lobes=%llu\n",
+           "candidates=%d trace_glossy=%g virtual_lights=%llu secondary_rays=%d clusters=%d merge=%s hl_lobes=%llu "
+           "plan_highlights=%d\n",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
            u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
            method_name((render_method)u->ctl.method), u->rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
            u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.candidates,
            (double)u->ctl.trace_glossy, u->virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
-           u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->hl_lobes);
+           u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->hl_lobes, u->plan_highlights);
     fflush(stdout);
 }
 
@@ -1333,6 +1340,8 @@ static int fetch(ui_thread *u) {
     u->hl_points = sh->hl_points;
     u->hl_lobes = sh->hl_lobes;
     u->hl_merge_share = sh->hl_merge_share;
+    memcpy(u->plan, sh->plan, sizeof u->plan);
+    u->plan_highlights = sh->plan_highlights;
     u->preview_frames = sh->preview_frames;
     int new_error = sh->rel_error_serial != u->rel_error_serial;
     double rel_error = sh->rel_error, rel_error_at = sh->rel_error_at;
@@ -1429,6 +1438,7 @@ static void print_view_help(void) {
            "  --size WxH           window and render size [960x540]\n"
            "  --method NAME        estimator: pt, vpl, vsl, vsl+hl [pt]\n"
            "  --max-depth D        scattering events per path [%d]\n"
+           "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
            "  --camera INDEX       start from the scene's camera INDEX\n"
            "  --seed S             random seed [0]\n"
@@ -1472,6 +1482,8 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         } else if (strcmp(a, "--max-depth") == 0) {
             if (!(v = cli_value(argc, argv, &i)) || cli_parse_int(a, v, 1, 1000, &n)) return -1;
             o->params.max_depth = (int)n;
+        } else if (strcmp(a, "--plan") == 0) {
+            if (!(v = cli_value(argc, argv, &i)) || cli_parse_plan(a, v, &o->params.plan)) return -1;
         } else if (strcmp(a, "--env") == 0) {
             if (!(o->env_path = cli_value(argc, argv, &i))) return -1;
         } else if (strcmp(a, "--camera") == 0) {
@@ -1652,6 +1664,7 @@ int cmd_view(int argc, char **argv) {
                        .hl_points = u.hl_points,
                        .hl_lobes = u.hl_lobes,
                        .hl_merge_share = u.hl_merge_share,
+                       .plan = u.plan,
                        .width = u.front.width,
                        .height = u.front.height,
                        .previewing = u.front.preview,

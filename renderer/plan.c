@@ -256,10 +256,20 @@ void plan_print(FILE *f, const scene *s, const scene_analysis *a, const effect_p
     fprintf(f, "            indirect light %s; glossy-to-glossy transport %s (%ld probe rays, %.0f ms); scale %.3g\n",
             a->indirect ? "possible" : "impossible", a->glossy_to_glossy ? "possible" : "not found", a->probe_rays,
             1e3 * a->seconds, (double)s->diag);
-    fprintf(f, "plan:       direct light: %s\n", p->why_direct);
-    fprintf(f, "            max depth: %s\n", p->why_depth);
-    fprintf(f, "            virtual lights: %s\n", p->why_virtual);
-    fprintf(f, "            VSL kernel: %s\n", p->why_kernel);
-    fprintf(f, "            highlights: %s\n", p->why_highlights);
-    fprintf(f, "            environment prefiltering: %s\n", p->why_env);
+    char text[1200];
+    plan_summary(p, text, sizeof text);
+    const char *line = text;
+    for (int first = 1; *line; first = 0) {
+        const char *end = strchr(line, '\n');
+        int n = end ? (int)(end - line) : (int)strlen(line);
+        fprintf(f, "%s%.*s\n", first ? "plan:       " : "            ", n, line);
+        line += n + (end != NULL);
+    }
+}
+
+void plan_summary(const effect_plan *p, char *buf, size_t len) {
+    snprintf(buf, len,
+             "direct light: %s\nmax depth: %s\nvirtual lights: %s\nVSL kernel: %s\nhighlights: %s\n"
+             "environment prefiltering: %s",
+             p->why_direct, p->why_depth, p->why_virtual, p->why_kernel, p->why_highlights, p->why_env);
 }

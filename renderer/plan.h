@@ -66,7 +66,9 @@ typedef struct {
 /* The plan for method `method` (render_method), asked max_depth, PLAN_AUTO or PLAN_FULL. */
 effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mode);
 
-/* The analysis and the plan as indented text lines (glint info, the viewer). */
+/* The plan's decisions, one "pass: why" line each (the viewer's panel, glint info). */
+void plan_summary(const effect_plan *p, char *buf, size_t len);
+/* The analysis and the plan as indented text lines (glint info). */
 void plan_print(FILE *f, const scene *s, const scene_analysis *a, const effect_plan *p);
 
 #endif

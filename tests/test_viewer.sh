@@ -156,6 +156,7 @@ grep '^stats ' out.txt >stats.txt
 [ "$(field 4 method)" = "vsl+hl" ] && [ "$(field 4 secondary_rays)" = "8" ] || fail "vsl+hl not applied: $(sed -n 4p stats.txt)"
 [ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "switching to vsl+hl did not reset the accumulation"
 [ "$(field 4 hl_lobes)" -gt 0 ] || fail "vsl+hl lit no highlight lobes"
+[ "$(field 4 plan_highlights)" = "1" ] || fail "the default scene's plan must run the highlight pass"
 [ "$(field 5 show)" = "3" ] || fail "show highlights not applied"
 [ "$(field 5 resets)" = "$(field 4 resets)" ] || fail "showing the highlights reset the accumulation"
 [ "$(field 5 frames)" -gt "$(field 4 frames)" ] || fail "frames did not keep accumulating when showing the highlights"

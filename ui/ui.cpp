@@ -222,6 +222,12 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
                 ImGui::TextUnformatted("merging -");
             }
         }
+        if (s->plan && s->plan[0] && ImGui::TreeNode("effect plan")) {
+            ImGui::PushTextWrapPos(0.0f);
+            ImGui::TextUnformatted(s->plan);
+            ImGui::PopTextWrapPos();
+            ImGui::TreePop();
+        }
     }
     ImGui::End();
 }

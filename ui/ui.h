@@ -75,6 +75,7 @@ typedef struct {
     /* the last full-resolution frame's highlight work (vsl+hl) */
     unsigned long long hl_points, hl_lobes; /* camera hits worked at, lobes lit */
     double hl_merge_share;     /* of the frame's thread time spent clustering and merging */
+    const char *plan;          /* the effect plan, "pass: why" a line; empty before the first frame */
     const char *const *tonemap_names;
     int num_tonemaps;
     const char *const *light_names; /* the scene's light groups, "name (type)" */
