@@ -112,6 +112,12 @@ typedef struct {
     float *combined;                    /* render thread: the whole image when another part is shown */
     size_t combined_len;
     int preview_divisor;                /* render thread */
+    /* Set by the UI thread with every change that resets the accumulation, cleared by the render
+     * thread when it takes the change: the frame in flight stops at its next tile, so a slow
+     * frame never holds up the first image of a new view. */
+    atomic_int abort_frame;
+    int full_film_partial;              /* render thread: a stopped frame left samples in the full
+                                         * film; cleared by the next full frame that completes */
 } viewer;
 
 static double seconds_since(double t) { return cli_now() - t; }
@@ -150,7 +156,9 @@ static render_session *create_preview(viewer *v, int divisor, const camera *cam,
     render_params p = *params;
     p.width = fp->width / divisor > 0 ? fp->width / divisor : 1;
     p.height = fp->height / divisor > 0 ? fp->height / divisor : 1;
-    return session_create(v->scene, cam, &p, err, errlen);
+    render_session *rs = session_create(v->scene, cam, &p, err, errlen);
+    if (rs) session_set_abort_flag(rs, &v->abort_frame);
+    return rs;
 }
 
 /* (Re)creates both sessions for the current scene at w x h. Returns 0 or -1 (message set). */
@@ -163,6 +171,8 @@ static int make_sessions(viewer *v, int w, int h, const camera *cam, const rende
     p.width = w;
     p.height = h;
     v->full = session_create(v->scene, cam, &p, err, sizeof err);
+    if (v->full) session_set_abort_flag(v->full, &v->abort_frame);
+    v->full_film_partial = 0; /* a new film */
     if (v->preview_divisor < PREVIEW_DIVISOR) v->preview_divisor = PREVIEW_DIVISOR;
     if (v->full) v->preview = create_preview(v, v->preview_divisor, cam, params, err, sizeof err);
     if (!v->full || !v->preview) {
@@ -325,8 +335,9 @@ static void *render_main(void *arg) {
     uint64_t applied = 0;
     pthread_mutex_lock(&v->sh.lock);
     for (;;) {
-        /* Exports and loads first: a quit right after an export request still writes it. */
-        if (v->sh.export_pending) {
+        /* Exports and loads first: a quit right after an export request still writes it. Not
+         * while a stopped frame's samples are in the film: after the next full frame. */
+        if (v->sh.export_pending && !v->full_film_partial) {
             char path[1024], err[1200];
             snprintf(path, sizeof path, "%s", v->sh.export_path);
             v->sh.export_pending = 0;
@@ -346,7 +357,7 @@ static void *render_main(void *arg) {
             pthread_mutex_lock(&v->sh.lock);
             continue;
         }
-        if (v->sh.quit) break;
+        if (v->sh.quit && !(v->sh.export_pending && v->full_film_partial)) break;
         if (v->sh.load_kind) {
             int kind = v->sh.load_kind;
             char path[1024];
@@ -363,6 +374,7 @@ static void *render_main(void *arg) {
         const film *ff = session_film(v->full);
         int resize = ff->width != v->sh.render_w || ff->height != v->sh.render_h;
         uint64_t gen = v->sh.generation;
+        atomic_store(&v->abort_frame, 0); /* this change is taken: frames of it run to the end */
         camera cam = v->sh.cam;
         render_params params = v->sh.params;
         int preview = seconds_since(v->sh.changed_at) < PREVIEW_HOLD_SECONDS;
@@ -403,7 +415,12 @@ static void *render_main(void *arg) {
         render_session *rs = preview ? v->preview : v->full;
         render_stats before = session_stats(rs);
         double t0 = cli_now();
-        session_render_frame(rs);
+        if (session_render_frame(rs) == 1) { /* stopped for a newer change: nothing to show */
+            if (rs == v->full) v->full_film_partial = 1;
+            pthread_mutex_lock(&v->sh.lock);
+            continue;
+        }
+        if (rs == v->full) v->full_film_partial = 0;
         double ms = 1e3 * seconds_since(t0);
         publish(v, rs, preview, ms, &before, resets_seen, gen);
         if (preview) adapt_preview(v, ms, &cam, &params);
@@ -615,6 +632,7 @@ static void send_change(ui_thread *u) {
     sh->lights_scene = u->info_serial;
     u->sent_generation = ++sh->generation;
     sh->changed_at = cli_now();
+    if (!sh->export_pending) atomic_store(&u->v->abort_frame, 1); /* an export takes the frame as asked */
     pthread_mutex_unlock(&sh->lock);
 }
 
@@ -971,6 +989,7 @@ static void request_load(ui_thread *u, int kind, const char *path) {
     sh->load_kind = kind;
     /* A new generation: frames counted after this show the result of the load. */
     u->sent_generation = ++sh->generation;
+    if (!sh->export_pending) atomic_store(&u->v->abort_frame, 1);
     pthread_mutex_unlock(&sh->lock);
 }
 

@@ -48,6 +48,7 @@ struct render_session {
     hl_setup hl;  /* vsl+hl: this frame's highlight settings */
     scene_analysis analysis;
     effect_plan plan;
+    const atomic_int *abort_flag; /* polled per tile; NULL: none */
     char error[256];
 };
 
@@ -100,6 +101,7 @@ static void render_tile(void *ctx, int tile, int worker) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
     render_stats *st = &rs->workers[worker].st;
+    if (rs->abort_flag && atomic_load_explicit(rs->abort_flag, memory_order_relaxed)) return;
     int x0 = (tile % rs->tiles_x) * TILE, y0 = (tile / rs->tiles_x) * TILE;
     int x1 = x0 + TILE < p->width ? x0 + TILE : p->width;
     int y1 = y0 + TILE < p->height ? y0 + TILE : p->height;
@@ -173,8 +175,11 @@ int session_render_frame(render_session *rs) {
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
     }
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
-    film_end_pass(&rs->film);
-    rs->frames++;
+    int aborted = rs->abort_flag && atomic_load(rs->abort_flag);
+    if (!aborted) {
+        film_end_pass(&rs->film);
+        rs->frames++;
+    }
     int n = threadpool_size(rs->pool);
     for (int w = 0; w < n; w++) {
         render_stats *st = &rs->workers[w].st;
@@ -192,8 +197,10 @@ int session_render_frame(render_session *rs) {
         for (int k = 0; k < PASS_COUNT; k++) t->pass_ns[k] += st->pass_ns[k];
         memset(st, 0, sizeof *st);
     }
-    return 0;
+    return aborted;
 }
+
+void session_set_abort_flag(render_session *rs, const atomic_int *flag) { rs->abort_flag = flag; }
 
 const char *session_error(const render_session *rs) { return rs->error; }
 

@@ -4,6 +4,7 @@
 #ifndef GLINT_SESSION_H
 #define GLINT_SESSION_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -116,8 +117,13 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
 void session_destroy(render_session *rs);
 
 /* Renders one frame (all threads; returns when done). Returns 0, or -1 with the reason in
- * session_error() when a frame could not be prepared (out of memory); the film is unchanged. */
+ * session_error() when a frame could not be prepared (out of memory; the film is unchanged), or 1
+ * when the abort flag stopped it: the frame is not counted, but the tiles rendered before the
+ * stop are in the film, so the caller must reset the accumulation. */
 int session_render_frame(render_session *rs);
+/* A flag the session polls before each tile: while it is non-zero, frames stop early (above).
+ * For interactive use, where the change that sets it resets the accumulation anyway. NULL: none. */
+void session_set_abort_flag(render_session *rs, const atomic_int *flag);
 const char *session_error(const render_session *rs);
 /* Clears the accumulation (the next frame starts a new mean). */
 void session_reset(render_session *rs);

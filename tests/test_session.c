@@ -1,0 +1,47 @@
+/* The render session's contract for interactive use: a frame stopped by the abort flag returns 1
+ * and is not counted; with the flag clear frames finish and count; a reset after a stopped frame
+ * leaves a film equal to one never stopped (same seed: the same image, bit for bit). */
+#include <math.h>
+
+#include "check.h"
+#include "test_scenes.h"
+
+#define W 16
+#define H 12
+
+int main(void) {
+    scene *s = ts_new("box");
+    ts_box(s, v3(-1, 0, -1), v3(1, 2, 1), 1, ts_lambert(s, v3s(0.6f), v3s(0.0f), 0));
+    ts_quad(s, v3(-0.3f, 1.98f, -0.3f), v3(0.3f, 1.98f, -0.3f), v3(0.3f, 1.98f, 0.3f), v3(-0.3f, 1.98f, 0.3f),
+            ts_lambert(s, v3s(0.0f), v3s(5.0f), 0));
+    ts_finalize(s);
+    camera cam = camera_look_at(v3(0, 1, 0.9f), v3(0, 1, -1), v3(0, 1, 0), 1.2f);
+    render_params p = {.width = W, .height = H, .max_depth = 4, .seed = 3};
+    char err[256];
+    render_session *a = session_create(s, &cam, &p, err, sizeof err), *b = session_create(s, &cam, &p, err, sizeof err);
+    CHECK(a && b, "session: %s", err);
+    atomic_int stop = 1;
+    session_set_abort_flag(a, &stop);
+    CHECK(session_render_frame(a) == 1, "a frame with the flag set must report that it stopped");
+    CHECK(session_frames(a) == 0, "a stopped frame must not count (%lld frames)", session_frames(a));
+    atomic_store(&stop, 0);
+    session_reset(a);
+    for (int f = 0; f < 3; f++) {
+        CHECK(session_render_frame(a) == 0, "frame %d with the flag clear must finish", f);
+        CHECK(session_render_frame(b) == 0, "frame %d without a flag must finish", f);
+    }
+    CHECK(session_frames(a) == 3, "3 frames expected, got %lld", session_frames(a));
+    float ia[3 * W * H], ib[3 * W * H];
+    film_resolve(session_film(a), ~0u, ia);
+    film_resolve(session_film(b), ~0u, ib);
+    int differ = 0;
+    for (int i = 0; i < 3 * W * H; i++) differ += ia[i] != ib[i];
+    CHECK(differ == 0, "after a stopped frame and a reset, %d channels differ from an uninterrupted render", differ);
+    double mean = 0;
+    for (int i = 0; i < 3 * W * H; i++) mean += ia[i];
+    CHECK(mean > 0.0 && isfinite(mean), "the box must be lit");
+    session_destroy(a);
+    session_destroy(b);
+    scene_destroy(s);
+    return check_exit("test_session");
+}
