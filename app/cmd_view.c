@@ -113,8 +113,8 @@ typedef struct {
     size_t combined_len;
     int preview_divisor;                /* render thread */
     /* Set by the UI thread with every change that resets the accumulation, cleared by the render
-     * thread when it takes the change: the frame in flight stops at its next tile, so a slow
-     * frame never holds up the first image of a new view. */
+     * thread when it takes the change: a full-resolution frame in flight stops at its next tile,
+     * so a slow frame never holds up the first preview of a new view. */
     atomic_int abort_frame;
     int full_film_partial;              /* render thread: a stopped frame left samples in the full
                                          * film; cleared by the next full frame that completes */
@@ -156,9 +156,8 @@ static render_session *create_preview(viewer *v, int divisor, const camera *cam,
     render_params p = *params;
     p.width = fp->width / divisor > 0 ? fp->width / divisor : 1;
     p.height = fp->height / divisor > 0 ? fp->height / divisor : 1;
-    render_session *rs = session_create(v->scene, cam, &p, err, errlen);
-    if (rs) session_set_abort_flag(rs, &v->abort_frame);
-    return rs;
+    /* No abort flag: while things move every preview frame must finish, or none would be shown. */
+    return session_create(v->scene, cam, &p, err, errlen);
 }
 
 /* (Re)creates both sessions for the current scene at w x h. Returns 0 or -1 (message set). */

@@ -4,7 +4,7 @@
  * against a path-traced reference. Error falls as 1/sqrt(time), so the time the forced plan
  * needs to reach the plan's error is T (e_full / e_auto)^2: the saving at equal error.
  *
- * usage: bench_plan SCENE|default REF.exr WxH REF_SECONDS SECONDS [METHOD]
+ * usage: bench_plan SCENE|default REF.exr WxH REF_SECONDS SECONDS [METHOD [ENV_MAP]]
  *   REF.exr (layer indirect.*) is path-traced for REF_SECONDS when it does not exist, and reused.
  * Prints one markdown table row per plan. */
 #define _POSIX_C_SOURCE 200809L
@@ -35,16 +35,17 @@ static render_session *render_for(const scene *s, const camera *cam, render_para
 }
 
 int main(int argc, char **argv) {
-    if (argc < 6 || argc > 7) die("usage: bench_plan SCENE|default REF.exr WxH REF_SECONDS SECONDS [METHOD]");
+    if (argc < 6 || argc > 8) die("usage: bench_plan SCENE|default REF.exr WxH REF_SECONDS SECONDS [METHOD [ENV_MAP]]");
     char err[1024];
     scene *s = strcmp(argv[1], "default") == 0 ? scene_load_default(NULL, NULL, err, sizeof err)
                                                : scene_load(argv[1], NULL, NULL, err, sizeof err);
     if (!s) die(err);
+    if (argc == 8 && scene_set_env(s, argv[7], 0.0f, err, sizeof err) != 0) die(err);
     int w, h;
     if (sscanf(argv[3], "%dx%d", &w, &h) != 2) die("bad size");
     camera cam = scene_camera(s, 0, (float)w / (float)h);
     double ref_seconds = atof(argv[4]), seconds = atof(argv[5]);
-    int method = argc == 7 ? method_from_name(argv[6]) : METHOD_VSL_HL;
+    int method = argc >= 7 ? method_from_name(argv[6]) : METHOD_VSL_HL;
     if (method < 0) die("unknown method");
     size_t n = (size_t)w * (size_t)h * 3;
     float *ref = malloc(sizeof(float) * n), *img = malloc(sizeof(float) * n);
