@@ -207,6 +207,7 @@ const char *session_error(const render_session *rs) { return rs->error; }
 void session_reset(render_session *rs) {
     film_clear(&rs->film);
     rs->frames = 0;
+    memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }
 
 void session_set_camera(render_session *rs, const camera *cam) {

@@ -82,7 +82,7 @@ typedef struct {
     vl_params vl;
 } render_params;
 
-/* Work done, by kind of ray; summed over the session's frames. */
+/* Work done, by kind of ray; summed over the frames since the last reset. */
 typedef enum { RAY_CAMERA = 0, RAY_SHADOW, RAY_BOUNCE, RAY_KIND_COUNT } ray_kind;
 extern const char *const ray_kind_names[RAY_KIND_COUNT];
 
@@ -125,7 +125,7 @@ int session_render_frame(render_session *rs);
  * For interactive use, where the change that sets it resets the accumulation anyway. NULL: none. */
 void session_set_abort_flag(render_session *rs, const atomic_int *flag);
 const char *session_error(const render_session *rs);
-/* Clears the accumulation (the next frame starts a new mean). */
+/* Clears the accumulation (the next frame starts a new mean) and the statistics with it. */
 void session_reset(render_session *rs);
 void session_set_camera(render_session *rs, const camera *cam);
 /* Takes new estimator parameters (method, max_depth, seed; the size and thread count stay) and

@@ -1,6 +1,7 @@
 /* The render session's contract for interactive use: a frame stopped by the abort flag returns 1
  * and is not counted; with the flag clear frames finish and count; a reset after a stopped frame
- * leaves a film equal to one never stopped (same seed: the same image, bit for bit). */
+ * leaves a film equal to one never stopped (same seed: the same image, bit for bit); statistics
+ * count the frames since the last reset (the viewer's rays per second and virtual lights). */
 #include <math.h>
 
 #include "check.h"
@@ -31,6 +32,10 @@ int main(void) {
         CHECK(session_render_frame(b) == 0, "frame %d without a flag must finish", f);
     }
     CHECK(session_frames(a) == 3, "3 frames expected, got %lld", session_frames(a));
+    render_stats sa = session_stats(a), sb = session_stats(b);
+    CHECK(sa.rays[RAY_CAMERA] == (uint64_t)(3 * W * H) && sb.rays[RAY_CAMERA] == sa.rays[RAY_CAMERA],
+          "statistics must count the frames since the reset: %llu and %llu camera rays for %d",
+          (unsigned long long)sa.rays[RAY_CAMERA], (unsigned long long)sb.rays[RAY_CAMERA], 3 * W * H);
     float ia[3 * W * H], ib[3 * W * H];
     film_resolve(session_film(a), ~0u, ia);
     film_resolve(session_film(b), ~0u, ib);
@@ -40,6 +45,8 @@ int main(void) {
     double mean = 0;
     for (int i = 0; i < 3 * W * H; i++) mean += ia[i];
     CHECK(mean > 0.0 && isfinite(mean), "the box must be lit");
+    session_reset(b);
+    CHECK(session_stats(b).rays[RAY_SHADOW] == 0, "a reset must clear the statistics");
     session_destroy(a);
     session_destroy(b);
     scene_destroy(s);
