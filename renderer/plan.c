@@ -207,7 +207,11 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
         snprintf(p.why_env, sizeof p.why_env, "%s", p.env_prefilter ? forced : !a->env ? "no environment map" : "no highlight pass");
         return p;
     }
-    if (max_depth > 1 && (!a->indirect || !emitters)) {
+    /* The path tracer is the reference: it keeps the depth asked, whatever the probes found. */
+    if (method == METHOD_PT) {
+        snprintf(p.why_depth, sizeof p.why_depth, "%d, as asked (path tracing, the reference, never drops bounces)",
+                 max_depth);
+    } else if (max_depth > 1 && (!a->indirect || !emitters)) {
         p.max_depth = 1;
         snprintf(p.why_depth, sizeof p.why_depth, "1 of %d asked: %s", max_depth,
                  !emitters ? "nothing emits" : "no reflecting surface sees another (direct light only)");

@@ -13,9 +13,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "camera.h"
+#include "clock.h"
 #include "highlights.h"
 #include "image_io.h"
 #include "lights.h"
@@ -23,11 +23,7 @@
 #include "metrics.h"
 #include "threadpool.h"
 
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+static double now(void) { return 1e-9 * (double)clock_ns(); }
 
 static void die(const char *what) {
     fprintf(stderr, "bench_hl: %s\n", what);
