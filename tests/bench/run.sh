@@ -15,11 +15,14 @@
 #      multiplier and column count, every lobe gathered, 10 s each, about 2 minutes), against a
 #      path-traced reference with its sidecar, rendered once into build/bench-cache
 #      (REF_SECONDS, default 1200). Results (CSV, plots, report.md) go to build/bench-results/.
-# Usage: tests/bench/run.sh [vsl|hl|bench] [SHARED_SCENES_DIR]
+#   6. With `plan` first: what the effect plan saves (bench_plan: vsl+hl with the plan and with
+#      every pass forced on, 30 s each) on the default scene and the shared Cornell box, against
+#      the path-traced references of mode 3 (rendered here when missing), about 2 minutes.
+# Usage: tests/bench/run.sh [vsl|hl|bench|plan] [SHARED_SCENES_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 mode=pt
-if [ "${1:-}" = vsl ] || [ "${1:-}" = hl ] || [ "${1:-}" = bench ]; then mode=$1; shift; fi
+case "${1:-}" in vsl | hl | bench | plan) mode=$1; shift ;; esac
 scenes=${1:-$root/../shared/scenes}
 build=$root/build
 source "$root/scripts/deps.sh"
@@ -52,6 +55,19 @@ if [ "$mode" = bench ]; then
     --sweep radius-mult=1,2,4,8,12,16,24 --sweep columns=64,128,256,512,1024 \
     --out "$build/bench-results/fig8-$stamp"
   cat "$build/bench-results/headline-$stamp/report.md" "$build/bench-results/fig8-$stamp/report.md"
+  exit 0
+fi
+
+if [ "$mode" = plan ]; then
+  mkdir -p "$build/bench-cache"
+  echo "## The effect plan's saving ($(nproc) threads, $(date +%F))"
+  "$build/tests/bench/bench_plan" default "$build/bench-cache/default-320x180-pt1200s.exr" 320x180 1200 30
+  cornell=$scenes/cornell-box/CornellBox-Original.gltf
+  if [ -f "$cornell" ]; then
+    "$build/tests/bench/bench_plan" "$cornell" "$build/bench-cache/cornell-320x320-pt600s.exr" 320x320 600 30 | tail -n 2
+  else
+    echo "skipping $cornell: not found"
+  fi
   exit 0
 fi
 
