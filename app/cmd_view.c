@@ -116,6 +116,7 @@ typedef struct {
      * thread when it takes the change: a full-resolution frame in flight stops at its next tile,
      * so a slow frame never holds up the first preview of a new view. */
     atomic_int abort_frame;
+    int scene_edited;                   /* render thread: lights changed since the plan was made */
     int full_film_partial;              /* render thread: a stopped frame left samples in the full
                                          * film; cleared by the next full frame that completes */
 } viewer;
@@ -246,6 +247,7 @@ static void apply_light_edits(viewer *v, const vec3 *offset, const float *gain) 
             set_message(v, "%s%s", err, "");
         }
         /* Taken as applied either way: a failed edit is reported once, not every frame. */
+        v->scene_edited |= !is_black3(d) || gain[g] != v->gain_applied[g];
         v->light_applied[g] = offset[g];
         v->gain_applied[g] = gain[g];
     }
@@ -401,6 +403,12 @@ static void *render_main(void *arg) {
         pthread_mutex_unlock(&v->sh.lock);
 
         if (edit_lights) apply_light_edits(v, light_offset, light_gain);
+        /* The scene's analysis follows light edits once they settle, not at every step of a drag. */
+        if (v->scene_edited && !preview) {
+            if (session_scene_changed(v->full) != 0 || session_scene_changed(v->preview) != 0)
+                set_message(v, "%s%s", session_error(v->full), "");
+            v->scene_edited = 0;
+        }
         if (resize) {
             if (make_sessions(v, rw, rh, &cam, &params) != 0) break;
             applied = gen;

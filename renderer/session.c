@@ -210,6 +210,16 @@ void session_reset(render_session *rs) {
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }
 
+int session_scene_changed(render_session *rs) {
+    scene_analysis a;
+    if (scene_analyse(rs->scene, &a, rs->error, sizeof rs->error) != 0) return -1;
+    scene_analysis_free(&rs->analysis);
+    rs->analysis = a;
+    rs->plan = plan_make(&rs->analysis, rs->params.method, rs->params.max_depth, rs->params.plan);
+    session_reset(rs);
+    return 0;
+}
+
 void session_set_camera(render_session *rs, const camera *cam) {
     rs->cam = *cam;
     session_reset(rs);

@@ -128,6 +128,9 @@ const char *session_error(const render_session *rs);
 /* Clears the accumulation (the next frame starts a new mean) and the statistics with it. */
 void session_reset(render_session *rs);
 void session_set_camera(render_session *rs, const camera *cam);
+/* The scene changed (a light moved or dimmed): analyses it again, re-makes the plan and resets.
+ * Returns 0, or -1 with session_error() set (out of memory; the old analysis stays). */
+int session_scene_changed(render_session *rs);
 /* Takes new estimator parameters (method, max_depth, seed; the size and thread count stay) and
  * resets the accumulation. */
 void session_set_params(render_session *rs, const render_params *params);

@@ -1,7 +1,8 @@
 /* The render session's contract for interactive use: a frame stopped by the abort flag returns 1
  * and is not counted; with the flag clear frames finish and count; a reset after a stopped frame
  * leaves a film equal to one never stopped (same seed: the same image, bit for bit); statistics
- * count the frames since the last reset (the viewer's rays per second and virtual lights). */
+ * count the frames since the last reset (the viewer's rays per second and virtual lights); a scene
+ * edit re-analyses the scene and restarts. */
 #include <math.h>
 
 #include "check.h"
@@ -47,6 +48,10 @@ int main(void) {
     CHECK(mean > 0.0 && isfinite(mean), "the box must be lit");
     session_reset(b);
     CHECK(session_stats(b).rays[RAY_SHADOW] == 0, "a reset must clear the statistics");
+    /* A scene edit: the analysis runs again and the accumulation restarts. */
+    CHECK(scene_move_light(s, 0, v3(0.1f, 0, 0), err, sizeof err) == 0, "move: %s", err);
+    CHECK(session_scene_changed(a) == 0 && session_frames(a) == 0, "after a scene change the session must restart");
+    CHECK(session_analysis(a)->area == 2 && session_analysis(a)->indirect, "the new analysis must see the moved light");
     session_destroy(a);
     session_destroy(b);
     scene_destroy(s);
