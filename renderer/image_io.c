@@ -1374,6 +1374,11 @@ static void parent_dir(const char *path, char *out, size_t outlen) {
 int write_file_atomic(const char *path, const void *data, size_t size, write_mode mode, char *err, size_t errlen) {
     if (!path || !path[0]) return fail(err, errlen, path ? path : "", "empty file name");
     if (!data && size > 0) return fail(err, errlen, path, "no data to write");
+    /* Only a regular file is ever replaced: renaming over a device (--stats /dev/null), a
+     * directory or a FIFO would destroy it (a session once turned /dev/null into a file). */
+    struct stat existing;
+    if (mode == WRITE_REPLACE && lstat(path, &existing) == 0 && !S_ISREG(existing.st_mode) && !S_ISLNK(existing.st_mode))
+        return fail(err, errlen, path, "not a regular file; not replacing it");
     /* The temporary file is created next to the target (so rename and link stay within one file
      * system), named after it with ".tmp-" so a leftover is recognisable. mkstemp is not used
      * because it creates files with mode 0600; this honours the umask like any other output. */

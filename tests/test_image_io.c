@@ -588,6 +588,17 @@ static void test_write_modes(void) {
     CHECK(got && size == 6 && memcmp(got, "third!", 6) == 0, "WRITE_REPLACE did not replace");
     free(got);
 
+    /* Only regular files are replaced: a FIFO (like a device such as /dev/null) stays what it is. */
+    path_in(path, sizeof path, "fifo");
+    CHECK(mkfifo(path, 0666) == 0, "mkfifo: %s", strerror(errno));
+    err[0] = '\0';
+    CHECK(write_file_atomic(path, "data", 4, WRITE_REPLACE, err, sizeof err) == -1, "a FIFO was replaced");
+    snprintf(expect, sizeof expect, "%s: not a regular file; not replacing it", path);
+    CHECK(strcmp(err, expect) == 0, "error '%s', expected '%s'", err, expect);
+    struct stat fifo_st;
+    CHECK(lstat(path, &fifo_st) == 0 && S_ISFIFO(fifo_st.st_mode), "the FIFO is gone");
+    unlink(path);
+
     /* An empty file is a valid output; so is a large one written in one go. */
     path_in(path, sizeof path, "empty.bin");
     CHECK(write_file_atomic(path, "", 0, WRITE_NO_REPLACE, err, sizeof err) == 0, "empty write: %s", err);
