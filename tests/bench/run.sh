@@ -14,7 +14,9 @@
 #      clamped vpl, vsl, vsl+hl; budgets 1 to 64 s, about 5 minutes) and the Fig. 8 sweeps (radius
 #      multiplier and column count, every lobe gathered, 10 s each, about 2 minutes), against a
 #      path-traced reference with its sidecar, rendered once into build/bench-cache
-#      (REF_SECONDS, default 1200). Results (CSV, plots, report.md) go to build/bench-results/.
+#      (REF_SECONDS, default 1200); then the same comparison (1 to 32 s) on the shared Cornell box
+#      and lamp scenes, each with its own reference. Results (CSV, plots, report.md) go to
+#      build/bench-results/.
 #   6. With `plan` first: what the effect plan saves (bench_plan: vsl+hl with the plan and with
 #      every pass forced on, 30 s each) on the default scene and the shared Cornell box, against
 #      the path-traced references of mode 3 (rendered here when missing), about 2 minutes.
@@ -54,6 +56,21 @@ if [ "$mode" = bench ]; then
   "$glint" bench --reference "$ref" --methods vsl --trace-glossy off --vsl-count 4096 --times 5,10 \
     --sweep radius-mult=1,2,4,8,12,16,24 --sweep columns=64,128,256,512,1024 \
     --out "$build/bench-results/fig8-$stamp"
+  # The same comparison on two scenes from the shared set: diffuse (Cornell box) and glossy
+  # metal with many emissive triangles and punctual lights (the lamp), budgets up to 32 s.
+  for entry in cornell-box/CornellBox-Original.gltf:cornell:240x240 \
+               lights-punctual-lamp/glTF/LightsPunctualLamp.gltf:lamp:320x240; do
+    IFS=: read -r file name size <<<"$entry"
+    [ -f "$scenes/$file" ] || { echo "skipping $file: not found"; continue; }
+    sref=$build/bench-cache/$name-$size-pt-ref.exr
+    if [ ! -f "$sref.json" ]; then
+      echo "rendering the path-traced reference of $name for ${REF_SECONDS:-1200} s"
+      "$glint" render "$scenes/$file" --method pt --time "${REF_SECONDS:-1200}" --size "$size" --seed 777 --out "$sref"
+    fi
+    "$glint" bench "$scenes/$file" --reference "$sref" --methods pt,vpl,vsl,vsl+hl --times 1,2,4,8,16,32 \
+      --out "$build/bench-results/$name-$stamp"
+    cat "$build/bench-results/$name-$stamp/report.md"
+  done
   cat "$build/bench-results/headline-$stamp/report.md" "$build/bench-results/fig8-$stamp/report.md"
   exit 0
 fi
