@@ -96,6 +96,13 @@ int cli_parse_size(const char *option, const char *text, int *width, int *height
     return 0;
 }
 
+int cli_scene_argument(const char *command, const char *arg, const char **scene_path) {
+    if (arg[0] == '-') return cli_error("unknown option '%s' (see glint %s --help)", arg, command), -1;
+    if (*scene_path) return cli_error("more than one scene given ('%s' and '%s')", *scene_path, arg), -1;
+    *scene_path = arg;
+    return 0;
+}
+
 const char *cli_value(int argc, char **argv, int *i) {
     if (*i + 1 >= argc) {
         cli_error("%s needs a value (see --help)", argv[*i]);

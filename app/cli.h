@@ -24,6 +24,10 @@ int cli_parse_plan(const char *option, const char *text, int *plan);
 /* "WxH", each 1..16384. */
 int cli_parse_size(const char *option, const char *text, int *width, int *height);
 
+/* An argument no option of `command` took: an unknown option (anything starting with '-'), else
+ * the scene, of which there is at most one. Returns 0 (*scene_path set), or -1 after a usage error. */
+int cli_scene_argument(const char *command, const char *arg, const char **scene_path);
+
 /* Fetches the value of option argv[*i] (advancing *i); prints a usage error when missing. */
 const char *cli_value(int argc, char **argv, int *i);
 

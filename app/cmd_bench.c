@@ -235,13 +235,7 @@ static int parse_bench_options(int argc, char **argv, bench_options *o) {
         } else if ((vl = cli_vl_option(argc, argv, &i, &o->vl)) != 0) {
             if (vl < 0) return -1;
             append_base(o, a, i > at ? argv[i] : NULL);
-        } else if (a[0] == '-' && a[1] != '\0') {
-            cli_error("unknown option '%s' (see glint bench --help)", a);
-            return -1;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            cli_error("more than one scene given ('%s' and '%s')", o->scene_path, a);
+        } else if (cli_scene_argument("bench", a, &o->scene_path) != 0) {
             return -1;
         }
 #undef VALUE

@@ -39,13 +39,7 @@ int cmd_info(int argc, char **argv) {
         } else if (strcmp(argv[i], "--plan") == 0) {
             const char *v = cli_value(argc, argv, &i);
             if (!v || cli_parse_plan("--plan", v, &plan_mode)) return EXIT_USAGE;
-        } else if (argv[i][0] == '-') {
-            cli_error("unknown option '%s' (see glint info --help)", argv[i]);
-            return EXIT_USAGE;
-        } else if (!path) {
-            path = argv[i];
-        } else {
-            cli_error("more than one scene given ('%s' and '%s')", path, argv[i]);
+        } else if (cli_scene_argument("info", argv[i], &path) != 0) {
             return EXIT_USAGE;
         }
     }

@@ -142,13 +142,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
             if (cli_parse_float(a, v, -50.0, 50.0, &o->exposure)) return -1;
         } else if ((vl = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
             if (vl < 0) return -1;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            cli_error("unknown option '%s' (see glint render --help)", a);
-            return -1;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            cli_error("more than one scene given ('%s' and '%s')", o->scene_path, a);
+        } else if (cli_scene_argument("render", a, &o->scene_path) != 0) {
             return -1;
         }
 #undef VALUE

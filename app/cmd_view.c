@@ -1527,12 +1527,8 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
             if (!(o->reference_path = cli_value(argc, argv, &i))) return -1;
         } else if (strcmp(a, "--script") == 0) {
             if (!(o->script_path = cli_value(argc, argv, &i))) return -1;
-        } else if (a[0] == '-') {
-            return cli_error("unknown option '%s' (see glint view --help)", a), -1;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            return cli_error("more than one scene given ('%s' and '%s')", o->scene_path, a), -1;
+        } else if (cli_scene_argument("view", a, &o->scene_path) != 0) {
+            return -1;
         }
     }
     return 0;
