@@ -13,36 +13,12 @@
 #include <stb_image.h>
 
 #include "check.h"
+#include "cli_harness.h"
 #include "image_io.h"
 
-static const char *glint;
-static char tmp[512];
-static char out_text[65536], err_text[65536];
 
 static const char *const header = "method,params,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,direct_relmse,"
                                   "indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse";
-
-static size_t read_file(const char *name, char *buf, size_t cap) {
-    char p[1024];
-    snprintf(p, sizeof p, "%s/%s", tmp, name);
-    buf[0] = 0;
-    FILE *f = fopen(p, "rb");
-    if (!f) return 0;
-    size_t n = fread(buf, 1, cap - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    return n;
-}
-
-/* Runs glint with the given arguments in directory tmp; returns the exit status (-1: a crash). */
-static int run(const char *args) {
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >stdout.txt 2>stderr.txt </dev/null", tmp, glint, args);
-    int status = system(cmd);
-    read_file("stdout.txt", out_text, sizeof out_text);
-    read_file("stderr.txt", err_text, sizeof err_text);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 static int count_lines(const char *s) {
     int n = 0;
@@ -305,16 +281,8 @@ static void test_exr_round_trip(void) {
 }
 
 int main(int argc, char **argv) {
-    if (argc < 2) {
-        fprintf(stderr, "usage: test_bench GLINT\n");
-        return 2;
-    }
-    glint = argv[1];
-    const char *t = getenv("GLINT_TEST_TMP");
-    snprintf(tmp, sizeof tmp, "%s/bench", t ? t : "/tmp");
-    char cmd[1100];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", tmp, tmp);
-    if (system(cmd) != 0) return 1;
+    int start = harness_start(argc, argv, "bench");
+    if (start != 0) return start;
     test_exr_round_trip();
     test_sidecar();
     test_bench_run();

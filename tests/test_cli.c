@@ -11,35 +11,9 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "cli_harness.h"
 #include "image_io.h"
 
-static const char *glint;
-static char tmp[512];
-static char out_text[65536], err_text[65536];
-
-static void read_file(const char *path, char *buf, size_t cap) {
-    buf[0] = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) return;
-    size_t n = fread(buf, 1, cap - 1, f);
-    buf[n] = 0;
-    fclose(f);
-}
-
-/* Runs glint with the given arguments (a shell command tail, in directory tmp); captures stdout
- * and stderr. Returns the exit status, or -1 if it did not exit normally (a crash). */
-static int run(const char *args) {
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt' </dev/null", tmp, glint, args, tmp, tmp);
-    int status = system(cmd);
-    char p[1024];
-    snprintf(p, sizeof p, "%s/stdout.txt", tmp);
-    read_file(p, out_text, sizeof out_text);
-    snprintf(p, sizeof p, "%s/stderr.txt", tmp);
-    read_file(p, err_text, sizeof err_text);
-    if (!WIFEXITED(status)) return -1;
-    return WEXITSTATUS(status);
-}
 
 static int count_lines(const char *s) {
     int n = 0;
@@ -158,8 +132,7 @@ static void test_outputs(void) {
     if (pf) fclose(pf);
     CHECK(memcmp(hdr, "\x89PNG", 4) == 0 && hdr[19] == 48 && hdr[23] == 27, "png header or size wrong");
     char json[8192];
-    snprintf(p, sizeof p, "%s/img.json", tmp);
-    read_file(p, json, sizeof json);
+    read_file("img.json", json, sizeof json);
     CHECK(strstr(json, "\"spp\": 4") && strstr(json, "\"method\": \"pt\"") && strstr(json, "\"width\": 48"),
           "stats json: %s", json);
 
@@ -220,30 +193,26 @@ static void test_many_light_options(void) {
     /* A tiny clamp bound clamps; switching clamping off clamps nothing. */
     int rc = run("render --method vpl --spp 2 --size 32x18 --vsl-count 64 --clamp-value 1e-4 --stats vpl.json --quiet");
     CHECK(rc == 0, "vpl render: exit %d: %s", rc, err_text);
-    snprintf(p, sizeof p, "%s/vpl.json", tmp);
-    read_file(p, json, sizeof json);
+    read_file("vpl.json", json, sizeof json);
     const char *total = strstr(json, "\"virtual_lights_total\": ");
     CHECK(strstr(json, "\"method\": \"vpl\"") && strstr(json, "\"virtual_lights_per_frame\": 64") && total &&
               atol(total + 24) >= 128 && !strstr(json, "\"clamped\": 0,"),
           "vpl stats json: %s", json);
     rc = run("render --method vpl --spp 2 --size 32x18 --vsl-count 64 --clamp off --vpl-glossy --stats vpl2.json --quiet");
     CHECK(rc == 0, "unclamped glossy vpl render: exit %d: %s", rc, err_text);
-    snprintf(p, sizeof p, "%s/vpl2.json", tmp);
-    read_file(p, json, sizeof json);
+    read_file("vpl2.json", json, sizeof json);
     CHECK(strstr(json, "\"clamped\": 0,") != NULL, "clamping off still clamped: %s", json);
 
     rc = run("render --method vsl --spp 2 --size 32x18 --vsl-count 256 --radius-mult 4 --candidates 2 --columns 32 "
              "--rows 40 --out vsl.exr --stats vsl.json --quiet");
     CHECK(rc == 0, "vsl render: exit %d: %s", rc, err_text);
-    snprintf(p, sizeof p, "%s/vsl.json", tmp);
-    read_file(p, json, sizeof json);
+    read_file("vsl.json", json, sizeof json);
     /* The default scene's metals are sharper than the default --trace-glossy: paths go through. */
     CHECK(strstr(json, "\"method\": \"vsl\"") && strstr(json, "\"columns\": 32") && !strstr(json, "\"vsl_samples\": 0,") &&
               !strstr(json, "\"glossy_bounces\": 0,"),
           "vsl stats json: %s", json);
     rc = run("render --method vsl --spp 1 --size 32x18 --vsl-count 64 --trace-glossy off --stats off.json --quiet");
-    snprintf(p, sizeof p, "%s/off.json", tmp);
-    read_file(p, json, sizeof json);
+    read_file("off.json", json, sizeof json);
     CHECK(rc == 0 && strstr(json, "\"glossy_bounces\": 0,"), "--trace-glossy off still traced: %s", json);
     snprintf(p, sizeof p, "%s/vsl.exr", tmp);
     exr_image exr;
@@ -290,18 +259,9 @@ static void test_highlights_layer(void) {
 }
 
 int main(int argc, char **argv) {
-    if (argc < 2) {
-        fprintf(stderr, "usage: test_cli GLINT\n");
-        return 2;
-    }
-    glint = argv[1];
-    const char *t = getenv("GLINT_TEST_TMP");
-    snprintf(tmp, sizeof tmp, "%s/cli", t ? t : "/tmp");
-    mkdir(tmp, 0755);
-    /* Start from an empty directory so the default-output numbering is known. */
-    char cmd[1100];
-    snprintf(cmd, sizeof cmd, "rm -f '%s'/*", tmp);
-    if (system(cmd) != 0) return 1;
+    /* An empty directory, so the default-output numbering is known. */
+    int start = harness_start(argc, argv, "cli");
+    if (start != 0) return start;
     test_usage();
     test_errors();
     test_outputs();
