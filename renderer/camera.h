@@ -12,18 +12,31 @@ camera camera_frame_bounds(bounds3 b, float yfov, float aspect);
 /* The scene's camera `index` (-1 or out of range: the first one, or the framing default). */
 camera scene_camera(const scene *s, int index, float aspect);
 
-/* Unit direction through image position (x, y) in [0,1)^2, y downward, for width/height aspect;
- * tan_half_fov = tan(yfov / 2), computed once by callers that trace many rays. */
-static inline vec3 camera_ray_dir_tan(const camera *c, float tan_half_fov, float aspect, float x, float y) {
-    float th = tan_half_fov;
+/* Unit direction through image position (x, y) in [0,1)^2, y downward, for width/height aspect. */
+static inline vec3 camera_ray_dir(const camera *c, float aspect, float x, float y) {
+    float th = tanf(0.5f * c->yfov);
     float sx = (2.0f * x - 1.0f) * th * aspect;
     float sy = (1.0f - 2.0f * y) * th;
     return normalize3(add3(c->forward, add3(scale3(c->right, sx), scale3(c->up, sy))));
 }
 
-/* The same, for a single ray. */
-static inline vec3 camera_ray_dir(const camera *c, float aspect, float x, float y) {
-    return camera_ray_dir_tan(c, tanf(0.5f * c->yfov), aspect, x, y);
+/* Primary rays of a width x height image, set up once per frame: the direction through pixel
+ * coordinates (px, py) (y downward) is corner + px dx + py dy, normalized. */
+typedef struct {
+    vec3 corner, dx, dy;
+} camera_raster;
+
+static inline camera_raster camera_raster_make(const camera *c, int width, int height) {
+    float th = tanf(0.5f * c->yfov), aspect = (float)width / (float)height;
+    camera_raster r;
+    r.dx = scale3(c->right, 2.0f * th * aspect / (float)width);
+    r.dy = scale3(c->up, -2.0f * th / (float)height);
+    r.corner = add3(c->forward, add3(scale3(c->right, -th * aspect), scale3(c->up, th)));
+    return r;
+}
+
+static inline vec3 camera_raster_dir(const camera_raster *r, float px, float py) {
+    return normalize3(madd3(madd3(r->corner, r->dx, px), r->dy, py));
 }
 
 #endif

@@ -25,15 +25,14 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int split_highlights, 
     else out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
 }
 
-/* The path tracer; *first (optional) receives the first hit, and the return value says whether
- * there was one. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
+/* The path tracer, for a ray (o, d) whose closest hit the caller has traced: *first, or NULL when
+ * the ray escaped. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
  * first belongs to that path's direct light and is not counted. With split_highlights the paths
  * camera - glossy - glossy - light go to COMP_HIGHLIGHTS: the product of the two vertices'
  * highlight lobes, out of the same samples (the lobes add up to the BSDF). */
-static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *rng, vec3 out[COMP_COUNT],
-                      uint64_t rays[RAY_KIND_COUNT], surface_hit *first, int continuation, int split_highlights,
-                      int first_lobes) {
-    int hit_any = 0;
+static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surface_hit *first, rng_state *rng,
+                       vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation, int split_highlights,
+                       int first_lobes) {
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     vec3 beta_hl = v3s(0.0f); /* the throughput through glossy lobes only (depths 1 and 2) */
@@ -42,17 +41,16 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
     for (int depth = 0;; depth++) {
         surface_hit h;
         rays[depth == 0 && !continuation ? RAY_CAMERA : RAY_BOUNCE]++;
-        if (!scene_intersect(s, o, d, INFINITY, &h)) {
+        int hit;
+        if (depth > 0) hit = scene_intersect(s, o, d, INFINITY, &h);
+        else if ((hit = first != NULL)) h = *first;
+        if (!hit) {
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (depth > 0 || !continuation)) {
                 float w = depth == 0 ? 1.0f : mis_power(prev_pdf, light_pdf_env(s, d));
                 add_emission(out, depth, split_highlights, beta, beta_hl, le, w);
             }
             break;
-        }
-        if (depth == 0) {
-            hit_any = 1;
-            if (first) *first = h;
         }
         vec3 le = material_emission(s, &h);
         if (!is_black3(le) && (depth > 0 || !continuation)) {
@@ -116,26 +114,24 @@ static int trace_path(const scene *s, int max_depth, vec3 o, vec3 d, rng_state *
             beta = scale3(beta, 1.0f / q);
         }
     }
-    return hit_any;
 }
 
-void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, rng_state *rng,
-                 vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, rng, out, rays, NULL, 0, split_highlights, BSDF_ALL);
+void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
+                 rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
+    trace_path(s, max_depth, o, d, first, rng, out, rays, 0, split_highlights, BSDF_ALL);
 }
 
-int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
-              uint64_t rays[RAY_KIND_COUNT]) {
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, rng_state *rng, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
-    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 0, 0, BSDF_ALL);
-    *direct = out[COMP_DIRECT];
-    return hit;
+    trace_path(s, 1, o, d, first, rng, out, rays, 0, 0, BSDF_ALL);
+    return out[COMP_DIRECT];
 }
 
 int pt_reflected_direct(const scene *s, vec3 o, vec3 d, int lobes, rng_state *rng, vec3 *direct, surface_hit *first,
                         uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
-    int hit = trace_path(s, 1, o, d, rng, out, rays, first, 1, 0, lobes);
+    int hit = scene_intersect(s, o, d, INFINITY, first);
+    trace_path(s, 1, o, d, hit ? first : NULL, rng, out, rays, 1, 0, lobes);
     *direct = out[COMP_DIRECT];
     return hit;
 }

@@ -9,19 +9,18 @@
 #include "scene.h"
 #include "session.h"
 
-/* Radiance along the ray (o, d), split by path-space component: out[COMP_DIRECT] gets emission
+/* Radiance along the camera ray (o, d) whose closest hit the caller has traced (first; NULL when
+ * the ray escaped), split by path-space component: out[COMP_DIRECT] gets emission
  * seen directly and light arriving at the first hit directly from an emitter, out[COMP_INDIRECT]
  * the rest; with split_highlights, the paths camera - glossy lobe - glossy lobe - light go to
  * out[COMP_HIGHLIGHTS] instead (the highlight estimator's subset, DESIGN.md). Counts rays into
  * rays[]. */
-void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, rng_state *rng,
-                 vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
+void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
+                 rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
 
 /* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
- * max depth 1, so every method shares one direct estimator), and that hit in *first. Returns 1
- * when the ray hit a surface. */
-int pt_direct(const scene *s, vec3 o, vec3 d, rng_state *rng, vec3 *direct, surface_hit *first,
-              uint64_t rays[RAY_KIND_COUNT]);
+ * max depth 1, so every method shares one direct estimator); first as for pt_radiance. */
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, rng_state *rng, uint64_t rays[RAY_KIND_COUNT]);
 
 /* The same without the emission at the hit (nor the environment when the ray escapes): only
  * light that reaches the hit directly from an emitter and is reflected back along the ray by the

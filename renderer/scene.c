@@ -62,6 +62,7 @@ void scene_destroy(scene *s) {
     free(s->uv1);
     free(s->indices);
     free(s->tri_material);
+    free(s->tri_normal);
     free(s->tri_light);
     free(s->materials);
     for (int i = 0; i < s->num_images; i++) free(s->images[i].rgba);
@@ -361,10 +362,21 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
 
     if (scene_build_lights(s, err, errlen) != 0) return -1;
 
+    /* Hits need the geometric normal, which moving a light (a translation) never changes. */
+    free(s->tri_normal);
+    if (!(s->tri_normal = malloc((size_t)s->num_triangles * sizeof(vec3))))
+        return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    for (int t = 0; t < s->num_triangles; t++) {
+        const uint32_t *v = &s->indices[3 * t];
+        vec3 p0 = s->positions[v[0]];
+        s->tri_normal[t] = normalize3(cross3(sub3(s->positions[v[1]], p0), sub3(s->positions[v[2]], p0)));
+    }
+
     s->device = rtcNewDevice(NULL);
     if (!s->device) return snprintf(err, errlen, "%s: cannot create an Embree device", s->path), -1;
     rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
     s->rtc = rtcNewScene(s->device);
+    rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry geom = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->positions, 0,
                                sizeof(vec3), (size_t)s->num_vertices);
@@ -574,26 +586,17 @@ static void init_ray(struct RTCRay *r, vec3 o, vec3 d, float tmax) {
     r->flags = 0;
 }
 
-int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) {
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    struct RTCRayHit rh;
-    init_ray(&rh.ray, o, d, tmax);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(s->rtc, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
-
-    int t = (int)rh.hit.primID;
+/* Fills h from Embree's hit (triangle t, barycentrics b1 b2, distance tfar) of the ray along d. */
+static void complete_hit(const scene *s, vec3 d, int t, float b1, float b2, float tfar, surface_hit *h) {
     const uint32_t *v = &s->indices[3 * t];
-    float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0f - b1 - b2;
+    float b0 = 1.0f - b1 - b2;
     vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
-    h->t = rh.ray.tfar;
+    h->t = tfar;
     h->tri = t;
     h->material = s->tri_material[t];
     /* Barycentric interpolation is more accurate than o + t d far from the origin. */
     h->p = add3(add3(scale3(p0, b0), scale3(p1, b1)), scale3(p2, b2));
-    vec3 ng = normalize3(cross3(sub3(p1, p0), sub3(p2, p0)));
+    vec3 ng = s->tri_normal[t];
     h->backface = dot3(ng, d) > 0.0f;
     if (h->backface) ng = neg3(ng);
     h->ng = ng;
@@ -619,7 +622,57 @@ int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) 
     h->shading = frame_from_normal_tangent(ns, tan);
     /* glTF bitangent = cross(n, t) * w; keep the handedness so anisotropy rotations turn the right way. */
     if (tg[v[0]].w < 0.0f) h->shading.b = neg3(h->shading.b);
+}
+
+int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) {
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    init_ray(&rh.ray, o, d, tmax);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(s->rtc, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    complete_hit(s, d, (int)rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, h);
     return 1;
+}
+
+_Static_assert(SCENE_PACKET == 16, "scene_intersect_packet traces one RTCRayHit16");
+
+unsigned scene_intersect_packet(const scene *s, vec3 o, const vec3 *d, int n, surface_hit *h) {
+    /* One 16-wide packet: Embree traverses the BVH once for rays that go the same way. */
+    RTC_ALIGN(64) int valid[SCENE_PACKET]; /* Embree reads the mask and packet as aligned vectors */
+    RTC_ALIGN(64) struct RTCRayHit16 rh;
+    for (int i = 0; i < SCENE_PACKET; i++) {
+        int live = i < n;
+        valid[i] = live ? -1 : 0;
+        vec3 di = live ? d[i] : v3(0, 0, 1);
+        rh.ray.org_x[i] = o.x;
+        rh.ray.org_y[i] = o.y;
+        rh.ray.org_z[i] = o.z;
+        rh.ray.tnear[i] = 0.0f;
+        rh.ray.dir_x[i] = di.x;
+        rh.ray.dir_y[i] = di.y;
+        rh.ray.dir_z[i] = di.z;
+        rh.ray.time[i] = 0.0f;
+        rh.ray.tfar[i] = INFINITY;
+        rh.ray.mask[i] = 0xFFFFFFFFu;
+        rh.ray.id[i] = (unsigned)i;
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect16(valid, s->rtc, &ctx, &rh);
+    unsigned hits = 0;
+    for (int i = 0; i < n; i++) {
+        if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+        complete_hit(s, d[i], (int)rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], rh.ray.tfar[i], &h[i]);
+        hits |= 1u << i;
+    }
+    return hits;
 }
 
 int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax) {

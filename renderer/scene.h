@@ -132,6 +132,7 @@ typedef struct scene {
     uint32_t *indices;
     int32_t *tri_material;
     int32_t *tri_light; /* light index of an emissive triangle, else -1 */
+    vec3 *tri_normal;   /* unit geometric normal (winding order), set by scene_finalize */
 
     material *materials;
     int num_materials, cap_materials;
@@ -247,6 +248,11 @@ typedef struct {
 
 /* Closest hit along o + t d for t in (0, tmax]. Returns 1 on hit and fills h. */
 int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h);
+/* Closest hits of up to SCENE_PACKET rays from one origin o along d[0..n-1] (unbounded), traced
+ * together: for camera rays, which go nearly the same way. Bit i of the result is set when ray i
+ * hit, and then h[i] is filled as scene_intersect fills it. */
+#define SCENE_PACKET 16
+unsigned scene_intersect_packet(const scene *s, vec3 o, const vec3 *d, int n, surface_hit *h);
 /* 1 if anything blocks o + t d for t in (0, tmax). */
 int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax);
 

@@ -27,6 +27,8 @@ int method_from_name(const char *name) {
 }
 
 #define TILE 16
+#define PACKET_W 4 /* PACKET_W x PACKET_H = SCENE_PACKET, dividing TILE */
+#define PACKET_H 4
 
 /* Per-worker counters, padded so threads never share a cache line. */
 typedef struct {
@@ -96,66 +98,84 @@ void session_destroy(render_session *rs) {
     free(rs);
 }
 
+/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
+static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 d, const surface_hit *first,
+                          rng_state *rng) {
+    const scene *s = rs->scene;
+    const render_params *p = &rs->params;
+    vec3 L[COMP_COUNT];
+    int depth = rs->plan.max_depth;
+    if (p->method == METHOD_PT) {
+        pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, first, rng, L, st->rays);
+    } else {
+        /* Many lights: the shared direct estimator, then the virtual lights at the hit and the
+         * highlights, each pass timed. */
+        for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
+        uint64_t t0 = clock_ns();
+        L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first, rng, st->rays);
+        uint64_t t1 = clock_ns();
+        st->pass_ns[PASS_DIRECT] += t1 - t0;
+        if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
+            shading_point sp = shading_point_at(s, first, d);
+            if (rs->plan.virtual_lights) {
+                L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, rng, st);
+                uint64_t t2 = clock_ns();
+                st->pass_ns[PASS_GATHER] += t2 - t1;
+                t1 = t2;
+            }
+            if (rs->plan.highlights) {
+                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, rng, st);
+                st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
+            }
+        }
+    }
+    float sample[COMP_COUNT][3];
+    int finite = 1;
+    for (int c = 0; c < COMP_COUNT; c++) {
+        finite &= is_finite3(L[c]);
+        sample[c][0] = L[c].x;
+        sample[c][1] = L[c].y;
+        sample[c][2] = L[c].z;
+    }
+    /* A NaN or Inf never reaches the film: the sample is dropped and counted. */
+    if (finite) {
+        film_add(&rs->film, pixel, (const float(*)[3])sample);
+    } else {
+        film_reject(&rs->film, pixel);
+        st->rejected_samples++;
+    }
+}
+
 static void render_tile(void *ctx, int tile, int worker) {
     render_session *rs = ctx;
-    const scene *s = rs->scene;
     const render_params *p = &rs->params;
     render_stats *st = &rs->workers[worker].st;
     if (rs->abort_flag && atomic_load_explicit(rs->abort_flag, memory_order_relaxed)) return;
     int x0 = (tile % rs->tiles_x) * TILE, y0 = (tile / rs->tiles_x) * TILE;
     int x1 = x0 + TILE < p->width ? x0 + TILE : p->width;
     int y1 = y0 + TILE < p->height ? y0 + TILE : p->height;
-    float aspect = (float)p->width / (float)p->height, tan_half_fov = tanf(0.5f * rs->cam.yfov);
+    camera_raster raster = camera_raster_make(&rs->cam, p->width, p->height);
     uint64_t tile_start = clock_ns();
-    for (int y = y0; y < y1; y++) {
-        for (int x = x0; x < x1; x++) {
-            int pixel = y * p->width + x;
-            rng_state rng = rng_for((uint64_t)pixel, (uint64_t)rs->frames, p->seed);
-            vec2 j = rng_vec2(&rng);
-            vec3 d = camera_ray_dir_tan(&rs->cam, tan_half_fov, aspect, ((float)x + j.x) / (float)p->width,
-                                        ((float)y + j.y) / (float)p->height);
-            vec3 L[COMP_COUNT];
-            int depth = rs->plan.max_depth;
-            if (p->method == METHOD_PT) {
-                pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, &rng, L, st->rays);
-            } else {
-                /* Many lights: the shared direct estimator, then the virtual lights at the hit and
-                 * the highlights, each pass timed. */
-                surface_hit h;
-                for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
-                uint64_t t0 = clock_ns();
-                int hit = pt_direct(s, rs->cam.position, d, &rng, &L[COMP_DIRECT], &h, st->rays);
-                uint64_t t1 = clock_ns();
-                st->pass_ns[PASS_DIRECT] += t1 - t0;
-                if (hit && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
-                    shading_point sp = shading_point_at(s, &h, d);
-                    if (rs->plan.virtual_lights) {
-                        L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, &rng, st);
-                        uint64_t t2 = clock_ns();
-                        st->pass_ns[PASS_GATHER] += t2 - t1;
-                        t1 = t2;
-                    }
-                    if (rs->plan.highlights) {
-                        L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &rng, st);
-                        st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
-                    }
+    /* Camera rays go in packets of PACKET_W x PACKET_H pixels: neighbours share most of their
+     * BVH traversal. */
+    for (int by = y0; by < y1; by += PACKET_H) {
+        for (int bx = x0; bx < x1; bx += PACKET_W) {
+            int pixel[SCENE_PACKET], n = 0;
+            rng_state rng[SCENE_PACKET];
+            vec3 d[SCENE_PACKET];
+            surface_hit hit[SCENE_PACKET];
+            for (int y = by; y < by + PACKET_H && y < y1; y++) {
+                for (int x = bx; x < bx + PACKET_W && x < x1; x++, n++) {
+                    pixel[n] = y * p->width + x;
+                    rng[n] = rng_for((uint64_t)pixel[n], (uint64_t)rs->frames, p->seed);
+                    vec2 j = rng_vec2(&rng[n]);
+                    d[n] = camera_raster_dir(&raster, (float)x + j.x, (float)y + j.y);
                 }
             }
-            float sample[COMP_COUNT][3];
-            int finite = 1;
-            for (int c = 0; c < COMP_COUNT; c++) {
-                finite &= is_finite3(L[c]);
-                sample[c][0] = L[c].x;
-                sample[c][1] = L[c].y;
-                sample[c][2] = L[c].z;
-            }
-            /* A NaN or Inf never reaches the film: the sample is dropped and counted. */
-            if (finite) {
-                film_add(&rs->film, pixel, (const float(*)[3])sample);
-            } else {
-                film_reject(&rs->film, pixel);
-                st->rejected_samples++;
-            }
+            uint64_t t0 = clock_ns();
+            unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
+            if (p->method != METHOD_PT) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
+            for (int i = 0; i < n; i++) render_sample(rs, st, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
         }
     }
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;

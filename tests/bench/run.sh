@@ -103,20 +103,25 @@ seconds_of() { # wall seconds of a command, its output discarded
   awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }'
 }
 
-echo "## Path-tracing throughput (640x360, 32 spp, path length 8, $(nproc) threads)"
+echo "## Path-tracing throughput (640x360, 32 spp, path length 8, $(nproc) threads, best of 3 alternating runs)"
 printf '| scene | glint samples/s | Embree pathtracer samples/s | ratio |\n|---|---|---|---|\n'
 for s in cornell-box/CornellBox-Original.gltf lights-punctual-lamp/glTF/LightsPunctualLamp.gltf; do
   [ -f "$scenes/$s" ] || { echo "skipping $s: not found"; continue; }
-  out=$("$build/tests/bench/bench_pt" "$scenes/$s" "$work" 640 360 32 8)
-  glint_sps=$(sed -n 's/^glint_samples_per_second: //p' <<<"$out")
-  read -r -a args <<<"$(sed -n 's/^embree_args: //p' <<<"$out")"
-  # Embree renders one frame of --spp samples; subtract a 1-spp run to remove load and BVH time.
-  one=("${args[@]}")
-  for i in "${!one[@]}"; do [ "${one[$i]}" = "--spp" ] && one[$((i + 1))]=1; done
-  t_full=$(seconds_of pathtracer "${args[@]}" --threads "$(nproc)" -o "$work/embree.ppm")
-  t_one=$(seconds_of pathtracer "${one[@]}" --threads "$(nproc)" -o "$work/embree1.ppm")
-  awk -v s="$s" -v g="$glint_sps" -v full="$t_full" -v one="$t_one" \
-    'BEGIN { e = 640 * 360 * 31 / (full - one); printf "| %s | %.0f | %.0f | %.2f |\n", s, g, e, g / e }'
+  best_g=0 best_e=0
+  for run in 1 2 3; do # alternate the two so both see the same machine load
+    out=$("$build/tests/bench/bench_pt" "$scenes/$s" "$work" 640 360 32 8)
+    g=$(sed -n 's/^glint_samples_per_second: //p' <<<"$out")
+    read -r -a args <<<"$(sed -n 's/^embree_args: //p' <<<"$out")"
+    # Embree renders one frame of --spp samples; subtract a 1-spp run to remove load and BVH time.
+    one=("${args[@]}")
+    for i in "${!one[@]}"; do [ "${one[$i]}" = "--spp" ] && one[$((i + 1))]=1; done
+    t_full=$(seconds_of pathtracer "${args[@]}" --threads "$(nproc)" -o "$work/embree.ppm")
+    t_one=$(seconds_of pathtracer "${one[@]}" --threads "$(nproc)" -o "$work/embree1.ppm")
+    e=$(awk -v full="$t_full" -v one="$t_one" 'BEGIN { printf "%.0f", 640 * 360 * 31 / (full - one) }')
+    best_g=$(awk -v a="$best_g" -v b="$g" 'BEGIN { print (b > a ? b : a) }')
+    best_e=$(awk -v a="$best_e" -v b="$e" 'BEGIN { print (b > a ? b : a) }')
+  done
+  awk -v s="$s" -v g="$best_g" -v e="$best_e" 'BEGIN { printf "| %s | %.0f | %.0f | %.2f |\n", s, g, e, g / e }'
 done
 
 echo
