@@ -59,13 +59,6 @@ bsdf make_bsdf_ward(vec3 kd, vec3 ks, float alpha_x, float alpha_y) {
     return b;
 }
 
-int bsdf_lobes(const bsdf *b) {
-    int lobes = 0;
-    if (!is_black3(b->diffuse)) lobes |= BSDF_DIFFUSE;
-    if (b->model != GLOSSY_NONE && !is_black3(b->specular)) lobes |= BSDF_GLOSSY;
-    return lobes;
-}
-
 int bsdf_highlight_lobe(const bsdf *b) {
     return (bsdf_lobes(b) & BSDF_GLOSSY) && bsdf_glossy_alpha(b) < BSDF_HIGHLIGHT_ALPHA ? BSDF_GLOSSY : 0;
 }

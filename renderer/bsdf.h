@@ -76,8 +76,13 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi, int lobes);
  * be produced (wo below the surface, a sample below the horizon, an empty mask). */
 int bsdf_sample(const bsdf *b, vec3 wo, int lobes, float u_lobe, vec2 u, bsdf_sample_result *out);
 
-/* Which lobes are present (non-zero). */
-int bsdf_lobes(const bsdf *b);
+/* Which lobes are present (non-zero). Inline: every estimator asks at every vertex. */
+static inline int bsdf_lobes(const bsdf *b) {
+    int lobes = 0;
+    if (!is_black3(b->diffuse)) lobes |= BSDF_DIFFUSE;
+    if (b->model != GLOSSY_NONE && !is_black3(b->specular)) lobes |= BSDF_GLOSSY;
+    return lobes;
+}
 /* The glossy lobe's width as a microfacet roughness alpha (geometric mean of the two axes;
  * Phong through its equivalent exponent); 0 without a glossy lobe. */
 float bsdf_glossy_alpha(const bsdf *b);

@@ -47,7 +47,8 @@ static inline float max_comp3(vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
 static inline float min_comp3(vec3 a) { return fminf(a.x, fminf(a.y, a.z)); }
 static inline float avg3(vec3 a) { return (a.x + a.y + a.z) * (1.0f / 3.0f); }
 static inline int is_black3(vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
-static inline int is_finite3(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+/* x - x is 0 for finite x and NaN otherwise: one branch for all three. */
+static inline int is_finite3(vec3 a) { return (a.x - a.x) + (a.y - a.y) + (a.z - a.z) == 0.0f; }
 /* Rec. 709 luminance of linear RGB. */
 static inline float luminance3(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline float clampf(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }

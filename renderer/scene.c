@@ -616,6 +616,14 @@ static void complete_hit(const scene *s, vec3 d, int t, float b1, float b2, floa
     const float min_cos = 1e-3f;
     if (cos_o < min_cos) ns = normalize3(madd3(ns, wo, min_cos - cos_o));
 
+    /* Only anisotropic lobes care which way the tangent points; the rest take any frame. */
+    const material *m = &s->materials[h->material];
+    int anisotropic = (m->model == MATERIAL_WARD && m->alpha_x != m->alpha_y) ||
+                      (m->model == MATERIAL_GLTF && m->anisotropy_strength > 0.0f);
+    if (!anisotropic) {
+        h->shading = frame_from_normal(ns);
+        return;
+    }
     const vec4 *tg = s->tangents;
     vec3 tan = add3(add3(scale3(v3(tg[v[0]].x, tg[v[0]].y, tg[v[0]].z), b0), scale3(v3(tg[v[1]].x, tg[v[1]].y, tg[v[1]].z), b1)),
                     scale3(v3(tg[v[2]].x, tg[v[2]].y, tg[v[2]].z), b2));

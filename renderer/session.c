@@ -103,6 +103,10 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
                           rng_state *rng) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
+    if (!first && !s->env) { /* into the void: every component is zero, nothing to add */
+        st->rays[RAY_CAMERA]++;
+        return;
+    }
     vec3 L[COMP_COUNT];
     int depth = rs->plan.max_depth;
     if (p->method == METHOD_PT) {

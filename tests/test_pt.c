@@ -7,6 +7,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "rng.h"
 #include "test_scenes.h"
 
 static const unsigned ALL = COMP_MASK_ALL;
@@ -424,7 +425,54 @@ static void test_highlights_layer(void) {
     }
 }
 
+/* Camera rays traced as a packet find what one-by-one tracing finds: the same hits and misses,
+ * the same surface records, for every packet size (partial packets at image edges), on the
+ * default scene's curved and anisotropic surfaces: from inside the room, and from outside it
+ * looking at a corner, where most rays miss. */
+static int hits_agree(const surface_hit *a, const surface_hit *b) {
+    const float tol = 1e-5f;
+    return a->tri == b->tri && a->material == b->material && a->backface == b->backface &&
+           fabsf(a->t - b->t) <= tol * (1.0f + a->t) && length3(sub3(a->p, b->p)) <= tol * (1.0f + length3(a->p)) &&
+           length3(sub3(a->ng, b->ng)) <= tol && length3(sub3(a->shading.n, b->shading.n)) <= 1e-4f &&
+           length3(sub3(a->shading.t, b->shading.t)) <= 1e-4f && fabsf(a->uv0.x - b->uv0.x) <= 1e-4f &&
+           fabsf(a->uv0.y - b->uv0.y) <= 1e-4f;
+}
+
+static void test_camera_packets(void) {
+    char err[256];
+    scene *s = scene_load_default(NULL, NULL, err, sizeof err);
+    CHECK(s != NULL, "default scene: %s", err);
+    if (!s) return;
+    vec3 c = bounds_center(s->bounds);
+    camera views[2] = {camera_look_at(c, add3(c, v3(1, -0.3f, 0.7f)), v3(0, 1, 0), 1.0f),
+                       camera_look_at(add3(s->bounds.hi, v3s(0.3f * s->diag)), s->bounds.hi, v3(0, 1, 0), 0.9f)};
+    rng_state rng = rng_make(99, 1);
+    int rays = 0, hits = 0, bad = 0;
+    for (int v = 0; v < 2; v++) {
+        for (int n = 1; n <= SCENE_PACKET; n++) {
+            for (int rep = 0; rep < 40; rep++) {
+                vec3 d[SCENE_PACKET];
+                surface_hit packet[SCENE_PACKET];
+                for (int i = 0; i < n; i++) d[i] = camera_ray_dir(&views[v], 1.5f, rng_float(&rng), rng_float(&rng));
+                unsigned mask = scene_intersect_packet(s, views[v].position, d, n, packet);
+                CHECK(mask >> n == 0, "packet of %d reports hits beyond its rays (mask %x)", n, mask);
+                for (int i = 0; i < n; i++) {
+                    surface_hit one;
+                    int hit = scene_intersect(s, views[v].position, d[i], INFINITY, &one);
+                    rays++;
+                    hits += hit;
+                    if (hit != (int)(mask >> i & 1u) || (hit && !hits_agree(&one, &packet[i]))) bad++;
+                }
+            }
+        }
+    }
+    CHECK(bad == 0, "packet and single rays disagree on %d of %d rays", bad, rays);
+    CHECK(hits > rays / 10 && hits < rays - rays / 10, "the views mix hits and misses (%d of %d hit)", hits, rays);
+    scene_destroy(s);
+}
+
 int main(void) {
+    test_camera_packets();
     test_highlights_layer();
     test_furnace_box(0.5f, 64);
     test_furnace_box(0.8f, 200);
