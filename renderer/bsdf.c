@@ -6,6 +6,8 @@
  * BSDF_MIN_ALPHA, cosines of tiny angles computed from chord lengths). */
 #include "bsdf.h"
 
+#include <pthread.h>
+
 #include "sampling.h"
 
 static float schlick_weight(float cos_theta) {
@@ -69,13 +71,69 @@ float bsdf_glossy_aspect(const bsdf *b) {
     return fmaxf(ax, ay) / fminf(ax, ay);
 }
 
+/* ---- directional albedo of the glossy lobe ---------------------------------------------------- */
+
+/* Tabulated without the lobe's colour over cos theta_o and the lobe's width alpha
+ * (bsdf_glossy_alpha), both on [0, 1] in ALBEDO_N steps, built once from stratified samples of the
+ * lobe itself, so masking, grazing loss and the horizon are in. Schlick's Fresnel is linear in
+ * F0: GGX's albedo is F0 scale + bias, two tables. Anisotropic lobes are looked up at their mean
+ * width. */
+#define ALBEDO_N 32
+#define ALBEDO_STRATA 16 /* per axis: 256 samples an entry */
+enum { ALBEDO_GGX_SCALE, ALBEDO_GGX_BIAS, ALBEDO_PHONG, ALBEDO_WARD, ALBEDO_TABLES };
+static float albedo_table[ALBEDO_TABLES][ALBEDO_N][ALBEDO_N]; /* [table][alpha][cos theta_o] */
+static pthread_once_t albedo_once = PTHREAD_ONCE_INIT;
+
+static float lobe_albedo_sampled(const bsdf *b, float cos_o) {
+    vec3 wo = v3(safe_sqrtf(1.0f - cos_o * cos_o), 0.0f, cos_o);
+    double sum = 0.0;
+    for (int i = 0; i < ALBEDO_STRATA; i++)
+        for (int j = 0; j < ALBEDO_STRATA; j++) {
+            vec2 u = v2(((float)i + 0.5f) / ALBEDO_STRATA, ((float)j + 0.5f) / ALBEDO_STRATA);
+            bsdf_sample_result bs;
+            if (bsdf_sample(b, wo, BSDF_GLOSSY, 0.0f, u, &bs) && bs.pdf > 0.0f && bs.wi.z > 0.0f)
+                sum += (double)(bs.f.x * bs.wi.z / bs.pdf);
+        }
+    return (float)(sum / (ALBEDO_STRATA * ALBEDO_STRATA));
+}
+
+static void build_albedo_tables(void) {
+    for (int a = 0; a < ALBEDO_N; a++) {
+        float alpha = fmaxf((float)a / (ALBEDO_N - 1), BSDF_MIN_ALPHA);
+        for (int c = 0; c < ALBEDO_N; c++) {
+            float cos_o = fmaxf((float)c / (ALBEDO_N - 1), 1e-3f);
+            bsdf ggx = {.model = GLOSSY_GGX, .specular = v3s(1.0f), .alpha_x = alpha, .alpha_y = alpha};
+            float full = lobe_albedo_sampled(&ggx, cos_o);
+            ggx.specular = v3s(0.5f);
+            float half = lobe_albedo_sampled(&ggx, cos_o);
+            albedo_table[ALBEDO_GGX_SCALE][a][c] = 2.0f * (full - half);
+            albedo_table[ALBEDO_GGX_BIAS][a][c] = 2.0f * half - full;
+            /* Phong's exponent with this alpha (the inverse of bsdf_glossy_alpha). */
+            bsdf phong = make_bsdf_phong(v3s(0.0f), v3s(1.0f), 0.5f * (1.0f / (alpha * alpha) - 1.0f));
+            albedo_table[ALBEDO_PHONG][a][c] = lobe_albedo_sampled(&phong, cos_o);
+            bsdf ward = make_bsdf_ward(v3s(0.0f), v3s(1.0f), alpha, alpha);
+            albedo_table[ALBEDO_WARD][a][c] = lobe_albedo_sampled(&ward, cos_o);
+        }
+    }
+}
+
+static float albedo_lookup(int table, float alpha, float cos_o) {
+    float x = clampf(cos_o, 0.0f, 1.0f) * (ALBEDO_N - 1), y = clampf(alpha, 0.0f, 1.0f) * (ALBEDO_N - 1);
+    int i = x < ALBEDO_N - 2 ? (int)x : ALBEDO_N - 2, j = y < ALBEDO_N - 2 ? (int)y : ALBEDO_N - 2;
+    float fx = x - (float)i, fy = y - (float)j;
+    const float(*t)[ALBEDO_N] = albedo_table[table];
+    return lerpf(lerpf(t[j][i], t[j][i + 1], fx), lerpf(t[j + 1][i], t[j + 1][i + 1], fx), fy);
+}
+
 vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo) {
     if (!(bsdf_lobes(b) & BSDF_GLOSSY) || wo.z <= 0.0f) return v3s(0.0f);
-    /* A sharp lobe reflects about its mirror direction, where the half vector is the normal: GGX
-     * is Fresnel at wo; modified Phong (no cosine in f) is ks times the mirror's cosine, wo.z;
-     * Ward's normalisation keeps it at ks. */
-    if (b->model == GLOSSY_GGX) return schlick_fresnel(b->specular, wo.z);
-    return b->model == GLOSSY_PHONG ? scale3(b->specular, wo.z) : b->specular;
+    pthread_once(&albedo_once, build_albedo_tables);
+    float alpha = bsdf_glossy_alpha(b);
+    if (b->model == GLOSSY_GGX) {
+        float scale = albedo_lookup(ALBEDO_GGX_SCALE, alpha, wo.z), bias = albedo_lookup(ALBEDO_GGX_BIAS, alpha, wo.z);
+        return add3(scale3(b->specular, scale), v3s(bias));
+    }
+    return scale3(b->specular, albedo_lookup(b->model == GLOSSY_PHONG ? ALBEDO_PHONG : ALBEDO_WARD, alpha, wo.z));
 }
 
 float bsdf_glossy_alpha(const bsdf *b) {

@@ -91,8 +91,9 @@ int bsdf_highlight_lobe(const bsdf *b);
 /* How anisotropic the glossy lobe is: its larger roughness over its smaller (GGX, Ward); 1 for an
  * isotropic lobe or none. */
 float bsdf_glossy_aspect(const bsdf *b);
-/* The glossy lobe's directional albedo for wo, approximated for sharp lobes (the lobe's value at
- * the mirror direction); 0 without a glossy lobe or with wo below. */
+/* The glossy lobe's directional albedo for wo, from tables built on first use: within 2% for
+ * isotropic lobes; anisotropic ones are looked up at their mean width (within 2% off grazing,
+ * 10% at grazing for aspect 1.4). 0 without a glossy lobe or with wo below. */
 vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo);
 /* Probability that bsdf_sample picks the glossy lobe for this wo (0 or 1 with one lobe). */
 float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes);

@@ -126,23 +126,6 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
 /* Lobes more anisotropic than this (larger roughness over smaller) are not fitted by a vMF. */
 #define HL_MAX_VMF_ASPECT 1.5f
 
-/* The glossy lobe's directional albedo at wo, the colour its vMF carries: estimated from a few
- * samples of the lobe itself (stratified), so it is unbiased for every model. The closed forms
- * (bsdf_glossy_albedo) miss masking, grazing loss and anisotropy: by 50% for the default scene's
- * brushed steel, 5-10% for Ward. */
-#define ALBEDO_SAMPLES 4
-static vec3 glossy_albedo(const bsdf *b, vec3 wo, rng_state *rng) {
-    vec3 sum = v3(0, 0, 0);
-    for (int k = 0; k < ALBEDO_SAMPLES; k++) {
-        vec2 u = rng_vec2(rng);
-        u = v2(0.5f * ((float)(k & 1) + u.x), 0.5f * ((float)(k >> 1) + u.y));
-        bsdf_sample_result bs;
-        if (bsdf_sample(b, wo, BSDF_GLOSSY, 0.0f, u, &bs) && bs.pdf > 0.0f && bs.wi.z > 0.0f)
-            sum = madd3(sum, bs.f, bs.wi.z / bs.pdf);
-    }
-    return scale3(sum, 1.0f / ALBEDO_SAMPLES);
-}
-
 /* One secondary hit's record. */
 typedef struct {
     vec3 p, n;   /* position, geometric normal toward x */
@@ -220,7 +203,6 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_
         vmf lobe;
         vec3 albedo;
         if (!vmf_fit_glossy(&q.b, q.wo, &lobe, &albedo)) continue;
-        albedo = glossy_albedo(&q.b, q.wo, rng);
         lobe.mu = normalize3(to_world(q.frame, lobe.mu));
         hl_hit *hit = &hits[count];
         hit->p = q.p;

@@ -2,7 +2,7 @@
  * camera - glossy(x) - glossy(q) - light, both lobes sharper than BSDF_HIGHLIGHT_ALPHA. At a
  * camera hit x, N secondary rays sample x's glossy lobe; each hit q_i with such a lobe contributes
  * that lobe, fitted as a vMF about the mirror of the direction back to x and weighted by its
- * albedo (estimated from lobe samples) and x's sample weight; an anisotropic lobe, which no
+ * albedo (bsdf_glossy_albedo's tables) and x's sample weight; an anisotropic lobe, which no
  * isotropic vMF follows, is lit through its own BSDF instead. The lobes are merged
  * into at most K vMFs (spherical hard EM on their directions, Eq. 5 per cluster, the clusters'
  * energies summing to the members', Eq. 10), and each merged lobe is lit once from its members'

@@ -3,13 +3,15 @@
  * converged estimate of the same paths, for path tracing those paths (--merge trace: each
  * secondary hit lit through its true glossy lobe, light and lobe sampling under MIS), the
  * paper's no-merging comparison (--merge off) and merging into K lobes, for N secondary rays;
- * and the share of the render threads' time spent clustering and merging (Table 1, column C).
+ * and the share of the render threads' time spent clustering and merging (Table 1, column C);
+ * then, for N = 8, each estimator's error split into noise and bias by two independent runs.
  *
  * usage: bench_hl SCENE|default REF.exr WxH REF_SECONDS SECONDS
  *   REF.exr (layer highlights.*) is rendered with --merge trace, 64 secondary rays, for
  *   REF_SECONDS when it does not exist, and reused after.
  * Prints a markdown table. */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +40,7 @@ typedef struct {
     long long frame;
     double *sum;          /* running sum per pixel channel */
     render_stats *stats;  /* per worker */
+    uint64_t seed;
 } run;
 
 /* One image row of one frame: a jittered camera ray per pixel, the highlights at its hit. */
@@ -47,7 +50,7 @@ static void render_row(void *ctx, int y, int worker) {
     render_stats *st = &r->stats[worker];
     for (int x = 0; x < r->w; x++) {
         int pixel = y * r->w + x;
-        rng_state rng = rng_for((uint64_t)pixel, (uint64_t)r->frame, 99);
+        rng_state rng = rng_for((uint64_t)pixel, (uint64_t)r->frame, 99 + 1000 * r->seed);
         vec2 j = rng_vec2(&rng);
         vec3 d = camera_ray_dir(&r->cam, aspect, ((float)x + j.x) / (float)r->w, ((float)y + j.y) / (float)r->h);
         surface_hit h;
@@ -81,6 +84,16 @@ static long long render_for(const run *proto, threadpool *pool, double seconds, 
     free(r.sum);
     free(r.stats);
     return r.frame;
+}
+
+/* sum (a - b)^2 / sum ref^2 */
+static double rel_sq(const float *a, const float *b, const float *ref, size_t n) {
+    double d = 0.0, r = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        d += ((double)a[i] - (double)b[i]) * ((double)a[i] - (double)b[i]);
+        r += (double)ref[i] * (double)ref[i];
+    }
+    return r > 0.0 ? d / r : 0.0;
 }
 
 int main(int argc, char **argv) {
@@ -149,6 +162,30 @@ int main(int argc, char **argv) {
     for (int r = 2; r < 5; r++)
         printf("| %d | %.1f%% | %.1f%% | %.1f%% |\n", rows[r].clusters, 100 * shares[r][0], 100 * shares[r][1],
                100 * shares[r][2]);
+
+    /* Two independent runs A, B: E|A - B|^2 = 2 var, E|A - ref|^2 = var + bias^2 (bias here
+     * includes the reference's own noise). */
+    printf("\nNoise and bias, N = 8, two independent runs of %g s each:\n\n"
+           "| estimator | frames | noise | bias |\n|---|---|---|---|\n", 0.5 * seconds);
+    float *img2 = malloc(sizeof(float) * n);
+    if (!img2) die("out of memory");
+    const int split_rows[] = {0, 1, 4};
+    for (int i = 0; i < 3; i++) {
+        int r = split_rows[i];
+        vl_params vp = {.merge = rows[r].merge, .clusters = rows[r].clusters, .secondary_rays = 8};
+        proto.hl = hl_setup_from(s, &vp, s->env ? env_map_vmf_filter(s->env, err, sizeof err) : NULL);
+        proto.seed = 1;
+        long long fa = render_for(&proto, pool, 0.5 * seconds, img, &share);
+        proto.seed = 2;
+        long long fb = render_for(&proto, pool, 0.5 * seconds, img2, &share);
+        proto.seed = 0;
+        double ea = metric_rel_l2(img, ref, n), eb = metric_rel_l2(img2, ref, n);
+        double noise2 = 0.5 * rel_sq(img, img2, ref, n);
+        double bias2 = 0.5 * (ea * ea + eb * eb) - noise2;
+        printf("| %s | %lld, %lld | %.4f | %.4f |\n", rows[r].label, fa, fb, sqrt(noise2), bias2 > 0.0 ? sqrt(bias2) : 0.0);
+        fflush(stdout);
+    }
+    free(img2);
     free(ref);
     free(img);
     threadpool_destroy(pool);
