@@ -241,7 +241,8 @@ typedef struct {
     int material;
     vec3 p;        /* position */
     vec3 ng;       /* geometric normal, facing the incoming ray */
-    frame3 shading;/* shading frame: n faces the incoming ray's side, t along the tangent */
+    frame3 shading;/* shading frame: n faces the incoming ray's side; t along the tangent for anisotropic
+                    * materials, any direction for the rest */
     vec2 uv0, uv1;
     int backface;  /* the ray hit the triangle's back (winding) side */
 } surface_hit;

@@ -176,9 +176,10 @@ static void render_tile(void *ctx, int tile, int worker) {
                     d[n] = camera_raster_dir(&raster, (float)x + j.x, (float)y + j.y);
                 }
             }
-            uint64_t t0 = clock_ns();
+            int timed = p->method != METHOD_PT; /* camera rays belong to the direct pass */
+            uint64_t t0 = timed ? clock_ns() : 0;
             unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
-            if (p->method != METHOD_PT) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
+            if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
             for (int i = 0; i < n; i++) render_sample(rs, st, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
         }
     }
