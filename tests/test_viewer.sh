@@ -120,7 +120,7 @@ export highlights.exr
 set secondary-rays 4
 wait 1
 stats
-set clusters 4
+set clusters 2
 wait 1
 stats
 set merge off
@@ -151,7 +151,7 @@ grep '^stats ' out.txt >stats.txt
 [ "$(field 3 radius_mult)" = "4" ] || fail "a bad radius multiplier replaced the last good one"
 # stats lines 4 on: vsl+hl (with fewer secondary rays than the default 32, to save time), then shown
 # as highlights only, then N, K and merge changed
-[ "$(field 1 secondary_rays)" = "32" ] && [ "$(field 1 clusters)" = "2" ] && [ "$(field 1 merge)" = "on" ] ||
+[ "$(field 1 secondary_rays)" = "32" ] && [ "$(field 1 clusters)" = "4" ] && [ "$(field 1 merge)" = "on" ] ||
   fail "highlight parameters do not start at their defaults: $(sed -n 1p stats.txt)"
 [ "$(field 4 method)" = "vsl+hl" ] && [ "$(field 4 secondary_rays)" = "8" ] || fail "vsl+hl not applied: $(sed -n 4p stats.txt)"
 [ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "switching to vsl+hl did not reset the accumulation"
@@ -160,12 +160,12 @@ grep '^stats ' out.txt >stats.txt
 [ "$(field 5 show)" = "3" ] || fail "show highlights not applied"
 [ "$(field 5 resets)" = "$(field 4 resets)" ] || fail "showing the highlights reset the accumulation"
 [ "$(field 5 frames)" -gt "$(field 4 frames)" ] || fail "frames did not keep accumulating when showing the highlights"
-for change in "6 secondary_rays 4" "7 clusters 4" "8 merge off" "9 merge trace" "10 merge on"; do
+for change in "6 secondary_rays 4" "7 clusters 2" "8 merge off" "9 merge trace" "10 merge on"; do
   set -- $change
   [ "$(field "$1" "$2")" = "$3" ] || fail "$2 $3 not applied: $(sed -n "$1p" stats.txt)"
   [ "$(field "$1" resets)" -gt "$(field $(($1 - 1)) resets)" ] || fail "$2 $3 did not reset the accumulation"
 done
-[ "$(field 11 clusters)" = "4" ] || fail "a bad cluster count replaced the last good one"
+[ "$(field 11 clusters)" = "2" ] || fail "a bad cluster count replaced the last good one"
 [ -s highlights.png ] || fail "vsl+hl screenshot missing"
 [ -s highlights.exr ] || fail "vsl+hl EXR export missing"
 head -c 2000 highlights.exr | grep -q 'highlights.R' || fail "the vsl+hl export lacks the highlights layer"

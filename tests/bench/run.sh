@@ -10,7 +10,8 @@
 #      highlight component alone at equal time, path tracing its paths vs no merging vs merging
 #      into K lobes, N secondary rays, against a 10-minute reference cached in build/bench-cache;
 #      and the share of time spent merging; for N = 8 the error split into noise and bias by two
-#      independent runs), about 10 minutes plus the reference.
+#      independent runs; then the whole renderer at equal time, the path tracer's highlights layer
+#      against vsl+hl's), about 16 minutes plus the reference.
 #   5. With `bench` first: `glint bench` on the default scene, the headline comparison (pt,
 #      clamped vpl, vsl, vsl+hl; budgets 1 to 64 s, about 5 minutes) and the Fig. 8 sweeps (radius
 #      multiplier and column count, every lobe gathered, 10 s each, about 2 minutes), against a
