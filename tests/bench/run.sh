@@ -5,7 +5,8 @@
 #   2. Load + BVH build time and peak memory for the 1.04 M-triangle sphere grid.
 #   3. With `vsl` first: the VSL paper's comparisons on the default scene (bench_vsl: equal-time
 #      error of pt, vpl and vsl against a 20-minute path-traced reference, cached in
-#      build/bench-cache, and the Fig. 8 sweeps), about 10 minutes plus the reference.
+#      build/bench-cache; pt and vsl again over 4 seeds, the aim's table; the Fig. 8 sweeps),
+#      about 18 minutes plus the reference.
 #   4. With `hl` first: the highlight paper's comparison on the default scene (bench_hl: the
 #      highlight component alone at equal time, path tracing its paths vs no merging vs merging
 #      into K lobes, N secondary rays, against a 10-minute reference cached in build/bench-cache;
