@@ -51,44 +51,49 @@ static double error_of(const bench *b, const render_session *rs) {
     return e;
 }
 
-/* Renders progressively, reading the error at each checkpoint of one run. */
-static void run_times(const bench *b, const char *label, render_params p, const double *times, int nt) {
+/* Renders one run progressively, reading the error and the frame count at each checkpoint. */
+static void run_checkpoints(const bench *b, render_params p, const double *times, int nt, double *err,
+                            long long *frames) {
     render_session *rs = start(b, p);
     double t0 = now();
-    printf("| %s |", label);
     for (int k = 0; k < nt; k++) {
         while (now() - t0 < times[k])
             if (session_render_frame(rs) != 0) die(session_error(rs));
-        printf(" %.4f (%lld) |", error_of(b, rs), session_frames(rs));
-        fflush(stdout);
+        err[k] = error_of(b, rs);
+        frames[k] = session_frames(rs);
     }
-    printf("\n");
     session_destroy(rs);
+}
+
+static void run_times(const bench *b, const char *label, render_params p, const double *times, int nt) {
+    double err[16];
+    long long frames[16];
+    run_checkpoints(b, p, times, nt, err, frames);
+    printf("| %s |", label);
+    for (int k = 0; k < nt; k++) printf(" %.4f (%lld) |", err[k], frames[k]);
+    printf("\n");
+    fflush(stdout);
 }
 
 /* The same over independent runs (seeds 1..seeds): root mean square of the error at each
  * checkpoint, its range, and the mean frame count. */
 static void run_seeds(const bench *b, const char *label, render_params p, const double *times, int nt, int seeds) {
-    double sum2[16] = {0}, lo[16], hi[16], frames[16] = {0};
+    double sum2[16] = {0}, lo[16], hi[16], mean_frames[16] = {0};
     for (int k = 0; k < nt; k++) lo[k] = INFINITY, hi[k] = 0.0;
     for (int r = 0; r < seeds; r++) {
+        double err[16];
+        long long frames[16];
         p.seed = (uint64_t)r + 1;
-        render_session *rs = start(b, p);
-        double t0 = now();
+        run_checkpoints(b, p, times, nt, err, frames);
         for (int k = 0; k < nt; k++) {
-            while (now() - t0 < times[k])
-                if (session_render_frame(rs) != 0) die(session_error(rs));
-            double e = error_of(b, rs);
-            sum2[k] += e * e;
-            lo[k] = e < lo[k] ? e : lo[k];
-            hi[k] = e > hi[k] ? e : hi[k];
-            frames[k] += (double)session_frames(rs);
+            sum2[k] += err[k] * err[k];
+            lo[k] = fmin(lo[k], err[k]);
+            hi[k] = fmax(hi[k], err[k]);
+            mean_frames[k] += (double)frames[k] / seeds;
         }
-        session_destroy(rs);
     }
     printf("| %s |", label);
-    for (int k = 0; k < nt; k++)
-        printf(" %.3f (%.3f-%.3f; %.0f) |", sqrt(sum2[k] / seeds), lo[k], hi[k], frames[k] / seeds);
+    for (int k = 0; k < nt; k++) printf(" %.3f (%.3f-%.3f; %.0f) |", sqrt(sum2[k] / seeds), lo[k], hi[k], mean_frames[k]);
     printf("\n");
     fflush(stdout);
 }
