@@ -41,6 +41,14 @@ static inline rng_state rng_for(uint64_t key, uint64_t frame, uint64_t seed) {
     return rng_make(s, rng_hash64(key + 0x1f83d9abfb41bd6bULL * (frame + 1)));
 }
 
+/* A stream of its own from r's next numbers: an estimator that takes its numbers from a fork
+ * does not shift another's when either changes how many it uses. */
+static inline rng_state rng_fork(rng_state *r, uint64_t stream) {
+    uint64_t s = (uint64_t)rng_next_u32(r) << 32;
+    s |= rng_next_u32(r);
+    return rng_make(rng_hash64(s), stream);
+}
+
 /* Uniform float in [0, 1): 24 random bits, so the result is never 1. */
 static inline float rng_float(rng_state *r) { return (float)(rng_next_u32(r) >> 8) * 0x1p-24f; }
 static inline vec2 rng_vec2(rng_state *r) {

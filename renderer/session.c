@@ -121,6 +121,7 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
         st->pass_ns[PASS_DIRECT] += t1 - t0;
         if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
             shading_point sp = shading_point_at(s, first, d);
+            rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
             if (rs->plan.virtual_lights) {
                 L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, rng, st);
                 uint64_t t2 = clock_ns();
@@ -128,7 +129,7 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
                 t1 = t2;
             }
             if (rs->plan.highlights) {
-                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, rng, st);
+                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &hl_rng, st);
                 st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
             }
         }
