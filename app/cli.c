@@ -148,10 +148,13 @@ const char *cli_vl_help(void) {
              "  --columns C          ... and clusters; 0 = no clustering [0]\n"
              "  --per-pixel N|all    lights (cluster representatives) each pixel shades per frame,\n"
              "                       picked by power (cluster norm) [%d; all with --columns]\n"
-             "  --candidates M       each of those is resampled from M candidates by its unshadowed\n"
-             "                       contribution at the pixel; 1 = plain sampling by power [%d]\n"
+             "  --light-select power|tree  where a pixel's light draws come from: by power, or\n"
+             "                       through a light tree by an estimate of what each sends there [power]\n"
+             "  --candidates M       draws per pixel, from which its lights are resampled by that\n"
+             "                       estimate; 1 = the draws are shaded as they come [%d]\n"
              "  --trace-glossy A|off receivers' glossy lobes with roughness alpha below A are not\n"
              "                       gathered from the lights: the path goes on through them [%g]\n"
+             "  --glossy-rays N      directions traced through such a lobe at the camera hit, 1..%d [%d]\n"
              "indirect highlights (vsl+hl):\n"
              "  --secondary-rays N   rays sampled from a camera hit's glossy lobe, 1..%d [%d]\n"
              "  --clusters K         merged vMF lobes per camera hit, 1..%d [%d]\n"
@@ -159,7 +162,7 @@ const char *cli_vl_help(void) {
              "                       paper's comparison); trace: no vMFs, each hit's true glossy lobe\n"
              "                       (the path tracer's answer for the same paths) [on]\n",
              VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_RADIUS_MULT, VL_DEFAULT_ROWS,
-             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES, (double)VL_DEFAULT_TRACE_GLOSSY,
+             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES, (double)VL_DEFAULT_TRACE_GLOSSY, VL_MAX_GLOSSY_RAYS, VL_DEFAULT_GLOSSY_RAYS,
              HL_MAX_SECONDARY_RAYS, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_CLUSTERS, HL_DEFAULT_CLUSTERS);
     return text;
 }
@@ -209,13 +212,20 @@ int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
         if (strcmp(value, "all") == 0) vl->per_pixel = -1;
         else if (cli_parse_int(option, value, 1, 1000000, &n)) return -1;
         else vl->per_pixel = (int)n;
+    } else if (strcmp(name, "light-select") == 0) {
+        if (strcmp(value, "tree") == 0) vl->select = VL_SELECT_TREE;
+        else if (strcmp(value, "power") == 0) vl->select = VL_SELECT_POWER;
+        else return cli_error("%s: expected tree or power, got '%s'", option, value), -1;
     } else if (strcmp(name, "candidates") == 0) {
-        if (cli_parse_int(option, value, 1, 4096, &n)) return -1;
+        if (cli_parse_int(option, value, 1, VL_MAX_CANDIDATES, &n)) return -1;
         vl->candidates = (int)n;
     } else if (strcmp(name, "trace-glossy") == 0) {
         if (strcmp(value, "off") == 0) vl->trace_glossy = -1.0f;
         else if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
         else vl->trace_glossy = x > 0.0 ? (float)x : -1.0f; /* 0 is off too, not the default */
+    } else if (strcmp(name, "glossy-rays") == 0) {
+        if (cli_parse_int(option, value, 1, VL_MAX_GLOSSY_RAYS, &n)) return -1;
+        vl->glossy_rays = (int)n;
     } else if (strcmp(name, "secondary-rays") == 0) {
         if (cli_parse_int(option, value, 1, HL_MAX_SECONDARY_RAYS, &n)) return -1;
         vl->secondary_rays = (int)n;
@@ -237,8 +247,8 @@ int cli_vl_option(int argc, char **argv, int *i, vl_params *vl) {
     if (strncmp(a, "--", 2) != 0) return 0;
     if (strcmp(a, "--vpl-glossy") == 0) return cli_set_vl_param("vpl-glossy", "on", vl);
     static const char *const names[] = {"vsl-count", "clamp", "clamp-value", "clamp-growth", "radius-mult",
-                                         "radius-shrink", "rows", "columns", "per-pixel", "candidates",
-                                         "trace-glossy", "secondary-rays", "clusters", "merge"};
+                                         "radius-shrink", "rows", "columns", "per-pixel", "light-select", "candidates",
+                                         "trace-glossy", "glossy-rays", "secondary-rays", "clusters", "merge"};
     int ours = 0;
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) ours |= strcmp(a + 2, names[k]) == 0;
     if (!ours) return 0;

@@ -595,8 +595,10 @@ static vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
     vl.count = c->vl_count;
     vl.columns = c->columns;
     vl.per_pixel = c->per_pixel;
+    vl.select = c->light_select == 1 ? VL_SELECT_TREE : VL_SELECT_POWER;
     vl.candidates = c->candidates;
     vl.trace_glossy = c->trace_glossy > 0.0f ? c->trace_glossy : -1.0f;
+    vl.glossy_rays = c->glossy_rays;
     vl.secondary_rays = c->secondary_rays;
     vl.clusters = c->clusters;
     vl.merge = c->merge == 1 ? HL_MERGE_OFF : c->merge == 2 ? HL_MERGE_TRACE : HL_MERGE_ON;
@@ -611,8 +613,10 @@ static void controls_from_vl(ui_controls *c, const vl_params *vl) {
     c->vl_count = vl->count > 0 ? vl->count : VL_DEFAULT_COUNT;
     c->columns = vl->columns;
     c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);
+    c->light_select = vl->select == VL_SELECT_TREE;
     c->candidates = vl->candidates > 0 ? vl->candidates : VL_DEFAULT_CANDIDATES;
     c->trace_glossy = vl->trace_glossy > 0.0f ? vl->trace_glossy : vl->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
+    c->glossy_rays = vl->glossy_rays > 0 ? vl->glossy_rays : VL_DEFAULT_GLOSSY_RAYS;
     c->secondary_rays = vl->secondary_rays > 0 ? vl->secondary_rays : HL_DEFAULT_SECONDARY_RAYS;
     c->clusters = vl->clusters > 0 ? vl->clusters : HL_DEFAULT_CLUSTERS;
     c->merge = vl->merge == HL_MERGE_OFF ? 1 : vl->merge == HL_MERGE_TRACE ? 2 : 0;
@@ -621,7 +625,8 @@ static void controls_from_vl(ui_controls *c, const vl_params *vl) {
 static int vl_controls_differ(const ui_controls *a, const ui_controls *b) {
     return a->clamp != b->clamp || a->clamp_value != b->clamp_value || a->radius_mult != b->radius_mult ||
            a->radius_shrink != b->radius_shrink || a->vl_count != b->vl_count || a->columns != b->columns ||
-           a->per_pixel != b->per_pixel || a->candidates != b->candidates || a->trace_glossy != b->trace_glossy ||
+           a->per_pixel != b->per_pixel || a->light_select != b->light_select || a->candidates != b->candidates ||
+           a->trace_glossy != b->trace_glossy || a->glossy_rays != b->glossy_rays ||
            a->secondary_rays != b->secondary_rays || a->clusters != b->clusters || a->merge != b->merge;
 }
 
@@ -1026,13 +1031,14 @@ static void print_stats(ui_thread *u) {
            nb ? marks : "-");
     printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
-           "candidates=%d trace_glossy=%g virtual_lights=%llu secondary_rays=%d clusters=%d merge=%s hl_lobes=%llu "
+           "light_select=%d candidates=%d trace_glossy=%g glossy_rays=%d virtual_lights=%llu secondary_rays=%d clusters=%d "
+           "merge=%s hl_lobes=%llu "
            "plan_highlights=%d\n",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
            u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
            method_name((render_method)u->ctl.method), u->rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
-           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.candidates,
-           (double)u->ctl.trace_glossy, u->virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
+           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.light_select, u->ctl.candidates,
+           (double)u->ctl.trace_glossy, u->ctl.glossy_rays, u->virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
            u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->hl_lobes, u->plan_highlights);
     fflush(stdout);
 }

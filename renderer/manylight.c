@@ -6,11 +6,13 @@
 
 #include "mrcs.h"
 #include "pt.h"
+#include "sampling.h"
 
 void manylight_deinit(manylight *m) {
     vlight_set_free(&m->set);
     free(m->entries);
     dist1d_deinit(&m->pick);
+    lighttree_free(&m->tree);
     memset(m, 0, sizeof *m);
 }
 
@@ -74,72 +76,11 @@ static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *v
     return c;
 }
 
-/* One end's factor of the stand-in below: f cos toward the light's centre, raised to what a
- * lobe sharper than the cone averages to over it when the lobe's axis falls inside the cone
- * (its glossy reflectance over the cone's solid angle), so that sharp lobes aimed at a large
- * sphere are not missed by the centre direction alone. */
-static float end_factor(const bsdf *b, frame3 f, vec3 wo_local, vec3 l_world, float cos_cone, float cone_solid_angle) {
-    vec3 l = to_local(f, l_world);
-    if (l.z <= 0.0f && cos_cone > 0.0f) return 0.0f;
-    float g = avg3(bsdf_eval(b, wo_local, l, BSDF_ALL)) * fmaxf(l.z, 0.0f);
-    if (b->model != GLOSSY_NONE) {
-        vec3 mirror = v3(-wo_local.x, -wo_local.y, wo_local.z);
-        if (dot3(mirror, l) >= cos_cone) g = fmaxf(g, avg3(b->specular) * mirror.z / cone_solid_angle);
-    }
-    return g;
-}
-
-/* A cheap stand-in for a light's contribution at x, for choosing lights per pixel: both ends'
- * factors toward the light's centre, no visibility, the distance clamped at the radius as a VSL
- * clamps it. The defensive terms keep it positive wherever the true contribution can be (a cone
- * straddling a horizon, a lobe missing the centre), which resampling needs to stay unbiased. */
-static float target_of(const virtual_light *vl, const shading_point *x) {
-    vec3 d = sub3(vl->p, x->p);
-    float dist2 = length_sq3(d), r2 = vl->radius * vl->radius;
-    if (!(dist2 > 0.0f) && !(r2 > 0.0f)) return 0.0f;
-    vec3 l = dist2 > 0.0f ? scale3(d, 1.0f / sqrtf(dist2)) : x->frame.n;
-    /* The cone around the sphere (the whole sphere of directions when x is inside it). */
-    float cos_cone = -1.0f, solid_angle = 2.0f * PI_F;
-    if (dist2 > r2) {
-        float omc = cone_one_minus_cos(sqrtf(r2 / dist2));
-        cos_cone = 1.0f - omc;
-        solid_angle = fmaxf(2.0f * PI_F * omc, 1e-12f);
-    }
-    float gx = end_factor(&x->b, x->frame, x->wo, l, cos_cone, solid_angle);
-    float gv = end_factor(&vl->b, vl->frame, vl->wi, neg3(l), cos_cone, solid_angle);
-    const float floor = 0.05f * INV_PI_F;
-    return luminance3(vl->power) * (gx + floor) * (gv + floor) / fmaxf(dist2, r2);
-}
-
-/* Picks one entry for x: `candidates` draws by the frame's pick distribution, one of them chosen
- * in proportion to target / pmf (resampled importance sampling, Talbot et al. 2005). Returns the
- * weight that makes entry *e's contribution an unbiased estimate of the sum over all entries
- * (its scale included), or 0 when nothing was drawn. */
-static float resample_entry(const manylight *m, const shading_point *x, rng_state *rng, int *e) {
-    float pmf;
-    if (m->candidates <= 1) {
-        *e = dist1d_sample_discrete(&m->pick, rng_float(rng), &pmf, NULL);
-        return pmf > 0.0f ? m->entries[*e].scale / pmf : 0.0f;
-    }
-    double w_sum = 0.0;
-    float chosen_target = 0.0f;
-    *e = -1;
-    for (int c = 0; c < m->candidates; c++) {
-        int cand = dist1d_sample_discrete(&m->pick, rng_float(rng), &pmf, NULL);
-        if (!(pmf > 0.0f)) continue;
-        const ml_entry *en = &m->entries[cand];
-        float t = target_of(&m->set.v[en->light], x) * en->scale;
-        if (!(t > 0.0f) || !isfinite(t)) continue;
-        double w = (double)t / (double)pmf;
-        w_sum += w;
-        /* Reservoir choice: keeps the candidate with probability w / w_sum, one pass. */
-        if ((double)rng_float(rng) * w_sum < w) {
-            *e = cand;
-            chosen_target = t;
-        }
-    }
-    if (*e < 0 || !(w_sum > 0.0)) return 0.0f;
-    return (float)(w_sum / (double)m->candidates / (double)chosen_target) * m->entries[*e].scale;
+/* One draw of an entry for x with u in [0,1): by the light tree, or by the frame's pick
+ * distribution. Returns the entry (-1: none can light x) and its probability in *pmf. */
+static int draw_entry(const manylight *m, const lt_receiver *r, float u, float *pmf) {
+    if (m->use_tree) return lighttree_sample(&m->tree, r, u, pmf);
+    return dist1d_sample_discrete(&m->pick, u, pmf, NULL);
 }
 
 vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, vl_terms terms, rng_state *rng,
@@ -153,10 +94,51 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
         }
         return sum;
     }
-    for (int k = 0; k < m->per_pixel; k++) {
-        int e;
-        float weight = resample_entry(m, x, rng, &e);
-        if (weight > 0.0f) sum = madd3(sum, shade_one(m, s, &m->set.v[m->entries[e].light], x, terms, rng, st), weight);
+    lt_receiver r;
+    if (m->tree.num_lights > 0) r = lighttree_receiver(x, s->ray_eps);
+    /* The pixel's lights are picked at u = (k + shift) / per_pixel: stratified over [0,1). A draw
+     * maps u onto the entries in contiguous runs, so each stratum's pick weighted by
+     * 1 / (per_pixel pmf) keeps the sum unbiased while the picks spread out. */
+    float shift = rng_float(rng);
+    if (m->candidates <= 1) {
+        for (int k = 0; k < m->per_pixel; k++) {
+            float pmf;
+            int e = draw_entry(m, &r, fminf(((float)k + shift) / (float)m->per_pixel, 0x1.fffffep-1f), &pmf);
+            if (e >= 0 && pmf > 0.0f)
+                sum = madd3(sum, shade_one(m, s, &m->set.v[m->entries[e].light], x, terms, rng, st), m->entries[e].scale / pmf);
+        }
+        return scale3(sum, 1.0f / (float)m->per_pixel);
+    }
+    /* Resampled importance sampling (Talbot et al. 2005): `candidates` draws, each weighted by
+     * target / pmf where the target is the light tree's estimate of what the light sends to x
+     * (lighttree_importance on its leaf: distance, both cosines, both lobes, no visibility), and
+     * the pixel's lights picked from them in proportion to the weights, stratified. Each pick y
+     * stands for the sum over all entries with weight (w_sum / candidates) / target(y): unbiased
+     * wherever the target is positive where a light can send something (the importance's zeros
+     * are exact). Cost: one estimate per candidate, one shading per pick. */
+    int cand[VL_MAX_CANDIDATES];
+    double cum[VL_MAX_CANDIDATES];
+    float target[VL_MAX_CANDIDATES];
+    double w_sum = 0.0;
+    int n = 0;
+    for (int c = 0; c < m->candidates; c++) {
+        float pmf;
+        int e = draw_entry(m, &r, rng_float(rng), &pmf);
+        if (e < 0 || !(pmf > 0.0f)) continue;
+        float t = lighttree_light_importance(&m->tree.leaves[m->entries[e].light], &r) * m->entries[e].scale;
+        if (!(t > 0.0f) || !isfinite(t)) continue;
+        w_sum += (double)t / (double)pmf;
+        cand[n] = e;
+        target[n] = t;
+        cum[n++] = w_sum;
+    }
+    if (n == 0 || !(w_sum > 0.0)) return sum;
+    for (int k = 0, i = 0; k < m->per_pixel; k++) {
+        double u = ((double)k + (double)shift) / (double)m->per_pixel * w_sum;
+        while (i < n - 1 && cum[i] <= u) i++;
+        const ml_entry *en = &m->entries[cand[i]];
+        float weight = (float)(w_sum / (double)m->candidates / (double)target[i]) * en->scale;
+        sum = madd3(sum, shade_one(m, s, &m->set.v[en->light], x, terms, rng, st), weight);
     }
     return scale3(sum, 1.0f / (float)m->per_pixel);
 }
@@ -264,29 +246,43 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         diffuse_only.b.model = GLOSSY_NONE;
         sum = add3(sum, mul3(beta, manylight_shade(m, s, &diffuse_only, terms, rng, st)));
 
-        float u_lobe = rng_float(rng);
-        vec2 u = rng_vec2(rng);
-        bsdf_sample_result bs;
-        if (!bsdf_sample(&x.b, x.wo, BSDF_GLOSSY, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) break;
-        vec3 wi = to_world(x.frame, bs.wi);
-        if (dot3(wi, x.ng) <= 0.0f) break;
-        beta = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
-        if (k >= 3) { /* Russian roulette, as the path tracer does */
-            float q = fminf(0.95f, max_comp3(beta));
-            if (rng_float(rng) >= q) break;
-            beta = scale3(beta, 1.0f / q);
-        }
-        if (is_black3(beta) || !is_finite3(beta)) break;
-        st->glossy_bounces++;
-        /* Emission at the next hit is the direct light at x, which the shared estimator has. */
-        surface_hit h;
-        vec3 direct;
+        /* At the camera hit the lobe is split: `split` stratified directions each take the direct
+         * light at their next hit (the reflection of lit surfaces, where a single direction is
+         * the noisiest part of the image), and one of them, chosen at random, carries the rest of
+         * the path (with weight 1: it stands for the mean of the split's continuations). */
+        int split = k == 1 ? m->glossy_split : 1;
+        vec2 shift = rng_vec2(rng);
+        int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
         /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (DESIGN.md) when both
          * lobes are highlight lobes. */
         int lobes = k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT : BSDF_ALL;
-        if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, lobes, rng, &direct, &h, st->rays)) break;
-        sum = add3(sum, mul3(beta, direct));
-        x = shading_point_at(s, &h, wi);
+        vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1);
+        surface_hit next;
+        int have_next = 0;
+        for (int j = 0; j < split; j++) {
+            bsdf_sample_result bs;
+            if (!bsdf_sample(&x.b, x.wo, BSDF_GLOSSY, 0.0f, split > 1 ? sample_r2(j, shift) : shift, &bs) || !(bs.pdf > 0.0f))
+                continue;
+            vec3 wi = to_world(x.frame, bs.wi);
+            if (dot3(wi, x.ng) <= 0.0f) continue;
+            vec3 b = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
+            if (k >= 3) { /* Russian roulette, as the path tracer does */
+                float q = fminf(0.95f, max_comp3(b));
+                if (rng_float(rng) >= q) continue;
+                b = scale3(b, 1.0f / q);
+            }
+            if (is_black3(b) || !is_finite3(b)) continue;
+            st->glossy_bounces++;
+            /* Emission at the next hit is the direct light at x, which the shared estimator has. */
+            surface_hit h;
+            vec3 direct;
+            if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, lobes, rng, &direct, &h, st->rays)) continue;
+            sum = madd3(sum, mul3(b, direct), 1.0f / (float)split);
+            if (j == chosen) next_beta = b, next = h, next_wi = wi, have_next = 1;
+        }
+        if (!have_next) break;
+        beta = next_beta;
+        x = shading_point_at(s, &next, next_wi);
     }
     return sum;
 }
@@ -306,6 +302,8 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
                                         vp->radius_shrink, i);
     m->num_entries = 0;
     m->clustered = 0;
+    m->use_tree = 0;
+    m->tree.num_lights = 0;
     int count = vp->count > 0 ? vp->count : VL_DEFAULT_COUNT;
     if (vlights_trace(s, count, plan->max_depth, p->seed, (uint64_t)frame, &m->set, &st->rays[RAY_BOUNCE]) != 0)
         return snprintf(err, errlen, "out of memory for %d virtual lights", count), -1;
@@ -318,18 +316,25 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     int clustering = vp->columns > 0 && vp->columns < m->set.count;
     m->per_pixel = vp->per_pixel > 0 ? vp->per_pixel : (clustering || vp->per_pixel < 0 ? 0 : VL_DEFAULT_PER_PIXEL);
     m->candidates = vp->candidates > 0 ? vp->candidates : VL_DEFAULT_CANDIDATES;
+    if (m->candidates > VL_MAX_CANDIDATES) m->candidates = VL_MAX_CANDIDATES;
+    m->glossy_split = vp->glossy_rays > 0 ? (vp->glossy_rays < VL_MAX_GLOSSY_RAYS ? vp->glossy_rays : VL_MAX_GLOSSY_RAYS)
+                                          : VL_DEFAULT_GLOSSY_RAYS;
     m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : vp->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
+    /* The light tree's per-light estimates serve resampling; its hierarchy, drawing through it. */
+    if (m->per_pixel > 0 && (vp->select == VL_SELECT_TREE || m->candidates > 1) && lighttree_build(&m->tree, &m->set) != 0)
+        return snprintf(err, errlen, "out of memory for the light tree"), -1;
     if (clustering) {
         if (cluster_lights(m, s, cam, p, frame, pool, st) != 0) return snprintf(err, errlen, "out of memory for the light clusters"), -1;
         m->clustered = 1;
         return 0;
     }
-    /* Every light its own entry; pixels that sample pick lights by power. */
+    /* Every light its own entry; pixels that sample draw lights through the tree or by power. */
     if (reserve_entries(m, m->set.count) != 0) return snprintf(err, errlen, "out of memory"), -1;
     m->num_entries = m->set.count;
     for (int j = 0; j < m->set.count; j++) m->entries[j] = (ml_entry){j, 1.0f};
     dist1d_deinit(&m->pick);
-    if (m->per_pixel > 0) {
+    m->use_tree = m->per_pixel > 0 && vp->select == VL_SELECT_TREE;
+    if (m->per_pixel > 0 && !m->use_tree) {
         float *power = malloc(sizeof(float) * (size_t)m->set.count);
         if (!power) return snprintf(err, errlen, "out of memory"), -1;
         for (int j = 0; j < m->set.count; j++) power[j] = luminance3(m->set.v[j].power);

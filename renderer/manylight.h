@@ -5,6 +5,7 @@
 #define GLINT_MANYLIGHT_H
 
 #include "camera.h"
+#include "lighttree.h"
 #include "session.h"
 #include "threadpool.h"
 #include "vsl.h"
@@ -24,12 +25,15 @@ typedef struct {
     float clamp_bound;  /* this frame's bound */
     float radius_mult;  /* this frame's multiplier */
     int per_pixel;      /* 0: every entry */
-    int candidates;     /* resampling candidates per sampled entry (1: plain sampling by pick) */
+    int candidates;     /* resampling candidates per pixel (1: the draws are shaded as they come) */
     float trace_alpha;  /* glossy lobes sharper than this are traced through, not gathered */
+    int glossy_split;   /* directions traced through such a lobe at the camera hit */
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;
     dist1d pick;        /* per-pixel choice of entries: by cluster norm, or by light power */
+    lighttree tree;     /* ... or by the light tree (use_tree) */
+    int use_tree;
     int clustered;      /* entries came from matrix row-column sampling this frame */
 } manylight;
 

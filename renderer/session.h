@@ -39,13 +39,18 @@ typedef struct {
     int per_pixel;       /* lights (or cluster representatives) sampled per pixel per frame, by
                           * power (or cluster norm); -1: every one; 0: the default, which is
                           * VL_DEFAULT_PER_PIXEL without clustering and every representative with */
-    int candidates;      /* per sampled light: candidates drawn by power (or cluster norm) and
-                          * resampled by their unshadowed contribution at the pixel; 1: none
+    int candidates;      /* per pixel: lights drawn (by power, cluster norm or the tree) from which
+                          * the pixel's per_pixel lights are resampled in proportion to an estimate
+                          * of what each sends there; 1: the draws are shaded as they come
                           * [VL_DEFAULT_CANDIDATES] */
+    int select;          /* VL_SELECT_*: where a pixel's light draws come from (without clustering) [power] */
     float trace_glossy;  /* a receiver's glossy lobe with roughness alpha below this is not
                           * gathered from the lights: the camera path goes on through it (BSDF
                           * sampling, direct light at the next hit, gathering there); < 0: never
                           * [VL_DEFAULT_TRACE_GLOSSY] */
+    int glossy_rays;     /* directions traced through such a lobe at the camera hit, each taking the
+                          * direct light at its next hit, one carrying the path on
+                          * [VL_DEFAULT_GLOSSY_RAYS] */
     /* vsl+hl: the highlight estimator (which owns the camera - glossy - glossy - light paths) */
     int secondary_rays;  /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
     int clusters;        /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
@@ -53,6 +58,9 @@ typedef struct {
 } vl_params;
 
 enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
+/* Where a pixel's light draws come from: VL_SELECT_POWER by power (or cluster norm); VL_SELECT_TREE
+ * through the light tree (lighttree.h), by an estimate of each group's contribution there. */
+enum { VL_SELECT_DEFAULT = 0, VL_SELECT_TREE, VL_SELECT_POWER };
 #define VL_DEFAULT_COUNT 1024
 #define VL_DEFAULT_CLAMP 1.0f
 /* The paper's multipliers (4-12) go with 10^5 lights in one set; radii scale as mult/sqrt(count),
@@ -60,8 +68,11 @@ enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
 #define VL_DEFAULT_RADIUS_MULT 1.0f
 #define VL_DEFAULT_ROWS 300
 #define VL_DEFAULT_PER_PIXEL 4
-#define VL_DEFAULT_CANDIDATES 1
+#define VL_DEFAULT_CANDIDATES 32
+#define VL_MAX_CANDIDATES 256 /* they live on the stack */
 #define VL_DEFAULT_TRACE_GLOSSY 0.35f
+#define VL_DEFAULT_GLOSSY_RAYS 4
+#define VL_MAX_GLOSSY_RAYS 64
 /* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the
  * path tracer's estimate of the same paths, to see what the approximation costs) */
 enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };

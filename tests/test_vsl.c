@@ -431,8 +431,9 @@ static void test_glossy_box_energy(void) {
 }
 
 /* Per-pixel light selection is unbiased: with the same light sets (same seed, so every frame
- * traces the same lights), sampling a few lights per pixel, plainly by power or resampled from
- * candidates, averages to the sum over every light; resampling gets there with less noise. */
+ * traces the same lights), sampling a few lights per pixel, by power or through the light tree,
+ * shaded as drawn or resampled from candidates, averages to the sum over every light; resampling
+ * and the tree get there with less noise than drawing by power. */
 static void test_light_selection_unbiased(void) {
     material m = material_default();
     m.model = MATERIAL_PHONG;
@@ -441,27 +442,33 @@ static void test_light_selection_unbiased(void) {
     m.exponent = 80.0f;
     scene *s = closed_box(m, v3(0.3f, 0.5f, 0.2f));
     camera cam = box_camera();
+    static const struct {
+        const char *name;
+        int select, candidates;
+    } ways[] = {{"by power", VL_SELECT_POWER, 1}, {"resampled from power draws", VL_SELECT_POWER, 16},
+                {"through the tree", VL_SELECT_TREE, 1}, {"resampled from tree draws", VL_SELECT_TREE, 8}};
     for (int method = METHOD_VPL; method <= METHOD_VSL; method++) {
         const int frames = 200;
         render_params p = vl_params_for((render_method)method, 256);
         p.vl.clamp = VL_CLAMP_OFF;
         p.vl.trace_glossy = -1.0f; /* every lobe gathered: the selection is all that differs */
         float *all = ts_render_with(s, &cam, &p, frames, INDIRECT);
+        double ma = image_mean(all, NPIX), e_power = 0.0;
         p.vl.per_pixel = 2;
-        p.vl.candidates = 1;
-        float *plain = ts_render_with(s, &cam, &p, frames, INDIRECT);
-        p.vl.candidates = 16;
-        float *ris = ts_render_with(s, &cam, &p, frames, INDIRECT);
-        double ma = image_mean(all, NPIX), e_plain = rel_l2(plain, all, NPIX), e_ris = rel_l2(ris, all, NPIX);
-        printf("light selection, %s: mean ratio plain %.4f, resampled %.4f; L2 to the exhaustive sum %.3f, %.3f\n",
-               method_name(p.method), image_mean(plain, NPIX) / ma, image_mean(ris, NPIX) / ma, e_plain, e_ris);
-        CHECK_NEAR(image_mean(plain, NPIX) / ma, 1.0, 0.03, "%s: plain sampling by power is biased", method_name(p.method));
-        CHECK_NEAR(image_mean(ris, NPIX) / ma, 1.0, 0.03, "%s: resampled selection is biased", method_name(p.method));
-        CHECK(e_ris < 0.8 * e_plain, "%s: resampling did not reduce the noise (%.3f vs %.3f)", method_name(p.method),
-              e_ris, e_plain);
+        for (int w = 0; w < 4; w++) {
+            p.vl.select = ways[w].select;
+            p.vl.candidates = ways[w].candidates;
+            float *img = ts_render_with(s, &cam, &p, frames, INDIRECT);
+            double ratio = image_mean(img, NPIX) / ma, e = rel_l2(img, all, NPIX);
+            printf("light selection, %s, %s: mean ratio %.4f, L2 to the exhaustive sum %.3f\n", method_name(p.method),
+                   ways[w].name, ratio, e);
+            CHECK_NEAR(ratio, 1.0, 0.03, "%s: selection %s is biased", method_name(p.method), ways[w].name);
+            if (w == 0) e_power = e;
+            else CHECK(e < 0.8 * e_power, "%s: %s is no less noisy than by power (%.3f vs %.3f)", method_name(p.method),
+                       ways[w].name, e, e_power);
+            free(img);
+        }
         free(all);
-        free(plain);
-        free(ris);
     }
     scene_destroy(s);
 }

@@ -134,10 +134,13 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
                              ImGuiSliderFlags_Logarithmic);
             ImGui::SliderInt("lights/pixel", &c->per_pixel, -1, 256, c->per_pixel < 0 ? "all" : "%d");
             if (c->per_pixel == 0) c->per_pixel = 1;
-            ImGui::SliderInt("candidates", &c->candidates, 1, 64, c->candidates > 1 ? "%d" : "1 (by power)",
+            static const char *const selects[] = {"by power", "light tree"};
+            ImGui::Combo("light draws", &c->light_select, selects, 2);
+            ImGui::SliderInt("candidates", &c->candidates, 1, 128, c->candidates > 1 ? "%d" : "1 (as drawn)",
                              ImGuiSliderFlags_Logarithmic);
             ImGui::SliderFloat("trace glossy below", &c->trace_glossy, 0.0f, 1.0f,
                                c->trace_glossy > 0.0f ? "alpha %.2f" : "never");
+            ImGui::SliderInt("glossy rays", &c->glossy_rays, 1, 64);
         }
     }
 

@@ -29,8 +29,10 @@ typedef struct {
     int vl_count;      /* virtual lights per frame */
     int columns;       /* clusters; 0: none */
     int per_pixel;     /* lights shaded per pixel per frame; -1: all */
-    int candidates;    /* resampling candidates per shaded light; 1: by power alone */
+    int light_select;  /* 0: draws by power, 1: through the light tree */
+    int candidates;    /* light draws per pixel, resampled by estimate; 1: shaded as drawn */
     float trace_glossy; /* glossy lobes with alpha below this are traced through; 0: never */
+    int glossy_rays;   /* directions traced through such a lobe at the camera hit */
     /* indirect highlights (method vsl+hl), as glint render's options */
     int secondary_rays; /* rays sampled from a camera hit's glossy lobe */
     int clusters;       /* merged vMF lobes per camera hit (K) */
