@@ -1,0 +1,288 @@
+/* glint bench: what it writes — results.csv, the error-versus-time and sweep plots (SVG, PNG) and
+ * report.md. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "bench.h"
+#include "cli.h"
+#include "metrics.h"
+#include "plot.h"
+
+static void csv_number(FILE *f, double v) {
+    if (isnan(v)) return;
+    if (isinf(v)) fputs("inf", f);
+    else fprintf(f, "%.6g", v);
+}
+
+int bench_write_csv(const char *dir, const bench_run *runs, int num_runs, write_mode mode) {
+    char *buf = NULL, path[4200], err[4400];
+    size_t size = 0;
+    FILE *f = open_memstream(&buf, &size);
+    if (!f) return cli_error("%s: out of memory", dir), -1;
+    fputs("method,params,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,direct_relmse,indirect_rel_l2,"
+          "indirect_relmse,highlights_rel_l2,highlights_relmse\n", f);
+    for (int r = 0; r < num_runs; r++)
+        for (int k = 0; k < runs[r].num_points; k++) {
+            const bench_run *u = &runs[r];
+            fprintf(f, "%s,%s,%.6f,%lld,%lld,%.0f", method_name(u->params.method), u->setting, u->seconds[k],
+                    u->frames[k], u->frames[k], u->rays[k]);
+            for (int c = 0; c < ERR_COUNT; c++) {
+                fputc(',', f);
+                csv_number(f, u->rel_l2[c][k]);
+                fputc(',', f);
+                csv_number(f, u->relmse[c][k]);
+            }
+            fputc('\n', f);
+        }
+    fclose(f);
+    snprintf(path, sizeof path, "%s/results.csv", dir);
+    int status = write_file_atomic(path, buf, size, mode, err, sizeof err);
+    free(buf);
+    if (status) cli_error("%s", err);
+    return status;
+}
+
+/* Error of run r at budget k in the reported component. */
+static double err_at(const bench_options *o, const bench_run *r, int k) {
+    return k < r->num_points ? r->rel_l2[o->component][k] : (double)NAN;
+}
+
+static int write_plot(const char *dir, const char *stem, const plot_desc *pd) {
+    char path[4200], err[4400];
+    snprintf(path, sizeof path, "%s/%s.svg", dir, stem);
+    if (plot_save_svg(pd, path, WRITE_NO_REPLACE, err, sizeof err) != 0) return cli_error("%s", err), -1;
+    snprintf(path, sizeof path, "%s/%s.png", dir, stem);
+    if (plot_save_png(pd, path, WRITE_NO_REPLACE, err, sizeof err) != 0) return cli_error("%s", err), -1;
+    return 0;
+}
+
+/* The best curve at the last budget: the equal-error reading is taken at its error. */
+static int best_run(const bench_options *o, const bench_run *runs, int num_runs, int k) {
+    int best = -1;
+    for (int r = 0; r < num_runs; r++) {
+        double e = err_at(o, &runs[r], k);
+        if (isfinite(e) && (best < 0 || e < err_at(o, &runs[best], k))) best = r;
+    }
+    return best;
+}
+
+static int write_time_plot(const bench_options *o, const char *dir, const bench_run *runs, int num_runs) {
+    plot_series series[MAX_RUNS];
+    double err[MAX_RUNS][MAX_TIMES];
+    int ns = 0;
+    for (int r = 0; r < num_runs; r++) {
+        for (int k = 0; k < runs[r].num_points; k++) err[r][k] = err_at(o, &runs[r], k);
+        series[ns++] = (plot_series){runs[r].label, runs[r].num_points, runs[r].seconds, err[r]};
+    }
+    int last = o->num_times - 1, best = best_run(o, runs, num_runs, last);
+    char title[160], ylabel[96], xmark[64], ymark[192];
+    snprintf(title, sizeof title, "Relative L2 error (%s) against render time", bench_err_names[o->component]);
+    snprintf(ylabel, sizeof ylabel, "relative L2 error, %s", bench_err_names[o->component]);
+    snprintf(xmark, sizeof xmark, "equal time: %g s", o->times[last]);
+    double ey = best >= 0 ? err_at(o, &runs[best], last) : (double)NAN;
+    snprintf(ymark, sizeof ymark, "equal error: %.3g (%s at %g s)", ey, best >= 0 ? runs[best].label : "", o->times[last]);
+    plot_desc pd = {title, "render time (s)", ylabel, 1, 1, series, ns, o->times[last], ey, xmark, ymark};
+    return write_plot(dir, "error-vs-time", &pd);
+}
+
+/* A sweep's values as numbers, when they all are (on/off sweeps get a table only). */
+static int sweep_numbers(const sweep *sw, double *x) {
+    for (int v = 0; v < sw->num_values; v++) {
+        char *end;
+        x[v] = strtod(sw->values[v], &end);
+        if (end == sw->values[v] || *end) return 0;
+    }
+    return 1;
+}
+
+static int write_sweep_plot(const bench_options *o, const char *dir, const bench_run *runs, int num_runs, int w) {
+    const sweep *sw = &o->sweeps[w];
+    double x[MAX_VALUES], y[MAX_METHODS][MAX_VALUES];
+    if (!sweep_numbers(sw, x)) return 0;
+    plot_series series[MAX_METHODS];
+    int ns = 0, last = o->num_times - 1, pos = 1;
+    for (int v = 0; v < sw->num_values; v++) pos &= x[v] > 0.0;
+    for (int m = 0; m < o->num_methods; m++) {
+        int any = 0;
+        for (int v = 0; v < sw->num_values; v++) {
+            y[ns][v] = (double)NAN;
+            for (int r = 0; r < num_runs; r++)
+                if (runs[r].sweep == w && runs[r].value == v && runs[r].params.method == o->methods[m])
+                    y[ns][v] = err_at(o, &runs[r], last), any = 1;
+        }
+        if (any) series[ns] = (plot_series){method_name(o->methods[m]), sw->num_values, x, y[ns]}, ns++;
+    }
+    if (ns == 0) return 0;
+    char title[160], ylabel[96], stem[64];
+    snprintf(title, sizeof title, "Relative L2 error (%s) against %s, %g s each", bench_err_names[o->component], sw->name,
+             o->times[last]);
+    snprintf(ylabel, sizeof ylabel, "relative L2 error, %s", bench_err_names[o->component]);
+    snprintf(stem, sizeof stem, "sweep-%s", sw->name);
+    plot_desc pd = {title, sw->name, ylabel, pos, 1, series, ns, (double)NAN, (double)NAN, "", ""};
+    return write_plot(dir, stem, &pd);
+}
+
+static void md_error(FILE *f, double e) {
+    if (isnan(e)) fputs("–", f);
+    else if (isinf(e)) fputs("inf", f);
+    else fprintf(f, "%.4f", e);
+}
+
+static int write_report(const bench_options *o, const char *dir, const bench_ref *ref,
+                        const reference_info *want, const bench_run *runs, int num_runs) {
+    char *buf = NULL, path[4200], err[4400];
+    size_t size = 0;
+    FILE *f = open_memstream(&buf, &size);
+    if (!f) return cli_error("%s: out of memory", dir), -1;
+    char date[64] = "";
+    time_t now = time(NULL);
+    struct tm tm;
+    if (gmtime_r(&now, &tm)) strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", &tm);
+    char host[256] = "";
+    gethostname(host, sizeof host - 1);
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    const int last = o->num_times - 1;
+    const char *comp = bench_err_names[o->component];
+
+    fprintf(f, "# glint bench\n\n");
+    fprintf(f, "- scene: `%s` (%s)%s%s%s\n", want->scene, want->scene_hash, want->env[0] ? ", environment `" : "",
+            want->env, want->env[0] ? "`" : "");
+    fprintf(f, "- %dx%d, camera %d, max depth %d, seed %llu, %d threads (0: one per core)\n", want->width,
+            want->height, want->camera_index, want->max_depth, (unsigned long long)want->seed, o->threads);
+    if (ref->has_info) {
+        fprintf(f, "- reference: `%s`, %s, %lld spp, %.0f s", o->ref_path, ref->info.method, ref->info.spp,
+                ref->info.seconds);
+        if (ref->info.has_noise)
+            fprintf(f, "; its own noise, estimated from two halves of its frames: relative L2 %.4f (errors near "
+                       "that are the reference's, not the method's)", ref->info.rel_l2_noise);
+        fputs("\n", f);
+    } else {
+        fprintf(f, "- reference: `%s` without a sidecar (--force): scene, camera and size were not checked\n",
+                o->ref_path);
+    }
+    fprintf(f, "- error: relative L2, ‖I − R‖₂ / ‖R‖₂ over all pixels and channels, of the %s%s\n", comp,
+            o->component == ERR_ALL ? " image" : " component");
+    if (o->base_text[0]) fprintf(f, "- options of every run: `%s`\n", o->base_text);
+    fprintf(f, "- measured %s on %s, %ld cores; time is render time only (frames), error measurement excluded\n\n",
+            date, host, cores);
+
+    fprintf(f, "## Error at each time budget\n\nRelative L2 error (%s), frames in brackets.\n\n| method |", comp);
+    for (int k = 0; k < o->num_times; k++) fprintf(f, " %g s |", o->times[k]);
+    fputs("\n|---|", f);
+    for (int k = 0; k < o->num_times; k++) fputs("---|", f);
+    fputs("\n", f);
+    for (int r = 0; r < num_runs; r++) {
+        fprintf(f, "| %s |", runs[r].label);
+        for (int k = 0; k < o->num_times; k++) {
+            fputc(' ', f);
+            md_error(f, err_at(o, &runs[r], k));
+            if (k < runs[r].num_points) fprintf(f, " (%lld)", runs[r].frames[k]);
+            fputs(" |", f);
+        }
+        fputs("\n", f);
+    }
+
+    fputs("\n## Who wins\n\n", f);
+    for (int k = 0; k < o->num_times; k++) {
+        int best = best_run(o, runs, num_runs, k), second = -1;
+        for (int r = 0; r < num_runs; r++) {
+            double e = err_at(o, &runs[r], k);
+            if (r != best && isfinite(e) && (second < 0 || e < err_at(o, &runs[second], k))) second = r;
+        }
+        if (best < 0) continue;
+        double eb = err_at(o, &runs[best], k);
+        fprintf(f, "- %g s: **%s**, %.4f", o->times[k], runs[best].label, eb);
+        if (second >= 0) {
+            double es = err_at(o, &runs[second], k);
+            if (eb > 0.0) fprintf(f, ", %.2f× lower than the next, %s (%.4f)", es / eb, runs[second].label, es);
+            else fprintf(f, "; next %s (%.4f)", runs[second].label, es);
+        }
+        fputs("\n", f);
+    }
+
+    int best = best_run(o, runs, num_runs, last);
+    if (best >= 0 && num_runs > 1) {
+        double eb = err_at(o, &runs[best], last), tb = runs[best].seconds[last];
+        fprintf(f, "\n## Equal error\n\nTime each curve needs to reach %.4f, the error of **%s** at %g s "
+                   "(interpolated in log–log; `~` extrapolated along the curve's fitted slope).\n\n"
+                   "| method | time to reach it | × %s's time |\n|---|---|---|\n",
+                eb, runs[best].label, o->times[last], runs[best].label);
+        for (int r = 0; r < num_runs; r++) {
+            const bench_run *u = &runs[r];
+            double e[MAX_TIMES];
+            for (int k = 0; k < u->num_points; k++) e[k] = err_at(o, u, k);
+            double t = metric_loglog_reach(u->seconds, e, u->num_points, eb);
+            const char *approx = "";
+            if (!isfinite(t) && u->num_points > 0) {
+                double slope = metric_loglog_slope(u->seconds, e, u->num_points), el = e[u->num_points - 1];
+                if (slope < -0.05 && el > 0.0 && isfinite(el)) {
+                    t = u->seconds[u->num_points - 1] * pow(eb / el, 1.0 / slope);
+                    approx = "~";
+                }
+            }
+            if (isfinite(t)) fprintf(f, "| %s | %s%.3g s | %s%.2f |\n", u->label, approx, t, approx, t / tb);
+            else fprintf(f, "| %s | not reached (the curve does not fall) | – |\n", u->label);
+        }
+    }
+
+    fputs("\n## Convergence\n\nSlope of each curve in log–log (least squares over the budgets): unbiased Monte "
+          "Carlo falls as time^−0.5; a flatter curve is dominated by bias (or by the reference's own noise).\n\n"
+          "| method | slope |\n|---|---|\n", f);
+    for (int r = 0; r < num_runs; r++) {
+        double e[MAX_TIMES];
+        for (int k = 0; k < runs[r].num_points; k++) e[k] = err_at(o, &runs[r], k);
+        double slope = metric_loglog_slope(runs[r].seconds, e, runs[r].num_points);
+        if (isfinite(slope)) fprintf(f, "| %s | %.2f |\n", runs[r].label, slope);
+        else fprintf(f, "| %s | – |\n", runs[r].label);
+    }
+
+    for (int w = 0; w < o->num_sweeps; w++) {
+        const sweep *sw = &o->sweeps[w];
+        fprintf(f, "\n## Sweep: %s\n\nRelative L2 error (%s) at %g s against the value of `--%s`.\n\n| %s |", sw->name,
+                comp, o->times[last], sw->name, sw->name);
+        for (int m = 0; m < o->num_methods; m++)
+            if (bench_sweep_methods(sw->name) & (1u << o->methods[m])) fprintf(f, " %s |", method_name(o->methods[m]));
+        fputs("\n|---|", f);
+        for (int m = 0; m < o->num_methods; m++)
+            if (bench_sweep_methods(sw->name) & (1u << o->methods[m])) fputs("---|", f);
+        fputs("\n", f);
+        for (int v = 0; v < sw->num_values; v++) {
+            fprintf(f, "| %s |", sw->values[v]);
+            for (int m = 0; m < o->num_methods; m++) {
+                if (!(bench_sweep_methods(sw->name) & (1u << o->methods[m]))) continue;
+                for (int r = 0; r < num_runs; r++)
+                    if (runs[r].sweep == w && runs[r].value == v && runs[r].params.method == o->methods[m]) {
+                        fputc(' ', f);
+                        md_error(f, err_at(o, &runs[r], last));
+                        fputs(" |", f);
+                    }
+            }
+            fputs("\n", f);
+        }
+        double x[MAX_VALUES];
+        if (sweep_numbers(sw, x)) fprintf(f, "\n![error against %s](sweep-%s.svg)\n", sw->name, sw->name);
+    }
+    fputs("\n## Files\n\n- `results.csv`: every checkpoint of every run, all components\n"
+          "- `error-vs-time.svg`, `error-vs-time.png`: the curves (log–log); squares mark the equal-time "
+          "reading at the last budget, diamonds the equal-error reading (the PNG's legend is numbered in the "
+          "SVG's order)\n\n![error against time](error-vs-time.svg)\n", f);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/report.md", dir);
+    int status = write_file_atomic(path, buf, size, WRITE_NO_REPLACE, err, sizeof err);
+    free(buf);
+    if (status) cli_error("%s", err);
+    return status;
+}
+
+int bench_write_plots_and_report(const bench_options *o, const char *dir, const bench_ref *ref,
+                                 const reference_info *want, const bench_run *runs, int num_runs) {
+    int status = write_time_plot(o, dir, runs, num_runs);
+    for (int w = 0; w < o->num_sweeps && status == 0; w++) status = write_sweep_plot(o, dir, runs, num_runs, w);
+    if (status == 0) status = write_report(o, dir, ref, want, runs, num_runs);
+    return status;
+}
