@@ -31,7 +31,11 @@ static void print_bench_help(void) {
            "  --max-depth D        [the reference's]\n"
            "  --env FILE           environment map; must match the reference's [none]\n"
            "  --env-rotation DEG   [0]\n"
-           "  --seed S             random seed; must differ from the reference's [the reference's + 1]\n"
+           "  --seed S             the first seed; none of the bench's may be the reference's\n"
+           "                       [the reference's + 1]\n"
+           "  --seeds N            renders per method and setting, with seeds S, S+1, ..., S+N-1; the\n"
+           "                       report takes the RMS over them and, from 2 on, splits the error\n"
+           "                       into noise and bias [1]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
            "  --out DIR            output directory, created; never overwritten [bench, bench-1, ...]\n"
            "  --force              accept a reference without a sidecar\n"
@@ -39,8 +43,9 @@ static void print_bench_help(void) {
            "  --help               this text\n"
            "\n"
            "Many-light options (see glint render --help) set every run's base parameters.\n"
-           "Writes DIR/results.csv, DIR/error-vs-time.svg and .png, DIR/report.md, and for each\n"
-           "numeric sweep DIR/sweep-NAME.svg and .png (error against the value at the last budget).\n");
+           "Writes DIR/results.csv (every render), DIR/summary.csv (over the seeds), DIR/report.md,\n"
+           "DIR/error-vs-time.svg and .png, and for each numeric sweep DIR/sweep-NAME.svg and .png\n"
+           "(error against the value at the last budget).\n");
 }
 
 /* Splits a comma-separated list into at most max items of up to 31 characters. -1 when empty,
@@ -98,6 +103,7 @@ static void append_base(bench_options *o, const char *a, const char *v) {
 int bench_parse_options(int argc, char **argv, bench_options *o) {
     memset(o, 0, sizeof *o);
     o->camera_index = -2;
+    o->seeds = 1;
     const char *methods = "pt,vpl,vsl,vsl+hl", *times = "1,2,4,8";
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *v = NULL;
@@ -156,6 +162,10 @@ int bench_parse_options(int argc, char **argv, bench_options *o) {
             VALUE();
             if (cli_parse_u64(a, v, &o->seed)) return -1;
             o->seed_given = 1;
+        } else if (strcmp(a, "--seeds") == 0) {
+            VALUE();
+            if (cli_parse_int(a, v, 1, MAX_SEEDS, &n)) return -1;
+            o->seeds = (int)n;
         } else if (strcmp(a, "--threads") == 0) {
             VALUE();
             if (cli_parse_int(a, v, 0, 1024, &n)) return -1;

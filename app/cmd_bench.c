@@ -1,8 +1,9 @@
 /* glint bench: what accuracy costs in time. Renders each method (and each setting of a parameter
- * sweep) progressively against a reference, reads the error at each time budget of one run, and
- * writes results.csv, error-versus-time plots (SVG, PNG) and report.md into a directory. This file
- * loads the reference, plans and runs the renders and measures them; bench_options.c parses the
- * command line, bench_report.c writes the outputs. */
+ * sweep) progressively against a reference, once per seed, reads the error at each time budget of
+ * every render, splits it into noise and bias over the seeds, and writes results.csv, summary.csv,
+ * error-versus-time plots (SVG, PNG) and report.md into a directory. This file loads the
+ * reference, plans, runs and measures the renders; bench_options.c parses the command line,
+ * bench_report.c writes the outputs. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -91,31 +92,42 @@ static int ref_load(const bench_options *o, bench_ref *r) {
 
 /* ---- measuring --------------------------------------------------------------------------------- */
 
+/* What measuring needs: the reference, a scratch image and, with two seeds or more, what the
+ * noise and bias split keeps of the reported component per budget over a run's seeds (a sum
+ * image and the sum of squared errors, not the images). */
 typedef struct {
     const bench_ref *ref;
+    int component;
     float *img;
     size_t n;
+    double *sum;            /* [budget][value]; NULL with one seed */
+    double err2[MAX_TIMES]; /* sum over the seeds of ||I - R||^2 */
 } meter;
 
-static void measure(meter *m, const render_session *rs, bench_run *run, int k) {
+static void measure(meter *m, const render_session *rs, bench_point *pt, int k) {
     const film *f = session_film(rs);
     const render_params *p = session_params(rs);
     int splits = p->pt_highlights || p->method == METHOD_VSL_HL;
     const unsigned masks[ERR_COUNT] = {COMP_MASK_ALL, 1u << COMP_DIRECT,
                                        (1u << COMP_INDIRECT) | (1u << COMP_HIGHLIGHTS), 1u << COMP_HIGHLIGHTS};
     for (int c = 0; c < ERR_COUNT; c++) {
-        run->rel_l2[c][k] = run->relmse[c][k] = (double)NAN;
+        pt->rel_l2[c] = pt->relmse[c] = (double)NAN;
         if (!m->ref->layer[c] || (c == ERR_HIGHLIGHTS && !splits)) continue;
         film_resolve(f, masks[c], m->img);
-        run->rel_l2[c][k] = metric_rel_l2(m->img, m->ref->layer[c], m->n);
-        run->relmse[c][k] = metric_relmse(m->img, m->ref->layer[c], m->n);
+        pt->rel_l2[c] = metric_rel_l2(m->img, m->ref->layer[c], m->n);
+        pt->relmse[c] = metric_relmse(m->img, m->ref->layer[c], m->n);
+        if (c == m->component && m->sum)
+            m->err2[k] += metric_accumulate(m->sum + (size_t)k * m->n, m->img, m->ref->layer[c], m->n);
     }
 }
 
-static int run_one(const bench_options *o, const scene *s, const camera *cam, meter *m, bench_run *run, int index,
-                   int total) {
+/* Renders run with its seed-th seed, measuring at every budget. */
+static int render_seed(const bench_options *o, const scene *s, const camera *cam, meter *m, bench_run *run,
+                       int seed, int index, int total) {
     char err[1024];
-    render_session *rs = session_create(s, cam, &run->params, err, sizeof err);
+    render_params params = run->params;
+    params.seed = run->params.seed + (uint64_t)seed;
+    render_session *rs = session_create(s, cam, &params, err, sizeof err);
     if (!rs) return cli_error("%s", err), -1;
     double rendered = 0.0;
     for (int k = 0; k < o->num_times; k++) {
@@ -130,19 +142,70 @@ static int run_one(const bench_options *o, const scene *s, const camera *cam, me
             rendered += cli_now() - t0;
         }
         render_stats st = session_stats(rs);
-        double rays = 0.0;
-        for (int r = 0; r < RAY_KIND_COUNT; r++) rays += (double)st.rays[r];
-        run->seconds[k] = rendered;
-        run->frames[k] = session_frames(rs);
-        run->rays[k] = rays;
-        measure(m, rs, run, k);
-        run->num_points = k + 1;
-        if (!o->quiet)
-            fprintf(stderr, "glint: bench %d/%d %s: %.2f s, %lld frames, %s rel. L2 %.4g\n", index + 1, total,
-                    run->label, rendered, run->frames[k], bench_err_names[o->component], run->rel_l2[o->component][k]);
+        bench_point *pt = &run->points[seed][k];
+        pt->rays = 0.0;
+        for (int r = 0; r < RAY_KIND_COUNT; r++) pt->rays += (double)st.rays[r];
+        pt->seconds = rendered;
+        pt->frames = session_frames(rs);
+        measure(m, rs, pt, k);
+        if (o->quiet) continue;
+        char which[64] = "";
+        if (o->seeds > 1)
+            snprintf(which, sizeof which, ", seed %llu (%d of %d)", (unsigned long long)params.seed, seed + 1, o->seeds);
+        fprintf(stderr, "glint: bench %d/%d %s%s: %.2f s, %lld frames, %s rel. L2 %.4g\n", index + 1, total,
+                run->label, which, rendered, pt->frames, bench_err_names[o->component], pt->rel_l2[o->component]);
     }
     session_destroy(rs);
     return 0;
+}
+
+/* The run's figures over its seeds, per budget, in the reported component. */
+static void aggregate(const bench_options *o, const meter *m, bench_run *run) {
+    const int c = o->component, n = run->seeds_done;
+    const float *ref = m->ref->layer[c];
+    double ref_norm2 = metric_norm2(ref, m->n), ref_noise = bench_ref_noise(m->ref, c);
+    for (int k = 0; k < o->num_times; k++) {
+        double secs = 0.0, frames = 0.0, sq = 0.0, relmse = 0.0, lo = INFINITY, hi = -INFINITY;
+        for (int i = 0; i < n; i++) {
+            const bench_point *pt = &run->points[i][k];
+            secs += pt->seconds;
+            frames += (double)pt->frames;
+            sq += pt->rel_l2[c] * pt->rel_l2[c];
+            relmse += pt->relmse[c];
+            lo = fmin(lo, pt->rel_l2[c]);
+            hi = fmax(hi, pt->rel_l2[c]);
+        }
+        run->seconds[k] = secs / n;
+        run->frames[k] = frames / n;
+        run->rms[k] = sqrt(sq / n); /* NAN when the component was not measured */
+        run->relmse[k] = relmse / n;
+        run->lo[k] = isnan(run->rms[k]) ? (double)NAN : lo;
+        run->hi[k] = isnan(run->rms[k]) ? (double)NAN : hi;
+        run->noise[k] = run->bias[k] = (double)NAN;
+        if (m->sum && !isnan(run->rms[k]))
+            metric_noise_bias(m->err2[k], metric_mean_err2(m->sum + (size_t)k * m->n, n, ref, m->n), ref_norm2, n,
+                              ref_noise, &run->noise[k], &run->bias[k]);
+    }
+    run->num_points = o->num_times;
+}
+
+/* Renders and measures every seed of one run, writing the CSVs as renders complete. */
+static int run_seeds(const bench_options *o, const scene *s, const camera *cam, meter *m, const char *dir,
+                     bench_run *runs, int r, int num_runs) {
+    bench_run *run = &runs[r];
+    if (m->sum) {
+        memset(m->sum, 0, sizeof(double) * m->n * (size_t)o->num_times);
+        memset(m->err2, 0, sizeof m->err2);
+    }
+    for (int i = 0; i < o->seeds; i++) {
+        if (render_seed(o, s, cam, m, run, i, r, num_runs) != 0) return -1;
+        run->seeds_done = i + 1;
+        /* Written after every render, so an interrupted bench keeps what it measured. */
+        int first = r == 0 && i == 0;
+        if (bench_write_csv(dir, runs, r + 1, o->num_times, first ? WRITE_NO_REPLACE : WRITE_REPLACE) != 0) return -1;
+    }
+    aggregate(o, m, run);
+    return bench_write_summary(o, dir, m->ref, runs, r + 1, r == 0 ? WRITE_NO_REPLACE : WRITE_REPLACE);
 }
 
 /* ---- the output directory ------------------------------------------------------------------------ */
@@ -158,8 +221,9 @@ static int prepare_dir(const bench_options *o, char *dir, size_t dirlen) {
     struct stat st;
     if (stat(dir, &st) == 0) {
         if (!S_ISDIR(st.st_mode)) return cli_error("--out: %s: exists and is not a directory", dir), -1;
-        char names[4 + 2 * MAX_SWEEPS][64] = {"results.csv", "report.md", "error-vs-time.svg", "error-vs-time.png"};
-        int n = 4;
+        char names[5 + 2 * MAX_SWEEPS][64] = {"results.csv", "summary.csv", "report.md", "error-vs-time.svg",
+                                              "error-vs-time.png"};
+        int n = 5;
         for (int w = 0; w < o->num_sweeps; w++) {
             snprintf(names[n++], 64, "sweep-%s.svg", o->sweeps[w].name);
             snprintf(names[n++], 64, "sweep-%s.png", o->sweeps[w].name);
@@ -232,15 +296,40 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     if (have && o->max_depth && o->max_depth != have->max_depth)
         cli_warning("%s: rendered with --max-depth %d, the bench uses %d: the errors include that difference",
                     o->ref_path, have->max_depth, o->max_depth);
-    /* The reference's own seed would replay its samples: pt would look converged. */
+    /* The reference's own seed would replay its samples: pt would look converged. The seeds are
+     * seed, seed + 1, ... (wrapping at 2^64, as the renderer's arithmetic does); a range that
+     * holds the reference's is refused rather than skipped, so seed k is always base + k. */
     base.seed = o->seed_given ? o->seed : have ? have->seed + 1 : 1;
-    if (have && base.seed == have->seed)
-        return cli_error("--seed %llu: is the reference's seed; the bench would repeat its samples",
-                         (unsigned long long)base.seed), EXIT_USAGE;
+    if (have && have->seed - base.seed < (uint64_t)o->seeds) {
+        if (o->seeds == 1)
+            return cli_error("--seed %llu: is the reference's seed; the bench would repeat its samples",
+                             (unsigned long long)base.seed), EXIT_USAGE;
+        return cli_error("--seeds %d: the seeds %llu to %llu hold the reference's seed %llu; the bench would repeat "
+                         "its samples (choose another --seed)", o->seeds, (unsigned long long)base.seed,
+                         (unsigned long long)(base.seed + (uint64_t)o->seeds - 1), (unsigned long long)have->seed),
+               EXIT_USAGE;
+    }
+    /* The split keeps one sum image of doubles per budget; refuse what would not fit in memory
+     * before rendering anything. */
+    size_t values = 3 * (size_t)width * (size_t)height;
+    double split_bytes = o->seeds > 1 ? (double)values * sizeof(double) * o->num_times : 0.0;
+    if (split_bytes > MAX_SPLIT_BYTES)
+        return cli_error("--seeds %d: the noise and bias split keeps a %dx%d image of doubles per budget, %.0f MiB for "
+                         "%d budgets, more than %.0f MiB (use fewer --times or a smaller size)", o->seeds, width,
+                         height, split_bytes / (1 << 20), o->num_times, MAX_SPLIT_BYTES / (1 << 20)),
+               EXIT_USAGE;
     if (o->component != ERR_ALL && !ref->layer[o->component])
         return cli_error("%s: no %s layer%s", o->ref_path, bench_err_names[o->component],
                          o->component == ERR_HIGHLIGHTS ? " (render the reference with --highlights-layer)" : ""),
                EXIT_FAILURE_;
+
+    int num_runs = plan_runs(o, &base, ref->layer[ERR_HIGHLIGHTS] != NULL, runs);
+    if (num_runs > MAX_RUNS)
+        return cli_error("more than %d runs (methods x sweep values); split the bench", MAX_RUNS), EXIT_USAGE;
+    if (num_runs * o->seeds > MAX_RENDERS)
+        return cli_error("--seeds %d: %d runs x %d seeds = %d renders, more than %d; split the bench", o->seeds,
+                         num_runs, o->seeds, num_runs * o->seeds, MAX_RENDERS),
+               EXIT_USAGE;
 
     scene *s = load_scene_or_default(o->scene_path, o->env_path, (float)(o->env_rotation_deg * 3.14159265358979 / 180.0));
     if (!s) return EXIT_FAILURE_;
@@ -263,31 +352,30 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
         cli_warning("%s: rendered with %s, not pt: its bias is in every error", o->ref_path, have->method);
     camera cam = scene_camera(s, cam_index, (float)width / (float)height);
 
-    int num_runs = plan_runs(o, &base, ref->layer[ERR_HIGHLIGHTS] != NULL, runs);
-    if (num_runs > MAX_RUNS) {
-        cli_error("more than %d runs (methods x sweep values); split the bench", MAX_RUNS);
-        scene_destroy(s);
-        return EXIT_USAGE;
-    }
     char dir[4096];
     if (prepare_dir(o, dir, sizeof dir) != 0) {
         scene_destroy(s);
         return EXIT_FAILURE_;
     }
+    int renders = num_runs * o->seeds;
+    double last = o->times[o->num_times - 1];
     if (!o->quiet)
-        fprintf(stderr, "glint: bench: %d run%s of %g s, about %.0f s; writing into %s\n", num_runs,
-                num_runs == 1 ? "" : "s", o->times[o->num_times - 1], num_runs * o->times[o->num_times - 1], dir);
-    meter m = {ref, NULL, 3 * (size_t)width * (size_t)height};
+        fprintf(stderr, "glint: bench: %d run%s x %d seed%s of %g s, about %.0f s; writing into %s\n", num_runs,
+                num_runs == 1 ? "" : "s", o->seeds, o->seeds == 1 ? "" : "s", last, renders * last, dir);
+    meter m = {.ref = ref, .component = o->component, .n = values};
     m.img = malloc(sizeof(float) * m.n);
-    int status = m.img ? 0 : (cli_error("out of memory"), -1);
+    if (o->seeds > 1) m.sum = malloc((size_t)split_bytes);
+    bench_point(*points)[MAX_TIMES] = calloc((size_t)renders, sizeof *points);
+    int status = m.img && (m.sum || o->seeds == 1) && points ? 0 : (cli_error("out of memory"), -1);
     for (int r = 0; r < num_runs && status == 0; r++) {
-        status = run_one(o, s, &cam, &m, &runs[r], r, num_runs);
-        /* Written after every run, so an interrupted bench keeps what it measured. */
-        if (status == 0) status = bench_write_csv(dir, runs, r + 1, r == 0 ? WRITE_NO_REPLACE : WRITE_REPLACE);
+        runs[r].points = points + (size_t)r * (size_t)o->seeds;
+        status = run_seeds(o, s, &cam, &m, dir, runs, r, num_runs);
     }
     free(m.img);
+    free(m.sum);
     if (status == 0) status = bench_write_plots_and_report(o, dir, ref, &want, runs, num_runs);
-    if (status == 0 && !o->quiet) printf("wrote %s/results.csv, %s/report.md and the plots\n", dir, dir);
+    if (status == 0 && !o->quiet) printf("wrote %s/results.csv, %s/summary.csv, %s/report.md and the plots\n", dir, dir, dir);
+    free(points);
     scene_destroy(s);
     return status == 0 ? EXIT_OK : EXIT_FAILURE_;
 }
