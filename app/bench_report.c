@@ -1,5 +1,5 @@
-/* glint bench: what it writes — results.csv, the error-versus-time and sweep plots (SVG, PNG) and
- * report.md. */
+/* glint bench: what it writes — results.csv (every render), summary.csv (over the seeds), the
+ * error-versus-time and sweep plots (SVG, PNG) and report.md. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -150,7 +150,9 @@ static int write_sweep_plot(const bench_options *o, const char *dir, const bench
                 if (runs[r].sweep == w && runs[r].value == v && runs[r].params.method == o->methods[m])
                     y[ns][v] = err_at(&runs[r], last), any = 1;
         }
-        if (any) series[ns] = (plot_series){.label = method_name(o->methods[m]), .n = sw->num_values, .x = x, .y = y[ns]}, ns++;
+        if (any)
+            series[ns] = (plot_series){.label = method_name(o->methods[m]), .n = sw->num_values, .x = x, .y = y[ns]},
+            ns++;
     }
     if (ns == 0) return 0;
     char title[160], ylabel[96], stem[64];
@@ -245,7 +247,9 @@ static void report_noise_bias(FILE *f, const bench_options *o, const bench_ref *
                "(their spread about their mean image M) and the bias: what is left of ‖M − R‖² once the mean's "
                "noise (noise²/%d) and the reference's own noise r are taken off, clamped at 0. Relative to ‖R‖₂ "
                "like the error, so RMS² = noise² + bias² + r² (exactly, unless the bias was clamped). Noise falls "
-               "as time^−0.5; a consistent estimator's bias falls too, a biased one's stays. ",
+               "as time^−0.5; a consistent estimator's bias falls too, a biased one's stays. With few seeds "
+               "the split is itself uncertain (fireflies above all): a bias well below the noise cannot be told "
+               "from 0, and more seeds narrow it. ",
             o->seeds, o->seeds);
     if (o->component == ERR_ALL && ref->has_info && ref->info.has_noise)
         fprintf(f, "Here r = %.4f, from the reference's sidecar.\n", rn);

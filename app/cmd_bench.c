@@ -374,7 +374,8 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     free(m.img);
     free(m.sum);
     if (status == 0) status = bench_write_plots_and_report(o, dir, ref, &want, runs, num_runs);
-    if (status == 0 && !o->quiet) printf("wrote %s/results.csv, %s/summary.csv, %s/report.md and the plots\n", dir, dir, dir);
+    if (status == 0 && !o->quiet)
+        printf("wrote %s/results.csv, %s/summary.csv, %s/report.md and the plots\n", dir, dir, dir);
     free(points);
     scene_destroy(s);
     return status == 0 ? EXIT_OK : EXIT_FAILURE_;
