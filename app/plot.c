@@ -93,6 +93,9 @@ static void layout_make(const plot_desc *p, layout *l) {
             double x = p->series[s].x[i], y = p->series[s].y[i];
             if (!usable(p->log_x, x) || !usable(p->log_y, y)) continue;
             xmin = fmin(xmin, x), xmax = fmax(xmax, x), ymin = fmin(ymin, y), ymax = fmax(ymax, y);
+            /* the band too, so it is not cut off at the plot's edge */
+            if (p->series[s].lo && usable(p->log_y, p->series[s].lo[i])) ymin = fmin(ymin, p->series[s].lo[i]);
+            if (p->series[s].hi && usable(p->log_y, p->series[s].hi[i])) ymax = fmax(ymax, p->series[s].hi[i]);
         }
     axis_fit(&l->x, p->log_x, xmin, xmax);
     axis_fit(&l->y, p->log_y, ymin, ymax);
@@ -199,6 +202,20 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
         fputs("</text>\n", f);
     }
 
+    /* the bands first, under every curve */
+    for (int s = 0; s < p->num_series; s++) {
+        const plot_series *se = &p->series[s];
+        if (!se->lo || !se->hi) continue;
+        const uint8_t *c = palette[s % 10];
+        fprintf(f, "<polygon fill=\"#%02x%02x%02x\" fill-opacity=\"0.15\" stroke=\"none\" points=\"", c[0], c[1], c[2]);
+        for (int i = 0; i < se->n; i++)
+            if (in_area(&l, se->x[i], se->lo[i]) && in_area(&l, se->x[i], se->hi[i]))
+                fprintf(f, "%.1f,%.1f ", px(&l, se->x[i]), py(&l, se->lo[i]));
+        for (int i = se->n - 1; i >= 0; i--)
+            if (in_area(&l, se->x[i], se->lo[i]) && in_area(&l, se->x[i], se->hi[i]))
+                fprintf(f, "%.1f,%.1f ", px(&l, se->x[i]), py(&l, se->hi[i]));
+        fputs("\"/>\n", f);
+    }
     for (int s = 0; s < p->num_series; s++) {
         const plot_series *se = &p->series[s];
         const uint8_t *c = palette[s % 10];

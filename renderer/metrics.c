@@ -42,6 +42,52 @@ double metric_mean_variance_halves(const float *first, const float *all, size_t 
     return var / (double)n;
 }
 
+double metric_accumulate(double *sum, const float *img, const float *ref, size_t n) {
+    double err = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double d = (double)img[i] - (double)ref[i];
+        err += d * d;
+        sum[i] += (double)img[i];
+    }
+    return err;
+}
+
+double metric_mean_err2(const double *sum, int count, const float *ref, size_t n) {
+    if (count <= 0) return 0.0;
+    double err = 0.0, inv = 1.0 / (double)count;
+    for (size_t i = 0; i < n; i++) {
+        double d = sum[i] * inv - (double)ref[i];
+        err += d * d;
+    }
+    return err;
+}
+
+double metric_norm2(const float *v, size_t n) {
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) s += (double)v[i] * (double)v[i];
+    return s;
+}
+
+/* x / norm, with metric_rel_l2's convention for a zero reference. */
+static double relative(double x, double norm) {
+    if (norm > 0.0) return x / norm;
+    return x > 0.0 ? (double)INFINITY : 0.0;
+}
+
+void metric_noise_bias(double sum_err2, double mean_err2, double ref_norm2, int count, double ref_noise,
+                       double *noise, double *bias) {
+    *noise = *bias = (double)NAN;
+    if (count < 2) return;
+    double n = (double)count;
+    /* sum_k ||I_k - R||^2 = sum_k ||I_k - M||^2 + count ||M - R||^2: the cross term sums to zero. */
+    double spread = fmax(sum_err2 - n * mean_err2, 0.0);
+    double noise2 = spread / (n - 1.0); /* absolute, one run */
+    /* E||M - R||^2 = bias^2 + noise^2 / count + the reference's own noise^2 (independent). */
+    double bias2 = fmax(mean_err2 - noise2 / n - ref_noise * ref_noise * ref_norm2, 0.0);
+    *noise = sqrt(relative(noise2, ref_norm2));
+    *bias = sqrt(relative(bias2, ref_norm2));
+}
+
 static int usable(double x, double y) { return x > 0.0 && isfinite(x) && y > 0.0 && isfinite(y); }
 
 double metric_loglog_slope(const double *x, const double *y, int n) {
@@ -57,6 +103,13 @@ double metric_loglog_slope(const double *x, const double *y, int n) {
     double den = (double)k * sxx - sx * sx;
     if (!(fabs(den) > 1e-12 * (double)k * sxx)) return (double)NAN;
     return ((double)k * sxy - sx * sy) / den;
+}
+
+int metric_last_doubling(const double *x, int n) {
+    if (n < 2) return 0;
+    int k = 0;
+    while (k < n - 2 && x[k] < 0.5 * x[n - 1]) k++;
+    return k;
 }
 
 double metric_loglog_at(const double *x, const double *y, int n, double x0) {

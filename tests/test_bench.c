@@ -1,7 +1,8 @@
 /* glint bench and reference sidecars, run as a user would: the sidecar beside a reference EXR,
  * a bench whose CSV parses (header, monotone time, pt's error falling), whose SVG and PNG plots
- * and report appear, sweeps, the highlights component; mismatched references (size, camera,
- * scene, no or broken sidecar) refused with one error line; nothing ever overwritten.
+ * and report appear, sweeps, the highlights component; several seeds per run, their summary and
+ * its split into noise and bias; mismatched references (size, camera, scene, no or broken
+ * sidecar) and impossible seed counts refused with one error line; nothing ever overwritten.
  * Usage: test_bench PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -17,8 +18,10 @@
 #include "image_io.h"
 
 
-static const char *const header = "method,params,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,direct_relmse,"
-                                  "indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse";
+static const char *const header = "method,params,seed,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,"
+                                  "direct_relmse,indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse";
+static const char *const summary_header = "method,params,component,budget,seeds,seconds,frames,rel_l2,relmse,noise,"
+                                          "bias,ref_noise,rel_l2_min,rel_l2_max";
 
 static int count_lines(const char *s) {
     int n = 0;
@@ -26,14 +29,17 @@ static int count_lines(const char *s) {
     return n;
 }
 
-/* A non-zero exit and stderr exactly one "glint: error: ..." line containing needle. */
-static void expect_refusal(const char *args, const char *needle) {
+/* A non-zero exit (usage: exactly 2) and stderr exactly one "glint: error: ..." line containing
+ * needle. */
+static void expect_exit(const char *args, const char *needle, int usage) {
     int rc = run(args);
-    CHECK(rc > 0, "'%s': exit %d, expected a failure", args, rc);
+    CHECK(usage ? rc == 2 : rc > 0, "'%s': exit %d, expected %s", args, rc, usage ? "2 (usage)" : "a failure");
     CHECK(strncmp(err_text, "glint: error: ", 14) == 0 && count_lines(err_text) == 1,
           "'%s': stderr is not one error line: '%s'", args, err_text);
     CHECK(strstr(err_text, needle) != NULL, "'%s': error '%s' lacks '%s'", args, err_text, needle);
 }
+static void expect_refusal(const char *args, const char *needle) { expect_exit(args, needle, 0); }
+static void expect_usage(const char *args, const char *needle) { expect_exit(args, needle, 1); }
 
 static int exists(const char *name) {
     char p[1024];
@@ -56,9 +62,23 @@ static void write_text(const char *name, const char *text) {
 typedef struct {
     char method[16], params[64];
     double seconds, rel_l2, highlights_rel_l2;
-    long long frames;
+    long long frames, seed;
     int fields, has_highlights;
 } row;
+
+/* Splits a CSV line in place (empty fields count: no strtok); returns the number of fields. */
+static int split_fields(char *line, char **field, int cap) {
+    int k = 0;
+    for (char *p = line;; p++) {
+        if (k < cap) field[k++] = p;
+        p = strchr(p, ',');
+        if (!p) break;
+        *p = 0;
+    }
+    return k;
+}
+
+static double number_or_nan(const char *field) { return field[0] ? atof(field) : NAN; }
 
 /* Parses results.csv: the header must be exact; returns the number of rows (-1: bad header). */
 static int parse_csv(const char *name, row *rows, int cap) {
@@ -76,22 +96,54 @@ static int parse_csv(const char *name, row *rows, int cap) {
         row *r = &rows[n++];
         memset(r, 0, sizeof *r);
         char *field[32];
-        int k = 0;
-        for (char *p = line;; p++) { /* empty fields count: no strtok */
-            if (k < 32) field[k++] = p;
-            p = strchr(p, ',');
-            if (!p) break;
-            *p = 0;
-        }
+        int k = split_fields(line, field, 32);
         r->fields = k;
-        if (k != 14) continue;
+        if (k != 15) continue;
         snprintf(r->method, sizeof r->method, "%s", field[0]);
         snprintf(r->params, sizeof r->params, "%s", field[1]);
-        r->seconds = atof(field[2]);
-        r->frames = atoll(field[3]);
-        r->rel_l2 = field[6][0] ? atof(field[6]) : NAN;
-        r->has_highlights = field[12][0] != 0;
-        r->highlights_rel_l2 = r->has_highlights ? atof(field[12]) : NAN;
+        r->seed = atoll(field[2]);
+        r->seconds = atof(field[3]);
+        r->frames = atoll(field[4]);
+        r->rel_l2 = number_or_nan(field[7]);
+        r->has_highlights = field[13][0] != 0;
+        r->highlights_rel_l2 = number_or_nan(field[13]);
+    }
+    return n;
+}
+
+/* One parsed summary.csv row: over the seeds of one method and setting at one budget. */
+typedef struct {
+    char method[16], component[16];
+    double budget, seconds, frames, rel_l2, relmse, noise, bias, ref_noise, lo, hi;
+    int seeds, fields;
+} summary_row;
+
+/* Parses summary.csv: the header must be exact; returns the number of rows (-1: bad header). */
+static int parse_summary(const char *name, summary_row *rows, int cap) {
+    static char text[1 << 16];
+    read_file(name, text, sizeof text);
+    char *line = text, *nl = strchr(line, '\n');
+    if (!nl) return -1;
+    *nl = 0;
+    if (strcmp(line, summary_header) != 0) return -1;
+    int n = 0;
+    for (line = nl + 1; *line && n < cap; line = nl + 1) {
+        nl = strchr(line, '\n');
+        if (!nl) break;
+        *nl = 0;
+        summary_row *r = &rows[n++];
+        memset(r, 0, sizeof *r);
+        char *field[32];
+        r->fields = split_fields(line, field, 32);
+        if (r->fields != 14) continue;
+        snprintf(r->method, sizeof r->method, "%s", field[0]);
+        snprintf(r->component, sizeof r->component, "%s", field[2]);
+        r->budget = atof(field[3]);
+        r->seeds = atoi(field[4]);
+        r->seconds = atof(field[5]);
+        r->frames = atof(field[6]);
+        double *v[7] = {&r->rel_l2, &r->relmse, &r->noise, &r->bias, &r->ref_noise, &r->lo, &r->hi};
+        for (int k = 0; k < 7; k++) *v[k] = number_or_nan(field[7 + k]);
     }
     return n;
 }
@@ -141,7 +193,8 @@ static void test_bench_run(void) {
     int n = parse_csv("b1/results.csv", rows, 64);
     CHECK(n == 6, "results.csv: %d rows (-1: bad header), expected 6", n);
     for (int i = 0; i < n; i++) {
-        CHECK(rows[i].fields == 14, "row %d has %d fields", i, rows[i].fields);
+        CHECK(rows[i].fields == 15, "row %d has %d fields", i, rows[i].fields);
+        CHECK(rows[i].seed == 8, "row %d: seed %lld, expected the reference's + 1", i, rows[i].seed);
         CHECK(isfinite(rows[i].rel_l2) && rows[i].rel_l2 > 0.0 && !rows[i].has_highlights,
               "row %d: rel_l2 %g, highlights column filled without a highlights layer", i, rows[i].rel_l2);
         if (i % 3 > 0)
@@ -157,6 +210,16 @@ static void test_bench_run(void) {
         CHECK(rows[2].rel_l2 < 0.6 * rows[0].rel_l2, "pt's error does not fall: %g at %g s, %g at %g s", rows[0].rel_l2,
               rows[0].seconds, rows[2].rel_l2, rows[2].seconds);
     }
+    /* One seed: the summary's RMS is the run's own error; noise and bias are unknown (empty). */
+    summary_row sum[16];
+    int ns = parse_summary("b1/summary.csv", sum, 16);
+    CHECK(ns == 6, "summary.csv: %d rows (-1: bad header), expected 6", ns);
+    for (int i = 0; i < ns && i < n; i++)
+        CHECK(sum[i].fields == 14 && sum[i].seeds == 1 && strcmp(sum[i].method, rows[i].method) == 0 &&
+                  strcmp(sum[i].component, "all") == 0 && fabs(sum[i].rel_l2 - rows[i].rel_l2) <= 1e-5 * rows[i].rel_l2 &&
+                  sum[i].lo == sum[i].hi && fabs(sum[i].lo - sum[i].rel_l2) <= 1e-5 * sum[i].lo && isnan(sum[i].noise) && isnan(sum[i].bias),
+              "summary row %d: %d fields, %d seeds, %s, rel_l2 %g (run %g), noise %g, bias %g", i, sum[i].fields,
+              sum[i].seeds, sum[i].method, sum[i].rel_l2, rows[i].rel_l2, sum[i].noise, sum[i].bias);
     char svg[1 << 16];
     read_file("b1/error-vs-time.svg", svg, sizeof svg);
     CHECK(strncmp(svg, "<svg", 4) == 0 && strstr(svg, "</svg>") && strstr(svg, "<polyline") && strstr(svg, ">pt<") &&
@@ -176,7 +239,7 @@ static void test_bench_run(void) {
     char md[1 << 16];
     read_file("b1/report.md", md, sizeof md);
     CHECK(strstr(md, "| pt |") && strstr(md, "| vsl |") && strstr(md, "## Convergence") && strstr(md, "## Equal error") &&
-              strstr(md, "| 1 s |"),
+              strstr(md, "| 1 s |") && strstr(md, "| 0.3–1 s |"),
           "report.md: %s", md);
 
     /* Nothing is overwritten: the same --out is refused, the files stay as they were. */
@@ -214,6 +277,117 @@ static void test_sweeps_and_highlights(void) {
     CHECK(n == 4, "highlights results: %d rows", n);
     for (int i = 0; i < n; i++)
         CHECK(rows[i].has_highlights && isfinite(rows[i].highlights_rel_l2), "row %d lacks its highlights error", i);
+}
+
+/* Every summary row with two seeds or more must satisfy the split's identity: RMS^2 = noise^2 +
+ * bias^2 + ref_noise^2, or, where the bias was clamped at 0, RMS^2 <= noise^2 + ref_noise^2. A
+ * split that forgets the mean's noise (noise^2 / N), the reference's noise or divides by N where
+ * N - 1 belongs breaks it. The CSV's 6 digits allow 1e-4 relative. */
+static void check_identity(const summary_row *r, const char *what) {
+    double rms2 = r->rel_l2 * r->rel_l2, parts = r->noise * r->noise + r->bias * r->bias + r->ref_noise * r->ref_noise;
+    CHECK(isfinite(r->noise) && isfinite(r->bias) && r->bias >= 0.0, "%s at %g s: noise %g, bias %g", what, r->budget,
+          r->noise, r->bias);
+    if (r->bias > 0.0)
+        CHECK(fabs(rms2 - parts) <= 1e-4 * rms2, "%s at %g s: RMS^2 %g != noise^2 + bias^2 + ref_noise^2 = %g", what,
+              r->budget, rms2, parts);
+    else
+        CHECK(rms2 <= parts * (1.0 + 1e-4), "%s at %g s: bias clamped, yet RMS^2 %g > noise^2 + ref_noise^2 = %g", what,
+              r->budget, rms2, parts);
+    CHECK(r->lo <= r->rel_l2 * (1.0 + 1e-5) && r->rel_l2 <= r->hi * (1.0 + 1e-5), "%s at %g s: RMS %g outside %g..%g",
+          what, r->budget, r->rel_l2, r->lo, r->hi);
+}
+
+static void test_seeds(void) {
+    /* pt against a reference of the same scene rendered far longer (1024 spp against some 10 to
+     * 60 frames here): unbiased, so the bias estimate is left with the estimate's own scatter.
+     * Measured on 12 benches of 4 seeds: bias/noise at most 0.64 per budget, the sum of bias^2
+     * at most 0.4 of the sum of noise^2 over the budgets; 6 seeds narrow that. Swapping noise and
+     * bias puts the ratio far above 1. */
+    int rc = run("bench --reference ref.exr --methods pt --seeds 6 --times 0.02,0.06 --threads 1 --quiet --out s1");
+    CHECK(rc == 0, "--seeds 6: exit %d: %s", rc, err_text);
+    row rows[64];
+    int n = parse_csv("s1/results.csv", rows, 64);
+    CHECK(n == 12, "--seeds 6: %d rows in results.csv (-1: bad header), expected 6 seeds x 2 budgets", n);
+    for (int i = 0; i < n; i++)
+        CHECK(rows[i].fields == 15 && rows[i].seed == 8 + i / 2 && isfinite(rows[i].rel_l2),
+              "row %d: seed %lld, expected %d (the reference's + 1, + 2, ...)", i, rows[i].seed, 8 + i / 2);
+    summary_row sum[16];
+    int ns = parse_summary("s1/summary.csv", sum, 16);
+    CHECK(ns == 2, "--seeds 6: %d summary rows (-1: bad header), expected 2", ns);
+    double noise2 = 0.0, bias2 = 0.0;
+    for (int i = 0; i < ns; i++) {
+        CHECK(sum[i].fields == 14 && sum[i].seeds == 6 && strcmp(sum[i].method, "pt") == 0 &&
+                  sum[i].budget == (i == 0 ? 0.02 : 0.06) && sum[i].ref_noise > 0.0,
+              "summary row %d: %d fields, %d seeds, %s at %g, ref_noise %g", i, sum[i].fields, sum[i].seeds,
+              sum[i].method, sum[i].budget, sum[i].ref_noise);
+        /* The summary against results.csv: RMS, least and largest over the seeds at this budget. */
+        double sq = 0.0, lo = INFINITY, hi = 0.0, frames = 0.0;
+        for (int j = i; j < n; j += 2) {
+            sq += rows[j].rel_l2 * rows[j].rel_l2;
+            lo = fmin(lo, rows[j].rel_l2);
+            hi = fmax(hi, rows[j].rel_l2);
+            frames += (double)rows[j].frames;
+        }
+        CHECK(fabs(sum[i].rel_l2 - sqrt(sq / 6)) <= 1e-4 * sum[i].rel_l2 && fabs(sum[i].lo - lo) <= 1e-5 * lo &&
+                  fabs(sum[i].hi - hi) <= 1e-5 * hi && fabs(sum[i].frames - frames / 6) <= 1e-4 * frames,
+              "summary row %d: RMS %g, min %g, max %g, frames %g; from results.csv %g, %g, %g, %g", i, sum[i].rel_l2,
+              sum[i].lo, sum[i].hi, sum[i].frames, sqrt(sq / 6), lo, hi, frames / 6);
+        check_identity(&sum[i], "pt");
+        CHECK(sum[i].bias < sum[i].noise, "pt at %g s: bias %g not below noise %g", sum[i].budget, sum[i].bias,
+              sum[i].noise);
+        noise2 += sum[i].noise * sum[i].noise;
+        bias2 += sum[i].bias * sum[i].bias;
+    }
+    CHECK(bias2 < 0.5 * noise2, "pt: bias^2 %g against noise^2 %g over the budgets", bias2, noise2);
+    char md[1 << 16];
+    read_file("s1/report.md", md, sizeof md);
+    CHECK(strstr(md, "RMS over 6 seeds") && strstr(md, "## Noise and bias") && strstr(md, "### pt") &&
+              strstr(md, "| noise | bias |"),
+          "report.md with seeds: %s", md);
+    char svg[1 << 16];
+    read_file("s1/error-vs-time.svg", svg, sizeof svg);
+    CHECK(strstr(svg, "fill-opacity") != NULL, "the SVG lacks the band over the seeds");
+
+    /* All bias, no noise: at depth 1 the path tracer has no indirect light at all, so every seed's
+     * indirect image is zero: noise 0 and bias 1 exactly (the reference's noise is not known for a
+     * component, so it counts as 0). */
+    rc = run("bench --reference ref.exr --methods pt --seeds 2 --max-depth 1 --component indirect --times 0.01 "
+             "--threads 1 --quiet --out s2");
+    CHECK(rc == 0, "depth 1: exit %d: %s", rc, err_text);
+    ns = parse_summary("s2/summary.csv", sum, 16);
+    CHECK(ns == 1 && strcmp(sum[0].component, "indirect") == 0 && sum[0].noise == 0.0 && sum[0].bias == 1.0 &&
+              sum[0].rel_l2 == 1.0 && sum[0].ref_noise == 0.0,
+          "depth 1, indirect: %d rows, noise %g, bias %g, RMS %g, ref_noise %g", ns, sum[0].noise, sum[0].bias,
+          sum[0].rel_l2, sum[0].ref_noise);
+    if (ns == 1) check_identity(&sum[0], "depth 1");
+    /* Bias and noise together: the whole image at depth 1 lacks the indirect light, a bias of
+     * 0.19 to 0.35 of the reference measured (8 benches of 3 seeds, 16 to 60 frames), never
+     * clamped at 0; its noise is the direct light's. So the identity holds in its strict form here,
+     * which a split that forgets the mean's noise or the reference's would break. */
+    rc = run("bench --reference ref.exr --methods pt --seeds 3 --max-depth 1 --times 0.06 --threads 1 --quiet --out s3");
+    CHECK(rc == 0, "depth 1, all: exit %d: %s", rc, err_text);
+    ns = parse_summary("s3/summary.csv", sum, 16);
+    CHECK(ns == 1 && sum[0].bias > 0.1 && sum[0].noise > 0.0, "depth 1, all: %d rows, noise %g, bias %g", ns,
+          sum[0].noise, sum[0].bias);
+    if (ns == 1) check_identity(&sum[0], "depth 1, all");
+
+    /* Impossible seed counts: usage errors, nothing created. The reference's seed is 7: the
+     * seeds 5, 6, 7 hold it. */
+    expect_usage("bench --reference ref.exr --seeds 0 --times 0.05 --out q1", "--seeds");
+    expect_usage("bench --reference ref.exr --seeds 1001 --times 0.05 --out q2", "--seeds");
+    expect_usage("bench --reference ref.exr --seeds two --times 0.05 --out q3", "--seeds");
+    expect_usage("bench --reference ref.exr --seed 5 --seeds 3 --times 0.05 --out q4", "reference's seed 7");
+    expect_usage("bench --reference ref.exr --methods vsl --sweep columns=1,2,3,4,5 --seeds 1000 --times 0.05 --out q5",
+                 "5000 renders");
+    /* The split's sum images, 640x560 doubles x 3 x 64 budgets, are 525 MiB: refused. */
+    rc = run("render --spp 1 --size 640x560 --max-depth 1 --out big.exr --quiet");
+    CHECK(rc == 0, "big reference: exit %d: %s", rc, err_text);
+    char times[512] = "1";
+    for (int k = 2; k <= 64; k++) snprintf(times + strlen(times), sizeof times - strlen(times), ",%d", k);
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "bench --reference big.exr --seeds 2 --times %s --out q6", times);
+    expect_usage(cmd, "MiB");
+    CHECK(!exists("q1") && !exists("q4") && !exists("q5") && !exists("q6"), "a refused bench created its directory");
 }
 
 static void test_refusals(void) {
@@ -287,6 +461,7 @@ int main(int argc, char **argv) {
     test_sidecar();
     test_bench_run();
     test_sweeps_and_highlights();
+    test_seeds();
     test_refusals();
     return check_exit("test_bench");
 }

@@ -1,7 +1,8 @@
 /* The error metrics and the error-curve numerics of glint bench, against hand-computed values:
  * relative L2 and relMSE (including no pixels and an all-zero reference), the two-halves
- * variance of a progressive mean (by hand, and on Gaussian samples of known variance), log-log
- * slopes and interpolation. */
+ * variance of a progressive mean (by hand, and on Gaussian samples of known variance), the noise
+ * and bias split over seeds (by hand, one seed, a zero reference, and on Gaussian runs of known
+ * noise and bias), log-log slopes, the last doubling and interpolation. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -69,6 +70,88 @@ static void test_variance(void) {
     free(b);
 }
 
+/* Accumulates the runs imgs[k] (n values each) as glint bench does and splits their error. */
+static void split(const float *imgs, int count, const float *ref, size_t n, double ref_noise, double *noise,
+                  double *bias, double *sum_err2) {
+    double sum[8] = {0};
+    *sum_err2 = 0.0;
+    for (int k = 0; k < count; k++) *sum_err2 += metric_accumulate(sum, imgs + (size_t)k * n, ref, n);
+    metric_noise_bias(*sum_err2, metric_mean_err2(sum, count, ref, n), metric_norm2(ref, n), count, ref_noise, noise,
+                      bias);
+}
+
+static void test_noise_bias(void) {
+    /* By hand: R = (1, 1), I_1 = (3, 2), I_2 = (3, 0). M = (3, 1): ||M - R||^2 = 4, each run's
+     * ||I_k - R||^2 = 5, ||I_k - M||^2 = 1, ||R||^2 = 2. noise^2 = (1 + 1) / 1 / 2 = 1; bias^2 =
+     * 4/2 - 1/2 = 1.5; the RMS of the runs' rel_l2 is sqrt(5/2) = sqrt(noise^2 + bias^2). */
+    const float ref[2] = {1, 1}, imgs[4] = {3, 2, 3, 0};
+    double sum[2] = {0, 0};
+    CHECK_NEAR(metric_accumulate(sum, imgs, ref, 2), 5.0, 0, "||I_1 - R||^2");
+    CHECK_NEAR(metric_accumulate(sum, imgs + 2, ref, 2), 5.0, 0, "||I_2 - R||^2");
+    CHECK(sum[0] == 6.0 && sum[1] == 2.0, "sum image %g %g", sum[0], sum[1]);
+    CHECK_NEAR(metric_mean_err2(sum, 2, ref, 2), 4.0, 1e-15, "||M - R||^2");
+    CHECK_NEAR(metric_norm2(ref, 2), 2.0, 0, "||R||^2");
+    double noise, bias, se;
+    split(imgs, 2, ref, 2, 0.0, &noise, &bias, &se);
+    CHECK_NEAR(noise, 1.0, 1e-15, "noise");
+    CHECK_NEAR(bias, sqrt(1.5), 1e-15, "bias");
+    CHECK_NEAR(se / 2 / 2, noise * noise + bias * bias, 1e-15, "rms^2 = noise^2 + bias^2");
+    /* The reference's own noise 0.5 comes off the bias: bias^2 = 1.5 - 0.25, and rms^2 = noise^2
+     * + bias^2 + ref_noise^2; a larger one than the bias clamps it at 0. */
+    split(imgs, 2, ref, 2, 0.5, &noise, &bias, &se);
+    CHECK_NEAR(noise, 1.0, 1e-15, "noise with a noisy reference");
+    CHECK_NEAR(bias, sqrt(1.25), 1e-15, "bias less the reference's noise");
+    CHECK_NEAR(se / 2 / 2, noise * noise + bias * bias + 0.25, 1e-15, "rms^2 with the reference's noise");
+    split(imgs, 2, ref, 2, 2.0, &noise, &bias, &se);
+    CHECK(noise == 1.0 && bias == 0.0, "bias clamped at 0: %g", bias);
+    /* Swapped roles must show: all runs equal (no noise, all bias), and runs symmetric about R (all
+     * noise, no bias). I = (2, 2) twice: noise 0, bias ||(1,1)|| / ||R|| = 1. */
+    const float same[4] = {2, 2, 2, 2}, around[4] = {2, 1, 0, 1};
+    split(same, 2, ref, 2, 0.0, &noise, &bias, &se);
+    CHECK(noise == 0.0 && bias == 1.0, "equal runs: noise %g, bias %g", noise, bias);
+    /* I = (2, 1), (0, 1): M = R, each ||I_k - M||^2 = 1, noise^2 = 2 / 1 / 2 = 1, bias 0. */
+    split(around, 2, ref, 2, 0.0, &noise, &bias, &se);
+    CHECK(noise == 1.0 && bias == 0.0, "runs about R: noise %g, bias %g", noise, bias);
+    /* Three runs: R = (2), I = 1, 2, 6: M = 3, ||M - R||^2 = 1, sum ||I_k - M||^2 = 4 + 1 + 9 = 14,
+     * ||R||^2 = 4: noise^2 = 14 / 2 / 4 = 1.75, bias^2 = 1/4 - 1.75/3 < 0 -> 0. */
+    const float r1[1] = {2}, three[3] = {1, 2, 6};
+    split(three, 3, r1, 1, 0.0, &noise, &bias, &se);
+    CHECK_NEAR(noise, sqrt(1.75), 1e-15, "three runs: noise");
+    CHECK(bias == 0.0, "three runs: bias %g", bias);
+
+    /* One run: noise and bias cannot be told apart. */
+    split(imgs, 1, ref, 2, 0.0, &noise, &bias, &se);
+    CHECK(isnan(noise) && isnan(bias) && se == 5.0, "one run: noise %g, bias %g", noise, bias);
+
+    /* A zero reference: zero runs are exact; equal nonzero runs are all bias (infinite relative);
+     * runs symmetric about zero are all noise. */
+    const float z[2] = {0, 0}, zeros[4] = {0, 0, 0, 0}, ones[4] = {1, 0, 1, 0}, pm[4] = {1, 0, -1, 0};
+    split(zeros, 2, z, 2, 0.0, &noise, &bias, &se);
+    CHECK(noise == 0.0 && bias == 0.0, "zero against zero: noise %g, bias %g", noise, bias);
+    split(ones, 2, z, 2, 0.0, &noise, &bias, &se);
+    CHECK(noise == 0.0 && isinf(bias), "equal runs against zero: noise %g, bias %g", noise, bias);
+    split(pm, 2, z, 2, 0.0, &noise, &bias, &se);
+    CHECK(isinf(noise) && bias == 0.0, "runs about zero: noise %g, bias %g", noise, bias);
+
+    /* Gaussian runs of known bias and noise: 4000 values of R = 1, each run R + 0.1 + N(0, 0.2^2)
+     * per value, 6 runs. Relative to ||R||: noise 0.2, bias 0.1. */
+    enum { N = 4000, K = 6 };
+    float *runs = malloc(sizeof(float) * N * K), *flat = malloc(sizeof(float) * N);
+    double *acc = calloc(N, sizeof(double));
+    double sum_err2 = 0.0;
+    for (int i = 0; i < N; i++) flat[i] = 1.0f;
+    for (int k = 0; k < K; k++) {
+        for (int i = 0; i < N; i++) runs[k * N + i] = (float)(1.1 + 0.2 * gauss());
+        sum_err2 += metric_accumulate(acc, runs + k * N, flat, N);
+    }
+    metric_noise_bias(sum_err2, metric_mean_err2(acc, K, flat, N), metric_norm2(flat, N), K, 0.0, &noise, &bias);
+    CHECK_NEAR(noise, 0.2, 0.01, "Gaussian runs: noise");
+    CHECK_NEAR(bias, 0.1, 0.01, "Gaussian runs: bias");
+    free(runs);
+    free(flat);
+    free(acc);
+}
+
 static void test_curves(void) {
     const double t[4] = {1, 2, 4, 8};
     double e[4];
@@ -82,6 +165,15 @@ static void test_curves(void) {
     /* Unusable points are skipped: a zero error, an infinite one. */
     const double holes[4] = {0.3, 0.0, INFINITY, 0.3 / sqrt(8.0)};
     CHECK_NEAR(metric_loglog_slope(t, holes, 4), -0.5, 1e-12, "skipping 0 and inf");
+
+    /* The last doubling: 4..8 of 1, 2, 4, 8; 300..600 of 2, 10, 60, 300, 600; the last step when it
+     * is more than a doubling; the whole curve when it spans less than one. */
+    const double budgets[5] = {2, 10, 60, 300, 600}, wide[2] = {10, 60}, narrow[3] = {1, 1.5, 2};
+    CHECK(metric_last_doubling(t, 4) == 2, "1, 2, 4, 8: %d", metric_last_doubling(t, 4));
+    CHECK(metric_last_doubling(budgets, 5) == 3, "up to 600 s: %d", metric_last_doubling(budgets, 5));
+    CHECK(metric_last_doubling(budgets, 3) == 1, "2, 10, 60: %d", metric_last_doubling(budgets, 3));
+    CHECK(metric_last_doubling(wide, 2) == 0 && metric_last_doubling(narrow, 3) == 0, "two points, or less than a doubling");
+    CHECK(metric_last_doubling(t, 1) == 0 && metric_last_doubling(t, 0) == 0, "fewer than two points");
 
     /* Log-log interpolation: between (1, 1) and (4, 0.5), at 2 (halfway in log) sqrt(0.5). */
     const double x[2] = {1, 4}, y[2] = {1, 0.5};
@@ -100,6 +192,7 @@ static void test_curves(void) {
 int main(void) {
     test_errors();
     test_variance();
+    test_noise_bias();
     test_curves();
     return check_exit("test_metrics");
 }

@@ -1,0 +1,113 @@
+/* glint bench: what the command's parts share — its options, the runs it plans and measures,
+ * the reference it measures against — and the parts' entry points: parsing the options
+ * (bench_options.c), running (cmd_bench.c), writing the results, plots and report
+ * (bench_report.c). */
+#ifndef GLINT_BENCH_H
+#define GLINT_BENCH_H
+
+#include <stdint.h>
+
+#include "image_io.h"
+#include "reference.h"
+#include "session.h"
+
+/* MAX_RENDERS bounds runs x seeds (each a render of the last budget's length); MAX_SPLIT_BYTES
+ * the sum images the noise and bias split keeps, one per budget (320x240 at 64 budgets takes
+ * 113 MiB). */
+enum { MAX_METHODS = 8, MAX_TIMES = 64, MAX_SWEEPS = 8, MAX_VALUES = 32, MAX_RUNS = 256, MAX_SEEDS = 1000,
+       MAX_RENDERS = 4096 };
+#define MAX_SPLIT_BYTES ((double)(512u << 20))
+
+/* The error columns: the image and its components. Indirect always means all light after the
+ * first bounce (highlights included), so it means the same for every method; highlights are
+ * compared only where both the reference and the method split them off. */
+enum { ERR_ALL = 0, ERR_DIRECT, ERR_INDIRECT, ERR_HIGHLIGHTS, ERR_COUNT };
+extern const char *const bench_err_names[ERR_COUNT];
+
+typedef struct {
+    char name[32];
+    int num_values;
+    char values[MAX_VALUES][32];
+} sweep;
+
+typedef struct {
+    const char *scene_path, *ref_path, *out_dir, *env_path;
+    double env_rotation_deg;
+    render_method methods[MAX_METHODS];
+    int num_methods;
+    double times[MAX_TIMES];
+    int num_times;
+    sweep sweeps[MAX_SWEEPS];
+    int num_sweeps;
+    int component; /* ERR_* */
+    int width, height;      /* 0: the reference's */
+    long long camera_index; /* -2: the reference's */
+    int max_depth;          /* 0: the reference's */
+    uint64_t seed; /* the first seed's */
+    int seed_given;
+    int seeds;     /* renders per run, with seeds seed, seed + 1, ... */
+    int threads;
+    vl_params vl; /* the many-light options given: every run's base */
+    char base_text[512];
+    int force, quiet;
+} bench_options;
+
+/* One checkpoint of one render. */
+typedef struct {
+    double seconds, rays;
+    long long frames;
+    double rel_l2[ERR_COUNT], relmse[ERR_COUNT]; /* NAN: not measured */
+} bench_point;
+
+/* A run: one method with one setting, rendered once per seed. */
+typedef struct {
+    render_params params; /* params.seed is the first seed's */
+    char setting[64];     /* "radius-mult=4", or "" for the base parameters */
+    char label[96];       /* "vsl radius-mult=4" */
+    int sweep;            /* index into the options' sweeps, -1 for a base run */
+    int value;
+    bench_point (*points)[MAX_TIMES]; /* [seed][budget] */
+    int seeds_done;                   /* renders measured at every budget */
+    /* Over the seeds, per budget, in the reported component; num_points is 0 until every seed
+     * is done. */
+    int num_points;
+    double seconds[MAX_TIMES], frames[MAX_TIMES]; /* means */
+    double rms[MAX_TIMES];                        /* RMS of rel_l2: sqrt(mean rel_l2^2) */
+    double relmse[MAX_TIMES];                     /* mean: relMSE is a mean of squares already */
+    double lo[MAX_TIMES], hi[MAX_TIMES];          /* min and max of rel_l2 */
+    double noise[MAX_TIMES], bias[MAX_TIMES];     /* metric_noise_bias; NAN with one seed */
+} bench_run;
+
+typedef struct {
+    int width, height;
+    float *layer[ERR_COUNT]; /* interleaved RGB; NULL when the EXR lacks the layer */
+    reference_info info;
+    int has_info;
+} bench_ref;
+
+/* The reference's own relative noise in a component, as its sidecar records it: known for the
+ * whole image only (0 otherwise, and without a sidecar). */
+static inline double bench_ref_noise(const bench_ref *r, int component) {
+    return component == ERR_ALL && r->has_info && r->info.has_noise ? r->info.rel_l2_noise : 0.0;
+}
+
+/* Parses glint bench's arguments. Returns 0 to run, 1 when --help was shown, -1 on a usage error
+ * (already reported). */
+int bench_parse_options(int argc, char **argv, bench_options *o);
+
+/* The methods a sweepable many-light parameter is live for (bit per render_method). */
+unsigned bench_sweep_methods(const char *name);
+
+/* results.csv: every checkpoint of every render done of the first num_runs runs; summary.csv:
+ * the aggregates of the runs done (num_points > 0). mode: WRITE_NO_REPLACE the first time, then
+ * WRITE_REPLACE as renders complete. Return 0, or -1 after reporting the error. */
+int bench_write_csv(const char *dir, const bench_run *runs, int num_runs, int num_times, write_mode mode);
+int bench_write_summary(const bench_options *o, const char *dir, const bench_ref *ref, const bench_run *runs,
+                        int num_runs, write_mode mode);
+
+/* The plots (error-vs-time, one per numeric sweep) and report.md, never replacing a file. want
+ * describes what the bench rendered. Returns 0, or -1 after reporting the error. */
+int bench_write_plots_and_report(const bench_options *o, const char *dir, const bench_ref *ref,
+                                 const reference_info *want, const bench_run *runs, int num_runs);
+
+#endif
