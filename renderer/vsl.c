@@ -132,10 +132,26 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
                                   (float)fmin(sum[2], VL_MAX_CONTRIBUTION)), 1.0 / n);
 }
 
+/* The share of a disk of radius 1 on the far side of a chord at signed distance h from its centre
+ * (1 for h >= 1, 1/2 for h = 0). */
+static double disk_share(double h) {
+    if (h >= 1.0) return 1.0;
+    if (h <= -1.0) return 0.0;
+    return 1.0 - (acos(h) - h * sqrt(1.0 - h * h)) / PI_D;
+}
+
+double vsl_front_share(const virtual_light *vl, const shading_point *x) {
+    vec3 d = sub3(vl->p, x->p);
+    double r = (double)vl->radius;
+    return fmin(disk_share((double)dot3(d, x->ng) / r), disk_share(-(double)dot3(d, vl->ng) / r));
+}
+
 vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
                       int *samples) {
     if (!(vl->radius > 0.0f)) return vpl_contribution(vl, x, 1, terms); /* the limit r -> 0 */
     vec3 i = vsl_integral(vl, x, terms, all_strategies, rng, samples);
     if (is_black3(i)) return i;
-    return saturate(vl->power, i, 1.0 / (PI_D * (double)vl->radius * (double)vl->radius));
+    double share = vsl_front_share(vl, x);
+    if (!(share > 0.0)) return v3(0, 0, 0);
+    return saturate(vl->power, i, 1.0 / (PI_D * (double)vl->radius * (double)vl->radius * share));
 }

@@ -37,13 +37,23 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
 /* Largest number of integration samples for one VSL (when x is inside its sphere, |Omega| = 2pi). */
 #define VSL_MAX_SAMPLES 100
 
-/* Phi_j / (pi r_j^2) x the integral over the cone Omega_j of Eq. 5, no visibility: uniform cone
- * sampling (cosine-weighted hemisphere when x is inside the sphere), BSDF sampling at x and BSDF
- * sampling at the light, one sample model with the balance heuristic; ceil(100 |Omega|/2pi)
+/* Phi_j / (pi r_j^2 share) x the integral over the cone Omega_j of Eq. 5, no visibility: uniform
+ * cone sampling (cosine-weighted hemisphere when x is inside the sphere), BSDF sampling at x and
+ * BSDF sampling at the light, one sample model with the balance heuristic; ceil(100 |Omega|/2pi)
  * samples, at least 1. Unless all_strategies, a pair without a glossy lobe sharper than
- * BSDF_HIGHLIGHT_ALPHA uses cone sampling alone. *samples (optional) receives the count used. */
+ * BSDF_HIGHLIGHT_ALPHA uses cone sampling alone. share is vsl_front_share: where the sphere
+ * reaches behind x's surface or the light's, that part would send its light from inside the
+ * geometry and the paper's estimator loses it (half of what a light on the floor by a wall sends
+ * to the wall, 10-20% along a room's edges); the rest of the sphere carries it instead
+ * (docs/design.md). *samples (optional) receives the count used. */
 vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
                       int *samples);
+
+/* The share of the sphere's cross-section in front of the receiver's tangent plane, and in front of
+ * the light's, whichever is smaller (1 when the sphere clears both): a disk seen edge-on to each
+ * plane, cut at the centre's distance from it over r. Within 5% of the energy the unclipped point
+ * light sends to a wall at any distance of the light from it (test_vsl). */
+double vsl_front_share(const virtual_light *vl, const shading_point *x);
 
 /* The integral of Eq. 5 alone (without Phi / (pi r^2)), for tests. */
 vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
