@@ -1,7 +1,7 @@
 /* glint — the one BSDF. Lambert plus one glossy lobe (GGX, modified Phong or Ward), evaluated,
  * sampled and given pdfs here and nowhere else. Everything is in the local shading frame.
  *
- * The glossy formulas are written in forms that stay finite at the traps DESIGN.md lists: grazing
+ * The glossy formulas are written in forms that stay finite at the traps docs/design.md lists: grazing
  * wo (Smith's Lambda is never formed as a ratio by wo.z), razor-sharp lobes (roughness floored at
  * BSDF_MIN_ALPHA, cosines of tiny angles computed from chord lengths). */
 #include "bsdf.h"

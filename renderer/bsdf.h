@@ -19,7 +19,7 @@ extern "C" {
  * for estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe. */
 enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_ALL = 3, BSDF_NOT_HIGHLIGHT = 4 };
 
-/* The path-space split (DESIGN.md): camera - glossy - glossy - light paths belong to the
+/* The path-space split (docs/design.md): camera - glossy - glossy - light paths belong to the
  * highlight estimator when both glossy lobes are sharper than this roughness (microfacet alpha).
  * A rougher lobe reflects much like a diffuse one: it stays with the many-light estimators, costs
  * no highlight rays, and cone sampling integrates it well (the effect plan's diffuse kernel). */

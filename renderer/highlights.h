@@ -1,4 +1,4 @@
-/* glint — indirect highlights by vMF merging (Laurijssen et al. 2010, DESIGN.md): the paths
+/* glint — indirect highlights by vMF merging (Laurijssen et al. 2010, docs/design.md): the paths
  * camera - glossy(x) - glossy(q) - light, both lobes sharper than BSDF_HIGHLIGHT_ALPHA. At a
  * camera hit x, N secondary rays sample x's glossy lobe; each hit q_i with such a lobe contributes
  * that lobe, fitted as a vMF about the mirror of the direction back to x and weighted by its

@@ -1,4 +1,4 @@
-/* glint — simulate only what the scene calls for (DESIGN.md). The scene is analysed once (which
+/* glint — simulate only what the scene calls for (docs/design.md). The scene is analysed once (which
  * kinds of surfaces and emitters it has, which can see which) and each session decides from that
  * and its parameters which passes to run. A decision never changes the answer beyond noise: a
  * pass the plan drops either has nothing to add (no surface can pass light on: no virtual

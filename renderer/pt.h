@@ -13,7 +13,7 @@
  * the ray escaped), split by path-space component: out[COMP_DIRECT] gets emission
  * seen directly and light arriving at the first hit directly from an emitter, out[COMP_INDIRECT]
  * the rest; with split_highlights, the paths camera - glossy lobe - glossy lobe - light go to
- * out[COMP_HIGHLIGHTS] instead (the highlight estimator's subset, DESIGN.md). Counts rays into
+ * out[COMP_HIGHLIGHTS] instead (the highlight estimator's subset, docs/design.md). Counts rays into
  * rays[]. */
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
                  rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
