@@ -132,8 +132,8 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
                                   (float)fmin(sum[2], VL_MAX_CONTRIBUTION)), 1.0 / n);
 }
 
-/* The share of a disk of radius 1 on the far side of a chord at signed distance h from its centre
- * (1 for h >= 1, 1/2 for h = 0). */
+/* The share of a disk of radius 1 on the near side of a chord at signed distance h beyond its
+ * centre (1 for h >= 1, 1/2 for h = 0). */
 static double disk_share(double h) {
     if (h >= 1.0) return 1.0;
     if (h <= -1.0) return 0.0;
@@ -143,7 +143,8 @@ static double disk_share(double h) {
 double vsl_front_share(const virtual_light *vl, const shading_point *x) {
     vec3 d = sub3(vl->p, x->p);
     double r = (double)vl->radius;
-    return fmin(disk_share((double)dot3(d, x->ng) / r), disk_share(-(double)dot3(d, vl->ng) / r));
+    double a = disk_share((double)dot3(d, x->ng) / r), b = disk_share(-(double)dot3(d, vl->ng) / r);
+    return fmin(a, b) * sqrt(fmax(a, b));
 }
 
 vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
