@@ -139,11 +139,11 @@ const char *cli_vl_help(void) {
              "  --vsl-count N        virtual lights traced per frame [%d]\n"
              "  --clamp on|off       clamp each light's contribution [on for vpl, off for vsl]\n"
              "  --clamp-value C      the clamp bound, in radiance [%g]\n"
-             "  --clamp-growth A     the bound grows as C * frame^A, so clamped VPLs converge [off]\n"
+             "  --clamp-growth A|off the bound grows as C * frame^A, so clamped VPLs converge [%g]\n"
              "  --vpl-glossy         VPLs reflect with their full BSDF, not only its diffuse part\n"
              "  --radius-mult M      VSL radius: M x distance to the 10th nearest light [%g]\n"
-             "  --radius-shrink A    0 < A < 1: M shrinks over frames (progressive photon mapping's\n"
-             "                       schedule), so VSLs converge to the path-traced answer [off]\n"
+             "  --radius-shrink A|off  0 < A < 1: M shrinks over frames (progressive photon mapping's\n"
+             "                       schedule), so VSLs converge to the path-traced answer [%g]\n"
              "  --rows R             matrix row-column sampling: sampled rows (pixels) [%d]\n"
              "  --columns C          ... and clusters; 0 = no clustering [0]\n"
              "  --per-pixel N|all    lights (cluster representatives) each pixel shades per frame,\n"
@@ -161,7 +161,8 @@ const char *cli_vl_help(void) {
              "  --merge on|off|trace off: every secondary hit's own vMF lobe is lit by itself (the\n"
              "                       paper's comparison); trace: no vMFs, each hit's true glossy lobe\n"
              "                       (the path tracer's answer for the same paths) [on]\n",
-             VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_RADIUS_MULT, VL_DEFAULT_ROWS,
+             VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_CLAMP_GROWTH, (double)VL_DEFAULT_RADIUS_MULT,
+             (double)VL_DEFAULT_RADIUS_SHRINK, VL_DEFAULT_ROWS,
              VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES, (double)VL_DEFAULT_TRACE_GLOSSY, VL_MAX_GLOSSY_RAYS, VL_DEFAULT_GLOSSY_RAYS,
              HL_MAX_SECONDARY_RAYS, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_CLUSTERS, HL_DEFAULT_CLUSTERS);
     return text;
@@ -190,8 +191,9 @@ int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
         if (cli_parse_float(option, value, 1e-12, 1e30, &x)) return -1;
         vl->clamp_value = (float)x;
     } else if (strcmp(name, "clamp-growth") == 0) {
-        if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
-        vl->clamp_growth = (float)x;
+        if (strcmp(value, "off") == 0) x = 0.0;
+        else if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
+        vl->clamp_growth = x > 0.0 ? (float)x : -1.0f; /* 0 is off too, not the default */
     } else if (strcmp(name, "vpl-glossy") == 0) {
         if (on_off(option, value, &b)) return -1;
         vl->vpl_glossy = b;
@@ -199,9 +201,10 @@ int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
         if (cli_parse_float(option, value, 1e-6, 1e6, &x)) return -1;
         vl->radius_mult = (float)x;
     } else if (strcmp(name, "radius-shrink") == 0) {
-        if (cli_parse_float(option, value, 0.0, 1.0, &x)) return -1;
-        if (x >= 1.0) return cli_error("%s: must be below 1 (0 turns it off), got '%s'", option, value), -1;
-        vl->radius_shrink = (float)x;
+        if (strcmp(value, "off") == 0) x = 0.0;
+        else if (cli_parse_float(option, value, 0.0, 1.0, &x)) return -1;
+        if (x >= 1.0) return cli_error("%s: must be below 1 (0 or off turns it off), got '%s'", option, value), -1;
+        vl->radius_shrink = x > 0.0 ? (float)x : -1.0f;
     } else if (strcmp(name, "rows") == 0) {
         if (cli_parse_int(option, value, 1, 100000, &n)) return -1;
         vl->rows = (int)n;

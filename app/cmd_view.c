@@ -591,7 +591,7 @@ static vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
     vl.clamp = c->clamp;
     vl.clamp_value = c->clamp_value;
     vl.radius_mult = c->radius_mult;
-    vl.radius_shrink = c->radius_shrink;
+    vl.radius_shrink = c->radius_shrink > 0.0f ? c->radius_shrink : -1.0f;
     vl.count = c->vl_count;
     vl.columns = c->columns;
     vl.per_pixel = c->per_pixel;
@@ -609,7 +609,7 @@ static void controls_from_vl(ui_controls *c, const vl_params *vl) {
     c->clamp = vl->clamp;
     c->clamp_value = vl->clamp_value > 0.0f ? vl->clamp_value : VL_DEFAULT_CLAMP;
     c->radius_mult = vl->radius_mult > 0.0f ? vl->radius_mult : VL_DEFAULT_RADIUS_MULT;
-    c->radius_shrink = vl->radius_shrink;
+    c->radius_shrink = vl->radius_shrink > 0.0f ? vl->radius_shrink : vl->radius_shrink < 0.0f ? 0.0f : VL_DEFAULT_RADIUS_SHRINK;
     c->vl_count = vl->count > 0 ? vl->count : VL_DEFAULT_COUNT;
     c->columns = vl->columns;
     c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);

@@ -253,7 +253,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         int split = k == 1 ? m->glossy_split : 1;
         vec2 shift = rng_vec2(rng);
         int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
-        /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (DESIGN.md) when both
+        /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (docs/design.md) when both
          * lobes are highlight lobes. */
         int lobes = k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT : BSDF_ALL;
         vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1);
@@ -297,9 +297,11 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     m->terms = plan->highlights ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
     m->all_strategies = plan->vsl_all_strategies;
     m->clamp = vp->clamp == VL_CLAMP_ON || (vp->clamp == VL_CLAMP_DEFAULT && p->method == METHOD_VPL);
-    m->clamp_bound = vpl_clamp_at(vp->clamp_value > 0.0f ? vp->clamp_value : VL_DEFAULT_CLAMP, vp->clamp_growth, i);
+    float growth = vp->clamp_growth > 0.0f ? vp->clamp_growth : vp->clamp_growth < 0.0f ? 0.0f : VL_DEFAULT_CLAMP_GROWTH;
+    float shrink = vp->radius_shrink > 0.0f ? vp->radius_shrink : vp->radius_shrink < 0.0f ? 0.0f : VL_DEFAULT_RADIUS_SHRINK;
+    m->clamp_bound = vpl_clamp_at(vp->clamp_value > 0.0f ? vp->clamp_value : VL_DEFAULT_CLAMP, growth, i);
     m->radius_mult = vsl_radius_mult_at(vp->radius_mult > 0.0f ? vp->radius_mult : VL_DEFAULT_RADIUS_MULT,
-                                        vp->radius_shrink, i);
+                                        shrink, i);
     m->num_entries = 0;
     m->clustered = 0;
     m->use_tree = 0;

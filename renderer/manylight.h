@@ -61,7 +61,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
 /* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
 shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);
 
-/* The schedules that make the progressive estimates consistent (DESIGN.md): the VSL radius
+/* The schedules that make the progressive estimates consistent (docs/design.md): the VSL radius
  * multiplier at frame index i >= 1, mult * prod_{k<i} sqrt((k + a) / (k + 1)), and the clamp
  * bound c i^growth. a <= 0 or growth <= 0 leave them constant. */
 float vsl_radius_mult_at(float mult, float shrink, long long i);

@@ -31,10 +31,13 @@ typedef struct {
     int count;           /* virtual lights per frame [VL_DEFAULT_COUNT] */
     int clamp;           /* VL_CLAMP_*: clamp each light's contribution [on for vpl, off for vsl] */
     float clamp_value;   /* the bound on one light's contribution [VL_DEFAULT_CLAMP] */
-    float clamp_growth;  /* > 0: the bound grows as c * frame^growth (consistent VPLs) */
+    float clamp_growth;  /* > 0: the bound grows as c * frame^growth (consistent VPLs); < 0: a fixed
+                          * bound [VL_DEFAULT_CLAMP_GROWTH] */
     int vpl_glossy;      /* vpl: the light's full BSDF instead of its diffuse lobe */
     float radius_mult;   /* vsl: radius = mult x distance to the 10th nearest light [VL_DEFAULT_RADIUS_MULT] */
-    float radius_shrink; /* vsl, in (0,1): mult shrinks as r_{i+1} = r_i sqrt((i + a) / (i + 1)) */
+    float radius_shrink; /* vsl, in (0,1): mult shrinks as r_{i+1} = r_i sqrt((i + a) / (i + 1)), so
+                          * VSLs converge to the path-traced answer; < 0: a fixed radius
+                          * [VL_DEFAULT_RADIUS_SHRINK] */
     int rows, columns;   /* matrix row-column sampling; columns 0: no clustering [rows 300] */
     int per_pixel;       /* lights (or cluster representatives) sampled per pixel per frame, by
                           * power (or cluster norm); -1: every one; 0: the default, which is
@@ -66,6 +69,11 @@ enum { VL_SELECT_DEFAULT = 0, VL_SELECT_TREE, VL_SELECT_POWER };
 /* The paper's multipliers (4-12) go with 10^5 lights in one set; radii scale as mult/sqrt(count),
  * so with ~10^3 fresh lights a frame a multiplier of 1 gives the same radii as 8 at 6.4 10^4. */
 #define VL_DEFAULT_RADIUS_MULT 1.0f
+/* The consistent schedules are on by default: progressive rendering should converge to the
+ * answer, not to the answer at one radius (docs/design.md; the values measured in
+ * docs/benchmarks.md). */
+#define VL_DEFAULT_RADIUS_SHRINK 0.9f
+#define VL_DEFAULT_CLAMP_GROWTH 0.5f
 #define VL_DEFAULT_ROWS 300
 #define VL_DEFAULT_PER_PIXEL 4
 #define VL_DEFAULT_CANDIDATES 32
