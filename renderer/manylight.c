@@ -11,7 +11,7 @@
 void manylight_deinit(manylight *m) {
     vlight_set_free(&m->set);
     free(m->entries);
-    dist1d_deinit(&m->pick);
+    alias_deinit(&m->pick);
     lighttree_free(&m->tree);
     memset(m, 0, sizeof *m);
 }
@@ -80,7 +80,7 @@ static vec3 shade_one(const manylight *m, const scene *s, const virtual_light *v
  * distribution. Returns the entry (-1: none can light x) and its probability in *pmf. */
 static int draw_entry(const manylight *m, const lt_receiver *r, float u, float *pmf) {
     if (m->use_tree) return lighttree_sample(&m->tree, r, u, pmf);
-    return dist1d_sample_discrete(&m->pick, u, pmf, NULL);
+    return alias_sample(&m->pick, u, pmf);
 }
 
 vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, vl_terms terms, rng_state *rng,
@@ -97,8 +97,8 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
     lt_receiver r;
     if (m->tree.num_lights > 0) r = lighttree_receiver(x, s->ray_eps);
     /* The pixel's lights are picked at u = (k + shift) / per_pixel: stratified over [0,1). A draw
-     * maps u onto the entries in contiguous runs, so each stratum's pick weighted by
-     * 1 / (per_pixel pmf) keeps the sum unbiased while the picks spread out. */
+     * maps to each entry a part of [0,1) as large as its probability, so each stratum's pick
+     * weighted by 1 / (per_pixel pmf) keeps the sum unbiased while the picks spread out. */
     float shift = rng_float(rng);
     if (m->candidates <= 1) {
         for (int k = 0; k < m->per_pixel; k++) {
@@ -220,8 +220,8 @@ static int cluster_lights(manylight *m, const scene *s, const camera *cam, const
                     weights[c] = clusters[c].weight;
                 }
                 m->num_entries = k;
-                dist1d_deinit(&m->pick);
-                status = k == 0 || m->per_pixel == 0 ? 0 : dist1d_init(&m->pick, weights, k);
+                alias_deinit(&m->pick);
+                status = k == 0 || m->per_pixel == 0 ? 0 : alias_init(&m->pick, weights, k);
                 free(weights);
             }
         }
@@ -334,13 +334,13 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     if (reserve_entries(m, m->set.count) != 0) return snprintf(err, errlen, "out of memory"), -1;
     m->num_entries = m->set.count;
     for (int j = 0; j < m->set.count; j++) m->entries[j] = (ml_entry){j, 1.0f};
-    dist1d_deinit(&m->pick);
+    alias_deinit(&m->pick);
     m->use_tree = m->per_pixel > 0 && vp->select == VL_SELECT_TREE;
     if (m->per_pixel > 0 && !m->use_tree) {
         float *power = malloc(sizeof(float) * (size_t)m->set.count);
         if (!power) return snprintf(err, errlen, "out of memory"), -1;
         for (int j = 0; j < m->set.count; j++) power[j] = luminance3(m->set.v[j].power);
-        int status = dist1d_init(&m->pick, power, m->set.count);
+        int status = alias_init(&m->pick, power, m->set.count);
         free(power);
         if (status != 0) return snprintf(err, errlen, "out of memory"), -1;
     }

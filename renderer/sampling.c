@@ -105,6 +105,62 @@ int dist1d_init(dist1d *d, const float *func, int n) {
     return 0;
 }
 
+int alias_init(alias_table *a, const float *weights, int n) {
+    *a = (alias_table){0};
+    if (n < 1) return -1;
+    a->pmf = malloc(sizeof(float) * (size_t)n);
+    a->keep = malloc(sizeof(float) * (size_t)n);
+    a->alias = malloc(sizeof(int) * (size_t)n);
+    int *work = malloc(sizeof(int) * (size_t)n);
+    double *scaled = malloc(sizeof(double) * (size_t)n);
+    if (!a->pmf || !a->keep || !a->alias || !work || !scaled) {
+        free(work);
+        free(scaled);
+        alias_deinit(a);
+        return -1;
+    }
+    a->n = n;
+    double total = 0.0;
+    for (int i = 0; i < n; i++) total += isfinite(weights[i]) && weights[i] > 0.0f ? (double)weights[i] : 0.0;
+    for (int i = 0; i < n; i++) {
+        double w = isfinite(weights[i]) && weights[i] > 0.0f ? (double)weights[i] : 0.0;
+        double p = total > 0.0 ? w / total : 1.0 / n;
+        a->pmf[i] = (float)p;
+        scaled[i] = p * n;
+    }
+    /* Small bins (scaled below 1) from the front of work, large ones from the back: each small
+     * bin takes its alias from a large one, which gives up what the small one lacks. */
+    int small = 0, large = n;
+    for (int i = 0; i < n; i++) {
+        if (scaled[i] < 1.0) work[small++] = i;
+        else work[--large] = i;
+    }
+    int s = 0;
+    while (s < small && large < n) {
+        int lo = work[s++], hi = work[large];
+        a->keep[lo] = (float)scaled[lo];
+        a->alias[lo] = hi;
+        scaled[hi] -= 1.0 - scaled[lo];
+        if (scaled[hi] < 1.0) { /* it became small: it moves to the small end */
+            large++;
+            work[small++] = hi;
+        }
+    }
+    /* What remains is 1 up to rounding. */
+    for (; s < small; s++) a->keep[work[s]] = 1.0f, a->alias[work[s]] = work[s];
+    for (; large < n; large++) a->keep[work[large]] = 1.0f, a->alias[work[large]] = work[large];
+    free(work);
+    free(scaled);
+    return 0;
+}
+
+void alias_deinit(alias_table *a) {
+    free(a->pmf);
+    free(a->keep);
+    free(a->alias);
+    *a = (alias_table){0};
+}
+
 void dist1d_deinit(dist1d *d) {
     free(d->func);
     free(d->cdf);

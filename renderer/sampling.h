@@ -84,6 +84,28 @@ float dist1d_pmf(const dist1d *d, int index);
 float dist1d_sample_continuous(const dist1d *d, float u, float *pdf, int *bin);
 float dist1d_pdf(const dist1d *d, float x);
 
+/* A discrete distribution drawn in constant time (Walker's alias method, Vose's construction):
+ * n bins, each split between itself and one alias. Owns its arrays (init/deinit). */
+typedef struct {
+    int n;
+    float *pmf;   /* n probabilities (non-finite or negative weights count as 0; all zero: uniform) */
+    float *keep;  /* the share of bin i's slot that draws i itself */
+    int *alias;   /* what the rest of the slot draws */
+} alias_table;
+
+/* Returns 0, or -1 when out of memory or n < 1. */
+int alias_init(alias_table *a, const float *weights, int n);
+void alias_deinit(alias_table *a);
+/* Index with probability pmf[index], from u in [0,1); *pmf (optional) receives it. */
+static inline int alias_sample(const alias_table *a, float u, float *pmf) {
+    float x = u * (float)a->n;
+    int i = (int)x;
+    if (i >= a->n) i = a->n - 1;
+    if (x - (float)i >= a->keep[i]) i = a->alias[i];
+    if (pmf) *pmf = a->pmf[i];
+    return i;
+}
+
 /* Piecewise-constant 2D distribution over [0,1)^2 from nu x nv values (row-major, v rows). */
 typedef struct {
     int nu, nv;

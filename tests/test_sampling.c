@@ -269,6 +269,44 @@ static void test_dist1d(void) {
     dist1d_deinit(&d);
 }
 
+/* The alias table draws each bin with its probability, whatever the weights' spread. */
+static void test_alias(void) {
+    float func[10] = {1.0f, 0.0f, 3.0f, NAN, 0.5f, -2.0f, INFINITY, 7.0f, 0.25f, 2.0f};
+    double valid[10] = {1, 0, 3, 0, 0.5, 0, 0, 7, 0.25, 2}, total = 13.75;
+    alias_table a;
+    CHECK(alias_init(&a, func, 10) == 0, "init");
+    double o[10] = {0}, e[10];
+    for (int i = 0; i < 10; i++) {
+        CHECK_NEAR(a.pmf[i], valid[i] / total, 1e-6, "alias pmf %d", i);
+        e[i] = SAMPLES * valid[i] / total;
+    }
+    rng_state rng = rng_make(9, 9);
+    int mismatch = 0;
+    for (long k = 0; k < SAMPLES; k++) {
+        float pmf;
+        int i = alias_sample(&a, rng_float(&rng), &pmf);
+        o[i] += 1.0;
+        mismatch += pmf != a.pmf[i];
+    }
+    check_chi2(chi2_counts(o, e, 10), "alias table");
+    CHECK(mismatch == 0, "the returned pmf differs from the table's %d times", mismatch);
+    alias_deinit(&a);
+    /* Weights over twelve orders of magnitude, and all zero (uniform). */
+    float wide[64];
+    double wtotal = 0.0, ow[64] = {0}, ew[64];
+    for (int i = 0; i < 64; i++) wtotal += wide[i] = powf(10.0f, (float)(i % 13) - 6.0f);
+    CHECK(alias_init(&a, wide, 64) == 0, "init wide");
+    for (long k = 0; k < SAMPLES; k++) ow[alias_sample(&a, rng_float(&rng), NULL)] += 1.0;
+    for (int i = 0; i < 64; i++) ew[i] = SAMPLES * wide[i] / wtotal;
+    check_chi2(chi2_counts(ow, ew, 64), "alias table, wide weights");
+    alias_deinit(&a);
+    float zeros[4] = {0, 0, 0, 0};
+    CHECK(alias_init(&a, zeros, 4) == 0, "init zeros");
+    for (int i = 0; i < 4; i++) CHECK_NEAR(a.pmf[i], 0.25, 1e-7, "uniform fallback %d", i);
+    CHECK(alias_sample(&a, 0x1.fffffep-1f, NULL) < 4, "u just below 1 stays in range");
+    alias_deinit(&a);
+}
+
 static void test_dist2d(void) {
     enum { NU = 8, NV = 6 };
     float func[NU * NV];
@@ -325,6 +363,7 @@ int main(void) {
     test_triangle();
     test_disk();
     test_dist1d();
+    test_alias();
     test_dist2d();
     test_mis();
     return check_exit("test_sampling");
