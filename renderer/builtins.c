@@ -14,9 +14,9 @@ EMBEDDED(showcase)
 
 /* The first is the default scene. */
 static const builtin_scene builtins[] = {
-    {"atelier", "a room lit only by an uplighter's bright ceiling patch and a brass reflector; glossy floor, metals",
+    {"atelier", "lit only by an uplighter: a bright ceiling, brass reflectors in the beam, glossy floor, metals",
      glint_scene_atelier_gltf, &glint_scene_atelier_gltf_size},
-    {"doorway", "light from a back room through a doorway; polished stone floor, chrome, brushed steel",
+    {"doorway", "lit through a doorway from a second room; polished stone floor, a steel panel in the beam",
      glint_scene_doorway_gltf, &glint_scene_doorway_gltf_size},
     {"showcase", "a small room of facing metals, a ceiling panel and a spot (the former default)",
      glint_scene_showcase_gltf, &glint_scene_showcase_gltf_size},

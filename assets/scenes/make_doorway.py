@@ -1,21 +1,22 @@
 #!/usr/bin/env python3
 """Writes doorway.gltf, the built-in scene `doorway`: two rooms joined by an open doorway. Both
-lights are in the back room, a ceiling panel and a spot shining through the doorway; the camera
-stands in the front room, which is lit only by what comes through the door: a pool of light on a
-polished stone floor, seen again in a polished steel panel, a chrome sphere and a brushed steel
-cabinet.
+lights are in the back room, a ceiling panel and a spot shining through the doorway onto a
+polished steel panel in the front room; the camera stands in the front room, which is lit only
+by what comes through the door. The polished stone floor shows the spot twice reflected, by the
+panel and by itself; a chrome sphere and a brushed steel sideboard show the rest.
 
     python3 assets/scenes/make_doorway.py   # rewrites assets/scenes/doorway.gltf
 """
-from gltfkit import (Scene, append, box, cylinder, emissive, merge, metal_rough, moved, phong, quad, sphere, spot,
-                     ward, write, yaw)
+from gltfkit import (Scene, add, append, box, cylinder, emissive, merge, metal_rough, moved, phong, quad, scale,
+                     sphere, spot, sub, ward, write, yaw)
 
 MATERIALS = [
     metal_rough("white plaster", (0.78, 0.77, 0.74)),
     metal_rough("warm plaster", (0.78, 0.58, 0.36)),
     metal_rough("sage plaster", (0.55, 0.6, 0.5)),
-    # Polished limestone: a sharp Phong lobe over a pale diffuse base.
+    # Polished limestone tiles in two tones: a sharp Phong lobe over a pale diffuse base.
     phong("polished stone", (0.6, 0.57, 0.52), kd=(0.5, 0.47, 0.42), ks=(0.35, 0.35, 0.35), exponent=300),
+    phong("polished stone, grey", (0.5, 0.5, 0.48), kd=(0.4, 0.4, 0.38), ks=(0.35, 0.35, 0.35), exponent=300),
     emissive("ceiling panel", (1.0, 0.94, 0.86), 200.0),
     metal_rough("chrome", (0.95, 0.95, 0.95), metallic=1.0, roughness=0.12),
     # Brushed stainless steel, anisotropic Ward: sharp along the brushing, rough across it.
@@ -27,6 +28,8 @@ MATERIALS = [
     metal_rough("dark bronze", (0.25, 0.18, 0.12), metallic=1.0, roughness=0.6),
     metal_rough("blue linen", (0.12, 0.2, 0.42)),
     metal_rough("terracotta", (0.6, 0.28, 0.14), roughness=0.8),
+    metal_rough("white trim", (0.85, 0.84, 0.8), roughness=0.6),
+    metal_rough("slate print", (0.2, 0.27, 0.36)),
 ]
 
 # ---- two rooms side by side along z; walls face inwards ----------------------------------
@@ -36,10 +39,28 @@ MATERIALS = [
 W, H = 2.5, 2.8
 ZF, ZB, T = 4.5, -3.6, 0.15
 DX0, DX1, DH = -1.3, -0.3, 2.1
+TILE = 0.625
 
-CAMERA_EYE, CAMERA_TARGET = (2.1, 1.4, 4.3), (-1.0, 0.55, -0.5)
-SPOT_POS, SPOT_AIM = (-0.3, 2.45, ZB + 0.2), (-0.6, 0.0, 2.0)
+CAMERA_EYE, CAMERA_TARGET = (1.6, 1.5, 4.3), (-1.0, 0.7, -0.3)
 PANEL_LIGHT = (-0.8, 0.0, -1.3)  # centre of the ceiling panel, over the back room's floor
+SPOT_POS = (1.45, 2.15, -1.55)   # in the back room, right of the door
+PANEL_X = -W + 0.02              # the steel panel's plane, on the left wall
+
+
+def double_mirror():
+    """Where the camera sees the spot reflected by the floor and then by the steel panel: the
+    floor point F and the panel point P of the path camera - F - P - spot. The spot is aimed at
+    P, so that path is the beam's centre: a glossy-to-glossy highlight in the floor."""
+    image = (2 * PANEL_X - SPOT_POS[0], -SPOT_POS[1], SPOT_POS[2])  # mirrored by the panel, then the floor
+    d = sub(image, CAMERA_EYE)
+    f = add(CAMERA_EYE, scale(d, CAMERA_EYE[1] / -d[1]))
+    d = (d[0], -d[1], d[2])
+    p = add(f, scale(d, (PANEL_X - f[0]) / d[0]))
+    # The beam from the spot to P must pass through the doorway.
+    for z in (0.0, -T):
+        q = add(p, scale(sub(SPOT_POS, p), (z - p[2]) / (SPOT_POS[2] - p[2])))
+        assert DX0 < q[0] < DX1 and q[1] < DH, q
+    return f, p
 
 
 def wall_with_door(z, facing_front):
@@ -61,9 +82,34 @@ def doorway_reveals():
                  quad((DX0, DH, -T), (DX1 - DX0, 0, 0), (0, 0, T)))  # head, faces down
 
 
+def tiles(z0, z1):
+    """Square tiles over x in [-W, W], z in [z0, z1] in a checker of two tones, as two meshes."""
+    tone = (([], [], [], []), ([], [], [], []))
+    nx = round(2 * W / TILE)
+    z = z0
+    for j in range(round((z1 - z0) / TILE + 0.49)):
+        depth = min(TILE, z1 - z)
+        for i in range(nx):
+            append(tone[(i + j) % 2], quad((-W + i * TILE, 0, z + depth), (TILE, 0, 0), (0, 0, -depth)))
+        z += depth
+    return tone
+
+
+def trim():
+    """An architrave around the doorway on the front room's side: two posts and a lintel."""
+    w, d = 0.08, 0.025
+    return merge(moved(box((w, DH + w, d)), (DX0 - w / 2, (DH + w) / 2, d / 2)),
+                 moved(box((w, DH + w, d)), (DX1 + w / 2, (DH + w) / 2, d / 2)),
+                 moved(box((DX1 - DX0, w, d)), ((DX0 + DX1) / 2, DH + w / 2, d / 2)))
+
+
+FRONT_TILES, BACK_TILES = tiles(0.0, ZF), tiles(ZB, -T)
+
 ROOM = [
-    ("front floor", "polished stone", quad((-W, 0, ZF), (2 * W, 0, 0), (0, 0, -ZF))),
-    ("back floor", "polished stone", quad((-W, 0, -T), (2 * W, 0, 0), (0, 0, ZB + T))),
+    ("front floor", "polished stone", FRONT_TILES[0]),
+    ("front floor, grey", "polished stone, grey", FRONT_TILES[1]),
+    ("back floor", "polished stone", BACK_TILES[0]),
+    ("back floor, grey", "polished stone, grey", BACK_TILES[1]),
     ("doorway floor", "polished stone", quad((DX0, 0, 0), (DX1 - DX0, 0, 0), (0, 0, -T))),
     ("ceiling", "white plaster", quad((-W, H, ZB), (2 * W, 0, 0), (0, 0, ZF - ZB))),
     ("front wall", "sage plaster", quad((W, 0, ZF), (-2 * W, 0, 0), (0, H, 0))),
@@ -79,8 +125,9 @@ ROOM = [
     ("ceiling panel", "ceiling panel", quad((PANEL_LIGHT[0] - 0.5, H - 0.01, PANEL_LIGHT[2] - 0.4), (1.0, 0, 0),
                                             (0, 0, 0.8))),
     # Polished steel on the front room's left wall, beside the doorway: it shows the lit floor.
-    ("steel panel", "polished steel", quad((-W + 0.02, 0.3, 1.8), (0, 0, -1.4), (0, 1.6, 0))),
-    ("panel frame", "dark bronze", quad((-W + 0.01, 0.25, 1.85), (0, 0, -1.5), (0, 1.7, 0))),
+    # A tall polished steel panel on the front room's left wall, in the spot's beam.
+    ("steel panel", "polished steel", quad((PANEL_X, 0.1, 2.3), (0, 0, -1.7), (0, 1.8, 0))),
+    ("panel frame", "dark bronze", quad((PANEL_X - 0.01, 0.05, 2.35), (0, 0, -1.8), (0, 1.9, 0))),
 ]
 
 
@@ -94,12 +141,14 @@ def cabinet():
 OBJECTS = [  # name, material, mesh, translation, rotation
     ("steel sideboard", "brushed steel", cabinet(), (1.15, 0.0, 0.3), None),
     ("chrome sphere", "chrome", sphere(0.3), (-0.2, 0.3, 2.4), None),
-    ("pouf", "blue linen", box((0.55, 0.4, 0.55)), (1.75, 0.2, 1.5), yaw(20)),
-    # The back room, seen through the door.
+    ("pouf", "blue linen", cylinder(0.3, 0.28, 0.42, 32), (1.7, 0.0, 1.6), None),
+    ("door trim", "white trim", trim(), None, None),
+    ("print", "slate print", box((0.6, 0.8, 0.02)), (-1.95, 1.45, 0.011), None),
+    # The back room's far left corner, what the camera sees of it through the door.
     ("table", "oak", merge(moved(box((1.2, 0.05, 0.7)), (0, 0.73, 0)),
                            *[moved(box((0.05, 0.7, 0.05)), (x, 0.35, z)) for x in (-0.55, 0.55) for z in (-0.3, 0.3)]),
-     (-0.6, 0.0, -2.2), yaw(10)),
-    ("pot", "terracotta", cylinder(0.18, 0.24, 0.5, 24), (-1.9, 0.0, -3.1), None),
+     (-1.75, 0.0, -2.5), yaw(80)),
+    ("pot", "terracotta", cylinder(0.18, 0.24, 0.5, 24), (-2.15, 0.0, -3.25), None),
 ]
 
 
@@ -110,7 +159,7 @@ def build():
     for name, material, mesh, t, r in OBJECTS:
         s.mesh(name, material, mesh, translation=t, rotation=r)
     s.camera(CAMERA_EYE, CAMERA_TARGET, yfov=0.95)
-    s.light(spot("spot", (1.0, 0.9, 0.75), 6000.0, inner=0.2, outer=0.3), SPOT_POS, SPOT_AIM)
+    s.light(spot("spot", (1.0, 0.9, 0.75), 3000.0, inner=0.2, outer=0.3), SPOT_POS, double_mirror()[1])
     return s.document("glint doorway", "glint assets/scenes/make_doorway.py")
 
 
