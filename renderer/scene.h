@@ -120,7 +120,7 @@ typedef struct {
 /* ---- the scene ----------------------------------------------------------------------------- */
 
 typedef struct scene {
-    char path[1024]; /* where it came from ("<default>" for the built-in scene) */
+    char path[1024]; /* where it came from (builtin:NAME for a built-in scene) */
 
     /* world-space geometry, flattened: vertex arrays parallel, 3 indices per triangle */
     int num_vertices, cap_vertices;
