@@ -249,9 +249,9 @@ int reference_load(const char *path, reference_info *r, char *err, size_t errlen
     /* Before there were several, the built-in scene showcase was spelt builtin:default. */
     static const char legacy[] = "builtin:default:";
     if (strncmp(r->scene_hash, legacy, strlen(legacy)) == 0) {
-        char rest[64];
+        char rest[sizeof r->scene_hash];
         snprintf(rest, sizeof rest, "%s", r->scene_hash + strlen(legacy));
-        snprintf(r->scene_hash, sizeof r->scene_hash, "builtin:showcase:%s", rest);
+        snprintf(r->scene_hash, sizeof r->scene_hash, "builtin:showcase:%.40s", rest); /* fnv1a64: + 16 digits */
     }
     NEED(json_str(text, "env", r->env, sizeof r->env) == 0, "env");
     NEED(json_str(text, "env_hash", r->env_hash, sizeof r->env_hash) == 0, "env_hash");
