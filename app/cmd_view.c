@@ -758,9 +758,8 @@ static void reset_lights(ui_thread *u) {
  * directory. */
 static void bookmarks_load(ui_thread *u) {
     memset(u->bookmark_set, 0, sizeof u->bookmark_set);
-    size_t prefix = strlen(SCENE_BUILTIN_PREFIX);
-    if (strncmp(u->info.name, SCENE_BUILTIN_PREFIX, prefix) == 0)
-        snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.glint-bookmarks", u->info.name + prefix);
+    const char *builtin = scene_builtin_name(u->info.name);
+    if (builtin) snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.glint-bookmarks", builtin);
     else snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.bookmarks", u->info.name);
     FILE *f = fopen(u->bookmarks_path, "r");
     if (!f) {

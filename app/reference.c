@@ -32,8 +32,8 @@ static uint64_t fnv1a64(uint64_t h, const unsigned char *p, size_t n) {
 #define FNV_OFFSET 0xcbf29ce484222325ull
 
 int reference_hash_file(const char *path, char out[64], char *err, size_t errlen) {
-    if (strncmp(path, SCENE_BUILTIN_PREFIX, strlen(SCENE_BUILTIN_PREFIX)) == 0) {
-        const builtin_scene *b = scene_builtin_find(path + strlen(SCENE_BUILTIN_PREFIX));
+    if (scene_builtin_name(path)) {
+        const builtin_scene *b = scene_builtin_find(scene_builtin_name(path));
         if (!b) return fail(err, errlen, "%s: no such built-in scene", path);
         uint64_t h = fnv1a64(FNV_OFFSET, b->gltf, *b->size);
         snprintf(out, 64, "%s:fnv1a64:%016llx", path, (unsigned long long)h);

@@ -4,7 +4,7 @@
 
 #include "scene.h"
 
-#define EMBEDDED(name)                                  \
+#define EMBEDDED(name)                                      \
     extern const unsigned char glint_scene_##name##_gltf[]; \
     extern const size_t glint_scene_##name##_gltf_size;
 EMBEDDED(atelier)
@@ -25,6 +25,11 @@ static const builtin_scene builtins[] = {
 const builtin_scene *scene_builtins(int *count) {
     *count = (int)(sizeof builtins / sizeof builtins[0]);
     return builtins;
+}
+
+const char *scene_builtin_name(const char *path) {
+    static const char prefix[] = "builtin:";
+    return strncmp(path, prefix, sizeof prefix - 1) == 0 ? path + sizeof prefix - 1 : NULL;
 }
 
 const builtin_scene *scene_builtin_find(const char *name) {

@@ -547,7 +547,7 @@ static scene *finish_load(scene *s, int status, char *err, size_t errlen) {
 }
 
 static scene *load_builtin(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
-    const builtin_scene *b = scene_builtin_find(path + strlen(SCENE_BUILTIN_PREFIX));
+    const builtin_scene *b = scene_builtin_find(scene_builtin_name(path));
     if (b) return scene_load_memory(b->gltf, *b->size, "", path, warn, warn_user, err, errlen);
     char names[256] = "";
     int n;
@@ -561,8 +561,7 @@ static scene *load_builtin(const char *path, scene_warn_fn warn, void *warn_user
 }
 
 scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
-    if (strncmp(path, SCENE_BUILTIN_PREFIX, strlen(SCENE_BUILTIN_PREFIX)) == 0)
-        return load_builtin(path, warn, warn_user, err, errlen);
+    if (scene_builtin_name(path)) return load_builtin(path, warn, warn_user, err, errlen);
     scene *s = scene_create(warn, warn_user);
     if (!s) return snprintf(err, errlen, "%s: out of memory", path), NULL;
     snprintf(s->path, sizeof s->path, "%s", path);
@@ -580,7 +579,7 @@ scene *scene_load_memory(const void *data, size_t size, const char *base_dir, co
 scene *scene_load_default(scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
     int n;
     char path[64];
-    snprintf(path, sizeof path, SCENE_BUILTIN_PREFIX "%s", scene_builtins(&n)[0].name);
+    snprintf(path, sizeof path, "builtin:%s", scene_builtins(&n)[0].name);
     return scene_load(path, warn, warn_user, err, errlen);
 }
 

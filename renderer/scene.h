@@ -171,9 +171,11 @@ typedef void (*scene_warn_fn)(void *user, const char *message);
 scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
 /* Loads the default built-in scene. */
 scene *scene_load_default(scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
+/* Loads glTF JSON or GLB from memory; base_dir resolves external URIs; name is used in messages. */
+scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name,
+                         scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
 
 /* The scenes compiled into the program (builtins.c), glTF with embedded buffers. */
-#define SCENE_BUILTIN_PREFIX "builtin:"
 typedef struct {
     const char *name;        /* loaded as builtin:NAME */
     const char *description; /* one line, for --help */
@@ -182,11 +184,10 @@ typedef struct {
 } builtin_scene;
 /* All of them, the default first; *count set. */
 const builtin_scene *scene_builtins(int *count);
-/* The one named name (without the prefix), or NULL. */
+/* The one named name, or NULL. */
 const builtin_scene *scene_builtin_find(const char *name);
-/* Loads glTF JSON or GLB from memory; base_dir resolves external URIs; name is used in messages. */
-scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name,
-                         scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
+/* NAME when path is spelt builtin:NAME, else NULL. */
+const char *scene_builtin_name(const char *path);
 /* Attaches an environment map (.exr or .hdr) to a loaded scene, replacing any previous one. The
  * scene must not be rendering. Returns 0, or -1 with err set (the scene keeps its old map). */
 int scene_set_env(scene *s, const char *path, float rotation, char *err, size_t errlen);
