@@ -133,7 +133,7 @@ def build():
         s.mesh(name, material, mesh, translation=t, rotation=r)
     s.camera(CAMERA_EYE, CAMERA_TARGET, yfov=1.15)
     # A wide beam straight up at the ceiling: 55 degrees to the edge of the cone.
-    s.light(spot("torchiere", (1.0, 0.86, 0.68), 3000.0, inner=0.75, outer=0.96), SPOT_POS, add(SPOT_POS, (0, 1, 0)))
+    s.light(spot("torchiere", (1.0, 0.86, 0.68), 8000.0, inner=0.75, outer=0.96), SPOT_POS, add(SPOT_POS, (0, 1, 0)))
     return s.document("glint atelier", "glint assets/scenes/make_atelier.py")
 
 
