@@ -103,6 +103,14 @@ int cli_scene_argument(const char *command, const char *arg, const char **scene_
     return 0;
 }
 
+void cli_print_scenes(void) {
+    int n;
+    const builtin_scene *b = scene_builtins(&n);
+    printf("SCENE is a glTF 2.0 file (.gltf or .glb) or builtin:NAME, one of the scenes compiled into\n"
+           "the program; without one, builtin:%s. The built-in scenes:\n", b[0].name);
+    for (int i = 0; i < n; i++) printf("  %-10s %s\n", b[i].name, b[i].description);
+}
+
 const char *cli_value(int argc, char **argv, int *i) {
     if (*i + 1 >= argc) {
         cli_error("%s needs a value (see --help)", argv[*i]);

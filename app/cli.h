@@ -28,6 +28,9 @@ int cli_parse_size(const char *option, const char *text, int *width, int *height
  * the scene, of which there is at most one. Returns 0 (*scene_path set), or -1 after a usage error. */
 int cli_scene_argument(const char *command, const char *arg, const char **scene_path);
 
+/* Prints what SCENE may be and lists the built-in scenes with their descriptions (for --help). */
+void cli_print_scenes(void);
+
 /* Fetches the value of option argv[*i] (advancing *i); prints a usage error when missing. */
 const char *cli_value(int argc, char **argv, int *i);
 

@@ -9,10 +9,12 @@
 static void print_info_help(void) {
     printf("usage: glint info [SCENE] [--env FILE] [--method NAME] [--max-depth D] [--plan auto|full]\n"
            "\n"
-           "Prints a summary of SCENE (default: the built-in scene): geometry, materials, lights,\n"
-           "cameras, size; then what the scene calls for (material classes, emitters, whether\n"
-           "indirect and glossy-to-glossy transport exist) and the passes method NAME would run\n"
-           "(default vsl+hl, which has them all), each with its reason.\n");
+           "Prints a summary of SCENE: geometry, materials, lights, cameras, size; then what the\n"
+           "scene calls for (material classes, emitters, whether indirect and glossy-to-glossy\n"
+           "transport exist) and the passes method NAME would run (default vsl+hl, which has them\n"
+           "all), each with its reason.\n"
+           "\n");
+    cli_print_scenes();
 }
 
 int cmd_info(int argc, char **argv) {

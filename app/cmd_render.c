@@ -33,8 +33,8 @@ typedef struct {
 static void print_render_help(void) {
     printf("usage: glint render [SCENE] [options]\n"
            "\n"
-           "Renders SCENE (a .gltf/.glb; default: the built-in scene) progressively, one sample per\n"
-           "pixel per frame, and writes the running mean.\n"
+           "Renders SCENE (a .gltf/.glb or builtin:NAME, see glint --help; default: the default\n"
+           "built-in scene) progressively, one sample per pixel per frame, and writes the running mean.\n"
            "\n"
            "options (default in brackets):\n"
            "  --method NAME        estimator: pt (path tracing, the reference), vpl (clamped virtual\n"

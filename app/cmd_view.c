@@ -754,10 +754,12 @@ static void reset_lights(ui_thread *u) {
 
 /* ---- camera bookmarks (UI thread) -------------------------------------------------------------- */
 
-/* Beside the scene file; the built-in scene has none, so the current directory. */
+/* Beside the scene file; a built-in scene has none, so NAME.glint-bookmarks in the current
+ * directory. */
 static void bookmarks_load(ui_thread *u) {
     memset(u->bookmark_set, 0, sizeof u->bookmark_set);
-    if (strcmp(u->info.name, "<default>") == 0) snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "default.glint-bookmarks");
+    const char *builtin = scene_builtin_name(u->info.name);
+    if (builtin) snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.glint-bookmarks", builtin);
     else snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.bookmarks", u->info.name);
     FILE *f = fopen(u->bookmarks_path, "r");
     if (!f) {
@@ -1464,7 +1466,8 @@ static void capture_window(ui_thread *u, int w, int h) {
 static void print_view_help(void) {
     printf("usage: glint [view] [SCENE] [options]\n"
            "\n"
-           "Opens the interactive viewer on SCENE (default: the built-in scene).\n"
+           "Opens the interactive viewer on SCENE (a .gltf/.glb or builtin:NAME, see glint --help;\n"
+           "default: the default built-in scene).\n"
            "\n"
            "options:\n"
            "  --size WxH           window and render size [960x540]\n"

@@ -16,9 +16,9 @@ static void print_help(void) {
            "  glint bench [SCENE] --reference REF.exr [options]\n"
            "                                   error against time per method (see glint bench --help)\n"
            "  glint --help | --version\n"
-           "\n"
-           "SCENE is a glTF 2.0 file (.gltf or .glb); without one, the built-in default scene.\n",
+           "\n",
            GLINT_VERSION);
+    cli_print_scenes();
 }
 
 int main(int argc, char **argv) {
@@ -37,7 +37,7 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "view") == 0) return cmd_view(argc - 2, argv + 2);
     /* `glint SCENE [options]` and `glint --option ...` open the viewer too. */
     struct stat st;
-    if (argv[1][0] == '-' || stat(argv[1], &st) == 0) return cmd_view(argc - 1, argv + 1);
+    if (argv[1][0] == '-' || stat(argv[1], &st) == 0 || scene_builtin_name(argv[1])) return cmd_view(argc - 1, argv + 1);
     cli_error("unknown command or missing scene file '%s' (see glint --help)", argv[1]);
     return EXIT_USAGE;
 }

@@ -13,10 +13,6 @@
 #include "camera.h"
 #include "metrics.h"
 
-/* The built-in scene, embedded by the renderer's build (renderer/CMakeLists.txt). */
-extern const unsigned char glint_default_scene_gltf[];
-extern const size_t glint_default_scene_gltf_size;
-
 static int fail(char *err, size_t errlen, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 static int fail(char *err, size_t errlen, const char *fmt, ...) {
     va_list ap;
@@ -36,9 +32,11 @@ static uint64_t fnv1a64(uint64_t h, const unsigned char *p, size_t n) {
 #define FNV_OFFSET 0xcbf29ce484222325ull
 
 int reference_hash_file(const char *path, char out[64], char *err, size_t errlen) {
-    if (!path) {
-        uint64_t h = fnv1a64(FNV_OFFSET, glint_default_scene_gltf, glint_default_scene_gltf_size);
-        snprintf(out, 64, "builtin:default:fnv1a64:%016llx", (unsigned long long)h);
+    if (scene_builtin_name(path)) {
+        const builtin_scene *b = scene_builtin_find(scene_builtin_name(path));
+        if (!b) return fail(err, errlen, "%s: no such built-in scene", path);
+        uint64_t h = fnv1a64(FNV_OFFSET, b->gltf, *b->size);
+        snprintf(out, 64, "%s:fnv1a64:%016llx", path, (unsigned long long)h);
         return 0;
     }
     FILE *f = fopen(path, "rb");
@@ -57,8 +55,9 @@ int reference_hash_file(const char *path, char out[64], char *err, size_t errlen
 int reference_describe(reference_info *r, const char *scene_path, const char *env_path, double env_rotation_deg,
                        const scene *s, int camera_index, const render_params *p, char *err, size_t errlen) {
     memset(r, 0, sizeof *r);
-    snprintf(r->scene, sizeof r->scene, "%s", scene_path ? scene_path : "<default>");
-    if (reference_hash_file(scene_path, r->scene_hash, err, errlen)) return -1;
+    /* Without a path, the scene is the default built-in, which knows its name. */
+    snprintf(r->scene, sizeof r->scene, "%s", scene_path ? scene_path : s->path);
+    if (reference_hash_file(r->scene, r->scene_hash, err, errlen)) return -1;
     if (env_path) {
         snprintf(r->env, sizeof r->env, "%s", env_path);
         if (reference_hash_file(env_path, r->env_hash, err, errlen)) return -1;
@@ -247,6 +246,13 @@ int reference_load(const char *path, reference_info *r, char *err, size_t errlen
     NEED(json_value(text, "glint_reference") != NULL, "glint_reference");
     NEED(json_str(text, "scene", r->scene, sizeof r->scene) == 0, "scene");
     NEED(json_str(text, "scene_hash", r->scene_hash, sizeof r->scene_hash) == 0, "scene_hash");
+    /* Before there were several, the built-in scene showcase was spelt builtin:default. */
+    static const char legacy[] = "builtin:default:";
+    if (strncmp(r->scene_hash, legacy, strlen(legacy)) == 0) {
+        char rest[sizeof r->scene_hash];
+        snprintf(rest, sizeof rest, "%s", r->scene_hash + strlen(legacy));
+        snprintf(r->scene_hash, sizeof r->scene_hash, "builtin:showcase:%.40s", rest); /* fnv1a64: + 16 digits */
+    }
     NEED(json_str(text, "env", r->env, sizeof r->env) == 0, "env");
     NEED(json_str(text, "env_hash", r->env_hash, sizeof r->env_hash) == 0, "env_hash");
     NEED(json_number(text, "env_rotation", &r->env_rotation) == 0, "env_rotation");

@@ -11,8 +11,8 @@
 #include "session.h"
 
 typedef struct {
-    char scene[1024];      /* as given on the command line, "<default>" for the built-in scene */
-    char scene_hash[64];   /* "fnv1a64:..." of the file's bytes, "builtin:default:fnv1a64:..." */
+    char scene[1024];      /* as given on the command line, "builtin:NAME" for a built-in scene */
+    char scene_hash[64];   /* "fnv1a64:..." of the file's bytes, "builtin:NAME:fnv1a64:..." */
     char env[1024];        /* "" without an environment map */
     char env_hash[64];
     double env_rotation;   /* degrees */
@@ -33,11 +33,11 @@ typedef struct {
     double rel_l2_noise;   /* expected relative L2 error of the reference against the truth */
 } reference_info;
 
-/* The content hash of a scene or environment file (FNV-1a 64 of its bytes; NULL path: the
- * built-in scene). Returns 0, or -1 with err = "PATH: problem". */
+/* The content hash of a scene or environment file (FNV-1a 64 of its bytes; for builtin:NAME,
+ * of the built-in scene's). Returns 0, or -1 with err = "PATH: problem". */
 int reference_hash_file(const char *path, char out[64], char *err, size_t errlen);
 
-/* Fills what identifies a rendering of scene s (loaded from scene_path, NULL: built-in; env_path
+/* Fills what identifies a rendering of scene s (loaded from scene_path, NULL: the default; env_path
  * may be NULL) from camera_index (-1: the default view, recorded as 0 when the scene has cameras)
  * at the size in p: paths, content hashes, camera, size, max depth, seed, threads. The method
  * and the results (spp, seconds, noise) are left to the caller. Returns 0, or -1 with err set

@@ -546,7 +546,22 @@ static scene *finish_load(scene *s, int status, char *err, size_t errlen) {
     return NULL;
 }
 
+static scene *load_builtin(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
+    const builtin_scene *b = scene_builtin_find(scene_builtin_name(path));
+    if (b) return scene_load_memory(b->gltf, *b->size, "", path, warn, warn_user, err, errlen);
+    char names[256] = "";
+    int n;
+    const builtin_scene *all = scene_builtins(&n);
+    for (int i = 0; i < n; i++) {
+        if (i) strncat(names, ", ", sizeof names - strlen(names) - 1);
+        strncat(names, all[i].name, sizeof names - strlen(names) - 1);
+    }
+    snprintf(err, errlen, "%s: no such built-in scene (have: %s)", path, names);
+    return NULL;
+}
+
 scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
+    if (scene_builtin_name(path)) return load_builtin(path, warn, warn_user, err, errlen);
     scene *s = scene_create(warn, warn_user);
     if (!s) return snprintf(err, errlen, "%s: out of memory", path), NULL;
     snprintf(s->path, sizeof s->path, "%s", path);
@@ -561,12 +576,11 @@ scene *scene_load_memory(const void *data, size_t size, const char *base_dir, co
     return finish_load(s, gltf_import_memory(s, data, size, base_dir, name, err, errlen), err, errlen);
 }
 
-extern const unsigned char glint_default_scene_gltf[];
-extern const size_t glint_default_scene_gltf_size;
-
 scene *scene_load_default(scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
-    return scene_load_memory(glint_default_scene_gltf, glint_default_scene_gltf_size, "", "<default>", warn,
-                             warn_user, err, errlen);
+    int n;
+    char path[64];
+    snprintf(path, sizeof path, "builtin:%s", scene_builtins(&n)[0].name);
+    return scene_load(path, warn, warn_user, err, errlen);
 }
 
 /* ---- ray queries --------------------------------------------------------------------------- */

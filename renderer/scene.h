@@ -120,7 +120,7 @@ typedef struct {
 /* ---- the scene ----------------------------------------------------------------------------- */
 
 typedef struct scene {
-    char path[1024]; /* where it came from ("<default>" for the built-in scene) */
+    char path[1024]; /* where it came from (builtin:NAME for a built-in scene) */
 
     /* world-space geometry, flattened: vertex arrays parallel, 3 indices per triangle */
     int num_vertices, cap_vertices;
@@ -166,13 +166,28 @@ typedef struct scene {
  * (may be NULL) as they happen, without a trailing newline. */
 typedef void (*scene_warn_fn)(void *user, const char *message);
 
-/* Loads a .gltf/.glb file. Returns a new scene (caller destroys) or NULL with err set. */
+/* Loads a .gltf/.glb file, or a built-in scene when path is "builtin:NAME" (the scene's path is
+ * then that spelling). Returns a new scene (caller destroys) or NULL with err set. */
 scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
-/* Loads the built-in default scene (compiled into the program). */
+/* Loads the default built-in scene. */
 scene *scene_load_default(scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
 /* Loads glTF JSON or GLB from memory; base_dir resolves external URIs; name is used in messages. */
 scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name,
                          scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
+
+/* The scenes compiled into the program (builtins.c), glTF with embedded buffers. */
+typedef struct {
+    const char *name;        /* loaded as builtin:NAME */
+    const char *description; /* one line, for --help */
+    const unsigned char *gltf;
+    const size_t *size;      /* of gltf, in bytes */
+} builtin_scene;
+/* All of them, the default first; *count set. */
+const builtin_scene *scene_builtins(int *count);
+/* The one named name, or NULL. */
+const builtin_scene *scene_builtin_find(const char *name);
+/* NAME when path is spelt builtin:NAME, else NULL. */
+const char *scene_builtin_name(const char *path);
 /* Attaches an environment map (.exr or .hdr) to a loaded scene, replacing any previous one. The
  * scene must not be rendering. Returns 0, or -1 with err set (the scene keeps its old map). */
 int scene_set_env(scene *s, const char *path, float rotation, char *err, size_t errlen);

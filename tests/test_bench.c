@@ -165,7 +165,7 @@ static void test_sidecar(void) {
     CHECK(rc == 0, "reference render: exit %d: %s", rc, err_text);
     char json[8192];
     read_file("ref.exr.json", json, sizeof json);
-    CHECK(strstr(json, "\"scene_hash\": \"builtin:default:fnv1a64:") && strstr(json, "\"spp\": 1024") &&
+    CHECK(strstr(json, "\"scene_hash\": \"builtin:atelier:fnv1a64:") && strstr(json, "\"spp\": 1024") &&
               strstr(json, "\"width\": 24") && strstr(json, "\"height\": 16") && strstr(json, "\"max_depth\": 3") &&
               strstr(json, "\"seed\": 7") && strstr(json, "\"index\": 0") && strstr(json, "\"method\": \"pt\"") &&
               strstr(json, "\"mean_pixel_variance\": "),

@@ -13,6 +13,7 @@
 #include "check.h"
 #include "cli_harness.h"
 #include "image_io.h"
+#include "scene.h"
 
 
 static int count_lines(const char *s) {
@@ -168,6 +169,73 @@ static void test_outputs(void) {
     CHECK(rc == 0 && strstr(out_text, "triangles"), "glint info: %s%s", out_text, err_text);
 }
 
+/* Replaces the first `from` in file `name` (in tmp) with `to`; returns 0, or -1 when absent. */
+static int edit_file(const char *name, const char *from, const char *to) {
+    char text[8192], p[1024];
+    read_file(name, text, sizeof text);
+    char *at = strstr(text, from);
+    if (!at) return -1;
+    snprintf(p, sizeof p, "%s/%s", tmp, name);
+    FILE *f = fopen(p, "wb");
+    if (!f) return -1;
+    fprintf(f, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+    fclose(f);
+    return 0;
+}
+
+/* builtin:NAME: listed in the help, loaded by every command, an unknown name one error; a
+ * built-in's sidecar names it and hashes the very bytes of its glTF under assets/scenes/. */
+static void test_builtin_scenes(void) {
+    int n;
+    const builtin_scene *all = scene_builtins(&n);
+    char names[256] = "", help[sizeof out_text * 2];
+    CHECK(run("--help") == 0, "--help");
+    snprintf(help, sizeof help, "%s", out_text);
+    CHECK(run("info --help") == 0, "info --help");
+    for (int i = 0; i < n; i++) {
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", i ? ", " : "", all[i].name);
+        CHECK(strstr(help, all[i].name) && strstr(help, all[i].description), "--help does not list %s", all[i].name);
+        CHECK(strstr(out_text, all[i].name) != NULL, "info --help does not list %s", all[i].name);
+    }
+    CHECK(strstr(help, "builtin:NAME") != NULL, "--help does not explain builtin:NAME");
+
+    char want[512], cmd[512];
+    snprintf(want, sizeof want, "builtin:nosuch: no such built-in scene (have: %s)", names);
+    const char *commands[] = {"render builtin:nosuch --spp 1 --size 8x8 --png x.png", "info builtin:nosuch",
+                              "view builtin:nosuch", "builtin:nosuch"};
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) expect_failure(commands[i], 1, want);
+
+    CHECK(run("info builtin:showcase") == 0 && strstr(out_text, "scene:      builtin:showcase\n"), "info builtin:showcase: %s%s",
+          out_text, err_text);
+    char json[8192], hash_builtin[64] = "", hash_file[64] = "";
+    CHECK(run("render --spp 1 --size 16x9 --out default.exr --quiet") == 0, "default render: %s", err_text);
+    read_file("default.exr.json", json, sizeof json);
+    snprintf(want, sizeof want, "\"scene\": \"builtin:%s\"", all[0].name);
+    CHECK(strstr(json, want) != NULL, "the default scene's sidecar: %s", json);
+    CHECK(run("render builtin:showcase --spp 1 --size 16x9 --out showcase.exr --quiet") == 0, "showcase: %s", err_text);
+    read_file("showcase.exr.json", json, sizeof json);
+    const char *h = strstr(json, "\"scene_hash\": \"builtin:showcase:fnv1a64:");
+    CHECK(strstr(json, "\"scene\": \"builtin:showcase\"") && h, "showcase sidecar: %s", json);
+    if (h) sscanf(h + strlen("\"scene_hash\": \"builtin:showcase:"), "%63[^\"]", hash_builtin);
+    snprintf(cmd, sizeof cmd, "render '%s/scenes/showcase.gltf' --spp 1 --size 16x9 --out file.exr --quiet",
+             GLINT_ASSETS_DIR);
+    CHECK(run(cmd) == 0, "showcase.gltf: %s", err_text);
+    read_file("file.exr.json", json, sizeof json);
+    h = strstr(json, "\"scene_hash\": \"");
+    if (h) sscanf(h + strlen("\"scene_hash\": \""), "%63[^\"]", hash_file);
+    CHECK(hash_builtin[0] && strcmp(hash_builtin, hash_file) == 0,
+          "the built-in showcase (%s) is not assets/scenes/showcase.gltf (%s)", hash_builtin, hash_file);
+    snprintf(want, sizeof want, "builtin:nosuch: no such built-in scene (have: %s)", names);
+    expect_failure("bench builtin:nosuch --reference showcase.exr --times 0.01 --out nosuch", 1, want);
+    /* A sidecar from before there were several built-ins calls the showcase builtin:default. */
+    CHECK(edit_file("showcase.exr.json", "builtin:showcase:fnv1a64:", "builtin:default:fnv1a64:") == 0,
+          "editing the sidecar");
+    CHECK(run("bench builtin:showcase --reference showcase.exr --methods pt --times 0.01 --quiet --out legacy") == 0,
+          "an old builtin:default sidecar refused: %s", err_text);
+    expect_failure("bench builtin:doorway --reference showcase.exr --methods pt --times 0.01 --quiet --out other", 1,
+                   "another scene");
+}
+
 /* The many-light options: listed in the help, bad values refused with a usage error, and the
  * methods run with them, report their lights and clamping in the stats, and write finite images. */
 static void test_many_light_options(void) {
@@ -264,6 +332,7 @@ int main(int argc, char **argv) {
     if (start != 0) return start;
     test_usage();
     test_errors();
+    test_builtin_scenes();
     test_outputs();
     test_many_light_options();
     test_highlights_layer();

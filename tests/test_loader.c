@@ -10,6 +10,8 @@
 
 #include "check.h"
 #include "lights.h"
+#include "rng.h"
+#include "sampling.h"
 #include "scene.h"
 
 static char tmp_dir[512];
@@ -399,26 +401,71 @@ static void test_env_errors(void) {
     scene_destroy(s);
 }
 
-static void test_default_scene(void) {
-    char err[512];
-    num_warnings = 0;
-    scene *s = scene_load_default(on_warn, NULL, err, sizeof err);
-    CHECK(s != NULL, "default scene: %s", err);
-    if (!s) return;
-    CHECK(num_warnings == 0, "default scene warns: %s", last_warning);
-    CHECK(s->num_cameras >= 1, "default scene has no camera");
-    int area = 0, punctual = 0, glossy = 0, aniso = 0;
-    for (int i = 0; i < s->num_lights; i++) {
-        area += s->lights[i].type == LIGHT_TRIANGLE;
-        punctual += s->lights[i].type <= LIGHT_DIRECTIONAL;
+/* Every built-in scene loads without a warning, has a camera and a light, glossy materials, and
+ * is closed: no ray from its camera escapes, so no light leaves the room. builtin:NAME names it;
+ * an unknown name is one error listing the scenes there are. */
+static void test_builtin_scenes(void) {
+    char err[512], want[512], names[256] = "";
+    int n;
+    const builtin_scene *all = scene_builtins(&n);
+    CHECK(n >= 3, "%d built-in scenes", n);
+    for (int i = 0; i < n; i++) {
+        CHECK(scene_builtin_find(all[i].name) == &all[i] && strlen(all[i].description) > 10,
+              "built-in %s: lookup or description", all[i].name);
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", i ? ", " : "", all[i].name);
+        char path[64];
+        snprintf(path, sizeof path, "builtin:%s", all[i].name);
+        num_warnings = 0;
+        scene *s = scene_load(path, on_warn, NULL, err, sizeof err);
+        CHECK(s != NULL, "%s: %s", path, err);
+        if (!s) continue;
+        CHECK(num_warnings == 0, "%s warns: %s", path, last_warning);
+        CHECK(strcmp(s->path, path) == 0, "%s loaded as '%s'", path, s->path);
+        CHECK(s->num_cameras >= 1 && s->num_lights >= 1, "%s: %d cameras, %d lights", path, s->num_cameras,
+              s->num_lights);
+        int glossy = 0;
+        for (int m = 0; m < s->num_materials; m++)
+            glossy += s->materials[m].model != MATERIAL_GLTF || s->materials[m].metallic > 0.5f;
+        CHECK(glossy >= 3, "%s: %d glossy materials", path, glossy);
+        if (s->num_cameras >= 1) {
+            rng_state rng = rng_make(5, (uint64_t)i);
+            int escaped = 0;
+            for (int k = 0; k < 4000; k++) {
+                surface_hit h;
+                vec3 d = sample_uniform_sphere(v2(rng_float(&rng), rng_float(&rng)));
+                escaped += !scene_intersect(s, s->cameras[0].position, d, INFINITY, &h);
+            }
+            CHECK(escaped == 0, "%s is not closed: %d of 4000 rays from the camera escape", path, escaped);
+        }
+        scene_destroy(s);
     }
-    for (int i = 0; i < s->num_materials; i++) {
-        const material *m = &s->materials[i];
-        glossy += m->model != MATERIAL_GLTF || m->metallic > 0.5f;
-        aniso += m->model == MATERIAL_WARD || m->anisotropy_strength > 0.0f;
+
+    /* The default is the first, and is what scene_load_default loads. */
+    scene *s = scene_load_default(NULL, NULL, err, sizeof err);
+    CHECK(s != NULL && strncmp(s->path, "builtin:", 8) == 0 && strcmp(s->path + 8, all[0].name) == 0,
+          "the default scene: %s", s ? s->path : err);
+    scene_destroy(s);
+
+    /* The former default keeps what the tests built on it rely on: both kinds of light, metals,
+     * anisotropy. */
+    s = scene_load("builtin:showcase", NULL, NULL, err, sizeof err);
+    CHECK(s != NULL, "builtin:showcase: %s", err);
+    if (s) {
+        int area = 0, punctual = 0, aniso = 0;
+        for (int i = 0; i < s->num_lights; i++) {
+            area += s->lights[i].type == LIGHT_TRIANGLE;
+            punctual += s->lights[i].type <= LIGHT_DIRECTIONAL;
+        }
+        for (int i = 0; i < s->num_materials; i++)
+            aniso += s->materials[i].model == MATERIAL_WARD || s->materials[i].anisotropy_strength > 0.0f;
+        CHECK(area > 0 && punctual > 0 && aniso >= 2, "showcase: %d area, %d punctual lights, %d anisotropic", area,
+              punctual, aniso);
+        scene_destroy(s);
     }
-    CHECK(area > 0 && punctual > 0, "default scene lights: %d area, %d punctual", area, punctual);
-    CHECK(glossy >= 2 && aniso >= 1, "default scene materials: %d glossy, %d anisotropic", glossy, aniso);
+
+    snprintf(want, sizeof want, "builtin:nosuch: no such built-in scene (have: %s)", names);
+    s = scene_load("builtin:nosuch", NULL, NULL, err, sizeof err);
+    CHECK(s == NULL && strcmp(err, want) == 0, "unknown built-in: '%s', expected '%s'", err, want);
     scene_destroy(s);
 }
 
@@ -433,6 +480,6 @@ int main(void) {
     test_glb();
     test_malformed();
     test_env_errors();
-    test_default_scene();
+    test_builtin_scenes();
     return check_exit("test_loader");
 }

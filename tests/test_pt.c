@@ -427,7 +427,7 @@ static void test_highlights_layer(void) {
 
 /* Camera rays traced as a packet find what one-by-one tracing finds: the same hits and misses,
  * the same surface records, for every packet size (partial packets at image edges), on the
- * default scene's curved and anisotropic surfaces: from inside the room, and from outside it
+ * showcase scene's curved and anisotropic surfaces: from inside the room, and from outside it
  * looking at a corner, where most rays miss. */
 static int hits_agree(const surface_hit *a, const surface_hit *b) {
     const float tol = 1e-5f;
@@ -440,8 +440,8 @@ static int hits_agree(const surface_hit *a, const surface_hit *b) {
 
 static void test_camera_packets(void) {
     char err[256];
-    scene *s = scene_load_default(NULL, NULL, err, sizeof err);
-    CHECK(s != NULL, "default scene: %s", err);
+    scene *s = scene_load("builtin:showcase", NULL, NULL, err, sizeof err);
+    CHECK(s != NULL, "builtin:showcase: %s", err);
     if (!s) return;
     vec3 c = bounds_center(s->bounds);
     camera views[2] = {camera_look_at(c, add3(c, v3(1, -0.3f, 0.7f)), v3(0, 1, 0), 1.0f),
