@@ -26,35 +26,259 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
     return h;
 }
 
-/* A lobe to light: what it carries and where its shadow rays start. The vMF modes approximate the
- * cosine-weighted glossy lobe at q by color x vMF; the traced mode evaluates the BSDF at q. */
+/* One secondary hit's record: where it lies and its glossy lobe as vMF bands. */
 typedef struct {
-    vec3 color;  /* x's sample weight (over N) times, for vMF lobes, the glossy albedo at q */
-    vec3 origin; /* on or just above the surface(s) the lobe came from */
-    vec3 n;      /* geometric normal there, toward x: no light from below it */
-    float spread2; /* mean squared distance of the members from their mean position */
-    vmf v;       /* world space */
-    const shading_point *q; /* HL_TRACED: the secondary hit */
+    vec3 p, n;  /* position, geometric normal toward x */
+    vec3 mu;    /* the lobe's mean direction (world) */
+    vec3 across; /* unit, across the plane of incidence (along which a microfacet lobe is narrower) */
+    vec3 color[VMF_LOBE_BANDS]; /* per band: x's weight / N x the lobe's albedo x the band's weight,
+                                 * over the band's mass above the surface (the lobe's energy lies above it) */
+    float lum[VMF_LOBE_BANDS];  /* their luminances: the members' weights in the merge */
+    float rbar[VMF_LOBE_BANDS]; /* mean resultant length A(kappa) of each band (Eq. 5) */
+    float var_along[VMF_LOBE_BANDS], var_across[VMF_LOBE_BANDS]; /* each band's variance per axis, 1 / kappa */
+    int bands;
+    float x_share[VMF_LOBE_BANDS]; /* the share of each band of x's lobe in the direction that reached it */
+} hl_hit;
+
+/* A cluster's lobe is a mixture of components, one per band of x's lobe and band of the members'
+ * lobes. x's lobe's bands matter because the members' spread is the image of x's lobe: GGX's long
+ * tails put a few members far out, and one Gaussian with the members' covariance would be far
+ * broader than the core that makes the highlight's peak (peak 0.64 of path tracing's for GGX
+ * alpha 0.09, K = 1). Each of x's bands is a near-Gaussian (Beckmann) lobe, so the members,
+ * each shared among x's bands by the bands' densities where it was sampled, are merged per band. */
+#define HL_COMPONENTS (VMF_LOBE_BANDS * VMF_LOBE_BANDS)
+
+/* A cluster of secondary hits lit as one lobe: the members, where the shadow rays start, and per
+ * band the members merged as seen from far away (Eq. 5), for the environment and lobe sampling. */
+typedef struct {
+    const hl_hit *hits;
+    const int *members;
+    int count;
+    vec3 origin, n; /* above every member's tangent plane; the members' mean normal */
+    vmf far[HL_COMPONENTS];
+    vec3 far_color[HL_COMPONENTS];
+    float comp_prob[HL_COMPONENTS]; /* lobe sampling's choice of component */
+} hl_cluster;
+
+/* The rotation by the smallest angle that takes unit a to unit b, applied to v. */
+static vec3 rotate_onto(vec3 a, vec3 b, vec3 v) {
+    float c = dot3(a, b);
+    if (c > 0.9999999f) return v;
+    if (c < -0.9999f) { /* a half turn about any axis across a */
+        vec3 axis = frame_from_normal(a).t;
+        return sub3(scale3(axis, 2.0f * dot3(axis, v)), v);
+    }
+    vec3 k = cross3(a, b);
+    return add3(add3(scale3(v, c), cross3(k, v)), scale3(k, dot3(k, v) / (1.0f + c)));
+}
+
+/* Moments of one band of a cluster's members: weight, colour, the weighted sums of rbar mu (Eq. 5),
+ * of mu, and of mu mu^T plus each member's own covariance (its lobe's variances across its mean). */
+typedef struct {
+    double w, r[3], m[3], s[6];
+    vec3 color;
+} band_moments;
+
+static void moments_add(band_moments *bm, vec3 mu, vec3 across, vec3 color, double w, double rbar, double var_along,
+                        double var_across) {
+    const double x = mu.x, y = mu.y, z = mu.z;
+    /* own covariance: var_along (I - mu mu^T - a a^T) + var_across a a^T */
+    const double ax = across.x, ay = across.y, az = across.z, dv = var_across - var_along;
+    bm->w += w;
+    bm->color = add3(bm->color, color);
+    bm->r[0] += w * rbar * x, bm->r[1] += w * rbar * y, bm->r[2] += w * rbar * z;
+    bm->m[0] += w * x, bm->m[1] += w * y, bm->m[2] += w * z;
+    bm->s[0] += w * (x * x + var_along * (1.0 - x * x) + dv * ax * ax);
+    bm->s[1] += w * (x * y - var_along * x * y + dv * ax * ay);
+    bm->s[2] += w * (x * z - var_along * x * z + dv * ax * az);
+    bm->s[3] += w * (y * y + var_along * (1.0 - y * y) + dv * ay * ay);
+    bm->s[4] += w * (y * z - var_along * y * z + dv * ay * az);
+    bm->s[5] += w * (z * z + var_along * (1.0 - z * z) + dv * az * az);
+}
+
+/* The band's mean direction and isotropic concentration (Eq. 5 and 3); 0 when it has no weight. */
+static int moments_vmf(const band_moments *bm, vmf *v) {
+    if (!(bm->w > 0.0)) return 0;
+    double len = sqrt(bm->r[0] * bm->r[0] + bm->r[1] * bm->r[1] + bm->r[2] * bm->r[2]);
+    if (!(len > 1e-12 * bm->w)) return 0; /* antipodal members: no mean direction */
+    v->mu = v3((float)(bm->r[0] / len), (float)(bm->r[1] / len), (float)(bm->r[2] / len));
+    v->kappa = (float)vmf_kappa_from_rbar(len / bm->w);
+    return 1;
+}
+
+/* The band's density toward direction s: a Gaussian across the members' mean direction with their
+ * covariance C (the spread of their means plus their own lobes' variances), K = C^-1: density
+ * sqrt(det K) / (2 pi (1 - e^{-2 sqrt(det K)})) exp(-(d^T K d + sqrt(det K) dn^2) / 2), d the offset of s
+ * across the mean and dn along it. For one round lobe (K = kappa I) this is that vMF exactly. Eq. 5
+ * alone, one round vMF of the members' mean resultant length, fails where they spread in a line,
+ * as the secondary hits of a lobe seen at a grazing angle do: it smears the highlight across that
+ * line, dimming its peak. */
+static double moments_density(const band_moments *bm, const vmf *v, vec3 s) {
+    frame3 f = frame_from_normal(v->mu);
+    const double t1[3] = {f.t.x, f.t.y, f.t.z}, t2[3] = {f.b.x, f.b.y, f.b.z};
+    double w = bm->w, m1 = 0.0, m2 = 0.0, c11 = 0.0, c12 = 0.0, c22 = 0.0;
+    const double *q = bm->s; /* xx xy xz yy yz zz */
+    const double S[3][3] = {{q[0], q[1], q[2]}, {q[1], q[3], q[4]}, {q[2], q[4], q[5]}};
+    for (int i = 0; i < 3; i++) {
+        m1 += bm->m[i] * t1[i];
+        m2 += bm->m[i] * t2[i];
+        for (int j = 0; j < 3; j++) {
+            c11 += t1[i] * S[i][j] * t1[j];
+            c12 += t1[i] * S[i][j] * t2[j];
+            c22 += t2[i] * S[i][j] * t2[j];
+        }
+    }
+    m1 /= w, m2 /= w;
+    c11 = c11 / w - m1 * m1;
+    c22 = c22 / w - m2 * m2;
+    c12 = c12 / w - m1 * m2;
+    double det = c11 * c22 - c12 * c12, tr = c11 + c22;
+    if (!(tr > 0.0) || !(det > 1e-12 * tr * tr)) return vmf_eval(*v, s);
+    double k11 = c22 / det, k22 = c11 / det, k12 = -c12 / det, kg = 1.0 / sqrt(det);
+    double dx = (double)s.x - (double)v->mu.x, dy = (double)s.y - (double)v->mu.y, dz = (double)s.z - (double)v->mu.z;
+    double omc = 0.5 * (dx * dx + dy * dy + dz * dz); /* 1 - mu.s */
+    double d1 = (double)s.x * t1[0] + (double)s.y * t1[1] + (double)s.z * t1[2];
+    double d2 = (double)s.x * t2[0] + (double)s.y * t2[1] + (double)s.z * t2[2];
+    double e = k11 * d1 * d1 + 2.0 * k12 * d1 * d2 + k22 * d2 * d2 + kg * omc * omc;
+    double norm = kg < 1e-8 ? 0.25 / 3.14159265358979 : kg / (2.0 * 3.14159265358979 * -expm1(-2.0 * kg));
+    return norm * exp(-0.5 * e);
+}
+
+/* Adds member h, its lobe's mean and across axis turned to mu and across, its weight scaled by g,
+ * to the components' moments. */
+static void members_add(band_moments *bm, const hl_hit *h, vec3 mu, vec3 across, double g) {
+    for (int xb = 0; xb < VMF_LOBE_BANDS; xb++) {
+        if (!(h->x_share[xb] > 0.0f)) continue;
+        double gx = g * (double)h->x_share[xb];
+        for (int b = 0; b < h->bands; b++)
+            moments_add(&bm[xb * VMF_LOBE_BANDS + b], mu, across, scale3(h->color[b], (float)gx), (double)h->lum[b] * gx,
+                        h->rbar[b], h->var_along[b], h->var_across[b]);
+    }
+}
+
+/* The cluster's lobe toward a light seen from its origin along unit wl, at point y unless `far`
+ * (directional light, environment): what it reflects per unit of the light's radiance at the
+ * origin. Each member sees the light from its own position: its lobe is turned by the rotation
+ * that takes its own direction to the light onto wl, its weight scaled by (distance from the
+ * origin / its own distance)^2, and a member the light lies below contributes nothing. Lighting
+ * every member from the origin instead (the paper's assumption of distant light) shifts each lobe by
+ * the parallax between the two: lobes sampled from a glossy x converge on x's mirror image, and
+ * for a light closer than that image the merged lobe came out narrower than the lobes it stood for
+ * and the highlight too bright at its peak (1.45 times path tracing's on a corner of three Phong-100
+ * planes, K = 1) and too dim around it. */
+static vec3 cluster_toward(const hl_cluster *c, vec3 wl, vec3 y, int far) {
+    band_moments bm[HL_COMPONENTS] = {{0}};
+    double d2o = far ? 1.0 : (double)length_sq3(sub3(y, c->origin));
+    for (int m = 0; m < c->count; m++) {
+        const hl_hit *h = &c->hits[c->members[m]];
+        vec3 li = wl;
+        double g = 1.0;
+        if (!far) {
+            vec3 dl = sub3(y, h->p);
+            float d2 = length_sq3(dl);
+            if (!(d2 > 0.0f)) continue;
+            li = scale3(dl, 1.0f / sqrtf(d2));
+            g = d2o / (double)d2;
+        }
+        if (!(dot3(li, h->n) > 0.0f)) continue;
+        vec3 mu = far ? h->mu : rotate_onto(li, wl, h->mu), across = far ? h->across : rotate_onto(li, wl, h->across);
+        members_add(bm, h, mu, across, g);
+    }
+    vec3 sum = v3(0, 0, 0);
+    for (int b = 0; b < HL_COMPONENTS; b++) {
+        vmf v;
+        if (!moments_vmf(&bm[b], &v)) continue;
+        sum = add3(sum, scale3(bm[b].color, (float)moments_density(&bm[b], &v, wl)));
+    }
+    return sum;
+}
+
+/* Lobe sampling's pdf of direction wi from the origin: the far lobes by their bands' choice. */
+static float cluster_pdf(const hl_cluster *c, vec3 wi) {
+    double pdf = 0.0;
+    for (int b = 0; b < HL_COMPONENTS; b++)
+        if (c->comp_prob[b] > 0.0f) pdf += (double)c->comp_prob[b] * vmf_eval(c->far[b], wi);
+    return (float)pdf;
+}
+
+/* Sets up cluster c from its members: origin, normal, far lobes. Where the shadow rays start: the
+ * members' mean position (weighted like the merge), raised along their mean normal until it lies
+ * above every member's tangent plane, so the rays never start under a curved surface (the paper's
+ * per-ray epsilon, made explicit). */
+static void cluster_make(hl_cluster *c, const hl_hit *hits, const int *members, int count) {
+    c->hits = hits;
+    c->members = members;
+    c->count = count;
+    vec3 p = v3(0, 0, 0), n = v3(0, 0, 0);
+    double w = 0.0;
+    int heaviest = members[0];
+    float heaviest_a = -1.0f;
+    band_moments bm[HL_COMPONENTS] = {{0}};
+    for (int m = 0; m < count; m++) {
+        const hl_hit *h = &hits[members[m]];
+        float a = 0.0f;
+        for (int b = 0; b < h->bands; b++) a += h->lum[b];
+        members_add(bm, h, h->mu, h->across, 1.0);
+        p = madd3(p, h->p, a);
+        n = madd3(n, h->n, a);
+        w += (double)a;
+        if (a > heaviest_a) heaviest_a = a, heaviest = members[m];
+    }
+    double total = 0.0;
+    for (int b = 0; b < HL_COMPONENTS; b++) {
+        c->far_color[b] = bm[b].color;
+        if (!moments_vmf(&bm[b], &c->far[b])) bm[b].w = 0.0;
+        total += bm[b].w;
+    }
+    for (int b = 0; b < HL_COMPONENTS; b++) c->comp_prob[b] = total > 0.0 ? (float)(bm[b].w / total) : 0.0f;
+    float len = length3(n);
+    p = scale3(p, (float)(1.0 / w));
+    if (!(len > 1e-3f * (float)w)) { /* opposed normals: no mean side to stand on */
+        c->origin = hits[heaviest].p;
+        c->n = hits[heaviest].n;
+        return;
+    }
+    n = scale3(n, 1.0f / len);
+    float raise = 0.0f;
+    for (int m = 0; m < count; m++) {
+        const hl_hit *h = &hits[members[m]];
+        float cs = dot3(n, h->n);
+        if (cs > 0.1f) raise = fmaxf(raise, dot3(sub3(h->p, p), h->n) / cs);
+    }
+    c->origin = madd3(p, n, raise);
+    c->n = n;
+}
+
+/* A lobe to light: a cluster of vMF lobes, or (traced) one secondary hit's own BSDF lobe. */
+typedef struct {
+    vec3 origin, n; /* where shadow rays start; no light from below n */
+    const hl_cluster *c;
+    const shading_point *q; /* traced: the secondary hit */
+    vec3 weight;            /* traced: x's sample weight (over N) */
 } lit_lobe;
 
-/* The lobe's value toward world direction wi and the pdf with which lobe_sample produces wi. */
-static vec3 lobe_eval(const lit_lobe *l, vec3 wi, float *pdf) {
+/* The lobe's value toward a light along wi (at point y unless far) and the pdf with which
+ * lobe_sample produces wi. */
+static vec3 lobe_eval(const lit_lobe *l, vec3 wi, vec3 y, int far, float *pdf) {
     if (l->q) {
         vec3 w = to_local(l->q->frame, wi);
         *pdf = bsdf_pdf(&l->q->b, l->q->wo, w, BSDF_GLOSSY);
         if (!(w.z > 0.0f) || !(dot3(wi, l->n) > 0.0f)) return v3(0, 0, 0);
-        return mul3(l->color, scale3(bsdf_eval(&l->q->b, l->q->wo, w, BSDF_GLOSSY), w.z));
+        return mul3(l->weight, scale3(bsdf_eval(&l->q->b, l->q->wo, w, BSDF_GLOSSY), w.z));
     }
-    float g = (float)vmf_eval(l->v, wi);
-    *pdf = g;
-    return dot3(wi, l->n) > 0.0f ? scale3(l->color, g) : v3(0, 0, 0);
+    *pdf = cluster_pdf(l->c, wi);
+    return dot3(wi, l->n) > 0.0f ? cluster_toward(l->c, wi, y, far) : v3(0, 0, 0);
 }
 
-/* A direction from the lobe (BSDF sampling, or the vMF); 0 when none. */
+/* A direction from the lobe (BSDF sampling, or the far vMF bands); 0 when none. */
 static int lobe_sample(const lit_lobe *l, rng_state *rng, vec3 *wi) {
+    float u_band = rng_float(rng);
     vec2 u = rng_vec2(rng);
     if (!l->q) {
-        *wi = vmf_sample(l->v, u);
+        int b = 0;
+        while (b < HL_COMPONENTS - 1 && u_band >= l->c->comp_prob[b]) u_band -= l->c->comp_prob[b++];
+        if (!(l->c->comp_prob[b] > 0.0f)) return 0;
+        *wi = vmf_sample(l->c->far[b], u);
         return 1;
     }
     bsdf_sample_result bs;
@@ -74,13 +298,9 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
         float pdf;
         if (s->lights[li].type == LIGHT_TRIANGLE || s->lights[li].type == LIGHT_ENV) continue;
         if (!light_sample_one(s, li, l->origin, v2(0.5f, 0.5f), &ls)) continue;
-        vec3 f = lobe_eval(l, ls.wi, &pdf);
+        vec3 f = lobe_eval(l, ls.wi, ls.p_light, !isfinite(ls.dist), &pdf);
         if (is_black3(f)) continue; /* outside the lobe: no shadow ray */
-        /* A merged lobe stands for a patch of surface: a light closer than the patch's extent lights
-         * it as a whole, not with the 1/d^2 peak at its centre (lights touching a reflector). */
-        float falloff = isfinite(ls.dist) ? ls.dist * ls.dist / (ls.dist * ls.dist + l->spread2) : 1.0f;
-        if (light_sample_visible(s, l->origin, l->n, &ls, &st->rays[RAY_SHADOW]))
-            sum = add3(sum, scale3(mul3(f, ls.radiance), falloff));
+        if (light_sample_visible(s, l->origin, l->n, &ls, &st->rays[RAY_SHADOW])) sum = add3(sum, mul3(f, ls.radiance));
     }
     int env_by_sampling = traced && s->env_light >= 0;
     if (h->area_lights || env_by_sampling) {
@@ -90,82 +310,100 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
         if (light_sample_direct(s, l->origin, u_sel, u, &ls) && !ls.delta &&
             (s->lights[ls.light].type == LIGHT_TRIANGLE || env_by_sampling)) {
             float pdf;
-            vec3 f = lobe_eval(l, ls.wi, &pdf);
+            vec3 f = lobe_eval(l, ls.wi, ls.p_light, !isfinite(ls.dist), &pdf);
             if (!is_black3(f) && light_sample_visible(s, l->origin, l->n, &ls, &st->rays[RAY_SHADOW]))
                 sum = add3(sum, scale3(mul3(f, ls.radiance), mis_power(ls.pdf, pdf) / ls.pdf));
         }
         vec3 wi;
-        float pdf;
         if (lobe_sample(l, rng, &wi)) {
-            vec3 f = lobe_eval(l, wi, &pdf);
-            if (!is_black3(f) && pdf > 0.0f) {
-                surface_hit e;
-                st->rays[RAY_BOUNCE]++;
-                if (scene_intersect(s, offset_origin(s, l->origin, l->n, wi), wi, INFINITY, &e)) {
-                    int li = s->tri_light[e.tri];
-                    vec3 le = li >= 0 ? material_emission(s, &e) : v3(0, 0, 0);
-                    if (!is_black3(le))
-                        sum = add3(sum, scale3(mul3(f, le), mis_power(pdf, light_pdf_triangle(s, li, l->origin, &e)) / pdf));
-                } else if (env_by_sampling) {
+            surface_hit e;
+            st->rays[RAY_BOUNCE]++;
+            if (scene_intersect(s, offset_origin(s, l->origin, l->n, wi), wi, INFINITY, &e)) {
+                int li = s->tri_light[e.tri];
+                vec3 le = li >= 0 ? material_emission(s, &e) : v3(0, 0, 0);
+                float pdf;
+                vec3 f = is_black3(le) ? le : lobe_eval(l, wi, e.p, 0, &pdf);
+                if (!is_black3(f) && pdf > 0.0f)
+                    sum = add3(sum, scale3(mul3(f, le), mis_power(pdf, light_pdf_triangle(s, li, l->origin, &e)) / pdf));
+            } else if (env_by_sampling) {
+                float pdf;
+                vec3 f = lobe_eval(l, wi, wi, 1, &pdf);
+                if (!is_black3(f) && pdf > 0.0f)
                     sum = add3(sum, scale3(mul3(f, env_eval(s, wi)), mis_power(pdf, light_pdf_env(s, wi)) / pdf));
-                }
             }
         }
     }
-    if (!traced && h->env_filter && dot3(l->v.mu, l->n) > 0.0f) {
-        vec3 e = env_vmf_filter_lookup(h->env_filter, l->v);
+    if (!traced && h->env_filter) {
+        /* One occlusion ray along the heaviest band's mean decides for the lobe (paper, Sec. 6.4). */
+        int main_band = 0;
+        for (int b = 1; b < HL_COMPONENTS; b++)
+            if (l->c->comp_prob[b] > l->c->comp_prob[main_band]) main_band = b;
+        vec3 dir = l->c->far[main_band].mu;
+        vec3 e = v3(0, 0, 0);
+        if (dot3(dir, l->n) > 0.0f)
+            for (int b = 0; b < HL_COMPONENTS; b++)
+                if (l->c->comp_prob[b] > 0.0f)
+                    e = add3(e, mul3(l->c->far_color[b], env_vmf_filter_lookup(h->env_filter, l->c->far[b])));
         if (!is_black3(e)) {
             st->rays[RAY_SHADOW]++;
-            if (!scene_occluded(s, offset_origin(s, l->origin, l->n, l->v.mu), l->v.mu, INFINITY))
-                sum = add3(sum, mul3(l->color, e));
+            if (!scene_occluded(s, offset_origin(s, l->origin, l->n, dir), dir, INFINITY)) sum = add3(sum, e);
         }
     }
     return sum;
 }
 
-/* Lobes more anisotropic than this (larger roughness over smaller) are not fitted by a vMF. */
+/* Lobes more anisotropic than this (larger roughness over smaller) are not fitted by a vMF: no
+ * isotropic vMF follows their streak (the default scene's brushed metals: over half the vMF
+ * modes' error). */
 #define HL_MAX_VMF_ASPECT 1.5f
+/* Nor are lobes whose broadest band has less of its mass above the surface than this: a broad lobe
+ * seen at a grazing angle, cut by the horizon and bent toward the normal by the cosine, is no
+ * vMF about the mirror direction (GGX alpha 0.36 in a corner of three planes: 0.83 of path
+ * tracing's highlights as vMFs). Broad lobes gain little from merging anyway: a light is rarely
+ * outside them. */
+#define HL_MIN_MASS_ABOVE 0.9
 
-/* One secondary hit's record. */
-typedef struct {
-    vec3 p, n;   /* position, geometric normal toward x */
-    vec3 color;  /* x's weight / N times the lobe's albedo */
-} hl_hit;
+enum { HIT_NONE = 0, HIT_VMF, HIT_TRACE };
 
-/* Where a cluster's shadow rays start: the members' mean position (weighted like the merge),
- * raised along their mean normal until it lies above every member's tangent plane, so the rays
- * never start under a curved surface (the paper's per-ray epsilon, made explicit). */
-static void cluster_origin(const hl_hit *hits, const float *alpha, const int *members, int count, vec3 *origin,
-                           vec3 *normal, float *spread2) {
-    vec3 p = v3(0, 0, 0), n = v3(0, 0, 0);
-    double w = 0.0;
-    int heaviest = members[0];
-    for (int m = 0; m < count; m++) {
-        int i = members[m];
-        p = madd3(p, hits[i].p, alpha[i]);
-        n = madd3(n, hits[i].n, alpha[i]);
-        w += (double)alpha[i];
-        if (alpha[i] > alpha[heaviest]) heaviest = i;
+/* Fills hit's record from the secondary hit q reached with x's sample weight and x's bands'
+ * shares there. Returns HIT_VMF, HIT_TRACE when the lobe is to be lit through its own BSDF, or
+ * HIT_NONE when it carries nothing. */
+static int hit_record(hl_hit *hit, const shading_point *q, vec3 weight, const float *x_share) {
+    vmf_lobe lobe;
+    vec3 albedo;
+    if (bsdf_glossy_aspect(&q->b) > HL_MAX_VMF_ASPECT) return HIT_TRACE;
+    if (!vmf_fit_glossy_bands(&q->b, q->wo, &lobe, &albedo)) return HIT_NONE;
+    /* The normal lies in the plane of incidence: what the horizon cuts is the spread along it. */
+    double sq = fmax((double)lobe.squeeze, 1e-3), broadest = (double)lobe.band[0].kappa;
+    for (int b = 1; b < lobe.bands; b++) broadest = fmin(broadest, (double)lobe.band[b].kappa);
+    vec3 mu = normalize3(to_world(q->frame, lobe.band[0].mu));
+    float cos_n = dot3(mu, q->ng), total = 0.0f;
+    if (vmf_mass_above(broadest * sq, (double)cos_n) < HL_MIN_MASS_ABOVE) return HIT_TRACE;
+    hit->p = q->p;
+    hit->n = q->ng;
+    hit->mu = mu;
+    vec3 across = cross3(q->frame.n, to_world(q->frame, q->wo));
+    float al = length3(across);
+    hit->across = al > 1e-6f ? scale3(across, 1.0f / al) : frame_from_normal(hit->mu).t;
+    hit->bands = lobe.bands;
+    for (int b = 0; b < VMF_LOBE_BANDS; b++) hit->x_share[b] = x_share[b];
+    vec3 color = mul3(weight, albedo);
+    for (int b = 0; b < VMF_LOBE_BANDS; b++) {
+        hit->color[b] = v3(0, 0, 0);
+        hit->lum[b] = hit->rbar[b] = hit->var_along[b] = hit->var_across[b] = 0.0f;
     }
-    float len = length3(n);
-    p = scale3(p, (float)(1.0 / w));
-    double s2 = 0.0;
-    for (int m = 0; m < count; m++) s2 += (double)alpha[members[m]] * (double)length_sq3(sub3(hits[members[m]].p, p));
-    *spread2 = (float)(s2 / w);
-    if (!(len > 1e-3f * (float)w)) { /* opposed normals: no mean side to stand on */
-        *origin = hits[heaviest].p;
-        *normal = hits[heaviest].n;
-        return;
+    for (int b = 0; b < lobe.bands; b++) {
+        double k = fmax((double)lobe.band[b].kappa, 1e-6), above = vmf_mass_above(k * sq, (double)cos_n);
+        hit->color[b] = scale3(color, (float)((double)lobe.weight[b] / fmax(above, 0.05)));
+        hit->lum[b] = luminance3(hit->color[b]);
+        hit->rbar[b] = (float)vmf_rbar_from_kappa(k);
+        hit->var_along[b] = (float)(1.0 / (k * sq));
+        hit->var_across[b] = (float)(sq / k);
+        total += hit->lum[b];
     }
-    n = scale3(n, 1.0f / len);
-    float raise = 0.0f;
-    for (int m = 0; m < count; m++) {
-        const hl_hit *hi = &hits[members[m]];
-        float c = dot3(n, hi->n);
-        if (c > 0.1f) raise = fmaxf(raise, dot3(sub3(hi->p, p), hi->n) / c);
-    }
-    *origin = madd3(p, n, raise);
-    *normal = n;
+    for (int b = 0; b < lobe.bands; b++)
+        if (!is_finite3(hit->color[b])) return HIT_NONE;
+    return total > 0.0f && isfinite(total) ? HIT_VMF : HIT_NONE;
 }
 
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_state *rng, render_stats *st) {
@@ -173,7 +411,6 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_
     if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) return sum;
     int n = h->secondary_rays;
     hl_hit hits[HL_MAX_SECONDARY_RAYS];
-    vmf lobes[HL_MAX_SECONDARY_RAYS];
     vec3 dirs[HL_MAX_SECONDARY_RAYS];
     float alpha[HL_MAX_SECONDARY_RAYS];
     int count = 0;
@@ -192,55 +429,50 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_
         if (!scene_intersect(s, offset_origin(s, x->p, x->ng, wi), wi, INFINITY, &hq)) continue;
         shading_point q = shading_point_at(s, &hq, wi);
         if (!bsdf_highlight_lobe(&q.b)) continue; /* a rough lobe: the VSLs keep these paths */
-        /* An isotropic vMF cannot follow an anisotropic lobe's streak (the default scene's brushed
-         * metals: over half the vMF modes' error); such a lobe is lit through its own BSDF. */
-        if (h->mode == HL_TRACED || bsdf_glossy_aspect(&q.b) > HL_MAX_VMF_ASPECT) {
-            lit_lobe l = {weight, q.p, q.ng, 0.0f, {v3(0, 0, 1), 0.0f}, &q};
-            sum = add3(sum, light_lobe(h, s, &l, rng, st));
-            st->hl_lobes++;
-            continue;
-        }
-        vmf lobe;
-        vec3 albedo;
-        if (!vmf_fit_glossy(&q.b, q.wo, &lobe, &albedo)) continue;
-        lobe.mu = normalize3(to_world(q.frame, lobe.mu));
         hl_hit *hit = &hits[count];
-        hit->p = q.p;
-        hit->n = q.ng;
-        hit->color = mul3(weight, albedo);
-        if (!is_finite3(hit->color) || !(max_comp3(hit->color) > 0.0f)) continue;
-        if (h->mode == HL_UNMERGED) {
-            lit_lobe l = {hit->color, q.p, q.ng, 0.0f, lobe, NULL};
+        float x_share[VMF_LOBE_BANDS];
+        vmf_glossy_band_shares(&x->b, x->wo, bs.wi, x_share);
+        int rec = h->mode == HL_TRACED ? HIT_TRACE : hit_record(hit, &q, weight, x_share);
+        if (rec == HIT_TRACE) {
+            lit_lobe l = {q.p, q.ng, NULL, &q, weight};
             sum = add3(sum, light_lobe(h, s, &l, rng, st));
             st->hl_lobes++;
             continue;
         }
-        lobes[count] = lobe;
-        dirs[count] = lobe.mu;
-        alpha[count] = fmaxf(luminance3(hit->color), 1e-30f);
+        if (rec == HIT_NONE) continue;
+        if (h->mode == HL_UNMERGED) { /* a cluster of one */
+            hl_cluster c;
+            int self = count;
+            cluster_make(&c, hits, &self, 1);
+            lit_lobe l = {c.origin, c.n, &c, NULL, v3(0, 0, 0)};
+            sum = add3(sum, light_lobe(h, s, &l, rng, st));
+            st->hl_lobes++;
+            continue;
+        }
+        dirs[count] = hit->mu;
+        alpha[count] = 0.0f;
+        for (int b = 0; b < hit->bands; b++) alpha[count] += hit->lum[b];
         count++;
     }
     if (count == 0) return sum;
 
     uint64_t t0 = clock_ns();
-    int assign[HL_MAX_SECONDARY_RAYS];
+    int assign[HL_MAX_SECONDARY_RAYS], members[HL_MAX_SECONDARY_RAYS];
     int k = vmf_em(dirs, alpha, count, h->clusters, assign);
-    lit_lobe merged[HL_MAX_CLUSTERS];
+    hl_cluster clusters[HL_MAX_CLUSTERS];
+    int used = 0;
     for (int c = 0; c < k; c++) {
-        int members[HL_MAX_SECONDARY_RAYS], m = 0;
-        vec3 color = v3(0, 0, 0);
-        for (int i = 0; i < count; i++) {
-            if (assign[i] != c) continue;
-            members[m++] = i;
-            color = add3(color, hits[i].color); /* Eq. 10: the clusters' energies sum to the members' */
-        }
-        merged[c].color = color;
-        merged[c].v = vmf_merge(lobes, alpha, members, m);
-        merged[c].q = NULL;
-        cluster_origin(hits, alpha, members, m, &merged[c].origin, &merged[c].n, &merged[c].spread2);
+        int m = 0;
+        for (int i = 0; i < count; i++)
+            if (assign[i] == c) members[used + m++] = i;
+        cluster_make(&clusters[c], hits, &members[used], m);
+        used += m;
     }
     st->hl_merge_ns += clock_ns() - t0;
-    for (int c = 0; c < k; c++) sum = add3(sum, light_lobe(h, s, &merged[c], rng, st));
+    for (int c = 0; c < k; c++) {
+        lit_lobe l = {clusters[c].origin, clusters[c].n, &clusters[c], NULL, v3(0, 0, 0)};
+        sum = add3(sum, light_lobe(h, s, &l, rng, st));
+    }
     st->hl_lobes += (uint64_t)k;
     return sum;
 }

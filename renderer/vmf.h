@@ -45,6 +45,36 @@ double vmf_convolve_kappa(double ka, double kb);
  * carries (bsdf_glossy_albedo). Returns 0 when b has no glossy lobe or wo is below the surface. */
 int vmf_fit_glossy(const bsdf *b, vec3 wo, vmf *lobe, vec3 *albedo);
 
+/* The same lobe as a mixture of vMF bands about the mirror direction, weights summing to 1: one
+ * band for Phong and Ward (the fit above), VMF_LOBE_BANDS for GGX, whose long tails one vMF of its
+ * median width misses (its peak 0.69 of the lobe's, its shoulders 1.5 times): GGX's distribution of
+ * normals is exactly a mixture of Beckmann ones, D_GGX(alpha) = int_0^inf e^-t D_Beckmann(alpha /
+ * sqrt t) dt, and each band is one Beckmann lobe (fitted like Ward's) at a node of the least-squares
+ * fit of that mixture. Returns the number of bands (0 as vmf_fit_glossy). */
+#define VMF_LOBE_BANDS 2
+typedef struct {
+    vmf band[VMF_LOBE_BANDS];
+    float weight[VMF_LOBE_BANDS];
+    int bands;
+    /* A microfacet lobe (GGX, Ward) seen off normal incidence is narrower across the plane of
+     * incidence than along it: its reflected directions spread by 2 dh along and 2 dh cos theta_o
+     * across for a tilt dh of the half vector. Each band's kappa is the geometric mean of the two
+     * axes'; the lobe's concentration is kappa cos theta_o along and kappa / cos theta_o across. 1
+     * for Phong, which is round about the mirror direction. */
+    float squeeze;
+} vmf_lobe;
+int vmf_fit_glossy_bands(const bsdf *b, vec3 wo, vmf_lobe *lobe, vec3 *albedo);
+/* For a direction wi reflected by b's glossy lobe (local frame), each band's share of the lobe
+ * there (the bands' densities at wi's half vector, normalised to sum to 1): the band it most
+ * likely came from. Returns the number of bands, as vmf_fit_glossy_bands. */
+int vmf_glossy_band_shares(const bsdf *b, vec3 wo, vec3 wi, float share[VMF_LOBE_BANDS]);
+
+/* The share of a vMF's mass above a plane through the sphere's centre whose normal makes cosine
+ * cos_mu_n with the mean: the normal approximation to the distribution of s.n, from the vMF's
+ * exact first two moments (within 0.035 of the exact share over every kappa and angle; exact at
+ * kappa 0, far above and far below). */
+double vmf_mass_above(double kappa, double cos_mu_n);
+
 /* A set of vMF lobes merged into one (the paper's Eq. 5): the weighted mean of the members'
  * unnormalized mean vectors rbar_i mu_i gives the merged mean direction and, through Eq. 3, its
  * concentration. Members with weight <= 0 are ignored; no member gives kappa 0. */

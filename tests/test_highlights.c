@@ -1,7 +1,8 @@
 /* The highlight estimator (vsl+hl) against the path tracer's highlights layer: the exact mode
  * (--merge trace) must agree with it statistically, the vMF modes within their approximation,
- * the VSL estimator must drop exactly the highlights' paths, one merged lobe must smear the
- * reflection of an edge that two lobes keep (the paper's Fig. 6), and hard cases stay finite. */
+ * the VSL estimator must drop exactly the highlights' paths, the merged lobes must keep the reflection
+ * of an edge dark (the paper's Fig. 6), the highlight's peak and shape must match path tracing's,
+ * and hard cases stay finite. */
 #include <math.h>
 
 #include "check.h"
@@ -142,9 +143,10 @@ static void vmf_modes_close_to_exact(int env, const material *wall) {
         float *img = ts_render_with(s, &cam, &p, 48, HL);
         double bias = total(img, NPIX) / total(exact, NPIX) - 1.0, err = rel_l2(img, exact, NPIX);
         printf("merge %s, K=%d: bias %+.3f, relative L2 %.3f\n", merges[k] == HL_MERGE_OFF ? "off" : "on", ks[k], bias, err);
-        /* Measured: biases within 1%, L2 0.024 unmerged and 0.09 merged (the shared position).
-         * The brushed wall's lobe is a streak: its secondary hits spread along the floor, and one
-         * merged lobe at their mean position errs more (+6%, 0.19; two lobes +5%, 0.09). */
+        /* Measured: biases within 1.1%, L2 0.022 unmerged and 0.03-0.04 merged (0.09 before merged
+         * lobes saw the lights from their members' positions). The brushed wall's lobe is a streak:
+         * its secondary hits spread along the floor, merged lobes follow that spread (+0.6%, 0.06;
+         * with one round lobe at their mean position +6%, 0.19). */
         double bias_tol = wall && merges[k] == HL_MERGE_ON ? 0.1 : 0.04;
         double err_tol = merges[k] == HL_MERGE_OFF ? 0.06 : wall && ks[k] == 1 ? 0.25 : 0.15;
         CHECK(fabs(bias) < bias_tol, "merge %d K=%d: highlights off by %+.3f", merges[k], ks[k], bias);
@@ -158,9 +160,10 @@ static void vmf_modes_close_to_exact(int env, const material *wall) {
 
 /* The paper's Fig. 6: a glossy floor in the corner of two perpendicular glossy walls, one red,
  * one green, a light in front of them. Near the reflection of the edge between the walls, a
- * camera hit's secondary rays reach both walls: one merged lobe averages a red lobe and a green
- * one into a broad, nearly diffuse lobe that smears light across the edge's reflection; two lobes
- * keep them apart. */
+ * camera hit's secondary rays reach both walls: the paper's single merged lobe averages a red lobe
+ * and a green one into a broad, round lobe that smears light across the edge's reflection (6e-4 of
+ * the highlights' light there, relative L2 0.39 over the image; two lobes 0.29). Merged lobes that
+ * follow their members' spread keep the edge dark with one lobe as with two. */
 static scene *fig6_corner(float far) {
     scene *s = ts_new("fig 6 corner");
     int floor_m = ts_material(s, ts_phong(v3s(0.05f), v3s(0.9f), 300.0f));
@@ -208,8 +211,8 @@ static void test_fig6_edge(void) {
             float m = sees_edge(&cam, (float)FW / FH, (x + 0.5f) / FW, (y + 0.5f) / FH, 0.15f) ? 1.0f : 0.0f;
             for (int c = 0; c < 3; c++) mask[3 * (y * FW + x) + c] = m;
         }
-    double err[2], edge_light[2], edge_ref = 0.0;
-    for (int i = 0; i < 3 * FN; i++) edge_ref += mask[i] * ref[i];
+    double err[2], edge_light[2], edge_ref = 0.0, edge_pixels = 0.0;
+    for (int i = 0; i < 3 * FN; i++) edge_ref += mask[i] * ref[i], edge_pixels += mask[i] / 3.0;
     for (int k = 1; k <= 2; k++) {
         p.vl.merge = HL_MERGE_ON;
         p.vl.clusters = k;
@@ -223,14 +226,13 @@ static void test_fig6_edge(void) {
         CHECK(all_finite(img, FN), "K=%d: non-finite pixels", k);
         free(img);
     }
-    /* Measured: one lobe puts 6e-4 of the highlights' light into the edge's reflection (a faint
-     * line, where the bright reflections of the light are the rest), the path tracer none, two
-     * lobes none (1e-27). */
+    /* Measured: no light in the edge's reflection with either, relative L2 0.048 (K=1) and 0.057 (K=2). */
+    CHECK(edge_pixels > 40.0, "only %.0f pixels see the edge's reflection: is the test still looking at it?", edge_pixels);
     CHECK(edge_ref <= 1e-6 * total(ref, FN), "the reference has light at the edge (%g): the region is wrong", edge_ref);
-    CHECK(edge_light[0] > 2e-4, "K=1 no longer smears the edge (%.4f): is the test still looking at it?", edge_light[0]);
-    CHECK(edge_light[1] < 1e-6, "K=2 smears the edge: %.4f of the light",
-          edge_light[1]);
-    CHECK(err[1] < err[0], "two lobes are further from the reference than one (%.3f vs %.3f)", err[1], err[0]);
+    for (int k = 0; k < 2; k++) {
+        CHECK(edge_light[k] < 1e-6, "K=%d smears the edge: %.4f of the light", k + 1, edge_light[k]);
+        CHECK(err[k] < 0.1, "K=%d: relative L2 %.3f against the exact mode", k + 1, err[k]);
+    }
     free(ref);
     free(mask);
     scene_destroy(s);
@@ -280,6 +282,139 @@ static void test_split_against_path_tracer(void) {
     }
     free(pt_ind);
     free(pt_hl);
+    scene_destroy(s);
+}
+
+/* The highlight's peak and shape against path tracing: a corner of three glossy planes (floor,
+ * back wall, side wall; metallic GGX of roughness 0.3, alpha 0.09) lit by one point light near the
+ * back wall, the camera looking at the floor's reflection of the wall's highlight (camera - floor -
+ * wall - light), a small image around it. The path tracer's highlights layer is the answer; both
+ * are rendered in independent batches, so every comparison carries its standard error. Checked:
+ * the peak (a 3x3 window around the brightest pixel), the halo (pixels between 5% and 30% of the
+ * peak) and the shape (relative L2 difference over the pixels above 5% of the peak, the noise of
+ * both estimates taken out). Before lobes were seen from each member's position, stretched along
+ * the members' spread and split into bands (GGX's tails), vsl+hl put 1.21 times path tracing's
+ * peak inside a halo of 0.67, shape error 0.40. */
+enum { PW = 32, PH = 24, PN = PW * PH, PB = 6 }; /* image, batches */
+
+static scene *corner_planes(const material *m, vec3 light_pos) {
+    scene *s = ts_new("corner of three planes");
+    material back = *m, side = *m;
+    back.base_color = v3(0.9f, 0.7f, 0.5f);
+    side.base_color = v3(0.5f, 0.7f, 0.9f);
+    int mf = ts_material(s, *m), mb = ts_material(s, back), ms = ts_material(s, side);
+    ts_quad(s, v3(-1.5f, 0, -1), v3(-1.5f, 0, 3), v3(2, 0, 3), v3(2, 0, -1), mf);
+    ts_quad(s, v3(-1.5f, 0, -1), v3(2, 0, -1), v3(2, 2, -1), v3(-1.5f, 2, -1), mb);
+    ts_quad(s, v3(-1.5f, 0, -1), v3(-1.5f, 2, -1), v3(-1.5f, 2, 3), v3(-1.5f, 0, 3), ms);
+    light pl = {.type = LIGHT_POINT, .color = v3s(1.0f), .position = light_pos};
+    scene_add_light(s, &pl);
+    ts_finalize(s);
+    return s;
+}
+
+/* Channel-summed highlights of PB independent batches of `frames` frames each: batch means in
+ * img[b * PN + i]. */
+static void render_batches(const scene *s, const camera *cam, render_params p, int frames, double *img) {
+    for (int b = 0; b < PB; b++) {
+        p.seed = 100 + (uint64_t)b;
+        float *one = ts_render_with(s, cam, &p, frames, HL);
+        for (int i = 0; i < PN; i++) img[b * PN + i] = (double)one[3 * i] + one[3 * i + 1] + one[3 * i + 2];
+        free(one);
+    }
+}
+
+/* Mean over batches of sum_i w_i img_b[i], and its standard error. */
+static void batch_stat(const double *img, const double *w, double *mean, double *se) {
+    double v[PB], m = 0.0, var = 0.0;
+    for (int b = 0; b < PB; b++) {
+        v[b] = 0.0;
+        for (int i = 0; i < PN; i++) v[b] += w[i] * img[b * PN + i];
+        m += v[b] / PB;
+    }
+    for (int b = 0; b < PB; b++) var += (v[b] - m) * (v[b] - m) / (PB - 1);
+    *mean = m;
+    *se = sqrt(var / PB);
+}
+
+typedef struct {
+    double peak, peak_se, halo, halo_se, shape;
+} peak_shape;
+
+/* img against ref (both PB batches): ratios of peak and halo, and the shape error. */
+static peak_shape compare_peak_shape(const double *img, const double *ref) {
+    double mean_ref[PN] = {0}, mean_img[PN] = {0}, var_ref[PN] = {0}, var_img[PN] = {0};
+    for (int i = 0; i < PN; i++) {
+        for (int b = 0; b < PB; b++) mean_ref[i] += ref[b * PN + i] / PB, mean_img[i] += img[b * PN + i] / PB;
+        for (int b = 0; b < PB; b++) {
+            var_ref[i] += (ref[b * PN + i] - mean_ref[i]) * (ref[b * PN + i] - mean_ref[i]) / ((PB - 1) * PB);
+            var_img[i] += (img[b * PN + i] - mean_img[i]) * (img[b * PN + i] - mean_img[i]) / ((PB - 1) * PB);
+        }
+    }
+    int best = 0;
+    for (int i = 1; i < PN; i++)
+        if (mean_ref[i] > mean_ref[best]) best = i;
+    double top = mean_ref[best], win[PN] = {0}, halo[PN] = {0};
+    for (int y = best / PW - 1; y <= best / PW + 1; y++)
+        for (int x = best % PW - 1; x <= best % PW + 1; x++)
+            if (x >= 0 && y >= 0 && x < PW && y < PH) win[y * PW + x] = 1.0;
+    double num = 0.0, den = 0.0;
+    for (int i = 0; i < PN; i++) {
+        halo[i] = mean_ref[i] > 0.05 * top && mean_ref[i] < 0.3 * top;
+        if (mean_ref[i] > 0.05 * top) {
+            double d = mean_img[i] - mean_ref[i];
+            num += d * d - var_img[i] - var_ref[i];
+            den += mean_ref[i] * mean_ref[i];
+        }
+    }
+    peak_shape r;
+    double a, sa, b, sb;
+    batch_stat(img, win, &a, &sa);
+    batch_stat(ref, win, &b, &sb);
+    r.peak = a / b;
+    r.peak_se = r.peak * sqrt(sa * sa / (a * a) + sb * sb / (b * b));
+    batch_stat(img, halo, &a, &sa);
+    batch_stat(ref, halo, &b, &sb);
+    r.halo = a / b;
+    r.halo_se = r.halo * sqrt(sa * sa / (a * a) + sb * sb / (b * b));
+    r.shape = num > 0.0 ? sqrt(num / den) : 0.0;
+    return r;
+}
+
+static void test_peak_and_shape(void) {
+    material ggx = material_default();
+    ggx.base_color = v3s(0.8f);
+    ggx.metallic = 1.0f;
+    ggx.roughness = 0.3f;
+    scene *s = corner_planes(&ggx, v3(0.3f, 0.3f, -0.3f));
+    camera cam = camera_look_at(v3(0, 0.6f, 2.2f), v3(0.2f, 0.0f, -0.4f), v3(0, 1, 0), 0.35f);
+    double *ref = malloc(sizeof(double) * PB * PN), *img = malloc(sizeof(double) * PB * PN);
+    render_params pt = {.width = PW, .height = PH, .max_depth = 2, .pt_highlights = 1};
+    render_batches(s, &cam, pt, 1500, ref);
+    const struct {
+        int merge, clusters, frames;
+        const char *name;
+    } runs[] = {{HL_MERGE_TRACE, 0, 24, "trace"}, {HL_MERGE_ON, 0, 24, "merged (defaults)"}, {HL_MERGE_ON, 1, 24, "merged, K=1"},
+                {HL_MERGE_OFF, 0, 24, "no merging"}};
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
+        render_params p = hl_params(runs[k].merge, runs[k].clusters, 0);
+        p.width = PW;
+        p.height = PH;
+        p.max_depth = 2;
+        render_batches(s, &cam, p, runs[k].frames, img);
+        peak_shape r = compare_peak_shape(img, ref);
+        printf("peak and shape, %s: peak %.3f +- %.3f, halo %.3f +- %.3f of path tracing's, shape error %.3f\n", runs[k].name,
+               r.peak, r.peak_se, r.halo, r.halo_se, r.shape);
+        /* The vMF lobes' own approximation (measured 2-8% at the peak, 0.05-0.1 in shape) plus
+         * four standard errors. */
+        double tol = runs[k].merge == HL_MERGE_TRACE ? 0.0 : 0.1;
+        CHECK(fabs(r.peak - 1.0) < tol + 4.0 * r.peak_se, "%s: peak %.3f of path tracing's (+- %.3f)", runs[k].name, r.peak,
+              r.peak_se);
+        CHECK(fabs(r.halo - 1.0) < tol + 4.0 * r.halo_se, "%s: halo %.3f of path tracing's (+- %.3f)", runs[k].name, r.halo,
+              r.halo_se);
+        CHECK(r.shape < (runs[k].merge == HL_MERGE_TRACE ? 0.05 : 0.15), "%s: shape error %.3f", runs[k].name, r.shape);
+    }
+    free(ref);
+    free(img);
     scene_destroy(s);
 }
 
@@ -385,6 +520,7 @@ static void test_vmf_modes_close_to_exact(void) {
 }
 
 int main(void) {
+    test_peak_and_shape();
     test_trace_matches_path_tracer();
     test_vmf_modes_close_to_exact();
     test_fig6_edge();

@@ -237,6 +237,67 @@ static void test_fit_glossy(void) {
                "roughness 0.9: the fit's median 1 - cos");
 }
 
+/* GGX's lobe as bands: weights summing to 1, the mixture's peak at normal incidence within 6% of
+ * the cosine-weighted lobe's (one vMF of the median width: 0.69 of it); Phong keeps its one band;
+ * the across squeeze is cos theta_o for microfacet lobes. */
+static void test_fit_bands(void) {
+    bsdf ggx = make_bsdf_gltf(v3s(1.0f), 1.0f, 0.3f, 0.0f); /* alpha 0.09 */
+    vmf_lobe lobe;
+    vmf single;
+    vec3 albedo, albedo1;
+    CHECK(vmf_fit_glossy_bands(&ggx, v3(0, 0, 1), &lobe, &albedo) == VMF_LOBE_BANDS, "GGX: %d bands", lobe.bands);
+    vmf_fit_glossy(&ggx, v3(0, 0, 1), &single, &albedo1);
+    double wsum = 0.0, peak = 0.0;
+    for (int b = 0; b < lobe.bands; b++) {
+        wsum += lobe.weight[b];
+        peak += lobe.weight[b] * vmf_eval(lobe.band[b], v3(0, 0, 1));
+    }
+    double want = avg3(bsdf_eval(&ggx, v3(0, 0, 1), v3(0, 0, 1), BSDF_GLOSSY)) / avg3(albedo);
+    CHECK_NEAR(wsum, 1.0, 1e-6, "GGX band weights");
+    CHECK(fabs(peak / want - 1.0) < 0.06, "GGX bands: peak %.3f of the lobe's %.3f", peak, want);
+    CHECK(vmf_eval(single, v3(0, 0, 1)) / want < 0.75, "one vMF's peak %.3f of the lobe's: the bands' reason is gone?",
+          vmf_eval(single, v3(0, 0, 1)) / want);
+    vec3 wo = v3(0.8f, 0.0f, 0.6f);
+    CHECK(vmf_fit_glossy_bands(&ggx, wo, &lobe, &albedo) && fabs(lobe.squeeze - 0.6f) < 1e-6f, "GGX squeeze %g",
+          (double)lobe.squeeze);
+    bsdf phong = make_bsdf_phong(v3s(0.0f), v3s(0.9f), 300.0f);
+    CHECK(vmf_fit_glossy_bands(&phong, wo, &lobe, &albedo) == 1 && lobe.squeeze == 1.0f && lobe.weight[0] == 1.0f,
+          "Phong: one round band");
+    /* Band shares: sum to 1; the sharp band owns the mirror direction, the broad one the tail. */
+    float share[VMF_LOBE_BANDS];
+    vec3 mirror = v3(-wo.x, -wo.y, wo.z), tail = normalize3(v3(-0.3f, 0.5f, 0.8f));
+    CHECK(vmf_glossy_band_shares(&ggx, wo, mirror, share) == VMF_LOBE_BANDS, "GGX: shares per band");
+    CHECK_NEAR(share[0] + share[1], 1.0, 1e-6, "shares at the mirror direction");
+    CHECK(share[1] > share[0], "at the mirror direction the sharp band's share %.3f is below the broad one's", share[1]);
+    vmf_glossy_band_shares(&ggx, wo, tail, share);
+    CHECK(share[0] > 0.99f, "far in the tail the broad band's share is only %.3f", share[0]);
+}
+
+/* vmf_mass_above against quadrature over the vMF (its quantiles in theta, the exact azimuthal share
+ * above the plane for each): within 0.035 everywhere, exact at kappa 0. */
+static void test_mass_above(void) {
+    const double mass_kappas[] = {0.0, 0.1, 1.0, 5.0, 30.0, 300.0, 1e4};
+    const double cosines[] = {-0.5, -0.1, 0.0, 0.1, 0.3, 0.6, 0.95, 1.0};
+    double worst = 0.0;
+    for (size_t i = 0; i < sizeof mass_kappas / sizeof mass_kappas[0]; i++)
+        for (size_t j = 0; j < sizeof cosines / sizeof cosines[0]; j++) {
+            double k = mass_kappas[i], c = cosines[j], sc = sqrt(fmax(0.0, 1.0 - c * c)), sum = 0.0;
+            enum { M = 20000 };
+            for (int q = 0; q < M; q++) {
+                double u = (q + 0.5) / M, omc = k < 1e-8 ? 2.0 * u : -log1p(u * expm1(-2.0 * k)) / k;
+                double t = 1.0 - omc, st = sqrt(fmax(0.0, omc * (2.0 - omc))), den = sc * st;
+                double x = den < 1e-12 ? (c * t > 0.0 ? -2.0 : 2.0) : -c * t / den;
+                sum += x <= -1.0 ? 1.0 : x >= 1.0 ? 0.0 : acos(x) / M_PI;
+            }
+            double exact = sum / M, got = vmf_mass_above(k, c);
+            worst = fmax(worst, fabs(got - exact));
+            CHECK(fabs(got - exact) < 0.035, "kappa %g, cos %g: mass above %.4f, quadrature %.4f", k, c, got, exact);
+            CHECK(got >= 0.0 && got <= 1.0, "kappa %g, cos %g: %g", k, c, got);
+        }
+    printf("vmf_mass_above: worst difference from quadrature %.4f\n", worst);
+    CHECK_NEAR(vmf_mass_above(0.0, 0.7), 0.5, 1e-12, "uniform sphere");
+}
+
 static void test_merge(void) {
     vmf same[3] = {{v3(0, 0, 1), 500.0f}, {v3(0, 0, 1), 500.0f}, {v3(0, 0, 1), 500.0f}};
     float w3[3] = {1.0f, 2.0f, 0.5f};
@@ -340,6 +401,8 @@ int main(void) {
     test_sampling();
     test_product_and_convolution();
     test_fit_glossy();
+    test_fit_bands();
+    test_mass_above();
     test_merge();
     test_em();
     return check_exit("test_vmf");
