@@ -58,28 +58,15 @@ typedef struct {
     light_group lights[MAX_LIGHT_GROUPS]; /* as loaded */
 } scene_info;
 
+/* Light edits: the offset and intensity multiplier of every light, against the scene as loaded. */
 typedef struct {
-    pthread_mutex_t lock;
-    /* requests: UI -> render thread */
-    camera cam;
-    render_params params;
-    uint64_t generation;     /* bumped by every change that resets the accumulation */
-    double changed_at;       /* when the last such change happened (cli_now) */
-    unsigned show_mask;
-    int render_w, render_h;  /* requested full resolution */
-    char export_path[1024];
-    int export_pending;
-    char load_path[1024];
-    int load_kind;           /* 0 none, 1 scene, 2 environment map */
-    int quit;
-    uint64_t lights_scene;   /* the scene (info_serial) the light requests below refer to */
-    vec3 light_offset[MAX_LIGHT_GROUPS]; /* wanted offset from the loaded position */
-    float light_gain[MAX_LIGHT_GROUPS];  /* wanted intensity multiplier */
-    image_rgb reference_new; /* a new reference for the error, handed over (the render thread frees it) */
-    int reference_pending;
-    /* results: render thread -> UI */
-    image_buf image;
-    uint64_t image_serial;
+    vec3 offset[MAX_LIGHT_GROUPS];
+    float gain[MAX_LIGHT_GROUPS];
+} light_edits;
+
+/* What the render thread reports about its frames. It writes them under the lock; the UI thread
+ * copies them as a whole with each image it takes. */
+typedef struct {
     uint64_t frames_generation; /* the request generation those frames show */
     long long frames;        /* full-resolution frames since the last reset */
     uint64_t frames_total;   /* full-resolution frames ever */
@@ -95,6 +82,30 @@ typedef struct {
     double rel_error_at;     /* ... and its seconds since the reset */
     uint64_t rel_error_serial, rel_error_resets;
     uint64_t preview_frames; /* reduced-resolution frames published, ever */
+} view_stats;
+
+typedef struct {
+    pthread_mutex_t lock;
+    /* requests: UI -> render thread */
+    camera cam;
+    render_params params;
+    uint64_t generation;     /* bumped by every change that resets the accumulation */
+    double changed_at;       /* when the last such change happened (cli_now) */
+    unsigned show_mask;
+    int render_w, render_h;  /* requested full resolution */
+    char export_path[1024];
+    int export_pending;
+    char load_path[1024];
+    int load_kind;           /* 0 none, 1 scene, 2 environment map */
+    int quit;
+    uint64_t lights_scene;   /* the scene (info_serial) the light requests below refer to */
+    light_edits lights;      /* wanted */
+    image_rgb reference_new; /* a new reference for the error, handed over (the render thread frees it) */
+    int reference_pending;
+    /* results: render thread -> UI */
+    image_buf image;
+    uint64_t image_serial;
+    view_stats stats;
     char message[1200];
     uint64_t message_serial;
     scene_info info;
@@ -106,8 +117,7 @@ typedef struct {
     scene *scene;                       /* render thread */
     render_session *full, *preview;     /* render thread */
     image_buf back;                     /* render thread */
-    vec3 light_applied[MAX_LIGHT_GROUPS]; /* render thread: the edits the scene has */
-    float gain_applied[MAX_LIGHT_GROUPS];
+    light_edits lights_applied;         /* render thread: the edits the scene has */
     image_rgb reference;                /* render thread: for the error of each frame */
     float *combined;                    /* render thread: the whole image when another part is shown */
     size_t combined_len;
@@ -136,10 +146,10 @@ static void fill_info(scene_info *info, const scene *s) {
 }
 
 /* The scene as loaded: no light edits. */
-static void clear_light_edits(vec3 *offset, float *gain) {
+static void clear_light_edits(light_edits *e) {
     for (int g = 0; g < MAX_LIGHT_GROUPS; g++) {
-        offset[g] = v3(0, 0, 0);
-        gain[g] = 1.0f;
+        e->offset[g] = v3(0, 0, 0);
+        e->gain[g] = 1.0f;
     }
 }
 
@@ -215,7 +225,7 @@ static void handle_load(viewer *v, int kind, const char *path, const camera *cam
         v->full = v->preview = NULL;
         scene_destroy(v->scene);
         v->scene = s;
-        clear_light_edits(v->light_applied, v->gain_applied);
+        clear_light_edits(&v->lights_applied);
         camera c = scene_camera(s, -1, (float)w / (float)h);
         make_sessions(v, w, h, &c, params);
         pthread_mutex_lock(&v->sh.lock);
@@ -236,20 +246,22 @@ static void handle_load(viewer *v, int kind, const char *path, const camera *cam
 }
 
 /* Brings the scene's lights to the wanted offsets and gains (render thread, between frames). */
-static void apply_light_edits(viewer *v, const vec3 *offset, const float *gain) {
+static void apply_light_edits(viewer *v, const light_edits *wanted) {
     char err[512];
+    light_edits *done = &v->lights_applied;
     for (int g = 0; g < MAX_LIGHT_GROUPS; g++) {
-        vec3 d = sub3(offset[g], v->light_applied[g]);
+        vec3 d = sub3(wanted->offset[g], done->offset[g]);
+        float gain = wanted->gain[g];
         int failed = !is_black3(d) && scene_move_light(v->scene, g, d, err, sizeof err) != 0;
-        failed = failed || (gain[g] != v->gain_applied[g] && scene_set_light_gain(v->scene, g, gain[g], err, sizeof err) != 0);
+        failed = failed || (gain != done->gain[g] && scene_set_light_gain(v->scene, g, gain, err, sizeof err) != 0);
         if (failed) {
             cli_error("%s", err);
             set_message(v, "%s%s", err, "");
         }
         /* Taken as applied either way: a failed edit is reported once, not every frame. */
-        v->scene_edited |= !is_black3(d) || gain[g] != v->gain_applied[g];
-        v->light_applied[g] = offset[g];
-        v->gain_applied[g] = gain[g];
+        v->scene_edited |= !is_black3(d) || gain != done->gain[g];
+        done->offset[g] = wanted->offset[g];
+        done->gain[g] = gain;
     }
 }
 
@@ -298,34 +310,34 @@ static void publish(viewer *v, render_session *rs, int preview, double frame_ms,
     double thread_ns = 1e6 * frame_ms * (double)session_params(rs)->threads;
     double merge_share = thread_ns > 0.0 ? (double)(st.hl_merge_ns - before->hl_merge_ns) / thread_ns : 0.0;
     pthread_mutex_lock(&v->sh.lock);
-    if (v->sh.resets == resets_seen) { /* drop a frame of a state already replaced */
+    if (v->sh.stats.resets == resets_seen) { /* drop a frame of a state already replaced */
         image_buf t = v->sh.image;
         v->sh.image = v->back;
         v->back = t;
         v->sh.image_serial++;
         if (!preview) {
-            v->sh.frames_generation = gen;
-            v->sh.frames = session_frames(rs);
-            v->sh.frames_total++;
+            v->sh.stats.frames_generation = gen;
+            v->sh.stats.frames = session_frames(rs);
+            v->sh.stats.frames_total++;
         }
-        v->sh.frame_ms = frame_ms;
-        double secs = seconds_since(v->sh.reset_at);
-        v->sh.rays_per_second = secs > 0.0 && !preview ? (double)rays / secs : 0.0;
-        v->sh.rejected = st.rejected_samples;
-        if (preview) v->sh.preview_frames++;
+        v->sh.stats.frame_ms = frame_ms;
+        double secs = seconds_since(v->sh.stats.reset_at);
+        v->sh.stats.rays_per_second = secs > 0.0 && !preview ? (double)rays / secs : 0.0;
+        v->sh.stats.rejected = st.rejected_samples;
+        if (preview) v->sh.stats.preview_frames++;
         if (!preview && rel_error >= 0.0) {
-            v->sh.rel_error = rel_error;
-            v->sh.rel_error_at = secs;
-            v->sh.rel_error_resets = v->sh.resets;
-            v->sh.rel_error_serial++;
+            v->sh.stats.rel_error = rel_error;
+            v->sh.stats.rel_error_at = secs;
+            v->sh.stats.rel_error_resets = v->sh.stats.resets;
+            v->sh.stats.rel_error_serial++;
         }
         if (!preview) {
-            plan_summary(session_plan(rs), v->sh.plan, sizeof v->sh.plan);
-            v->sh.plan_highlights = session_plan(rs)->highlights;
-            v->sh.virtual_lights = st.virtual_lights;
-            v->sh.hl_points = st.hl_points - before->hl_points;
-            v->sh.hl_lobes = st.hl_lobes - before->hl_lobes;
-            v->sh.hl_merge_share = merge_share;
+            plan_summary(session_plan(rs), v->sh.stats.plan, sizeof v->sh.stats.plan);
+            v->sh.stats.plan_highlights = session_plan(rs)->highlights;
+            v->sh.stats.virtual_lights = st.virtual_lights;
+            v->sh.stats.hl_points = st.hl_points - before->hl_points;
+            v->sh.stats.hl_lobes = st.hl_lobes - before->hl_lobes;
+            v->sh.stats.hl_merge_share = merge_share;
         }
     }
     pthread_mutex_unlock(&v->sh.lock);
@@ -382,12 +394,8 @@ static void *render_main(void *arg) {
         int rw = v->sh.render_w, rh = v->sh.render_h;
         /* Light requests made for a scene since replaced are stale: the new one starts as loaded. */
         int edit_lights = gen != applied && v->sh.lights_scene == v->sh.info_serial;
-        vec3 light_offset[MAX_LIGHT_GROUPS];
-        float light_gain[MAX_LIGHT_GROUPS];
-        if (edit_lights) {
-            memcpy(light_offset, v->sh.light_offset, sizeof light_offset);
-            memcpy(light_gain, v->sh.light_gain, sizeof light_gain);
-        }
+        light_edits lights;
+        if (edit_lights) lights = v->sh.lights;
         if (v->sh.reference_pending) {
             image_rgb_free(&v->reference);
             v->reference = v->sh.reference_new;
@@ -395,14 +403,14 @@ static void *render_main(void *arg) {
             v->sh.reference_pending = 0;
         }
         if (gen != applied || resize) {
-            v->sh.resets++;
-            v->sh.reset_at = cli_now();
-            v->sh.frames = 0;
+            v->sh.stats.resets++;
+            v->sh.stats.reset_at = cli_now();
+            v->sh.stats.frames = 0;
         }
-        uint64_t resets_seen = v->sh.resets;
+        uint64_t resets_seen = v->sh.stats.resets;
         pthread_mutex_unlock(&v->sh.lock);
 
-        if (edit_lights) apply_light_edits(v, light_offset, light_gain);
+        if (edit_lights) apply_light_edits(v, &lights);
         /* The scene's analysis follows light edits once they settle, not at every step of a drag. */
         if (v->scene_edited && !preview) {
             if (session_scene_changed(v->full) != 0 || session_scene_changed(v->preview) != 0)
@@ -516,23 +524,11 @@ typedef struct {
     int tex_w, tex_h;
     int need_tonemap;
     char message[1200];
-    /* statistics copied from the render thread */
-    long long frames;
-    uint64_t frames_total, resets, frames_generation;
+    view_stats stats; /* copied from the render thread */
     uint64_t sent_generation;
-    double reset_at, frame_ms, rays_per_second;
-    unsigned long long rejected;
-    unsigned long long virtual_lights;
-    char plan[1200];
-    int plan_highlights;
-    unsigned long long hl_points, hl_lobes;
-    double hl_merge_share;
-    uint64_t preview_frames;
     int preview_w, preview_h; /* the last preview frame's size */
     double started_at;
-    /* lights: the wanted offset and intensity of each, sent with every change */
-    vec3 light_offset[MAX_LIGHT_GROUPS];
-    float light_gain[MAX_LIGHT_GROUPS];
+    light_edits lights; /* the wanted offset and intensity of each, sent with every change */
     char light_labels[MAX_LIGHT_GROUPS][96];
     const char *light_label_ptrs[MAX_LIGHT_GROUPS];
     float light_xy[2 * MAX_LIGHT_GROUPS]; /* window positions, NaN off screen */
@@ -546,7 +542,7 @@ typedef struct {
     image_rgb reference;
     char reference_path[1024];
     double rel_error;
-    uint64_t rel_error_serial, curve_resets;
+    uint64_t curve_resets;
     error_curve curves[MAX_CURVES];
     int num_curves, current_curve;
     ui_curve ui_curves[MAX_CURVES];
@@ -639,8 +635,7 @@ static void send_change(ui_thread *u) {
     sh->params.max_depth = u->ctl.max_depth;
     sh->params.method = (render_method)u->ctl.method;
     sh->params.vl = vl_from_controls(&u->ctl, sh->params.vl);
-    memcpy(sh->light_offset, u->light_offset, sizeof sh->light_offset);
-    memcpy(sh->light_gain, u->light_gain, sizeof sh->light_gain);
+    sh->lights = u->lights;
     sh->lights_scene = u->info_serial;
     u->sent_generation = ++sh->generation;
     sh->changed_at = cli_now();
@@ -650,7 +645,7 @@ static void send_change(ui_thread *u) {
 
 /* Full-resolution frames rendered in the state the UI last asked for. */
 static long long frames_of_current_state(const ui_thread *u) {
-    return u->frames_generation == u->sent_generation ? u->frames : 0;
+    return u->stats.frames_generation == u->sent_generation ? u->stats.frames : 0;
 }
 
 /* Sends what changed in the controls since the last call: estimator settings reset the
@@ -662,9 +657,9 @@ static void apply_controls(ui_thread *u, int camera_changed) {
     /* Picking another light shows its intensity; changing the intensity changes the light. */
     if (u->ctl.light < 0 || u->ctl.light >= u->info.num_lights) u->ctl.light = -1;
     if (u->ctl.light != u->applied_ctl.light) {
-        u->ctl.light_gain = u->ctl.light >= 0 ? u->light_gain[u->ctl.light] : 1.0f;
+        u->ctl.light_gain = u->ctl.light >= 0 ? u->lights.gain[u->ctl.light] : 1.0f;
     } else if (u->ctl.light >= 0 && u->ctl.light_gain != u->applied_ctl.light_gain) {
-        u->light_gain[u->ctl.light] = u->ctl.light_gain;
+        u->lights.gain[u->ctl.light] = u->ctl.light_gain;
         camera_changed = 1;
     }
     if (camera_changed) send_change(u);
@@ -681,7 +676,7 @@ static void apply_controls(ui_thread *u, int camera_changed) {
 /* ---- lights (UI thread) ------------------------------------------------------------------------ */
 
 static vec3 light_position(const ui_thread *u, int g) {
-    return add3(u->info.lights[g].center, u->light_offset[g]);
+    return add3(u->info.lights[g].center, u->lights.offset[g]);
 }
 
 static int light_movable(const ui_thread *u, int g) {
@@ -734,13 +729,13 @@ static int move_light(ui_thread *u, int g, vec3 delta, char *err, size_t errlen)
         return snprintf(err, errlen, "light %d (%s) is directional: it has no position", g, u->info.lights[g].name), -1;
     if (!is_finite3(delta) || length3(delta) > 1e3f * u->info.diag)
         return snprintf(err, errlen, "light %d: move too large", g), -1;
-    u->light_offset[g] = add3(u->light_offset[g], delta);
+    u->lights.offset[g] = add3(u->lights.offset[g], delta);
     return 0;
 }
 
 /* A new scene: its lights as loaded, the first one selected. */
 static void reset_lights(ui_thread *u) {
-    clear_light_edits(u->light_offset, u->light_gain);
+    clear_light_edits(&u->lights);
     static const char *const kinds[] = {"point", "spot", "directional", "area", "environment"};
     for (int g = 0; g < u->info.num_lights; g++) {
         const light_group *lg = &u->info.lights[g];
@@ -1028,7 +1023,7 @@ static void print_stats(ui_thread *u) {
     printf("stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
            "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
            u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z, (double)lx, (double)ly,
-           tonemap_names[u->ctl.tonemap], mean, u->rel_error, (unsigned long long)u->preview_frames, u->preview_w, u->preview_h,
+           tonemap_names[u->ctl.tonemap], mean, u->rel_error, (unsigned long long)u->stats.preview_frames, u->preview_w, u->preview_h,
            seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
            nb ? marks : "-");
     printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
@@ -1036,12 +1031,12 @@ static void print_stats(ui_thread *u) {
            "light_select=%d candidates=%d trace_glossy=%g glossy_rays=%d virtual_lights=%llu secondary_rays=%d clusters=%d "
            "merge=%s hl_lobes=%llu "
            "plan_highlights=%d\n",
-           u->info.name, frames_of_current_state(u), (unsigned long long)u->frames_total, (unsigned long long)u->resets, u->front.width,
+           u->info.name, frames_of_current_state(u), (unsigned long long)u->stats.frames_total, (unsigned long long)u->stats.resets, u->front.width,
            u->front.height, u->front.preview, (double)u->ctl.exposure, u->ctl.show, u->ctl.max_depth,
-           method_name((render_method)u->ctl.method), u->rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
+           method_name((render_method)u->ctl.method), u->stats.rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
            u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.light_select, u->ctl.candidates,
-           (double)u->ctl.trace_glossy, u->ctl.glossy_rays, u->virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
-           u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->hl_lobes, u->plan_highlights);
+           (double)u->ctl.trace_glossy, u->ctl.glossy_rays, u->stats.virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
+           u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->stats.hl_lobes, u->stats.plan_highlights);
     fflush(stdout);
 }
 
@@ -1362,25 +1357,8 @@ static int fetch(ui_thread *u) {
         fresh = 1;
         if (u->front.preview) u->preview_w = u->front.width, u->preview_h = u->front.height;
     }
-    u->frames = sh->frames;
-    u->frames_total = sh->frames_total;
-    u->frames_generation = sh->frames_generation;
-    u->resets = sh->resets;
-    u->reset_at = sh->reset_at;
-    u->frame_ms = sh->frame_ms;
-    u->rays_per_second = sh->rays_per_second;
-    u->rejected = sh->rejected;
-    u->virtual_lights = sh->virtual_lights;
-    u->hl_points = sh->hl_points;
-    u->hl_lobes = sh->hl_lobes;
-    u->hl_merge_share = sh->hl_merge_share;
-    memcpy(u->plan, sh->plan, sizeof u->plan);
-    u->plan_highlights = sh->plan_highlights;
-    u->preview_frames = sh->preview_frames;
-    int new_error = sh->rel_error_serial != u->rel_error_serial;
-    double rel_error = sh->rel_error, rel_error_at = sh->rel_error_at;
-    uint64_t rel_error_resets = sh->rel_error_resets;
-    u->rel_error_serial = sh->rel_error_serial;
+    int new_error = sh->stats.rel_error_serial != u->stats.rel_error_serial;
+    u->stats = sh->stats;
     if (sh->message_serial != u->message_serial) {
         snprintf(u->message, sizeof u->message, "%s", sh->message);
         u->message_serial = sh->message_serial;
@@ -1391,7 +1369,7 @@ static int fetch(ui_thread *u) {
         new_info = 1;
     }
     pthread_mutex_unlock(&sh->lock);
-    if (new_error && u->reference.rgb) add_error_point(u, rel_error_at, rel_error, rel_error_resets);
+    if (new_error && u->reference.rgb) add_error_point(u, u->stats.rel_error_at, u->stats.rel_error, u->stats.rel_error_resets);
     if (new_info) { /* a new scene: its own view, lights and bookmarks */
         u->ctl.camera = -1;
         u->applied_ctl.camera = -1;
@@ -1631,8 +1609,8 @@ int cmd_view(int argc, char **argv) {
     controls_from_vl(&u.ctl, &o.params.vl);
     u.applied_ctl = u.ctl;
     reset_lights(&u);
-    clear_light_edits(v.sh.light_offset, v.sh.light_gain);
-    clear_light_edits(v.light_applied, v.gain_applied);
+    clear_light_edits(&v.sh.lights);
+    clear_light_edits(&v.lights_applied);
     bookmarks_load(&u);
     u.rel_error = -1.0;
     u.current_curve = -1;
@@ -1646,7 +1624,7 @@ int cmd_view(int argc, char **argv) {
     v.sh.render_h = fh > 0 ? fh : o.height;
     v.sh.show_mask = COMP_MASK_ALL;
     v.sh.changed_at = -1e9;
-    v.sh.reset_at = cli_now(); /* the first accumulation starts now, not at the clock's origin */
+    v.sh.stats.reset_at = cli_now(); /* the first accumulation starts now, not at the clock's origin */
     if (make_sessions(&v, v.sh.render_w, v.sh.render_h, &v.sh.cam, &o.params) != 0) {
         cli_error("%s", v.sh.message);
         ui_shutdown();
@@ -1681,21 +1659,21 @@ int cmd_view(int argc, char **argv) {
             u.ui_curves[c] = (ui_curve){u.curves[c].label, u.curves[c].seconds, u.curves[c].error, u.curves[c].n};
         describe_bookmarks(&u);
         ui_stats st = {.scene_name = u.info.name,
-                       .frames = u.frames,
-                       .spp = (double)u.frames,
-                       .seconds = seconds_since(u.reset_at),
-                       .frame_ms = u.frame_ms,
-                       .rays_per_second = u.rays_per_second,
-                       .rejected_samples = u.rejected,
+                       .frames = u.stats.frames,
+                       .spp = (double)u.stats.frames,
+                       .seconds = seconds_since(u.stats.reset_at),
+                       .frame_ms = u.stats.frame_ms,
+                       .rays_per_second = u.stats.rays_per_second,
+                       .rejected_samples = u.stats.rejected,
                        .many_light = u.ctl.method != METHOD_PT,
-                       .virtual_lights = u.virtual_lights,
+                       .virtual_lights = u.stats.virtual_lights,
                        .highlights = u.ctl.method == METHOD_VSL_HL,
                        .max_secondary_rays = HL_MAX_SECONDARY_RAYS,
                        .max_clusters = HL_MAX_CLUSTERS,
-                       .hl_points = u.hl_points,
-                       .hl_lobes = u.hl_lobes,
-                       .hl_merge_share = u.hl_merge_share,
-                       .plan = u.plan,
+                       .hl_points = u.stats.hl_points,
+                       .hl_lobes = u.stats.hl_lobes,
+                       .hl_merge_share = u.stats.hl_merge_share,
+                       .plan = u.stats.plan,
                        .width = u.front.width,
                        .height = u.front.height,
                        .previewing = u.front.preview,
