@@ -1,0 +1,251 @@
+/* glint view: the interactive viewer's internals, shared by its files (not a public interface).
+ *
+ * Two threads. The render thread (view_render.c) owns the scene and the render sessions: it
+ * renders frame after frame, applies requested changes between frames, and publishes each
+ * resolved image by swapping buffers under a lock held only for the swap. The UI thread owns the
+ * window: it handles input (view_input.c, view_camera.c) and scripts (view_script_run.c),
+ * tone-maps and draws the newest image with the panel (view_display.c), and never waits for a
+ * frame. The two meet only in shared_state, under its lock.
+ *
+ * While the camera moves, frames come from a preview session at a fraction of the resolution
+ * (coarser while its frames are slow) so the image follows the input; once things rest, the
+ * full-resolution session accumulates.
+ *
+ * Lights are edited the same way: the UI keeps the wanted offset and intensity of every light and
+ * sends them with each change; the render thread applies the difference to the scene between
+ * frames, when nothing reads it. */
+#ifndef GLINT_VIEW_H
+#define GLINT_VIEW_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <GLFW/glfw3.h>
+
+#include "camera.h"
+#include "cli.h"
+#include "session.h"
+#include "ui.h"
+#include "view_script.h"
+
+#define MAX_VIEW_CAMERAS 32
+#define MAX_LIGHT_GROUPS 64    /* lights the viewer lists and edits; more are rendered, not listed */
+#define MAX_CURVES 6           /* error curves kept for comparison */
+#define MAX_CURVE_POINTS 512   /* per curve; halved (every other point) when full */
+
+static inline double seconds_since(double t) { return cli_now() - t; }
+
+/* ---- shared state (view_render.c) ------------------------------------------------------------ */
+
+typedef struct {
+    float *rgb;
+    int width, height;
+    int preview;
+} image_buf;
+
+typedef struct {
+    char name[1024];
+    int num_cameras;
+    camera cameras[MAX_VIEW_CAMERAS];
+    bounds3 bounds;
+    float diag;
+    int num_lights;
+    light_group lights[MAX_LIGHT_GROUPS]; /* as loaded */
+} scene_info;
+
+/* Light edits: the offset and intensity multiplier of every light, against the scene as loaded. */
+typedef struct {
+    vec3 offset[MAX_LIGHT_GROUPS];
+    float gain[MAX_LIGHT_GROUPS];
+} light_edits;
+
+/* What the render thread reports about its frames. It writes them under the lock; the UI thread
+ * copies them as a whole with each image it takes. */
+typedef struct {
+    uint64_t frames_generation; /* the request generation those frames show */
+    long long frames;        /* full-resolution frames since the last reset */
+    uint64_t frames_total;   /* full-resolution frames ever */
+    uint64_t resets;
+    double reset_at, frame_ms, rays_per_second;
+    unsigned long long rejected;
+    unsigned long long virtual_lights;
+    char plan[1200];         /* the full-resolution session's effect plan, one pass a line */
+    int plan_highlights;
+    unsigned long long hl_points, hl_lobes; /* the last full-resolution frame's (vsl+hl) */
+    double hl_merge_share;   /* its thread time spent merging, as a fraction */
+    double rel_error;        /* the last full-resolution frame's against the reference */
+    double rel_error_at;     /* ... and its seconds since the reset */
+    uint64_t rel_error_serial, rel_error_resets;
+    uint64_t preview_frames; /* reduced-resolution frames published, ever */
+} view_stats;
+
+/* Everything the two threads hand each other; every field under lock except abort_frame. */
+typedef struct {
+    pthread_mutex_t lock;
+    /* requests: UI -> render thread */
+    camera cam;
+    render_params params;
+    uint64_t generation;     /* bumped by every change that resets the accumulation */
+    double changed_at;       /* when the last such change happened (cli_now) */
+    unsigned show_mask;
+    int render_w, render_h;  /* requested full resolution */
+    char export_path[1024];
+    int export_pending;
+    char load_path[1024];
+    int load_kind;           /* 0 none, 1 scene, 2 environment map */
+    int quit;
+    uint64_t lights_scene;   /* the scene (info_serial) the light requests below refer to */
+    light_edits lights;      /* wanted */
+    image_rgb reference_new; /* a new reference for the error, handed over (the render thread frees it) */
+    int reference_pending;
+    /* Set by the UI thread with every change that resets the accumulation, cleared by the render
+     * thread when it takes the change: a full-resolution frame in flight stops at its next tile,
+     * so a slow frame never holds up the first preview of a new view. */
+    atomic_int abort_frame;
+    /* results: render thread -> UI */
+    image_buf image;
+    uint64_t image_serial;
+    view_stats stats;
+    char message[1200];
+    uint64_t message_serial;
+    scene_info info;
+    uint64_t info_serial;
+} shared_state;
+
+/* The render thread's own state, private to view_render.c. */
+typedef struct render_thread render_thread;
+
+/* The caller's memory: zeroed, the lock made, the scene as loaded (no light edits), everything
+ * shown, no change yet. */
+void shared_state_init(shared_state *sh);
+/* Frees the buffers left in it (after the render thread stopped) and the lock. */
+void shared_state_deinit(shared_state *sh);
+/* What the UI thread knows of a scene: its name, cameras, bounds and lights as loaded. */
+void fill_scene_info(scene_info *info, const scene *s);
+/* The scene as loaded: no light edits. */
+void clear_light_edits(light_edits *e);
+/* Creates the sessions for s at sh's requested size, camera and parameters and starts the thread,
+ * which then owns s. Returns the thread (free with render_thread_stop), or NULL with the error in
+ * sh->message; s is then still the caller's. */
+render_thread *render_thread_start(shared_state *sh, scene *s);
+/* Asks the thread to quit (a pending export is still written), waits for it and frees what it
+ * owns, the scene included. */
+void render_thread_stop(render_thread *rt);
+
+/* ---- the UI thread --------------------------------------------------------------------------- */
+
+/* The free camera, orbiting a centre in front of it. */
+typedef struct {
+    vec3 pos;
+    float yaw, pitch; /* radians; yaw 0 looks along -z, pitch up positive */
+    float dist;       /* to the orbit centre */
+    float yfov;
+} cam_ctl;
+
+/* Relative error against seconds since a reset, for one method and setting. */
+typedef struct {
+    char label[96];
+    int n;
+    float seconds[MAX_CURVE_POINTS], error[MAX_CURVE_POINTS];
+} error_curve;
+
+typedef struct {
+    shared_state *sh;
+    GLFWwindow *win;
+    ui_controls ctl, applied_ctl;
+    cam_ctl cam;
+    scene_info info;
+    uint64_t info_serial, image_serial, message_serial;
+    image_buf front;
+    unsigned char *pixels;
+    int pixels_cap;
+    unsigned texture;
+    int tex_w, tex_h;
+    int need_tonemap;
+    char message[1200];
+    view_stats stats; /* copied from the render thread */
+    uint64_t sent_generation;
+    int preview_w, preview_h; /* the last preview frame's size */
+    double started_at;
+    light_edits lights; /* the wanted offset and intensity of each, sent with every change */
+    char light_labels[MAX_LIGHT_GROUPS][96];
+    const char *light_label_ptrs[MAX_LIGHT_GROUPS];
+    float light_xy[2 * MAX_LIGHT_GROUPS]; /* window positions, NaN off screen */
+    int left_was_down, dragging_light;
+    /* camera bookmarks 1-9 of this scene, and their file */
+    cam_ctl bookmarks[10];
+    int bookmark_set[10];
+    char bookmarks_path[1100];
+    char bookmarks_text[1200];
+    /* the reference image and the error against it */
+    image_rgb reference;
+    char reference_path[1024];
+    double rel_error;
+    uint64_t curve_resets;
+    error_curve curves[MAX_CURVES];
+    int num_curves, current_curve;
+    ui_curve ui_curves[MAX_CURVES];
+    /* a scripted continuous orbit */
+    double spin_rate, spin_until; /* degrees per second, until when */
+    /* input */
+    double mouse_x, mouse_y;
+    double scroll;
+    int keys_pressed[GLFW_KEY_LAST + 1];
+    double last_time;
+    /* script */
+    view_script script;
+    const char *script_path_for_errors;
+    char window_shot[1024]; /* a pending capture of the window, taken after the next draw */
+    int script_pos, script_waiting, script_errors;
+    long long script_wait_target;
+    uint64_t script_wait_generation;
+    int quit;
+} ui_thread;
+
+/* view_camera.c: the free camera, the scene's cameras and the bookmarks file */
+camera ctl_camera(const cam_ctl *c);
+void ctl_orbit(cam_ctl *c, float dyaw, float dpitch);
+void ctl_pan(cam_ctl *c, float dx, float dy);
+void ctl_zoom(cam_ctl *c, float factor);
+/* The camera chosen in the controls (or the scene's first, or one framing the scene). */
+void reset_view(ui_thread *u);
+void bookmarks_load(ui_thread *u);
+int bookmark_save(ui_thread *u, int slot);
+int bookmark_restore(ui_thread *u, int slot);
+/* Which bookmarks are set, and where they live, for the panel. */
+void describe_bookmarks(ui_thread *u);
+
+/* view_input.c: controls, lights, keys and mouse; the requests they make of the render thread */
+vl_params vl_from_controls(const ui_controls *c, vl_params vl);
+void controls_from_vl(ui_controls *c, const vl_params *vl);
+void send_change(ui_thread *u);
+void apply_controls(ui_thread *u, int camera_changed);
+long long frames_of_current_state(const ui_thread *u);
+void request_export(ui_thread *u, const char *name);
+/* kind: 1 a scene, 2 an environment map. */
+void request_load(ui_thread *u, int kind, const char *path);
+vec3 light_position(const ui_thread *u, int g);
+int light_movable(const ui_thread *u, int g);
+void update_light_screen(ui_thread *u);
+int move_light(ui_thread *u, int g, vec3 delta, char *err, size_t errlen);
+void reset_lights(ui_thread *u);
+void press_key(ui_thread *u, int key, int mods);
+void on_key(GLFWwindow *win, int key, int scancode, int action, int mods);
+void on_scroll(GLFWwindow *win, double dx, double dy);
+void on_drop(GLFWwindow *win, int count, const char **paths);
+int handle_input(ui_thread *u, double dt);
+
+/* view_script_run.c */
+void run_script(ui_thread *u);
+
+/* view_display.c: the image, its error against a reference, the panel */
+int fetch_published(ui_thread *u);
+int load_reference(ui_thread *u, const char *path);
+void tonemap_and_upload(ui_thread *u);
+void take_screenshot(ui_thread *u, const char *name);
+void capture_window(ui_thread *u, int w, int h);
+void draw_image_and_panel(ui_thread *u);
+
+#endif

@@ -1,0 +1,298 @@
+/* glint view: what the window shows (UI thread). The newest published image, tone-mapped or as
+ * its error against a reference, in a GL texture behind the panel; the error plot; screenshots
+ * of the image and captures of the whole window. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image_io.h"
+#include "view.h"
+
+/* ---- the reference image and the error plot -------------------------------------------------- */
+
+/* Loads a reference for the error view and plot: it must match the render size. Returns 0, or -1
+ * with the message shown (the previous reference stays). */
+int load_reference(ui_thread *u, const char *path) {
+    image_rgb img;
+    char err[1200];
+    if (image_rgb_load(path, &img, err, sizeof err) != 0) {
+        snprintf(u->message, sizeof u->message, "%s", err);
+        cli_error("%s", err);
+        return -1;
+    }
+    shared_state *sh = u->sh;
+    pthread_mutex_lock(&sh->lock);
+    int w = sh->render_w, h = sh->render_h;
+    pthread_mutex_unlock(&sh->lock);
+    image_rgb copy = {img.width, img.height, NULL};
+    size_t bytes = sizeof(float) * 3 * (size_t)img.width * (size_t)img.height;
+    if (img.width != w || img.height != h) {
+        snprintf(u->message, sizeof u->message, "%s: the reference is %dx%d but the render is %dx%d; not used", path,
+                 img.width, img.height, w, h);
+    } else if (!(copy.rgb = malloc(bytes))) {
+        snprintf(u->message, sizeof u->message, "%s: out of memory", path);
+    }
+    if (!copy.rgb) {
+        cli_error("%s", u->message);
+        image_rgb_free(&img);
+        return -1;
+    }
+    memcpy(copy.rgb, img.rgb, bytes);
+    pthread_mutex_lock(&sh->lock);
+    image_rgb_free(&sh->reference_new);
+    sh->reference_new = copy; /* the render thread's own copy, for the error of each frame */
+    sh->reference_pending = 1;
+    pthread_mutex_unlock(&sh->lock);
+    image_rgb_free(&u->reference);
+    u->reference = img;
+    snprintf(u->reference_path, sizeof u->reference_path, "%s", path);
+    u->rel_error = -1.0;
+    u->num_curves = 0; /* errors against another image do not compare */
+    u->current_curve = -1;
+    u->need_tonemap = 1;
+    snprintf(u->message, sizeof u->message, "reference %s", path);
+    return 0;
+}
+
+/* The plot's name for the current method and settings. */
+static void curve_label(const ui_thread *u, char *out, size_t n) {
+    const ui_controls *c = &u->ctl;
+    int len = snprintf(out, n, "%s, depth %d", method_name((render_method)c->method), c->max_depth);
+    if (c->method != METHOD_PT && len < (int)n)
+        len += snprintf(out + len, n - (size_t)len, ", %d lights, radius x%g", c->vl_count, (double)c->radius_mult);
+    if (c->method == METHOD_VSL_HL && len < (int)n)
+        snprintf(out + len, n - (size_t)len, ", N %d, K %d", c->secondary_rays, c->clusters);
+}
+
+/* A new error measurement. A new accumulation starts its curve afresh, replacing an earlier one of
+ * the same settings, so switching between methods leaves one curve for each side by side. */
+static void add_error_point(ui_thread *u, double seconds, double error, uint64_t resets) {
+    if (u->current_curve < 0 || resets != u->curve_resets) {
+        char label[96];
+        curve_label(u, label, sizeof label);
+        int c = -1;
+        for (int i = 0; i < u->num_curves; i++)
+            if (strcmp(u->curves[i].label, label) == 0) c = i;
+        if (c < 0 && u->num_curves == MAX_CURVES) { /* forget the oldest */
+            memmove(&u->curves[0], &u->curves[1], sizeof(error_curve) * (MAX_CURVES - 1));
+            c = MAX_CURVES - 1;
+        } else if (c < 0) {
+            c = u->num_curves++;
+        }
+        snprintf(u->curves[c].label, sizeof u->curves[c].label, "%s", label);
+        u->curves[c].n = 0;
+        u->current_curve = c;
+        u->curve_resets = resets;
+    }
+    error_curve *k = &u->curves[u->current_curve];
+    if (k->n == MAX_CURVE_POINTS) { /* keep the whole time span at half the density */
+        for (int i = 0; i < MAX_CURVE_POINTS / 2; i++) {
+            k->seconds[i] = k->seconds[2 * i + 1];
+            k->error[i] = k->error[2 * i + 1];
+        }
+        k->n = MAX_CURVE_POINTS / 2;
+    }
+    k->seconds[k->n] = (float)seconds;
+    k->error[k->n] = (float)error;
+    k->n++;
+    u->rel_error = error;
+}
+
+/* Per-pixel relative error |I - R| / (|R| + eps) as colours on a log scale: blue 1%, green 10%,
+ * red 100% and more. eps, a hundredth of the mean reference, keeps black pixels from glaring. */
+static void false_colour_error(const float *img, const float *ref, int num_pixels, unsigned char *out) {
+    size_t n = 3 * (size_t)num_pixels;
+    double mean = 0.0;
+    for (size_t i = 0; i < n; i++) mean += (double)ref[i];
+    float eps = (float)(0.01 * mean / (double)(n ? n : 1)) + 1e-20f;
+    for (int i = 0; i < num_pixels; i++) {
+        const float *a = img + 3 * (size_t)i, *r = ref + 3 * (size_t)i;
+        float d2 = 0.0f, r2 = 0.0f;
+        for (int k = 0; k < 3; k++) {
+            d2 += (a[k] - r[k]) * (a[k] - r[k]);
+            r2 += r[k] * r[k];
+        }
+        float e = sqrtf(d2) / (sqrtf(r2) + eps);
+        float t = isfinite(e) ? clampf(0.5f * (log10f(fmaxf(e, 1e-6f)) + 2.0f), 0.0f, 1.0f) : 1.0f;
+        float rgb[3] = {clampf(2.0f * t - 1.0f, 0.0f, 1.0f), 1.0f - fabsf(2.0f * t - 1.0f), clampf(1.0f - 2.0f * t, 0.0f, 1.0f)};
+        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+    }
+}
+
+/* Takes the newest published image and statistics. Returns 1 when the image is new. */
+int fetch_published(ui_thread *u) {
+    shared_state *sh = u->sh;
+    int fresh = 0, new_info = 0;
+    pthread_mutex_lock(&sh->lock);
+    if (sh->image_serial != u->image_serial) {
+        image_buf t = u->front;
+        u->front = sh->image;
+        sh->image = t;
+        u->image_serial = sh->image_serial;
+        fresh = 1;
+        if (u->front.preview) u->preview_w = u->front.width, u->preview_h = u->front.height;
+    }
+    int new_error = sh->stats.rel_error_serial != u->stats.rel_error_serial;
+    u->stats = sh->stats;
+    if (sh->message_serial != u->message_serial) {
+        snprintf(u->message, sizeof u->message, "%s", sh->message);
+        u->message_serial = sh->message_serial;
+    }
+    if (sh->info_serial != u->info_serial) {
+        u->info = sh->info;
+        u->info_serial = sh->info_serial;
+        new_info = 1;
+    }
+    pthread_mutex_unlock(&sh->lock);
+    if (new_error && u->reference.rgb)
+        add_error_point(u, u->stats.rel_error_at, u->stats.rel_error, u->stats.rel_error_resets);
+    if (new_info) { /* a new scene: its own view, lights and bookmarks */
+        u->ctl.camera = -1;
+        u->applied_ctl.camera = -1;
+        u->ctl.reset_view = 1;
+        reset_lights(u);
+        bookmarks_load(u);
+    }
+    return fresh;
+}
+
+/* ---- the image and the panel ----------------------------------------------------------------- */
+
+/* The image shown, tone-mapped (or its error in false colour), into the texture drawn. */
+void tonemap_and_upload(ui_thread *u) {
+    int w = u->front.width, h = u->front.height;
+    if (!u->front.rgb || w <= 0 || h <= 0) return;
+    if (w * h > u->pixels_cap) {
+        free(u->pixels);
+        u->pixels = malloc(3 * (size_t)w * (size_t)h);
+        u->pixels_cap = u->pixels ? w * h : 0;
+        if (!u->pixels) return;
+    }
+    const image_rgb *ref = &u->reference;
+    if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
+        false_colour_error(u->front.rgb, ref->rgb, w * h, u->pixels);
+    } else { /* also the preview while moving in the error view: it has another size */
+        tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f, (tonemap_op)u->ctl.tonemap};
+        tonemap_apply(u->front.rgb, w * h, &tp, u->pixels);
+    }
+    if (!u->texture) {
+        GLuint t;
+        glGenTextures(1, &t);
+        u->texture = t;
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_2D, u->texture);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    if (w != u->tex_w || h != u->tex_h) {
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, w, h, 0, GL_RGB, GL_UNSIGNED_BYTE, u->pixels);
+        u->tex_w = w;
+        u->tex_h = h;
+    } else {
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, u->pixels);
+    }
+}
+
+/* Saves the image as shown, without the panel, as a PNG (numbered, never overwriting). */
+void take_screenshot(ui_thread *u, const char *name) {
+    char path[1024], err[1200];
+    if (u->need_tonemap) { /* a newer image or exposure than the one drawn last: save what is current */
+        tonemap_and_upload(u);
+        u->need_tonemap = 0;
+    }
+    if (!u->front.rgb || !u->pixels) {
+        snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
+        cli_error("%s", u->message);
+        return;
+    }
+    if (unique_path(name, path, sizeof path) != 0) {
+        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
+        cli_error("%s", u->message);
+        return;
+    }
+    if (png_save_rgb8(path, u->front.width, u->front.height, u->pixels, WRITE_NO_REPLACE, err, sizeof err) != 0) {
+        snprintf(u->message, sizeof u->message, "%s", err);
+        cli_error("%s", err);
+        return;
+    }
+    snprintf(u->message, sizeof u->message, "wrote %s", path);
+    printf("glint: wrote %s\n", path);
+    fflush(stdout);
+}
+
+/* Saves the window's back buffer as drawn (panel included). */
+void capture_window(ui_thread *u, int w, int h) {
+    char path[1024], err[1200];
+    unsigned char *px = malloc(3 * (size_t)w * (size_t)h), *row = malloc(3 * (size_t)w);
+    if (!px || !row || unique_path(u->window_shot, path, sizeof path) != 0) {
+        cli_error("%s: cannot capture the window", u->window_shot);
+    } else {
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, px);
+        for (int y = 0; y < h / 2; y++) { /* OpenGL's rows run bottom-up */
+            memcpy(row, px + 3 * (size_t)w * (size_t)y, 3 * (size_t)w);
+            memcpy(px + 3 * (size_t)w * (size_t)y, px + 3 * (size_t)w * (size_t)(h - 1 - y), 3 * (size_t)w);
+            memcpy(px + 3 * (size_t)w * (size_t)(h - 1 - y), row, 3 * (size_t)w);
+        }
+        if (png_save_rgb8(path, w, h, px, WRITE_NO_REPLACE, err, sizeof err) != 0) cli_error("%s", err);
+        else printf("glint: wrote %s\n", path);
+    }
+    free(px);
+    free(row);
+    u->window_shot[0] = 0;
+}
+
+/* The image behind the panel, the light markers over it, and the panel with the statistics and
+ * controls; the panel edits u->ctl in place. */
+void draw_image_and_panel(ui_thread *u) {
+    ui_draw_image(u->texture);
+    if (u->ctl.show_panel) {
+        update_light_screen(u);
+        ui_draw_lights(u->light_xy, u->info.num_lights, u->ctl.light);
+    }
+    for (int c = 0; c < u->num_curves; c++)
+        u->ui_curves[c] = (ui_curve){u->curves[c].label, u->curves[c].seconds, u->curves[c].error, u->curves[c].n};
+    describe_bookmarks(u);
+    ui_stats st = {.scene_name = u->info.name,
+                   .frames = u->stats.frames,
+                   .spp = (double)u->stats.frames,
+                   .seconds = seconds_since(u->stats.reset_at),
+                   .frame_ms = u->stats.frame_ms,
+                   .rays_per_second = u->stats.rays_per_second,
+                   .rejected_samples = u->stats.rejected,
+                   .many_light = u->ctl.method != METHOD_PT,
+                   .virtual_lights = u->stats.virtual_lights,
+                   .highlights = u->ctl.method == METHOD_VSL_HL,
+                   .max_secondary_rays = HL_MAX_SECONDARY_RAYS,
+                   .max_clusters = HL_MAX_CLUSTERS,
+                   .hl_points = u->stats.hl_points,
+                   .hl_lobes = u->stats.hl_lobes,
+                   .hl_merge_share = u->stats.hl_merge_share,
+                   .plan = u->stats.plan,
+                   .width = u->front.width,
+                   .height = u->front.height,
+                   .previewing = u->front.preview,
+                   .num_cameras = u->info.num_cameras,
+                   .tonemap_names = tonemap_names,
+                   .num_tonemaps = TONEMAP_COUNT,
+                   .light_names = u->light_label_ptrs,
+                   .num_lights = u->info.num_lights,
+                   .light_movable = light_movable(u, u->ctl.light),
+                   .reference = u->reference.rgb ? u->reference_path : NULL,
+                   .rel_error = u->rel_error,
+                   .curves = u->ui_curves,
+                   .num_curves = u->num_curves,
+                   .bookmarks = u->bookmarks_text,
+                   .message = u->message};
+    const char *methods[METHOD_COUNT];
+    for (int m = 0; m < METHOD_COUNT; m++) methods[m] = method_name((render_method)m);
+    st.method_names = methods;
+    st.num_methods = METHOD_COUNT;
+    ui_panel(&u->ctl, &st);
+}

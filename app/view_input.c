@@ -1,0 +1,349 @@
+/* glint view: the UI thread's input. The panel's controls, keys and mouse move the camera and the
+ * lights and change the settings; each change goes to the render thread as a request in the
+ * shared state. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "image_io.h"
+#include "view.h"
+
+/* ---- the controls, and the requests they make ------------------------------------------------ */
+
+static unsigned show_mask_of(int show) {
+    switch (show) {
+    case UI_SHOW_DIRECT: return 1u << COMP_DIRECT;
+    case UI_SHOW_INDIRECT: return 1u << COMP_INDIRECT;
+    case UI_SHOW_HIGHLIGHTS: return 1u << COMP_HIGHLIGHTS;
+    default: return COMP_MASK_ALL;
+    }
+}
+
+/* The many-light settings the panel edits, onto the parameters (fields it lacks are kept). */
+vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
+    vl.clamp = c->clamp;
+    vl.clamp_value = c->clamp_value;
+    vl.radius_mult = c->radius_mult;
+    vl.radius_shrink = c->radius_shrink > 0.0f ? c->radius_shrink : -1.0f;
+    vl.count = c->vl_count;
+    vl.columns = c->columns;
+    vl.per_pixel = c->per_pixel;
+    vl.select = c->light_select == 1 ? VL_SELECT_TREE : VL_SELECT_POWER;
+    vl.candidates = c->candidates;
+    vl.trace_glossy = c->trace_glossy > 0.0f ? c->trace_glossy : -1.0f;
+    vl.glossy_rays = c->glossy_rays;
+    vl.secondary_rays = c->secondary_rays;
+    vl.clusters = c->clusters;
+    vl.merge = c->merge == 1 ? HL_MERGE_OFF : c->merge == 2 ? HL_MERGE_TRACE : HL_MERGE_ON;
+    return vl;
+}
+
+void controls_from_vl(ui_controls *c, const vl_params *vl) {
+    c->clamp = vl->clamp;
+    c->clamp_value = vl->clamp_value > 0.0f ? vl->clamp_value : VL_DEFAULT_CLAMP;
+    c->radius_mult = vl->radius_mult > 0.0f ? vl->radius_mult : VL_DEFAULT_RADIUS_MULT;
+    c->radius_shrink = vl->radius_shrink > 0.0f ? vl->radius_shrink : vl->radius_shrink < 0.0f ? 0.0f : VL_DEFAULT_RADIUS_SHRINK;
+    c->vl_count = vl->count > 0 ? vl->count : VL_DEFAULT_COUNT;
+    c->columns = vl->columns;
+    c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);
+    c->light_select = vl->select == VL_SELECT_TREE;
+    c->candidates = vl->candidates > 0 ? vl->candidates : VL_DEFAULT_CANDIDATES;
+    c->trace_glossy = vl->trace_glossy > 0.0f ? vl->trace_glossy : vl->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
+    c->glossy_rays = vl->glossy_rays > 0 ? vl->glossy_rays : VL_DEFAULT_GLOSSY_RAYS;
+    c->secondary_rays = vl->secondary_rays > 0 ? vl->secondary_rays : HL_DEFAULT_SECONDARY_RAYS;
+    c->clusters = vl->clusters > 0 ? vl->clusters : HL_DEFAULT_CLUSTERS;
+    c->merge = vl->merge == HL_MERGE_OFF ? 1 : vl->merge == HL_MERGE_TRACE ? 2 : 0;
+}
+
+static int vl_controls_differ(const ui_controls *a, const ui_controls *b) {
+    return a->clamp != b->clamp || a->clamp_value != b->clamp_value || a->radius_mult != b->radius_mult ||
+           a->radius_shrink != b->radius_shrink || a->vl_count != b->vl_count || a->columns != b->columns ||
+           a->per_pixel != b->per_pixel || a->light_select != b->light_select || a->candidates != b->candidates ||
+           a->trace_glossy != b->trace_glossy || a->glossy_rays != b->glossy_rays ||
+           a->secondary_rays != b->secondary_rays || a->clusters != b->clusters || a->merge != b->merge;
+}
+
+/* Sends the camera and estimator settings to the render thread; each call is a change that
+ * resets the accumulation. */
+void send_change(ui_thread *u) {
+    shared_state *sh = u->sh;
+    pthread_mutex_lock(&sh->lock);
+    sh->cam = ctl_camera(&u->cam);
+    sh->params.max_depth = u->ctl.max_depth;
+    sh->params.method = (render_method)u->ctl.method;
+    sh->params.vl = vl_from_controls(&u->ctl, sh->params.vl);
+    sh->lights = u->lights;
+    sh->lights_scene = u->info_serial;
+    u->sent_generation = ++sh->generation;
+    sh->changed_at = cli_now();
+    if (!sh->export_pending) atomic_store(&sh->abort_frame, 1); /* an export takes the frame as asked */
+    pthread_mutex_unlock(&sh->lock);
+}
+
+/* Full-resolution frames rendered in the state the UI last asked for. */
+long long frames_of_current_state(const ui_thread *u) {
+    return u->stats.frames_generation == u->sent_generation ? u->stats.frames : 0;
+}
+
+/* Sends what changed in the controls since the last call: estimator settings reset the
+ * accumulation; display settings only change how the image is shown. */
+void apply_controls(ui_thread *u, int camera_changed) {
+    if (u->ctl.method != u->applied_ctl.method || u->ctl.max_depth != u->applied_ctl.max_depth ||
+        vl_controls_differ(&u->ctl, &u->applied_ctl))
+        camera_changed = 1;
+    /* Picking another light shows its intensity; changing the intensity changes the light. */
+    if (u->ctl.light < 0 || u->ctl.light >= u->info.num_lights) u->ctl.light = -1;
+    if (u->ctl.light != u->applied_ctl.light) {
+        u->ctl.light_gain = u->ctl.light >= 0 ? u->lights.gain[u->ctl.light] : 1.0f;
+    } else if (u->ctl.light >= 0 && u->ctl.light_gain != u->applied_ctl.light_gain) {
+        u->lights.gain[u->ctl.light] = u->ctl.light_gain;
+        camera_changed = 1;
+    }
+    if (camera_changed) send_change(u);
+    if (u->ctl.exposure != u->applied_ctl.exposure || u->ctl.tonemap != u->applied_ctl.tonemap) u->need_tonemap = 1;
+    if (u->ctl.show != u->applied_ctl.show) {
+        pthread_mutex_lock(&u->sh->lock);
+        u->sh->show_mask = show_mask_of(u->ctl.show);
+        pthread_mutex_unlock(&u->sh->lock);
+        u->need_tonemap = 1;
+    }
+    u->applied_ctl = u->ctl;
+}
+
+void request_export(ui_thread *u, const char *name) {
+    char path[1024];
+    if (unique_path(name, path, sizeof path) != 0) {
+        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
+        return;
+    }
+    shared_state *sh = u->sh;
+    pthread_mutex_lock(&sh->lock);
+    snprintf(sh->export_path, sizeof sh->export_path, "%s", path);
+    sh->export_pending = 1;
+    pthread_mutex_unlock(&sh->lock);
+}
+
+void request_load(ui_thread *u, int kind, const char *path) {
+    shared_state *sh = u->sh;
+    pthread_mutex_lock(&sh->lock);
+    snprintf(sh->load_path, sizeof sh->load_path, "%s", path);
+    sh->load_kind = kind;
+    /* A new generation: frames counted after this show the result of the load. */
+    u->sent_generation = ++sh->generation;
+    if (!sh->export_pending) atomic_store(&sh->abort_frame, 1);
+    pthread_mutex_unlock(&sh->lock);
+}
+
+/* ---- lights ---------------------------------------------------------------------------------- */
+
+vec3 light_position(const ui_thread *u, int g) {
+    return add3(u->info.lights[g].center, u->lights.offset[g]);
+}
+
+int light_movable(const ui_thread *u, int g) {
+    return g >= 0 && g < u->info.num_lights && u->info.lights[g].type != LIGHT_DIRECTIONAL;
+}
+
+/* World units per window pixel at distance z in front of the camera. */
+static float pixel_footprint(const ui_thread *u, float z) {
+    int wh;
+    glfwGetWindowSize(u->win, NULL, &wh);
+    return 2.0f * z * tanf(0.5f * u->cam.yfov) / (float)(wh > 0 ? wh : 1);
+}
+
+/* Where each light appears in the window (for markers and picking). */
+void update_light_screen(ui_thread *u) {
+    int ww, wh;
+    glfwGetWindowSize(u->win, &ww, &wh);
+    camera c = ctl_camera(&u->cam);
+    float t = tanf(0.5f * c.yfov), aspect = wh > 0 ? (float)ww / (float)wh : 1.0f;
+    for (int g = 0; g < u->info.num_lights; g++) {
+        vec3 d = sub3(light_position(u, g), c.position);
+        float z = dot3(d, c.forward);
+        u->light_xy[2 * g] = u->light_xy[2 * g + 1] = NAN;
+        if (!light_movable(u, g) || !(z > 1e-6f)) continue;
+        float x = dot3(d, c.right) / (z * t * aspect), y = dot3(d, c.up) / (z * t);
+        u->light_xy[2 * g] = 0.5f * (x + 1.0f) * (float)ww;
+        u->light_xy[2 * g + 1] = 0.5f * (1.0f - y) * (float)wh;
+    }
+}
+
+/* The light drawn nearest to window position (x, y), within a few pixels; -1 for none. */
+static int pick_light(ui_thread *u, double x, double y) {
+    update_light_screen(u);
+    int best = -1;
+    double best_d2 = 24.0 * 24.0;
+    for (int g = 0; g < u->info.num_lights; g++) {
+        double dx = (double)u->light_xy[2 * g] - x, dy = (double)u->light_xy[2 * g + 1] - y;
+        double d2 = dx * dx + dy * dy;
+        if (d2 < best_d2) best_d2 = d2, best = g;
+    }
+    return best;
+}
+
+/* Moves light g by delta (world units); the caller sends the change. Returns 0, or -1 with a
+ * message when g has no position. */
+int move_light(ui_thread *u, int g, vec3 delta, char *err, size_t errlen) {
+    if (g < 0 || g >= u->info.num_lights)
+        return snprintf(err, errlen, "no light %d (the scene has %d)", g, u->info.num_lights), -1;
+    if (!light_movable(u, g))
+        return snprintf(err, errlen, "light %d (%s) is directional: it has no position", g, u->info.lights[g].name), -1;
+    if (!is_finite3(delta) || length3(delta) > 1e3f * u->info.diag)
+        return snprintf(err, errlen, "light %d: move too large", g), -1;
+    u->lights.offset[g] = add3(u->lights.offset[g], delta);
+    return 0;
+}
+
+/* A new scene: its lights as loaded, the first one selected. */
+void reset_lights(ui_thread *u) {
+    clear_light_edits(&u->lights);
+    static const char *const kinds[] = {"point", "spot", "directional", "area", "environment"};
+    for (int g = 0; g < u->info.num_lights; g++) {
+        const light_group *lg = &u->info.lights[g];
+        snprintf(u->light_labels[g], sizeof u->light_labels[g], "%d: %.60s (%s)", g, lg->name,
+                 (unsigned)lg->type < 5 ? kinds[lg->type] : "?");
+        u->light_label_ptrs[g] = u->light_labels[g];
+    }
+    u->ctl.light = u->applied_ctl.light = u->info.num_lights > 0 ? 0 : -1;
+    u->ctl.light_gain = u->applied_ctl.light_gain = 1.0f;
+}
+
+/* ---- keys and mouse -------------------------------------------------------------------------- */
+
+/* keys_pressed holds 1 + the modifier bits of each press since the last frame. */
+void press_key(ui_thread *u, int key, int mods) {
+    if (key >= 0 && key <= GLFW_KEY_LAST) u->keys_pressed[key] = 1 + mods;
+}
+
+void on_key(GLFWwindow *win, int key, int scancode, int action, int mods) {
+    (void)scancode;
+    ui_thread *u = glfwGetWindowUserPointer(win);
+    if (action == GLFW_PRESS && !ui_wants_keyboard()) press_key(u, key, mods);
+}
+
+void on_scroll(GLFWwindow *win, double dx, double dy) {
+    (void)dx;
+    ui_thread *u = glfwGetWindowUserPointer(win);
+    if (!ui_wants_mouse()) u->scroll += dy;
+}
+
+void on_drop(GLFWwindow *win, int count, const char **paths) {
+    ui_thread *u = glfwGetWindowUserPointer(win);
+    if (count < 1) return;
+    /* An image is an environment map; anything else is taken for a scene. */
+    const char *dot = strrchr(paths[0], '.');
+    int env = dot && (strcmp(dot, ".exr") == 0 || strcmp(dot, ".hdr") == 0);
+    request_load(u, env ? 2 : 1, paths[0]);
+}
+
+/* Keys, mouse and the panel's actions. Returns 1 when the camera changed. */
+int handle_input(ui_thread *u, double dt) {
+    int changed = 0;
+    float speed = 0.25f * u->info.diag; /* scene sizes per second */
+    if (!ui_wants_keyboard()) {
+        camera c = ctl_camera(&u->cam);
+        vec3 move = v3s(0.0f);
+        if (glfwGetKey(u->win, GLFW_KEY_W) == GLFW_PRESS) move = add3(move, c.forward);
+        if (glfwGetKey(u->win, GLFW_KEY_S) == GLFW_PRESS) move = sub3(move, c.forward);
+        if (glfwGetKey(u->win, GLFW_KEY_D) == GLFW_PRESS) move = add3(move, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_A) == GLFW_PRESS) move = sub3(move, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_E) == GLFW_PRESS) move = add3(move, v3(0, 1, 0));
+        if (glfwGetKey(u->win, GLFW_KEY_Q) == GLFW_PRESS) move = sub3(move, v3(0, 1, 0));
+        if (!is_black3(move)) {
+            u->cam.pos = madd3(u->cam.pos, normalize3(move), speed * (float)dt);
+            changed = 1;
+        }
+        /* The selected light: arrows along the view plane, PageUp/PageDown along the view. */
+        vec3 lmove = v3s(0.0f);
+        if (glfwGetKey(u->win, GLFW_KEY_RIGHT) == GLFW_PRESS) lmove = add3(lmove, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_LEFT) == GLFW_PRESS) lmove = sub3(lmove, c.right);
+        if (glfwGetKey(u->win, GLFW_KEY_UP) == GLFW_PRESS) lmove = add3(lmove, c.up);
+        if (glfwGetKey(u->win, GLFW_KEY_DOWN) == GLFW_PRESS) lmove = sub3(lmove, c.up);
+        if (glfwGetKey(u->win, GLFW_KEY_PAGE_UP) == GLFW_PRESS) lmove = add3(lmove, c.forward);
+        if (glfwGetKey(u->win, GLFW_KEY_PAGE_DOWN) == GLFW_PRESS) lmove = sub3(lmove, c.forward);
+        char err[256];
+        if (!is_black3(lmove) && light_movable(u, u->ctl.light) &&
+            move_light(u, u->ctl.light, scale3(normalize3(lmove), speed * (float)dt), err, sizeof err) == 0)
+            changed = 1;
+    }
+    if (cli_now() < u->spin_until) { /* a scripted drag */
+        ctl_orbit(&u->cam, (float)(u->spin_rate * dt * 3.14159265358979 / 180.0), 0.0f);
+        changed = 1;
+    }
+    double x, y;
+    glfwGetCursorPos(u->win, &x, &y);
+    double dx = x - u->mouse_x, dy = y - u->mouse_y;
+    u->mouse_x = x;
+    u->mouse_y = y;
+    /* Ctrl + left button: a click picks the light drawn nearest, a drag moves the selected one
+     * with the cursor (at the light's depth, so it stays under the cursor). */
+    int left = glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    int ctrl = glfwGetKey(u->win, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+               glfwGetKey(u->win, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
+    if (left && !u->left_was_down && ctrl && !ui_wants_mouse()) {
+        int g = pick_light(u, x, y);
+        if (g >= 0) u->ctl.light = g;
+        u->dragging_light = 1;
+    }
+    if (!left) u->dragging_light = 0;
+    u->left_was_down = left;
+    if (u->dragging_light) {
+        int g = u->ctl.light;
+        if ((dx != 0.0 || dy != 0.0) && light_movable(u, g)) {
+            camera c = ctl_camera(&u->cam);
+            float z = dot3(sub3(light_position(u, g), c.position), c.forward);
+            float px = pixel_footprint(u, fmaxf(z, 0.01f * u->info.diag));
+            vec3 d = add3(scale3(c.right, (float)dx * px), scale3(c.up, (float)-dy * px));
+            char err[256];
+            if (move_light(u, g, d, err, sizeof err) == 0) changed = 1;
+        }
+    } else if (!ui_wants_mouse() && (dx != 0.0 || dy != 0.0)) {
+        int wh;
+        glfwGetWindowSize(u->win, NULL, &wh);
+        float scale = 1.0f / (float)(wh > 0 ? wh : 1);
+        if (left) {
+            ctl_orbit(&u->cam, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
+            changed = 1;
+        } else if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
+                   glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) {
+            ctl_pan(&u->cam, (float)-dx * scale, (float)dy * scale);
+            changed = 1;
+        }
+    }
+    if (u->scroll != 0.0) {
+        ctl_zoom(&u->cam, powf(0.85f, (float)u->scroll));
+        u->scroll = 0.0;
+        changed = 1;
+    }
+    if (u->keys_pressed[GLFW_KEY_R]) u->ctl.reset_view = 1;
+    if (u->keys_pressed[GLFW_KEY_F12]) u->ctl.screenshot = 1;
+    if (u->keys_pressed[GLFW_KEY_F11]) u->ctl.export_exr = 1;
+    if (u->keys_pressed[GLFW_KEY_TAB]) u->ctl.show_panel = !u->ctl.show_panel;
+    if (u->keys_pressed[GLFW_KEY_ESCAPE]) u->quit = 1;
+    /* 1-9 the scene's cameras; with ctrl, save bookmark N; with shift, restore it. */
+    for (int k = 1; k <= 9; k++) {
+        int pressed = u->keys_pressed[GLFW_KEY_0 + k];
+        int mods = pressed - 1;
+        if (!pressed) continue;
+        if (mods & GLFW_MOD_CONTROL) bookmark_save(u, k);
+        else if (mods & GLFW_MOD_SHIFT) bookmark_restore(u, k);
+        else if (k - 1 < u->info.num_cameras) u->ctl.camera = k - 1;
+    }
+    memset(u->keys_pressed, 0, sizeof u->keys_pressed);
+
+    if (u->ctl.camera != u->applied_ctl.camera) u->ctl.reset_view = 1;
+    if (u->ctl.reset_view) {
+        reset_view(u);
+        u->ctl.reset_view = 0;
+        changed = 1;
+    }
+    if (u->ctl.screenshot) take_screenshot(u, "glint-screenshot.png");
+    if (u->ctl.export_exr) request_export(u, "glint-export.exr");
+    if (u->ctl.load_scene) request_load(u, 1, u->ctl.path);
+    if (u->ctl.load_env) request_load(u, 2, u->ctl.path);
+    if (u->ctl.load_reference) load_reference(u, u->ctl.path);
+    u->ctl.screenshot = u->ctl.export_exr = u->ctl.load_scene = u->ctl.load_env = u->ctl.load_reference = 0;
+    return changed;
+}

@@ -1,0 +1,211 @@
+/* glint view: runs a script's actions (view_script.h) through the viewer's own input paths, one
+ * UI frame at a time, so tests drive the real window. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "view.h"
+
+static void print_stats(ui_thread *u) {
+    /* the mean luminance of the image shown: light edits must move it */
+    double mean = 0.0;
+    int np = u->front.rgb ? u->front.width * u->front.height : 0;
+    for (int i = 0; i < np; i++) {
+        const float *c = u->front.rgb + 3 * (size_t)i;
+        mean += (double)luminance3(v3(c[0], c[1], c[2]));
+    }
+    mean = np > 0 ? mean / np : 0.0;
+    vec3 lp = u->ctl.light >= 0 ? light_position(u, u->ctl.light) : v3(0, 0, 0);
+    update_light_screen(u);
+    float lx = u->ctl.light >= 0 ? u->light_xy[2 * u->ctl.light] : NAN;
+    float ly = u->ctl.light >= 0 ? u->light_xy[2 * u->ctl.light + 1] : NAN;
+    int nb = 0;
+    char marks[16];
+    for (int i = 1; i <= 9; i++)
+        if (u->bookmark_set[i]) marks[nb++] = (char)('0' + i);
+    marks[nb] = 0;
+    printf("stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
+           "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
+           u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z, (double)lx, (double)ly,
+           tonemap_names[u->ctl.tonemap], mean, u->rel_error, (unsigned long long)u->stats.preview_frames, u->preview_w,
+           u->preview_h, seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
+           nb ? marks : "-");
+    printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
+           "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
+           "light_select=%d candidates=%d trace_glossy=%g glossy_rays=%d virtual_lights=%llu secondary_rays=%d clusters=%d "
+           "merge=%s hl_lobes=%llu "
+           "plan_highlights=%d\n",
+           u->info.name, frames_of_current_state(u), (unsigned long long)u->stats.frames_total,
+           (unsigned long long)u->stats.resets, u->front.width, u->front.height, u->front.preview, (double)u->ctl.exposure,
+           u->ctl.show, u->ctl.max_depth,
+           method_name((render_method)u->ctl.method), u->stats.rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
+           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.light_select, u->ctl.candidates,
+           (double)u->ctl.trace_glossy, u->ctl.glossy_rays, u->stats.virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
+           u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->stats.hl_lobes, u->stats.plan_highlights);
+    fflush(stdout);
+}
+
+/* A live parameter by its command-line name. Returns 0, or -1 with a message. */
+static int set_parameter(ui_thread *u, const char *name, const char *value, char *err, size_t errlen) {
+    char opt[80];
+    snprintf(opt, sizeof opt, "--%s", name);
+    long long n;
+    double x;
+    if (strcmp(name, "vpl-glossy") != 0) { /* the many-light settings, as glint render's options */
+        vl_params vl = vl_from_controls(&u->ctl, (vl_params){0});
+        int applied = cli_set_vl_param(name, value, &vl);
+        if (applied < 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        if (applied > 0) {
+            controls_from_vl(&u->ctl, &vl);
+            return 0;
+        }
+    }
+    if (strcmp(name, "method") == 0) {
+        int m = method_from_name(value);
+        if (m < 0) return snprintf(err, errlen, "unknown method '%s'", value), -1;
+        u->ctl.method = m;
+    } else if (strcmp(name, "max-depth") == 0) {
+        if (cli_parse_int(opt, value, 1, 1000, &n) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        u->ctl.max_depth = (int)n;
+    } else if (strcmp(name, "exposure") == 0) {
+        if (cli_parse_float(opt, value, -30, 30, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        u->ctl.exposure = (float)x;
+    } else if (strcmp(name, "show") == 0) {
+        static const char *names[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
+        int found = -1;
+        for (int i = 0; i < UI_SHOW_COUNT; i++)
+            if (strcmp(value, names[i]) == 0) found = i;
+        if (found < 0) return snprintf(err, errlen, "show: one of all, direct, indirect, highlights, error"), -1;
+        if (found == UI_SHOW_ERROR && !u->reference.rgb) return snprintf(err, errlen, "show error: no reference loaded"), -1;
+        u->ctl.show = found;
+    } else if (strcmp(name, "tonemap") == 0) {
+        int t = tonemap_from_name(value);
+        if (t < 0) return snprintf(err, errlen, "tonemap: one of reinhard, clamp, exponential"), -1;
+        u->ctl.tonemap = t;
+    } else if (strcmp(name, "light") == 0) {
+        if (cli_parse_int(opt, value, 0, u->info.num_lights - 1, &n) != 0) return snprintf(err, errlen, "no light %s", value), -1;
+        u->ctl.light = (int)n;
+    } else if (strcmp(name, "light-intensity") == 0) {
+        if (u->ctl.light < 0) return snprintf(err, errlen, "light-intensity: no light selected"), -1;
+        if (cli_parse_float(opt, value, 1e-3, 1e3, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        u->ctl.light_gain = (float)x;
+    } else if (strcmp(name, "camera") == 0) {
+        if (cli_parse_int(opt, value, -1, u->info.num_cameras - 1, &n) != 0)
+            return snprintf(err, errlen, "no camera %s", value), -1;
+        u->ctl.camera = (int)n;
+    } else if (strcmp(name, "panel") == 0) {
+        if (cli_parse_int(opt, value, 0, 1, &n) != 0) return snprintf(err, errlen, "panel: 0 or 1"), -1;
+        u->ctl.show_panel = (int)n;
+    } else {
+        return snprintf(err, errlen, "unknown parameter '%s'", name), -1;
+    }
+    return 0;
+}
+
+/* A key by name, with "ctrl+" or "shift+" in front for the modifier (into *mods). */
+static int key_from_name(const char *name, int *mods) {
+    *mods = 0;
+    if (strncmp(name, "ctrl+", 5) == 0) *mods = GLFW_MOD_CONTROL, name += 5;
+    else if (strncmp(name, "shift+", 6) == 0) *mods = GLFW_MOD_SHIFT, name += 6;
+    if (strcmp(name, "r") == 0) return GLFW_KEY_R;
+    if (strcmp(name, "f11") == 0) return GLFW_KEY_F11;
+    if (strcmp(name, "f12") == 0) return GLFW_KEY_F12;
+    if (strcmp(name, "tab") == 0) return GLFW_KEY_TAB;
+    if (strcmp(name, "escape") == 0) return GLFW_KEY_ESCAPE;
+    if (strlen(name) == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
+    return -1;
+}
+
+/* Runs script actions until one has to wait. */
+void run_script(ui_thread *u) {
+    while (u->script_pos < u->script.count && !u->quit) {
+        const script_action *a = &u->script.actions[u->script_pos];
+        char err[1200];
+        switch (a->kind) {
+        case ACT_WAIT:
+            /* N frames of the current state: frames of a state already replaced do not count. */
+            if (!u->script_waiting || u->script_wait_generation != u->sent_generation) {
+                u->script_waiting = 1;
+                u->script_wait_generation = u->sent_generation;
+                u->script_wait_target = frames_of_current_state(u) + (long long)a->a;
+            }
+            if (frames_of_current_state(u) < u->script_wait_target) return;
+            u->script_waiting = 0;
+            break;
+        case ACT_SET:
+            if (set_parameter(u, a->name, a->text, err, sizeof err) != 0) {
+                cli_error("%s:%d: %s", u->script_path_for_errors, a->line, err);
+                u->script_errors++;
+            }
+            if (u->ctl.camera != u->applied_ctl.camera) {
+                reset_view(u);
+                apply_controls(u, 1);
+            } else {
+                apply_controls(u, 0);
+            }
+            break;
+        case ACT_ORBIT:
+            ctl_orbit(&u->cam, (float)(a->a * 3.14159265358979 / 180.0), (float)(a->b * 3.14159265358979 / 180.0));
+            send_change(u);
+            break;
+        case ACT_PAN:
+            ctl_pan(&u->cam, (float)a->a, (float)a->b);
+            send_change(u);
+            break;
+        case ACT_ZOOM:
+            ctl_zoom(&u->cam, (float)a->a);
+            send_change(u);
+            break;
+        case ACT_KEY: {
+            int mods, k = key_from_name(a->name, &mods);
+            if (k < 0) {
+                cli_error("%s:%d: unknown key '%s'", u->script_path_for_errors, a->line, a->name);
+                u->script_errors++;
+            } else {
+                press_key(u, k, mods);
+            }
+            break;
+        }
+        case ACT_MOVE_LIGHT:
+            if (move_light(u, (int)a->a, v3((float)a->b, (float)a->c, (float)a->d), err, sizeof err) != 0) {
+                cli_error("%s:%d: %s", u->script_path_for_errors, a->line, err);
+                u->script_errors++;
+            } else {
+                u->ctl.light = (int)a->a;
+                apply_controls(u, 1);
+            }
+            break;
+        case ACT_SAVE_BOOKMARK:
+            if (bookmark_save(u, (int)a->a) != 0) u->script_errors++;
+            break;
+        case ACT_RESTORE_BOOKMARK:
+            if (bookmark_restore(u, (int)a->a) != 0) {
+                cli_error("%s:%d: %s", u->script_path_for_errors, a->line, u->message);
+                u->script_errors++;
+            }
+            break;
+        case ACT_REFERENCE: load_reference(u, a->text); break;
+        case ACT_SPIN:
+            if (!u->script_waiting) {
+                u->script_waiting = 1;
+                u->spin_rate = a->a;
+                u->spin_until = cli_now() + a->b;
+            }
+            if (cli_now() < u->spin_until) return;
+            u->script_waiting = 0;
+            break;
+        case ACT_SCREENSHOT: take_screenshot(u, a->text); break;
+        case ACT_EXPORT: request_export(u, a->text); break;
+        case ACT_LOAD: request_load(u, 1, a->text); break;
+        case ACT_ENV: request_load(u, 2, a->text); break;
+        case ACT_WINDOW_SHOT: /* taken after this frame's draw: later actions wait for it */
+            snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text);
+            u->script_pos++;
+            return;
+        case ACT_STATS: print_stats(u); break;
+        case ACT_QUIT: u->quit = 1; break;
+        }
+        u->script_pos++;
+    }
+}
