@@ -264,6 +264,11 @@ class Scene:
             node["rotation"] = list(rotation)
         self.nodes.append(node)
 
+    def add_meshes(self, entries):
+        """One node each: (name, material, mesh[, translation[, rotation]])."""
+        for entry in entries:
+            self.mesh(*entry)
+
     def camera(self, eye, target, yfov=1.1, name="camera"):
         """A 16:9 perspective camera at eye looking at target; yfov in radians."""
         self.cameras.append({"type": "perspective",

@@ -121,16 +121,14 @@ OBJECTS = [  # name, material, mesh, translation, rotation
 
 def build():
     s = Scene(MATERIALS)
-    for name, material, mesh in ROOM:
-        s.mesh(name, material, mesh)
+    s.add_meshes(ROOM)
     for name, material, mesh, t in torchiere():
         s.mesh(name, material, mesh, translation=t)
     for i, (centre, aim) in enumerate(leaves()):
         s.mesh("brass reflector leaf %d" % i, "polished brass", box(LEAF_SIZE), translation=centre,
                rotation=leaf_rotation(centre, aim))
         s.mesh("rod %d" % i, "black metal", cylinder(0.006, 0.006, H - LEAF_Y, 8, caps=False), translation=centre)
-    for name, material, mesh, t, r in OBJECTS:
-        s.mesh(name, material, mesh, translation=t, rotation=r)
+    s.add_meshes(OBJECTS)
     s.camera(CAMERA_EYE, CAMERA_TARGET, yfov=1.15)
     # A wide beam straight up at the ceiling: 55 degrees to the edge of the cone.
     s.light(spot("torchiere", (1.0, 0.86, 0.68), 8000.0, inner=0.75, outer=0.96), SPOT_POS, add(SPOT_POS, (0, 1, 0)))

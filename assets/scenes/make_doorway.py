@@ -154,10 +154,8 @@ OBJECTS = [  # name, material, mesh, translation, rotation
 
 def build():
     s = Scene(MATERIALS)
-    for name, material, mesh in ROOM:
-        s.mesh(name, material, mesh)
-    for name, material, mesh, t, r in OBJECTS:
-        s.mesh(name, material, mesh, translation=t, rotation=r)
+    s.add_meshes(ROOM)
+    s.add_meshes(OBJECTS)
     s.camera(CAMERA_EYE, CAMERA_TARGET, yfov=0.95)
     s.light(spot("spot", (1.0, 0.9, 0.75), 3000.0, inner=0.2, outer=0.3), SPOT_POS, double_mirror()[1])
     return s.document("glint doorway", "glint assets/scenes/make_doorway.py")

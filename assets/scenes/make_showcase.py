@@ -60,10 +60,8 @@ SPOT_POS, SPOT_TARGET = (-1.7, 2.4, 1.2), (0.45, 0.3, -0.15)
 
 def build():
     s = Scene(MATERIALS)
-    for name, material, mesh in ROOM:
-        s.mesh(name, material, mesh)
-    for name, material, mesh, t, r in OBJECTS:
-        s.mesh(name, material, mesh, translation=t, rotation=r)
+    s.add_meshes(ROOM)
+    s.add_meshes(OBJECTS)
     s.camera(CAMERA_EYE, CAMERA_TARGET)
     s.light(spot("spot", (1.0, 0.95, 0.88), 15.0, inner=0.22, outer=0.32), SPOT_POS, SPOT_TARGET)
     return s.document("glint default room", "glint assets/default/make_default_scene.py")
