@@ -13,13 +13,12 @@
 #      and the share of time spent merging; for N = 8 the error split into noise and bias by two
 #      independent runs; then the whole renderer at equal time, the path tracer's highlights layer
 #      against vsl+hl's), about 16 minutes plus the reference.
-#   5. With `bench` first: `glint bench` on the default scene, the headline comparison (pt,
-#      clamped vpl, vsl, vsl+hl; budgets 1 to 64 s, about 5 minutes) and the Fig. 8 sweeps (radius
-#      multiplier and column count, every lobe gathered, 10 s each, about 2 minutes), against a
-#      path-traced reference with its sidecar, rendered once into build/bench-cache
-#      (REF_SECONDS, default 1200); then the same comparison (1 to 32 s) on the shared Cornell box
-#      and lamp scenes, each with its own reference. Results (CSV, plots, report.md) go to
-#      build/bench-results/.
+#   5. With `bench` first: `glint bench`, the headline comparison: pt, vsl and vsl+hl, 2 seeds,
+#      at 2, 10 and 60 s (LONG_SECONDS adds a longer budget), on builtin:atelier, doorway and
+#      showcase and the shared Cornell box at 320x240, each against a path-traced reference with
+#      its highlights layer, rendered once into build/bench-cache (REF_SECONDS, default 1200);
+#      then the Fig. 8 sweeps on showcase. About 8 minutes a scene plus the references; results
+#      (CSV, plots, report.md) go to build/bench-results/.
 #   6. With `plan` first: what the effect plan saves (bench_plan: vsl+hl with the plan and with
 #      every pass forced on, 30 s each) on the default scene and the shared Cornell box, against
 #      the path-traced references of mode 3 (rendered here when missing), about 2 minutes.
@@ -45,36 +44,35 @@ if [ "$mode" = vsl ]; then
 fi
 
 if [ "$mode" = bench ]; then
+  # The headline: pt, vsl and vsl+hl at equal time against a long path-traced reference (with
+  # its highlights layer, so the highlight estimator's share compares too), 2 seeds, at 2, 10 and
+  # 60 s, on the indirect-lit rooms, the former default and the shared Cornell box. Set
+  # LONG_SECONDS (e.g. 300) to add that budget for the slope past 5 minutes.
   glint=$build/app/glint
-  ref=$build/bench-cache/default-320x180-pt-ref.exr
   mkdir -p "$build/bench-cache" "$build/bench-results"
-  if [ ! -f "$ref.json" ]; then
-    echo "rendering the path-traced reference for ${REF_SECONDS:-1200} s"
-    "$glint" render --method pt --time "${REF_SECONDS:-1200}" --size 320x180 --seed 12345 --out "$ref"
-  fi
   stamp=$(date +%Y%m%d-%H%M%S)
-  "$glint" bench --reference "$ref" --methods pt,vpl,vsl,vsl+hl --times 1,2,4,8,16,32,64 \
-    --out "$build/bench-results/headline-$stamp"
-  # Fig. 8: the paper's estimator (every lobe gathered), 4096 lights a frame, both sweeps in one run.
-  "$glint" bench --reference "$ref" --methods vsl --trace-glossy off --vsl-count 4096 --times 5,10 \
-    --sweep radius-mult=1,2,4,8,12,16,24 --sweep columns=64,128,256,512,1024 \
-    --out "$build/bench-results/fig8-$stamp"
-  # The same comparison on two scenes from the shared set: diffuse (Cornell box) and glossy
-  # metal with many emissive triangles and punctual lights (the lamp), budgets up to 32 s.
-  for entry in cornell-box/CornellBox-Original.gltf:cornell:240x240 \
-               lights-punctual-lamp/glTF/LightsPunctualLamp.gltf:lamp:320x240; do
-    IFS=: read -r file name size <<<"$entry"
-    [ -f "$scenes/$file" ] || { echo "skipping $file: not found"; continue; }
-    sref=$build/bench-cache/$name-$size-pt-ref.exr
-    if [ ! -f "$sref.json" ]; then
+  times=2,10,60${LONG_SECONDS:+,$LONG_SECONDS}
+  for entry in builtin:atelier:atelier builtin:doorway:doorway builtin:showcase:showcase \
+               "$scenes/cornell-box/CornellBox-Original.gltf:cornell"; do
+    file=${entry%:*}
+    name=${entry##*:}
+    case "$file" in builtin:*) ;; *) [ -f "$file" ] || { echo "skipping $file: not found"; continue; } ;; esac
+    ref=$build/bench-cache/$name-320x240-pt-ref.exr
+    if [ ! -f "$ref.json" ]; then
       echo "rendering the path-traced reference of $name for ${REF_SECONDS:-1200} s"
-      "$glint" render "$scenes/$file" --method pt --time "${REF_SECONDS:-1200}" --size "$size" --seed 777 --out "$sref"
+      "$glint" render "$file" --method pt --time "${REF_SECONDS:-1200}" --size 320x240 --seed 777 \
+        --highlights-layer --out "$ref" --quiet
     fi
-    "$glint" bench "$scenes/$file" --reference "$sref" --methods pt,vpl,vsl,vsl+hl --times 1,2,4,8,16,32 \
-      --out "$build/bench-results/$name-$stamp"
+    "$glint" bench "$file" --reference "$ref" --methods pt,vsl,vsl+hl --seeds 2 --times "$times" \
+      --out "$build/bench-results/$name-$stamp" --quiet
     cat "$build/bench-results/$name-$stamp/report.md"
   done
-  cat "$build/bench-results/headline-$stamp/report.md" "$build/bench-results/fig8-$stamp/report.md"
+  # Fig. 8: the paper's estimator (every lobe gathered), 4096 lights a frame, both sweeps in one run.
+  "$glint" bench builtin:showcase --reference "$build/bench-cache/showcase-320x240-pt-ref.exr" \
+    --methods vsl --trace-glossy off --vsl-count 4096 --times 5,10 \
+    --sweep radius-mult=1,2,4,8,12,16,24 --sweep columns=64,128,256,512,1024 \
+    --out "$build/bench-results/fig8-$stamp" --quiet
+  cat "$build/bench-results/fig8-$stamp/report.md"
   exit 0
 fi
 
