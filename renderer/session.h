@@ -84,7 +84,7 @@ enum { VL_SELECT_DEFAULT = 0, VL_SELECT_TREE, VL_SELECT_POWER };
 /* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the
  * path tracer's estimate of the same paths, to see what the approximation costs) */
 enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };
-#define HL_DEFAULT_SECONDARY_RAYS 32
+#define HL_DEFAULT_SECONDARY_RAYS 8
 #define HL_DEFAULT_CLUSTERS 4
 #define HL_MAX_CLUSTERS 8
 #define HL_MAX_SECONDARY_RAYS 256 /* the paper uses 32-64; per-hit records live on the stack */

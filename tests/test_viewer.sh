@@ -116,7 +116,7 @@ stats
 set radius-mult -2
 stats
 set method vsl+hl
-set secondary-rays 8
+set secondary-rays 6
 wait 1
 stats
 set show highlights
@@ -156,11 +156,11 @@ grep '^stats ' out.txt >stats.txt
   fail "radius, candidates or trace-glossy not applied"
 [ "$(field 2 resets)" -gt "$(field 1 resets)" ] || fail "a many-light change did not reset the accumulation"
 [ "$(field 3 radius_mult)" = "4" ] || fail "a bad radius multiplier replaced the last good one"
-# stats lines 4 on: vsl+hl (with fewer secondary rays than the default 32, to save time), then shown
+# stats lines 4 on: vsl+hl (with fewer secondary rays than the default 8, to save time), then shown
 # as highlights only, then N, K and merge changed
-[ "$(field 1 secondary_rays)" = "32" ] && [ "$(field 1 clusters)" = "4" ] && [ "$(field 1 merge)" = "on" ] ||
+[ "$(field 1 secondary_rays)" = "8" ] && [ "$(field 1 clusters)" = "4" ] && [ "$(field 1 merge)" = "on" ] ||
   fail "highlight parameters do not start at their defaults: $(sed -n 1p stats.txt)"
-[ "$(field 4 method)" = "vsl+hl" ] && [ "$(field 4 secondary_rays)" = "8" ] || fail "vsl+hl not applied: $(sed -n 4p stats.txt)"
+[ "$(field 4 method)" = "vsl+hl" ] && [ "$(field 4 secondary_rays)" = "6" ] || fail "vsl+hl not applied: $(sed -n 4p stats.txt)"
 [ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "switching to vsl+hl did not reset the accumulation"
 [ "$(field 4 hl_lobes)" -gt 0 ] || fail "vsl+hl lit no highlight lobes"
 [ "$(field 4 plan_highlights)" = "1" ] || fail "the default scene's plan must run the highlight pass"
