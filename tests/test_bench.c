@@ -2,7 +2,8 @@
  * a bench whose CSV parses (header, monotone time, pt's error falling), whose SVG and PNG plots
  * and report appear, sweeps, the highlights component; several seeds per run, their summary and
  * its split into noise and bias; mismatched references (size, camera, scene, no or broken
- * sidecar) and impossible seed counts refused with one error line; nothing ever overwritten.
+ * sidecar, a sidecar of unexpected shape) and impossible seed counts refused with one error line;
+ * nothing ever overwritten.
  * Usage: test_bench PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -420,6 +421,105 @@ static void test_refusals(void) {
     expect_refusal("bench --reference broken.exr --times 0.05 --out r15", "broken.exr.json");
 }
 
+/* Sidecars of unexpected shape, as a hand edit, another program or a broken disk might leave them:
+ * wrong types, missing keys, nesting deeper than any parser's stack, numbers past every range,
+ * not JSON at all. Each is one error line naming the file and what is wrong, never a crash. A
+ * seed above 2^53, beyond a double's integers, reads back exactly. */
+static void test_sidecar_shapes(void) {
+    static char good[8192];
+    read_file("ref.exr.json", good, sizeof good);
+    CHECK(strstr(good, "\"seed\": 7,") && strstr(good, "\"width\": 24,"), "ref.exr.json: %s", good);
+    static char huge[420] = "\"spp\": 1"; /* 400 digits: past a double's range */
+    memset(huge + strlen(huge), '0', 400);
+    struct {
+        const char *from, *to, *problem; /* to replaces the first from in the good sidecar */
+    } edits[] = {
+        {"\"width\": 24", "\"width\": \"24\"", "missing or bad \"width\""},
+        {"\"width\": 24", "\"width\": 1e999", "missing or bad \"width\""},
+        {"\"width\": 24", "\"width\": 24.5", "missing or bad \"width\""},
+        {"\"height\": 16", "\"height\": -16", "missing or bad \"height\""},
+        {"\"spp\": 1024", "\"spp\": 123456789012345678901234567890", "missing or bad \"spp\""},
+        {"\"spp\": 1024", huge, "missing or bad \"spp\""},
+        {"\"seed\": 7", "\"seed\": -7", "missing or bad \"seed\""},
+        {"\"seed\": 7", "\"seed\": 18446744073709551616", "missing or bad \"seed\""},
+        {"\"seed\": 7", "\"seed\": \"7\"", "missing or bad \"seed\""},
+        {"\"scene_hash\"", "\"scene_hush\"", "missing or bad \"scene_hash\""},
+        {"\"scene\": ", "\"scene\": [[[[[[[[1]]]]]]]], \"x\": ", "missing or bad \"scene\""},
+        {"\"index\": 0", "\"index\": null", "missing or bad \"camera index\""},
+        {"\"position\": [", "\"position\": [1, ", "missing or bad \"camera position\""},
+        {"\"yfov\": ", "\"yfov\": 1e300, \"x\": ", "missing or bad \"camera yfov\""},
+        {"\"camera\": {", "\"camera\": 5, \"cam\": {", "missing or bad \"camera index\""},
+        {"\"highlights_layer\": false", "\"highlights_layer\": 0", "missing or bad \"highlights_layer\""},
+        {"\"method\": \"pt\"", "\"method\": \"a method name longer than any\"", "missing or bad \"method\""},
+        {"\"glint_reference\": 1,", "", "missing or bad \"glint_reference\""},
+        {"{", "[", "not JSON, line 2)"},
+    };
+    enum { N = sizeof edits / sizeof edits[0], EXTRA = 5 };
+    char cmd[4096] = "", name[64], args[256], needle[256];
+    for (int k = 0; k < N + EXTRA + 1; k++)
+        snprintf(cmd + strlen(cmd), sizeof cmd - strlen(cmd), "%scp '%s/ref.exr' '%s/shape%d.exr'", k ? " && " : "",
+                 tmp, tmp, k);
+    CHECK(system(cmd) == 0, "copying the reference");
+    static char text[1 << 21];
+    for (int k = 0; k < N; k++) {
+        const char *at = strstr(good, edits[k].from);
+        CHECK(at != NULL, "the good sidecar lacks '%s'", edits[k].from);
+        if (!at) continue;
+        snprintf(text, sizeof text, "%.*s%s%s", (int)(at - good), good, edits[k].to, at + strlen(edits[k].from));
+        snprintf(name, sizeof name, "shape%d.exr.json", k);
+        write_text(name, text);
+        snprintf(args, sizeof args, "bench --reference shape%d.exr --times 0.05 --out shape%d", k, k);
+        snprintf(needle, sizeof needle, "%s: not a glint reference sidecar (%s", name, edits[k].problem);
+        expect_refusal(args, needle);
+    }
+    /* Nesting a million deep, a top-level value that is no object, trailing text, an empty file,
+     * more than the 1 MiB a sidecar may take. */
+    const char *problems[EXTRA] = {"not JSON, line 1", "not a JSON object", "not JSON, line", "not JSON, line 1",
+                                   "too large"};
+    for (int k = 0; k < EXTRA; k++) {
+        size_t n = 0;
+        if (k == 0) {
+            n = (size_t)snprintf(text, sizeof text, "{\"glint_reference\": 1, \"x\": ");
+            memset(text + n, '[', 1000000);
+            n += 1000000;
+        } else if (k == 1) {
+            n = (size_t)snprintf(text, sizeof text, "[%s]", good);
+        } else if (k == 2) {
+            n = (size_t)snprintf(text, sizeof text, "%s}", good);
+        } else if (k == 4) {
+            n = (size_t)snprintf(text, sizeof text, "%s", good);
+            memset(text + n, ' ', (1 << 20) + 1);
+            n += (1 << 20) + 1;
+        }
+        text[n] = 0;
+        snprintf(name, sizeof name, "shape%d.exr.json", N + k);
+        write_text(name, text);
+        snprintf(args, sizeof args, "bench --reference shape%d.exr --times 0.05 --out shape%d", N + k, N + k);
+        snprintf(needle, sizeof needle, "%s: ", name);
+        expect_refusal(args, needle);
+        CHECK(strstr(err_text, problems[k]) != NULL, "%s: '%s' lacks '%s'", name, err_text, problems[k]);
+    }
+    /* 2^53 + 1 and 2^64 - 1: a double would read 2^53 and 2^64, and the bench's seeds just below
+     * would not seem to hold the reference's. */
+    const char *at = strstr(good, "\"seed\": 7");
+    static const char *const seeds[2][2] = {{"9007199254740992", "9007199254740993"},
+                                            {"18446744073709551614", "18446744073709551615"}};
+    for (int k = 0; at && k < 2; k++) {
+        snprintf(text, sizeof text, "%.*s\"seed\": %s%s", (int)(at - good), good, seeds[k][1], at + 9);
+        snprintf(name, sizeof name, "shape%d.exr.json", N + EXTRA);
+        write_text(name, text);
+        snprintf(args, sizeof args, "bench --reference shape%d.exr --seed %s --seeds 2 --times 0.05 --out seedbig",
+                 N + EXTRA, seeds[k][0]);
+        snprintf(needle, sizeof needle, "the reference's seed %s;", seeds[k][1]);
+        expect_usage(args, needle);
+    }
+    for (int k = 0; k <= N + EXTRA; k++) {
+        snprintf(name, sizeof name, "shape%d", k);
+        CHECK(!exists(name), "a refused bench created %s", name);
+    }
+    CHECK(!exists("seedbig"), "a refused bench created seedbig");
+}
+
 /* References must read back exactly. OpenEXR 3.1's ZIP encoder kept zlib output exactly as long
  * as the raw chunk, which readers take for raw pixels (OpenEXR issue #2306); partly compressible
  * chunks of every length between all-zero and all-random meet that length now and then. */
@@ -463,5 +563,6 @@ int main(int argc, char **argv) {
     test_sweeps_and_highlights();
     test_seeds();
     test_refusals();
+    test_sidecar_shapes();
     return check_exit("test_bench");
 }
