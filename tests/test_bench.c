@@ -3,7 +3,7 @@
  * and report appear, sweeps, the highlights component; several seeds per run, their summary and
  * its split into noise and bias; mismatched references (size, camera, scene, no or broken
  * sidecar, a sidecar of unexpected shape) and impossible seed counts refused with one error line;
- * nothing ever overwritten.
+ * nothing ever overwritten; the PNG plot's words.
  * Usage: test_bench PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -160,6 +160,47 @@ static const char *const other_scene =
     "\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.01}}],\"nodes\":[{\"mesh\":0},{\"light\":0,"
     "\"translation\":[0,1,0]},{\"camera\":0,\"translation\":[0,1,3]}],\"scenes\":[{\"nodes\":[0,1,2]}],\"scene\":0}\n";
 
+/* The extent of dark pixels (text, not the light grid) in [x0, x1) x [y0, y1) of an RGB image:
+ * width and height in pixels, 0 when there are none. */
+static void ink(const unsigned char *rgb, int w, int h, int x0, int y0, int x1, int y1, int *iw, int *ih) {
+    int lx = x1, hx = x0 - 1, ly = y1, hy = y0 - 1;
+    for (int y = y0 < 0 ? 0 : y0; y < y1 && y < h; y++)
+        for (int x = x0 < 0 ? 0 : x0; x < x1 && x < w; x++) {
+            const unsigned char *q = rgb + 3 * ((size_t)y * (size_t)w + (size_t)x);
+            if (q[0] < 150 && q[1] < 150 && q[2] < 150) {
+                lx = x < lx ? x : lx, hx = x > hx ? x : hx;
+                ly = y < ly ? y : ly, hy = y > hy ? y : hy;
+            }
+        }
+    *iw = hx >= lx ? hx - lx + 1 : 0;
+    *ih = hy >= ly ? hy - ly + 1 : 0;
+}
+
+/* The PNG plot has words where the SVG has them: title, axis labels, the curves' names and the
+ * readings' in the legend. The regions hold nothing else (app/plot.c's layout: the plot area
+ * 80..580 x 40..430, the legend from x 600, a row every 20 px from y 50). Digits alone, as the
+ * PNG once had beside its legend swatches, are narrower than the names asked for. */
+static void check_png_words(const unsigned char *png, int w, int h) {
+    enum { AREA_X0 = 80, AREA_X1 = 580, AREA_Y0 = 40, AREA_Y1 = 430, LEGEND_X = 600 };
+    int iw, ih;
+    ink(png, w, h, AREA_X0, 0, AREA_X1, AREA_Y0 - 6, &iw, &ih);
+    CHECK(iw >= 150 && ih >= 8, "the PNG has no title (ink %dx%d)", iw, ih);
+    ink(png, w, h, AREA_X0, AREA_Y1 + 24, AREA_X1, h, &iw, &ih);
+    CHECK(iw >= 60 && ih >= 8, "the PNG has no x axis label (ink %dx%d)", iw, ih);
+    ink(png, w, h, 0, AREA_Y0, 30, AREA_Y1, &iw, &ih);
+    CHECK(ih >= 80 && iw >= 8, "the PNG has no y axis label (ink %dx%d)", iw, ih);
+    ink(png, w, h, 30, AREA_Y0 - 8, AREA_X0 - 6, AREA_Y1 + 8, &iw, &ih);
+    CHECK(iw >= 15 && ih >= 200, "the PNG has no y tick labels (ink %dx%d)", iw, ih);
+    ink(png, w, h, AREA_X0 - 20, AREA_Y1 + 8, AREA_X1 + 20, AREA_Y1 + 24, &iw, &ih);
+    CHECK(iw >= 400 && ih >= 6, "the PNG has no x tick labels (ink %dx%d)", iw, ih);
+    static const char *const names[] = {"pt", "vsl", "equal time", "equal error"};
+    static const int rows[] = {50, 70, 100, 120}, widths[] = {10, 15, 45, 45};
+    for (int k = 0; k < 4; k++) {
+        ink(png, w, h, LEGEND_X + 28, rows[k] - 9, w, rows[k] + 7, &iw, &ih);
+        CHECK(iw >= widths[k] && ih >= 6, "the PNG's legend lacks '%s' (ink %dx%d)", names[k], iw, ih);
+    }
+}
+
 static void test_sidecar(void) {
     /* 1024 spp: the reference's own noise must stay below pt's error at the bench's budgets. */
     int rc = run("render --spp 1024 --size 24x16 --max-depth 3 --seed 7 --out ref.exr --quiet");
@@ -235,6 +276,8 @@ static void test_bench_run(void) {
         long dark = 0;
         for (long i = 0; i < (long)w * h * 3; i++) dark += png[i] < 128;
         CHECK(dark > 1000, "the png is blank (%ld dark values)", dark);
+        if (w == 860 && h == 500) check_png_words(png, w, h);
+        else CHECK(0, "error-vs-time.png is %dx%d, not the 860x500 of the layout the words are looked for in", w, h);
     }
     stbi_image_free(png);
     char md[1 << 16];
