@@ -106,7 +106,7 @@ static int write_time_plot(const bench_options *o, const char *dir, const bench_
     plot_series series[MAX_RUNS];
     for (int r = 0; r < num_runs; r++) {
         const bench_run *u = &runs[r];
-        /* With several seeds, a light band from the best seed to the worst (SVG only). */
+        /* With several seeds, a light band from the best seed to the worst. */
         series[r] = (plot_series){u->label, u->num_points, u->seconds, u->rms, o->seeds > 1 ? u->lo : NULL,
                                   o->seeds > 1 ? u->hi : NULL};
     }

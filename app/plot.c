@@ -1,7 +1,8 @@
-/* glint — line plots as SVG and as rasterised PNG, from one layout. */
+/* glint — line plots as SVG text and as PNG drawn by cairo, from one layout. */
 #define _POSIX_C_SOURCE 200809L
 #include "plot.h"
 
+#include <cairo.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -125,6 +126,13 @@ static int in_area(const layout *l, double x, double y) {
     return X >= AREA_X0 - 0.5 && X <= AREA_X1 + 0.5 && Y >= AREA_Y0 - 0.5 && Y <= AREA_Y1 + 0.5;
 }
 
+/* The vertical reading's label goes right of its line, or left of it where it would run out of the
+ * plot into the legend (the last budget often sits at the axis' end). 6 px a character: a little
+ * more than sans-serif's average at 11 px, as the SVG cannot measure its text. */
+static int mark_label_left(double X, const char *label) {
+    return label && X + 4.0 + 6.0 * (double)strlen(label) > AREA_X1;
+}
+
 /* ---- SVG ------------------------------------------------------------------------------------- */
 
 static void xml_text(FILE *f, const char *s) {
@@ -189,7 +197,9 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
         double X = px(&l, p->mark_x);
         fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#555\" stroke-dasharray=\"6 4\"/>\n", X,
                 AREA_Y0, X, AREA_Y1);
-        fprintf(f, "<text x=\"%.1f\" y=\"%d\" font-size=\"11\" fill=\"#555\">", X + 4, AREA_Y0 + 12);
+        int left = mark_label_left(X, p->mark_x_label);
+        fprintf(f, "<text x=\"%.1f\" y=\"%d\" font-size=\"11\" fill=\"#555\"%s>", left ? X - 4 : X + 4,
+                AREA_Y0 + 12, left ? " text-anchor=\"end\"" : "");
         xml_text(f, p->mark_x_label);
         fputs("</text>\n", f);
     }
@@ -263,159 +273,204 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
     return status;
 }
 
-/* ---- PNG: a small anti-aliased rasteriser ------------------------------------------------------ */
+/* ---- PNG: the same figure drawn by cairo ------------------------------------------------------ */
 
-typedef struct {
-    uint8_t *px;
-    int w, h;
-} canvas;
+#define TAU 6.28318530717958647692 /* a full turn, for cairo_arc */
 
-static void blend(canvas *c, int x, int y, const uint8_t col[3], double a) {
-    if (x < 0 || y < 0 || x >= c->w || y >= c->h || !(a > 0.0)) return;
-    if (a > 1.0) a = 1.0;
-    uint8_t *q = c->px + 3 * ((size_t)y * (size_t)c->w + (size_t)x);
-    for (int k = 0; k < 3; k++) q[k] = (uint8_t)lround((double)q[k] + a * ((double)col[k] - (double)q[k]));
+static void colour(cairo_t *cr, const uint8_t c[3], double alpha) {
+    cairo_set_source_rgba(cr, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, alpha);
 }
 
-/* A segment of width w: each pixel covered by its distance to the segment (1 px of ramp). */
-static void seg(canvas *c, double x0, double y0, double x1, double y1, double w, const uint8_t col[3]) {
-    double r = 0.5 * w + 1.0;
-    int xa = (int)floor(fmin(x0, x1) - r), xb = (int)ceil(fmax(x0, x1) + r);
-    int ya = (int)floor(fmin(y0, y1) - r), yb = (int)ceil(fmax(y0, y1) + r);
-    double dx = x1 - x0, dy = y1 - y0, len2 = dx * dx + dy * dy;
-    for (int y = ya; y <= yb; y++)
-        for (int x = xa; x <= xb; x++) {
-            double qx = x + 0.5 - x0, qy = y + 0.5 - y0;
-            double t = len2 > 0.0 ? fmin(fmax((qx * dx + qy * dy) / len2, 0.0), 1.0) : 0.0;
-            double ex = qx - t * dx, ey = qy - t * dy;
-            blend(c, x, y, col, 0.5 * w + 0.5 - sqrt(ex * ex + ey * ey));
-        }
+/* 1 px lines on pixel centres, so grid and frame come out sharp rather than two grey rows. */
+static double crisp(double v) { return floor(v) + 0.5; }
+
+static void line(cairo_t *cr, double x0, double y0, double x1, double y1) {
+    cairo_move_to(cr, x0, y0);
+    cairo_line_to(cr, x1, y1);
+    cairo_stroke(cr);
 }
 
-static void dashed(canvas *c, double x0, double y0, double x1, double y1, double on, double off, const uint8_t col[3]) {
-    double len = hypot(x1 - x0, y1 - y0);
-    for (double s = 0.0; s < len; s += on + off) {
-        double e = fmin(s + on, len);
-        seg(c, x0 + (x1 - x0) * s / len, y0 + (y1 - y0) * s / len, x0 + (x1 - x0) * e / len, y0 + (y1 - y0) * e / len,
-            1.0, col);
+/* Text with its baseline at y, starting at x (align 0), centred on it (0.5) or ending there (1). */
+static void words(cairo_t *cr, double x, double y, const char *s, double align) {
+    if (!s || !*s) return;
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, s, &e);
+    cairo_move_to(cr, x - align * e.x_advance, y);
+    cairo_show_text(cr, s);
+}
+
+static void square_marker(cairo_t *cr, double cx, double cy, const uint8_t col[3]) {
+    static const uint8_t white[3] = {255, 255, 255};
+    cairo_rectangle(cr, cx - 4.5, cy - 4.5, 9, 9);
+    colour(cr, white, 1.0);
+    cairo_fill_preserve(cr);
+    colour(cr, col, 1.0);
+    cairo_stroke(cr);
+}
+
+static void diamond_marker(cairo_t *cr, double cx, double cy, const uint8_t col[3]) {
+    static const uint8_t white[3] = {255, 255, 255};
+    cairo_move_to(cr, cx, cy - 6);
+    cairo_line_to(cr, cx + 6, cy);
+    cairo_line_to(cr, cx, cy + 6);
+    cairo_line_to(cr, cx - 6, cy);
+    cairo_close_path(cr);
+    colour(cr, white, 1.0);
+    cairo_fill_preserve(cr);
+    colour(cr, col, 1.0);
+    cairo_stroke(cr);
+}
+
+/* The SVG's figure, element for element at its coordinates and sizes. */
+static void draw(cairo_t *cr, const plot_desc *p, const layout *l) {
+    static const uint8_t white[3] = {255, 255, 255}, minor[3] = {240, 240, 240}, grid[3] = {216, 216, 216},
+                         black[3] = {0, 0, 0}, grey[3] = {85, 85, 85};
+    colour(cr, white, 1.0);
+    cairo_paint(cr);
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, 12);
+    cairo_set_line_width(cr, 1.0);
+    colour(cr, minor, 1.0);
+    for (int k = 0; k < l->x.num_minor; k++) {
+        double X = crisp(px(l, pow(10.0, l->x.minor[k])));
+        line(cr, X, AREA_Y0, X, AREA_Y1);
     }
-}
+    for (int k = 0; k < l->y.num_minor; k++) {
+        double Y = crisp(py(l, pow(10.0, l->y.minor[k])));
+        line(cr, AREA_X0, Y, AREA_X1, Y);
+    }
+    char t[64];
+    for (int k = 0; k < l->x.num_ticks; k++) {
+        double X = crisp(px(l, tick_value(&l->x, l->x.ticks[k])));
+        colour(cr, grid, 1.0);
+        line(cr, X, AREA_Y0, X, AREA_Y1);
+        colour(cr, black, 1.0);
+        line(cr, X, AREA_Y1, X, AREA_Y1 + 5);
+        tick_text(&l->x, l->x.ticks[k], t, sizeof t);
+        words(cr, X, AREA_Y1 + 19, t, 0.5);
+    }
+    for (int k = 0; k < l->y.num_ticks; k++) {
+        double Y = crisp(py(l, tick_value(&l->y, l->y.ticks[k])));
+        colour(cr, grid, 1.0);
+        line(cr, AREA_X0, Y, AREA_X1, Y);
+        colour(cr, black, 1.0);
+        line(cr, AREA_X0 - 5, Y, AREA_X0, Y);
+        tick_text(&l->y, l->y.ticks[k], t, sizeof t);
+        words(cr, AREA_X0 - 8, Y + 4, t, 1.0);
+    }
+    cairo_rectangle(cr, AREA_X0 + 0.5, AREA_Y0 + 0.5, AREA_X1 - AREA_X0, AREA_Y1 - AREA_Y0);
+    cairo_stroke(cr);
+    words(cr, (AREA_X0 + AREA_X1) / 2, AREA_Y1 + 42, p->x_label, 0.5);
+    cairo_save(cr);
+    cairo_translate(cr, 22, (AREA_Y0 + AREA_Y1) / 2);
+    cairo_rotate(cr, -0.25 * TAU);
+    words(cr, 0, 0, p->y_label, 0.5);
+    cairo_restore(cr);
+    cairo_set_font_size(cr, 14);
+    words(cr, (AREA_X0 + AREA_X1) / 2, 24, p->title, 0.5);
 
-static void disc(canvas *c, double cx, double cy, double r, const uint8_t col[3]) {
-    for (int y = (int)floor(cy - r - 1); y <= (int)ceil(cy + r + 1); y++)
-        for (int x = (int)floor(cx - r - 1); x <= (int)ceil(cx + r + 1); x++)
-            blend(c, x, y, col, r + 0.5 - hypot(x + 0.5 - cx, y + 0.5 - cy));
-}
+    /* the readings: dashed lines, labelled */
+    cairo_set_font_size(cr, 11);
+    colour(cr, grey, 1.0);
+    if (in_area(l, p->mark_x, tick_value(&l->y, l->y.lo))) {
+        double X = crisp(px(l, p->mark_x)), dash[2] = {6, 4};
+        cairo_set_dash(cr, dash, 2, 0);
+        line(cr, X, AREA_Y0, X, AREA_Y1);
+        int left = mark_label_left(X, p->mark_x_label);
+        words(cr, left ? X - 4 : X + 4, AREA_Y0 + 12, p->mark_x_label, left ? 1.0 : 0.0);
+    }
+    if (in_area(l, tick_value(&l->x, l->x.lo), p->mark_y)) {
+        double Y = crisp(py(l, p->mark_y)), dash[2] = {2, 3};
+        cairo_set_dash(cr, dash, 2, 0);
+        line(cr, AREA_X0, Y, AREA_X1, Y);
+        words(cr, AREA_X0 + 4, Y - 4, p->mark_y_label, 0.0);
+    }
+    cairo_set_dash(cr, NULL, 0, 0);
+    cairo_set_font_size(cr, 12);
 
-static void square(canvas *c, double cx, double cy, double h, const uint8_t col[3]) {
-    static const uint8_t white[3] = {255, 255, 255};
-    for (int y = (int)lround(cy - h); y < (int)lround(cy + h); y++)
-        for (int x = (int)lround(cx - h); x < (int)lround(cx + h); x++) blend(c, x, y, white, 1.0);
-    seg(c, cx - h, cy - h, cx + h, cy - h, 2.0, col);
-    seg(c, cx + h, cy - h, cx + h, cy + h, 2.0, col);
-    seg(c, cx + h, cy + h, cx - h, cy + h, 2.0, col);
-    seg(c, cx - h, cy + h, cx - h, cy - h, 2.0, col);
-}
-
-static void diamond(canvas *c, double cx, double cy, double h, const uint8_t col[3]) {
-    static const uint8_t white[3] = {255, 255, 255};
-    for (int y = (int)floor(cy - h); y <= (int)ceil(cy + h); y++)
-        for (int x = (int)floor(cx - h); x <= (int)ceil(cx + h); x++)
-            if (fabs(x + 0.5 - cx) + fabs(y + 0.5 - cy) < h) blend(c, x, y, white, 1.0);
-    seg(c, cx, cy - h, cx + h, cy, 2.0, col);
-    seg(c, cx + h, cy, cx, cy + h, 2.0, col);
-    seg(c, cx, cy + h, cx - h, cy, 2.0, col);
-    seg(c, cx - h, cy, cx, cy - h, 2.0, col);
-}
-
-/* Tick labels only: digits and the few signs %g prints, 3x5 cells drawn 2x. */
-static const char glyph_chars[] = "0123456789.-+e";
-static const uint8_t glyphs[][5] = {
-    {7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7}, {5, 5, 7, 1, 1}, {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7},
-    {7, 1, 1, 1, 1}, {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7}, {0, 0, 0, 0, 2}, {0, 0, 7, 0, 0}, {0, 2, 7, 2, 0}, {0, 7, 7, 4, 7}};
-
-static void text(canvas *c, double x, double y, const char *s, int align_right_or_centre) {
-    static const uint8_t ink[3] = {40, 40, 40};
-    int width = 8 * (int)strlen(s) - 2;
-    int x0 = (int)lround(align_right_or_centre > 0 ? x - width : align_right_or_centre < 0 ? x - width / 2 : x);
-    int y0 = (int)lround(y - 5);
-    for (const char *p = s; *p; p++, x0 += 8) {
-        const char *g = strchr(glyph_chars, *p);
-        if (!g || !*p) continue;
-        const uint8_t *rows = glyphs[g - glyph_chars];
-        for (int r = 0; r < 5; r++)
-            for (int b = 0; b < 3; b++)
-                if (rows[r] & (4 >> b))
-                    for (int dy = 0; dy < 2; dy++)
-                        for (int dx = 0; dx < 2; dx++) blend(c, x0 + 2 * b + dx, y0 + 2 * r + dy, ink, 1.0);
+    /* the bands first, under every curve */
+    for (int s = 0; s < p->num_series; s++) {
+        const plot_series *se = &p->series[s];
+        if (!se->lo || !se->hi) continue;
+        cairo_new_path(cr); /* cairo_show_text leaves a current point, which the path would start at */
+        for (int i = 0; i < se->n; i++)
+            if (in_area(l, se->x[i], se->lo[i]) && in_area(l, se->x[i], se->hi[i]))
+                cairo_line_to(cr, px(l, se->x[i]), py(l, se->lo[i]));
+        for (int i = se->n - 1; i >= 0; i--)
+            if (in_area(l, se->x[i], se->lo[i]) && in_area(l, se->x[i], se->hi[i]))
+                cairo_line_to(cr, px(l, se->x[i]), py(l, se->hi[i]));
+        colour(cr, palette[s % 10], 0.15);
+        cairo_fill(cr);
+    }
+    cairo_set_line_width(cr, 2.0);
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    for (int s = 0; s < p->num_series; s++) {
+        const plot_series *se = &p->series[s];
+        const uint8_t *col = palette[s % 10];
+        colour(cr, col, 1.0);
+        cairo_new_path(cr);
+        for (int i = 0; i < se->n; i++)
+            if (in_area(l, se->x[i], se->y[i])) cairo_line_to(cr, px(l, se->x[i]), py(l, se->y[i]));
+        cairo_stroke(cr);
+        for (int i = 0; i < se->n; i++)
+            if (in_area(l, se->x[i], se->y[i])) {
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, px(l, se->x[i]), py(l, se->y[i]), 3.0, 0.0, TAU);
+            }
+        cairo_fill(cr);
+        double yx = cross_x(se, p->mark_x), xy = cross_y(se, p->mark_y);
+        if (in_area(l, p->mark_x, yx)) square_marker(cr, px(l, p->mark_x), py(l, yx), col);
+        if (in_area(l, xy, p->mark_y)) diamond_marker(cr, px(l, xy), py(l, p->mark_y), col);
+        /* legend entry */
+        int ly = AREA_Y0 + 10 + 20 * s;
+        colour(cr, col, 1.0);
+        line(cr, LEGEND_X, ly, LEGEND_X + 24, ly);
+        cairo_arc(cr, LEGEND_X + 12, ly, 3.0, 0.0, TAU);
+        cairo_fill(cr);
+        colour(cr, black, 1.0);
+        words(cr, LEGEND_X + 30, ly + 4, se->label, 0.0);
+    }
+    int ly = AREA_Y0 + 10 + 20 * p->num_series + 10;
+    if (isfinite(p->mark_x)) {
+        square_marker(cr, LEGEND_X + 12.5, ly + 0.5, grey);
+        words(cr, LEGEND_X + 30, ly + 4, "equal time", 0.0);
+        ly += 20;
+    }
+    if (isfinite(p->mark_y)) {
+        diamond_marker(cr, LEGEND_X + 12, ly, grey);
+        words(cr, LEGEND_X + 30, ly + 4, "equal error", 0.0);
     }
 }
 
 int plot_save_png(const plot_desc *p, const char *path, write_mode mode, char *err, size_t errlen) {
     layout l;
     layout_make(p, &l);
-    canvas c = {malloc((size_t)FIG_W * FIG_H * 3), FIG_W, FIG_H};
-    if (!c.px) {
-        snprintf(err, errlen, "%s: out of memory", path);
+    /* cairo draws into its own image surface (xRGB, 32 bits a pixel); its pixels go out through
+     * png_save_rgb8, the atomic writer every glint export uses. */
+    cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, FIG_W, FIG_H);
+    cairo_t *cr = cairo_create(surface);
+    draw(cr, p, &l);
+    cairo_status_t st = cairo_status(cr);
+    cairo_destroy(cr);
+    cairo_surface_flush(surface);
+    unsigned char *rgb = st == CAIRO_STATUS_SUCCESS ? malloc((size_t)FIG_W * FIG_H * 3) : NULL;
+    if (!rgb) {
+        cairo_surface_destroy(surface);
+        snprintf(err, errlen, "%s: cannot draw the plot: %s", path,
+                 cairo_status_to_string(st != CAIRO_STATUS_SUCCESS ? st : CAIRO_STATUS_NO_MEMORY));
         return -1;
     }
-    memset(c.px, 255, (size_t)FIG_W * FIG_H * 3);
-    static const uint8_t minor[3] = {240, 240, 240}, grid[3] = {216, 216, 216}, black[3] = {0, 0, 0},
-                         grey[3] = {85, 85, 85};
-    for (int k = 0; k < l.x.num_minor; k++) {
-        double X = px(&l, pow(10.0, l.x.minor[k]));
-        seg(&c, X, AREA_Y0, X, AREA_Y1, 1.0, minor);
-    }
-    for (int k = 0; k < l.y.num_minor; k++) {
-        double Y = py(&l, pow(10.0, l.y.minor[k]));
-        seg(&c, AREA_X0, Y, AREA_X1, Y, 1.0, minor);
-    }
-    char t[64];
-    for (int k = 0; k < l.x.num_ticks; k++) {
-        double X = px(&l, tick_value(&l.x, l.x.ticks[k]));
-        seg(&c, X, AREA_Y0, X, AREA_Y1, 1.0, grid);
-        seg(&c, X, AREA_Y1, X, AREA_Y1 + 5, 1.0, black);
-        tick_text(&l.x, l.x.ticks[k], t, sizeof t);
-        text(&c, X, AREA_Y1 + 16, t, -1);
-    }
-    for (int k = 0; k < l.y.num_ticks; k++) {
-        double Y = py(&l, tick_value(&l.y, l.y.ticks[k]));
-        seg(&c, AREA_X0, Y, AREA_X1, Y, 1.0, grid);
-        seg(&c, AREA_X0 - 5, Y, AREA_X0, Y, 1.0, black);
-        tick_text(&l.y, l.y.ticks[k], t, sizeof t);
-        text(&c, AREA_X0 - 9, Y, t, 1);
-    }
-    seg(&c, AREA_X0, AREA_Y0, AREA_X1, AREA_Y0, 1.0, black);
-    seg(&c, AREA_X1, AREA_Y0, AREA_X1, AREA_Y1, 1.0, black);
-    seg(&c, AREA_X1, AREA_Y1, AREA_X0, AREA_Y1, 1.0, black);
-    seg(&c, AREA_X0, AREA_Y1, AREA_X0, AREA_Y0, 1.0, black);
-    if (in_area(&l, p->mark_x, tick_value(&l.y, l.y.lo)))
-        dashed(&c, px(&l, p->mark_x), AREA_Y0, px(&l, p->mark_x), AREA_Y1, 6, 4, grey);
-    if (in_area(&l, tick_value(&l.x, l.x.lo), p->mark_y))
-        dashed(&c, AREA_X0, py(&l, p->mark_y), AREA_X1, py(&l, p->mark_y), 2, 3, grey);
-    for (int s = 0; s < p->num_series; s++) {
-        const plot_series *se = &p->series[s];
-        const uint8_t *col = palette[s % 10];
-        double lx = NAN, ly = NAN;
-        for (int i = 0; i < se->n; i++) {
-            if (!in_area(&l, se->x[i], se->y[i])) continue;
-            double X = px(&l, se->x[i]), Y = py(&l, se->y[i]);
-            if (isfinite(lx)) seg(&c, lx, ly, X, Y, 2.0, col);
-            lx = X, ly = Y;
+    const unsigned char *data = cairo_image_surface_get_data(surface);
+    int stride = cairo_image_surface_get_stride(surface);
+    for (int y = 0; y < FIG_H; y++)
+        for (int x = 0; x < FIG_W; x++) {
+            uint32_t v;
+            memcpy(&v, data + (size_t)y * (size_t)stride + 4 * (size_t)x, sizeof v);
+            unsigned char *q = rgb + 3 * ((size_t)y * FIG_W + (size_t)x);
+            q[0] = (unsigned char)(v >> 16), q[1] = (unsigned char)(v >> 8), q[2] = (unsigned char)v;
         }
-        for (int i = 0; i < se->n; i++)
-            if (in_area(&l, se->x[i], se->y[i])) disc(&c, px(&l, se->x[i]), py(&l, se->y[i]), 3.0, col);
-        double yx = cross_x(se, p->mark_x), xy = cross_y(se, p->mark_y);
-        if (in_area(&l, p->mark_x, yx)) square(&c, px(&l, p->mark_x), py(&l, yx), 4.5, col);
-        if (in_area(&l, xy, p->mark_y)) diamond(&c, px(&l, xy), py(&l, p->mark_y), 6.0, col);
-        /* legend swatch, in the SVG's order (the PNG has no words) */
-        int y = AREA_Y0 + 10 + 20 * s;
-        seg(&c, LEGEND_X, y, LEGEND_X + 24, y, 2.0, col);
-        disc(&c, LEGEND_X + 12, y, 3.0, col);
-        snprintf(t, sizeof t, "%d", s + 1);
-        text(&c, LEGEND_X + 32, y, t, 0);
-    }
-    int status = png_save_rgb8(path, FIG_W, FIG_H, c.px, mode, err, errlen);
-    free(c.px);
+    cairo_surface_destroy(surface);
+    int status = png_save_rgb8(path, FIG_W, FIG_H, rgb, mode, err, errlen);
+    free(rgb);
     return status;
 }

@@ -1,6 +1,6 @@
-/* glint — line plots for glint bench: one description drawn two ways, as SVG text and
- * rasterised into RGB pixels for a PNG (no text there beyond the tick marks: the SVG is the
- * labelled figure, the PNG is for quick viewing). Log or linear axes; decade ticks on log axes. */
+/* glint — line plots for glint bench: one description drawn two ways, as SVG text and as a PNG
+ * drawn by cairo, the same figure with its title, axis and tick labels and legend. Log or linear
+ * axes; decade ticks on log axes. */
 #ifndef GLINT_PLOT_H
 #define GLINT_PLOT_H
 
@@ -12,7 +12,7 @@ typedef struct {
     const char *label;
     int n;
     const double *x, *y; /* points with a non-positive or non-finite coordinate on a log axis are skipped */
-    const double *lo, *hi; /* optional: a light band from lo to hi at each x (the SVG only); NULL for none */
+    const double *lo, *hi; /* optional: a light band from lo to hi at each x; NULL for none */
 } plot_series;
 
 /* A reading marked on the plot: a dashed line at x (vertical) or y (horizontal) with a marker

@@ -3,7 +3,9 @@
 #define _POSIX_C_SOURCE 200809L
 #include "reference.h"
 
+#include <cjson/cJSON.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -134,83 +136,75 @@ int reference_save(const char *path, const reference_info *r, char *err, size_t 
     return status;
 }
 
-/* ---- reading: only our own flat format; every key name is unique in the file ---------------- */
+/* ---- reading: cJSON parses, then every field is checked for its type and range ---------------- */
 
-/* The value after "key": (skipping white space), or NULL. */
-static const char *json_value(const char *text, const char *key) {
-    char pat[80];
-    snprintf(pat, sizeof pat, "\"%s\"", key);
-    for (const char *p = strstr(text, pat); p; p = strstr(p + 1, pat)) {
-        const char *q = p + strlen(pat);
-        while (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r') q++;
-        if (*q != ':') continue;
-        q++;
-        while (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r') q++;
-        return q;
-    }
-    return NULL;
-}
-
-static int json_number(const char *text, const char *key, double *out) {
-    const char *v = json_value(text, key);
-    if (!v) return -1;
-    char *end;
-    errno = 0;
-    double x = strtod(v, &end);
-    if (end == v || errno || !isfinite(x)) return -1;
-    *out = x;
+/* obj's member key, a string that fits out. */
+static int json_str(const cJSON *obj, const char *key, char *out, size_t outlen) {
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!cJSON_IsString(v) || strlen(v->valuestring) >= outlen) return -1;
+    memcpy(out, v->valuestring, strlen(v->valuestring) + 1);
     return 0;
 }
 
-static int json_int(const char *text, const char *key, long long lo, long long hi, long long *out) {
+/* A finite number: cJSON reads 1e999 as infinity. */
+static int finite_number(const cJSON *v, double *out) {
+    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble)) return -1;
+    *out = v->valuedouble;
+    return 0;
+}
+
+static int json_number(const cJSON *obj, const char *key, double *out) {
+    return finite_number(cJSON_GetObjectItemCaseSensitive(obj, key), out);
+}
+
+static int json_int(const cJSON *obj, const char *key, long long lo, long long hi, long long *out) {
     double x;
-    if (json_number(text, key, &x) || x != floor(x) || x < (double)lo || x > (double)hi) return -1;
+    if (json_number(obj, key, &x) || x != floor(x) || x < (double)lo || x > (double)hi) return -1;
     *out = (long long)x;
     return 0;
 }
 
-/* A string as reference_json_string writes it: \" and \\ unescaped, \u00XX read as "?". */
-static int json_str(const char *text, const char *key, char *out, size_t outlen) {
-    const char *v = json_value(text, key);
-    if (!v || *v != '"') return -1;
-    size_t k = 0;
-    for (v++; *v && *v != '"'; v++) {
-        if (*v == '\\') {
-            v++;
-            if (*v == 'u') { /* control characters: never in a name we compare; keep a marker */
-                if (strlen(v) < 5) return -1;
-                v += 4;
-                if (k + 1 < outlen) out[k++] = '?';
-                continue;
-            }
-            if (!*v) return -1;
-        }
-        if (k + 1 >= outlen) return -1;
-        out[k++] = *v;
-    }
-    if (*v != '"') return -1;
-    out[k] = '\0';
+/* A float of the camera: beyond FLT_MAX it would become infinite. */
+static int json_float(const cJSON *v, float *out) {
+    double x;
+    if (finite_number(v, &x) || fabs(x) > (double)FLT_MAX) return -1;
+    *out = (float)x;
     return 0;
 }
 
-static int json_vec(const char *text, const char *key, vec3 *out) {
-    const char *v = json_value(text, key);
-    if (!v || *v != '[') return -1;
+static int json_vec(const cJSON *obj, const char *key, vec3 *out) {
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     float c[3];
-    v++;
-    for (int k = 0; k < 3; k++) {
-        char *end;
-        errno = 0;
-        double x = strtod(v, &end);
-        if (end == v || errno || !isfinite(x)) return -1;
-        c[k] = (float)x;
-        v = end;
-        while (*v == ' ' || *v == '\n') v++;
-        if (*v != (k < 2 ? ',' : ']')) return -1;
-        v++;
-    }
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3) return -1;
+    for (int k = 0; k < 3; k++)
+        if (json_float(cJSON_GetArrayItem(v, k), &c[k])) return -1;
     *out = (vec3){c[0], c[1], c[2]};
     return 0;
+}
+
+/* The seed, any uint64. cJSON keeps numbers as doubles, exact to 2^53 only, and the bench must
+ * know the reference's seed exactly (not to replay its samples); so a larger seed is read again
+ * from the digits after a "seed": in the text, taken when they are the number cJSON read. */
+static int json_seed(const cJSON *obj, const char *text, uint64_t *out) {
+    double x;
+    /* 2^64 - 1 rounds to 2^64: that far the digits decide */
+    if (json_number(obj, "seed", &x) || x != floor(x) || x < 0.0 || x > 18446744073709551616.0) return -1;
+    if (x < 9007199254740992.0) { /* 2^53 itself may be 2^53 + 1 rounded */
+        *out = (uint64_t)x;
+        return 0;
+    }
+    for (const char *p = strstr(text, "\"seed\""); p; p = strstr(p + 1, "\"seed\"")) {
+        const char *q = p + 6 + strspn(p + 6, " \t\r\n");
+        if (*q != ':') continue;
+        q += 1 + strspn(q + 1, " \t\r\n");
+        errno = 0;
+        unsigned long long v = *q >= '0' && *q <= '9' ? strtoull(q, NULL, 10) : 0;
+        if (errno == 0 && (double)v == x) {
+            *out = v;
+            return 0;
+        }
+    }
+    return -1;
 }
 
 int reference_load(const char *path, reference_info *r, char *err, size_t errlen) {
@@ -238,14 +232,28 @@ int reference_load(const char *path, reference_info *r, char *err, size_t errlen
         free(text);
         return fail(err, errlen, "%s: not a glint reference sidecar (binary data)", path);
     }
+    /* cJSON refuses nesting deeper than CJSON_NESTING_LIMIT (1000), so no input exhausts the stack. */
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
+    if (!root) {
+        int line = 1;
+        for (const char *p = text; end && p < end; p++) line += *p == '\n';
+        free(text);
+        return fail(err, errlen, "%s: not a glint reference sidecar (not JSON, line %d)", path, line);
+    }
+    if (!cJSON_IsObject(root)) {
+        cJSON_Delete(root);
+        free(text);
+        return fail(err, errlen, "%s: not a glint reference sidecar (not a JSON object)", path);
+    }
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
     const char *missing = NULL;
     long long ll = 0;
-    double x = 0.0;
 #define NEED(ok, key) \
     if (!missing && !(ok)) missing = key
-    NEED(json_value(text, "glint_reference") != NULL, "glint_reference");
-    NEED(json_str(text, "scene", r->scene, sizeof r->scene) == 0, "scene");
-    NEED(json_str(text, "scene_hash", r->scene_hash, sizeof r->scene_hash) == 0, "scene_hash");
+    NEED(cJSON_GetObjectItemCaseSensitive(root, "glint_reference") != NULL, "glint_reference");
+    NEED(json_str(root, "scene", r->scene, sizeof r->scene) == 0, "scene");
+    NEED(json_str(root, "scene_hash", r->scene_hash, sizeof r->scene_hash) == 0, "scene_hash");
     /* Before there were several, the built-in scene showcase was spelt builtin:default. */
     static const char legacy[] = "builtin:default:";
     if (strncmp(r->scene_hash, legacy, strlen(legacy)) == 0) {
@@ -253,34 +261,35 @@ int reference_load(const char *path, reference_info *r, char *err, size_t errlen
         snprintf(rest, sizeof rest, "%s", r->scene_hash + strlen(legacy));
         snprintf(r->scene_hash, sizeof r->scene_hash, "builtin:showcase:%.40s", rest); /* fnv1a64: + 16 digits */
     }
-    NEED(json_str(text, "env", r->env, sizeof r->env) == 0, "env");
-    NEED(json_str(text, "env_hash", r->env_hash, sizeof r->env_hash) == 0, "env_hash");
-    NEED(json_number(text, "env_rotation", &r->env_rotation) == 0, "env_rotation");
-    NEED(json_int(text, "index", -1, 1000000, &ll) == 0, "camera index");
+    NEED(json_str(root, "env", r->env, sizeof r->env) == 0, "env");
+    NEED(json_str(root, "env_hash", r->env_hash, sizeof r->env_hash) == 0, "env_hash");
+    NEED(json_number(root, "env_rotation", &r->env_rotation) == 0, "env_rotation");
+    NEED(json_int(cam, "index", -1, 1000000, &ll) == 0, "camera index");
     r->camera_index = (int)ll;
-    NEED(json_vec(text, "position", &r->cam.position) == 0, "camera position");
-    NEED(json_vec(text, "right", &r->cam.right) == 0, "camera right");
-    NEED(json_vec(text, "up", &r->cam.up) == 0, "camera up");
-    NEED(json_vec(text, "forward", &r->cam.forward) == 0, "camera forward");
-    NEED(json_number(text, "yfov", &x) == 0, "camera yfov");
-    r->cam.yfov = (float)x;
-    NEED(json_int(text, "width", 1, 16384, &ll) == 0, "width");
+    NEED(json_vec(cam, "position", &r->cam.position) == 0, "camera position");
+    NEED(json_vec(cam, "right", &r->cam.right) == 0, "camera right");
+    NEED(json_vec(cam, "up", &r->cam.up) == 0, "camera up");
+    NEED(json_vec(cam, "forward", &r->cam.forward) == 0, "camera forward");
+    NEED(json_float(cJSON_GetObjectItemCaseSensitive(cam, "yfov"), &r->cam.yfov) == 0, "camera yfov");
+    NEED(json_int(root, "width", 1, 16384, &ll) == 0, "width");
     r->width = (int)ll;
-    NEED(json_int(text, "height", 1, 16384, &ll) == 0, "height");
+    NEED(json_int(root, "height", 1, 16384, &ll) == 0, "height");
     r->height = (int)ll;
-    NEED(json_str(text, "method", r->method, sizeof r->method) == 0, "method");
-    const char *hl = json_value(text, "highlights_layer");
-    NEED(hl && (strncmp(hl, "true", 4) == 0 || strncmp(hl, "false", 5) == 0), "highlights_layer");
-    r->highlights_layer = hl && strncmp(hl, "true", 4) == 0;
-    NEED(json_int(text, "spp", 0, (long long)1 << 50, &r->spp) == 0, "spp");
-    NEED(json_number(text, "seconds", &r->seconds) == 0, "seconds");
-    NEED(json_int(text, "max_depth", 1, 10000, &ll) == 0, "max_depth");
+    NEED(json_str(root, "method", r->method, sizeof r->method) == 0, "method");
+    const cJSON *hl = cJSON_GetObjectItemCaseSensitive(root, "highlights_layer");
+    NEED(cJSON_IsBool(hl), "highlights_layer");
+    r->highlights_layer = cJSON_IsTrue(hl);
+    NEED(json_int(root, "spp", 0, (long long)1 << 50, &r->spp) == 0, "spp");
+    NEED(json_number(root, "seconds", &r->seconds) == 0, "seconds");
+    NEED(json_int(root, "max_depth", 1, 10000, &ll) == 0, "max_depth");
     r->max_depth = (int)ll;
-    NEED(json_number(text, "seed", &x) == 0, "seed");
-    r->seed = (uint64_t)strtoull(json_value(text, "seed") ? json_value(text, "seed") : "0", NULL, 10);
-    r->has_noise = json_number(text, "mean_pixel_variance", &r->mean_variance) == 0 &&
-                   json_number(text, "rel_l2_noise", &r->rel_l2_noise) == 0;
+    NEED(json_seed(root, text, &r->seed) == 0, "seed");
+    /* "variance": null when the reference rendered a single frame. */
+    const cJSON *var = cJSON_GetObjectItemCaseSensitive(root, "variance");
+    r->has_noise = json_number(var, "mean_pixel_variance", &r->mean_variance) == 0 &&
+                   json_number(var, "rel_l2_noise", &r->rel_l2_noise) == 0;
 #undef NEED
+    cJSON_Delete(root);
     free(text);
     if (missing) return fail(err, errlen, "%s: not a glint reference sidecar (missing or bad \"%s\")", path, missing);
     return 0;

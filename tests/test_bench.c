@@ -2,7 +2,8 @@
  * a bench whose CSV parses (header, monotone time, pt's error falling), whose SVG and PNG plots
  * and report appear, sweeps, the highlights component; several seeds per run, their summary and
  * its split into noise and bias; mismatched references (size, camera, scene, no or broken
- * sidecar) and impossible seed counts refused with one error line; nothing ever overwritten.
+ * sidecar, a sidecar of unexpected shape) and impossible seed counts refused with one error line;
+ * nothing ever overwritten; the PNG plot's words.
  * Usage: test_bench PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -159,6 +160,47 @@ static const char *const other_scene =
     "\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.01}}],\"nodes\":[{\"mesh\":0},{\"light\":0,"
     "\"translation\":[0,1,0]},{\"camera\":0,\"translation\":[0,1,3]}],\"scenes\":[{\"nodes\":[0,1,2]}],\"scene\":0}\n";
 
+/* The extent of dark pixels (text, not the light grid) in [x0, x1) x [y0, y1) of an RGB image:
+ * width and height in pixels, 0 when there are none. */
+static void ink(const unsigned char *rgb, int w, int h, int x0, int y0, int x1, int y1, int *iw, int *ih) {
+    int lx = x1, hx = x0 - 1, ly = y1, hy = y0 - 1;
+    for (int y = y0 < 0 ? 0 : y0; y < y1 && y < h; y++)
+        for (int x = x0 < 0 ? 0 : x0; x < x1 && x < w; x++) {
+            const unsigned char *q = rgb + 3 * ((size_t)y * (size_t)w + (size_t)x);
+            if (q[0] < 150 && q[1] < 150 && q[2] < 150) {
+                lx = x < lx ? x : lx, hx = x > hx ? x : hx;
+                ly = y < ly ? y : ly, hy = y > hy ? y : hy;
+            }
+        }
+    *iw = hx >= lx ? hx - lx + 1 : 0;
+    *ih = hy >= ly ? hy - ly + 1 : 0;
+}
+
+/* The PNG plot has words where the SVG has them: title, axis labels, the curves' names and the
+ * readings' in the legend. The regions hold nothing else (app/plot.c's layout: the plot area
+ * 80..580 x 40..430, the legend from x 600, a row every 20 px from y 50). Digits alone, as the
+ * PNG once had beside its legend swatches, are narrower than the names asked for. */
+static void check_png_words(const unsigned char *png, int w, int h) {
+    enum { AREA_X0 = 80, AREA_X1 = 580, AREA_Y0 = 40, AREA_Y1 = 430, LEGEND_X = 600 };
+    int iw, ih;
+    ink(png, w, h, AREA_X0, 0, AREA_X1, AREA_Y0 - 6, &iw, &ih);
+    CHECK(iw >= 150 && ih >= 8, "the PNG has no title (ink %dx%d)", iw, ih);
+    ink(png, w, h, AREA_X0, AREA_Y1 + 24, AREA_X1, h, &iw, &ih);
+    CHECK(iw >= 60 && ih >= 8, "the PNG has no x axis label (ink %dx%d)", iw, ih);
+    ink(png, w, h, 0, AREA_Y0, 30, AREA_Y1, &iw, &ih);
+    CHECK(ih >= 80 && iw >= 8, "the PNG has no y axis label (ink %dx%d)", iw, ih);
+    ink(png, w, h, 30, AREA_Y0 - 8, AREA_X0 - 6, AREA_Y1 + 8, &iw, &ih);
+    CHECK(iw >= 15 && ih >= 200, "the PNG has no y tick labels (ink %dx%d)", iw, ih);
+    ink(png, w, h, AREA_X0 - 20, AREA_Y1 + 8, AREA_X1 + 20, AREA_Y1 + 24, &iw, &ih);
+    CHECK(iw >= 400 && ih >= 6, "the PNG has no x tick labels (ink %dx%d)", iw, ih);
+    static const char *const names[] = {"pt", "vsl", "equal time", "equal error"};
+    static const int rows[] = {50, 70, 100, 120}, widths[] = {10, 15, 45, 45};
+    for (int k = 0; k < 4; k++) {
+        ink(png, w, h, LEGEND_X + 28, rows[k] - 9, w, rows[k] + 7, &iw, &ih);
+        CHECK(iw >= widths[k] && ih >= 6, "the PNG's legend lacks '%s' (ink %dx%d)", names[k], iw, ih);
+    }
+}
+
 static void test_sidecar(void) {
     /* 1024 spp: the reference's own noise must stay below pt's error at the bench's budgets. */
     int rc = run("render --spp 1024 --size 24x16 --max-depth 3 --seed 7 --out ref.exr --quiet");
@@ -234,6 +276,8 @@ static void test_bench_run(void) {
         long dark = 0;
         for (long i = 0; i < (long)w * h * 3; i++) dark += png[i] < 128;
         CHECK(dark > 1000, "the png is blank (%ld dark values)", dark);
+        if (w == 860 && h == 500) check_png_words(png, w, h);
+        else CHECK(0, "error-vs-time.png is %dx%d, not the 860x500 of the layout the words are looked for in", w, h);
     }
     stbi_image_free(png);
     char md[1 << 16];
@@ -420,6 +464,105 @@ static void test_refusals(void) {
     expect_refusal("bench --reference broken.exr --times 0.05 --out r15", "broken.exr.json");
 }
 
+/* Sidecars of unexpected shape, as a hand edit, another program or a broken disk might leave them:
+ * wrong types, missing keys, nesting deeper than any parser's stack, numbers past every range,
+ * not JSON at all. Each is one error line naming the file and what is wrong, never a crash. A
+ * seed above 2^53, beyond a double's integers, reads back exactly. */
+static void test_sidecar_shapes(void) {
+    static char good[8192];
+    read_file("ref.exr.json", good, sizeof good);
+    CHECK(strstr(good, "\"seed\": 7,") && strstr(good, "\"width\": 24,"), "ref.exr.json: %s", good);
+    static char huge[420] = "\"spp\": 1"; /* 400 digits: past a double's range */
+    memset(huge + strlen(huge), '0', 400);
+    struct {
+        const char *from, *to, *problem; /* to replaces the first from in the good sidecar */
+    } edits[] = {
+        {"\"width\": 24", "\"width\": \"24\"", "missing or bad \"width\""},
+        {"\"width\": 24", "\"width\": 1e999", "missing or bad \"width\""},
+        {"\"width\": 24", "\"width\": 24.5", "missing or bad \"width\""},
+        {"\"height\": 16", "\"height\": -16", "missing or bad \"height\""},
+        {"\"spp\": 1024", "\"spp\": 123456789012345678901234567890", "missing or bad \"spp\""},
+        {"\"spp\": 1024", huge, "missing or bad \"spp\""},
+        {"\"seed\": 7", "\"seed\": -7", "missing or bad \"seed\""},
+        {"\"seed\": 7", "\"seed\": 18446744073709551616", "missing or bad \"seed\""},
+        {"\"seed\": 7", "\"seed\": \"7\"", "missing or bad \"seed\""},
+        {"\"scene_hash\"", "\"scene_hush\"", "missing or bad \"scene_hash\""},
+        {"\"scene\": ", "\"scene\": [[[[[[[[1]]]]]]]], \"x\": ", "missing or bad \"scene\""},
+        {"\"index\": 0", "\"index\": null", "missing or bad \"camera index\""},
+        {"\"position\": [", "\"position\": [1, ", "missing or bad \"camera position\""},
+        {"\"yfov\": ", "\"yfov\": 1e300, \"x\": ", "missing or bad \"camera yfov\""},
+        {"\"camera\": {", "\"camera\": 5, \"cam\": {", "missing or bad \"camera index\""},
+        {"\"highlights_layer\": false", "\"highlights_layer\": 0", "missing or bad \"highlights_layer\""},
+        {"\"method\": \"pt\"", "\"method\": \"a method name longer than any\"", "missing or bad \"method\""},
+        {"\"glint_reference\": 1,", "", "missing or bad \"glint_reference\""},
+        {"{", "[", "not JSON, line 2)"},
+    };
+    enum { N = sizeof edits / sizeof edits[0], EXTRA = 5 };
+    char cmd[4096] = "", name[64], args[256], needle[256];
+    for (int k = 0; k < N + EXTRA + 1; k++)
+        snprintf(cmd + strlen(cmd), sizeof cmd - strlen(cmd), "%scp '%s/ref.exr' '%s/shape%d.exr'", k ? " && " : "",
+                 tmp, tmp, k);
+    CHECK(system(cmd) == 0, "copying the reference");
+    static char text[1 << 21];
+    for (int k = 0; k < N; k++) {
+        const char *at = strstr(good, edits[k].from);
+        CHECK(at != NULL, "the good sidecar lacks '%s'", edits[k].from);
+        if (!at) continue;
+        snprintf(text, sizeof text, "%.*s%s%s", (int)(at - good), good, edits[k].to, at + strlen(edits[k].from));
+        snprintf(name, sizeof name, "shape%d.exr.json", k);
+        write_text(name, text);
+        snprintf(args, sizeof args, "bench --reference shape%d.exr --times 0.05 --out shape%d", k, k);
+        snprintf(needle, sizeof needle, "%s: not a glint reference sidecar (%s", name, edits[k].problem);
+        expect_refusal(args, needle);
+    }
+    /* Nesting a million deep, a top-level value that is no object, trailing text, an empty file,
+     * more than the 1 MiB a sidecar may take. */
+    const char *problems[EXTRA] = {"not JSON, line 1", "not a JSON object", "not JSON, line", "not JSON, line 1",
+                                   "too large"};
+    for (int k = 0; k < EXTRA; k++) {
+        size_t n = 0;
+        if (k == 0) {
+            n = (size_t)snprintf(text, sizeof text, "{\"glint_reference\": 1, \"x\": ");
+            memset(text + n, '[', 1000000);
+            n += 1000000;
+        } else if (k == 1) {
+            n = (size_t)snprintf(text, sizeof text, "[%s]", good);
+        } else if (k == 2) {
+            n = (size_t)snprintf(text, sizeof text, "%s}", good);
+        } else if (k == 4) {
+            n = (size_t)snprintf(text, sizeof text, "%s", good);
+            memset(text + n, ' ', (1 << 20) + 1);
+            n += (1 << 20) + 1;
+        }
+        text[n] = 0;
+        snprintf(name, sizeof name, "shape%d.exr.json", N + k);
+        write_text(name, text);
+        snprintf(args, sizeof args, "bench --reference shape%d.exr --times 0.05 --out shape%d", N + k, N + k);
+        snprintf(needle, sizeof needle, "%s: ", name);
+        expect_refusal(args, needle);
+        CHECK(strstr(err_text, problems[k]) != NULL, "%s: '%s' lacks '%s'", name, err_text, problems[k]);
+    }
+    /* 2^53 + 1 and 2^64 - 1: a double would read 2^53 and 2^64, and the bench's seeds just below
+     * would not seem to hold the reference's. */
+    const char *at = strstr(good, "\"seed\": 7");
+    static const char *const seeds[2][2] = {{"9007199254740992", "9007199254740993"},
+                                            {"18446744073709551614", "18446744073709551615"}};
+    for (int k = 0; at && k < 2; k++) {
+        snprintf(text, sizeof text, "%.*s\"seed\": %s%s", (int)(at - good), good, seeds[k][1], at + 9);
+        snprintf(name, sizeof name, "shape%d.exr.json", N + EXTRA);
+        write_text(name, text);
+        snprintf(args, sizeof args, "bench --reference shape%d.exr --seed %s --seeds 2 --times 0.05 --out seedbig",
+                 N + EXTRA, seeds[k][0]);
+        snprintf(needle, sizeof needle, "the reference's seed %s;", seeds[k][1]);
+        expect_usage(args, needle);
+    }
+    for (int k = 0; k <= N + EXTRA; k++) {
+        snprintf(name, sizeof name, "shape%d", k);
+        CHECK(!exists(name), "a refused bench created %s", name);
+    }
+    CHECK(!exists("seedbig"), "a refused bench created seedbig");
+}
+
 /* References must read back exactly. OpenEXR 3.1's ZIP encoder kept zlib output exactly as long
  * as the raw chunk, which readers take for raw pixels (OpenEXR issue #2306); partly compressible
  * chunks of every length between all-zero and all-random meet that length now and then. */
@@ -463,5 +606,6 @@ int main(int argc, char **argv) {
     test_sweeps_and_highlights();
     test_seeds();
     test_refusals();
+    test_sidecar_shapes();
     return check_exit("test_bench");
 }
