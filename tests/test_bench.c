@@ -239,8 +239,10 @@ static void test_bench_run(void) {
         CHECK(rows[i].seed == 8, "row %d: seed %lld, expected the reference's + 1", i, rows[i].seed);
         CHECK(isfinite(rows[i].rel_l2) && rows[i].rel_l2 > 0.0 && !rows[i].has_highlights,
               "row %d: rel_l2 %g, highlights column filled without a highlights layer", i, rows[i].rel_l2);
+        /* Non-decreasing: a frame longer than two budgets (a loaded machine, a sanitised build)
+         * meets both at once, and both rows read the same moment. */
         if (i % 3 > 0)
-            CHECK(rows[i].seconds > rows[i - 1].seconds && rows[i].frames >= rows[i - 1].frames &&
+            CHECK(rows[i].seconds >= rows[i - 1].seconds && rows[i].frames >= rows[i - 1].frames &&
                       strcmp(rows[i].method, rows[i - 1].method) == 0,
                   "row %d: seconds %g after %g, not monotone within one run", i, rows[i].seconds, rows[i - 1].seconds);
     }
