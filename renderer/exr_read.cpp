@@ -209,7 +209,9 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
                const char **stage) {
     FdStream in(path, fd, size);
     check_attribute_sizes(in);
-    Imf::MultiPartInputFile file(in, 0); // no worker threads: the renderer has its own
+    // No worker threads: the renderer has its own. No rebuilt offset table: a damaged file is
+    // refused with its error rather than loaded with holes.
+    Imf::MultiPartInputFile file(in, 0, false);
     int part = -1;
     for (int p = 0; p < file.parts() && part < 0; p++)
         if (!Imf::isDeepData(file.header(p).type())) part = p;
