@@ -1,5 +1,5 @@
-/* glint — image files: OpenEXR (C API) and Radiance HDR in, OpenEXR and PNG out, and the one
- * atomic file writer every export goes through.
+/* glint — image files: OpenEXR and Radiance HDR in, OpenEXR and PNG out, and the one atomic file
+ * writer every export goes through.
  *
  * Errors: functions that can fail return 0 on success and -1 on failure, with a one-line message
  * in err (at most errlen bytes, "PATH: problem", no trailing newline, no "glint: error:" prefix).
@@ -20,15 +20,17 @@ typedef struct {
     float *rgb; /* owned: free with image_rgb_free */
 } image_rgb;
 
-/* Loads a linear RGB image: .exr through OpenEXR's C API (any compression it supports, plus
- * DWAA/DWAB decoded here; half or float channels; R,G,B or a single Y channel; alpha ignored),
- * .hdr through stb_image. The format is recognised by the file's magic bytes, not its name.
+/* Loads a linear RGB image: .exr through OpenEXR's C++ library (every compression, DWAA/DWAB
+ * included; half, float or uint channels; R,G,B or a single Y channel; alpha ignored), .hdr
+ * through stb_image. The format is recognised by the file's magic bytes, not its name.
  * Non-finite or negative texels are an error, except slightly negative texels of DWA's lossy
  * DCT, which are coding noise and read as zero. */
 int image_rgb_load(const char *path, image_rgb *out, char *err, size_t errlen);
 void image_rgb_free(image_rgb *img);
 
-/* A multi-channel float image as read from an EXR: one plane of width*height floats per channel. */
+/* A multi-channel float image as read from an EXR: one plane of width*height floats per channel,
+ * over the display window (zero where the data window does not cover it); every channel of the
+ * first flat part, converted to float. */
 typedef struct {
     int width, height;
     int num_channels;

@@ -1,0 +1,287 @@
+// glint — OpenEXR reading through OpenEXR's C++ library (Imf), which reads every compression the
+// format has and is fuzzed upstream. See exr_read.h. Every exception stops at exr_read_fd.
+#include "exr_read.h"
+
+#include <Iex.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfPartType.h>
+#include <ImfTiledInputPart.h>
+
+#include <cerrno>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace {
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+// Writes "PATH: message" to err as one line and returns -1 (as image_io.c's fail).
+int fail(char *err, size_t errlen, const char *path, const char *fmt, ...) {
+    if (!err || errlen == 0) return -1;
+    int n = std::snprintf(err, errlen, "%s: ", path ? path : "(null)");
+    if (n >= 0 && (size_t)n < errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        std::vsnprintf(err + n, errlen - (size_t)n, fmt, ap);
+        va_end(ap);
+    }
+    // The library's messages may carry newlines; the contract is one line.
+    for (char *c = err; *c; c++)
+        if ((unsigned char)*c < 0x20) *c = ' ';
+    size_t len = std::strlen(err);
+    while (len > 0 && err[len - 1] == ' ') err[--len] = '\0';
+    return -1;
+}
+
+struct Refused : std::runtime_error { // a file refused by our own checks, with its message
+    using std::runtime_error::runtime_error;
+};
+
+// The open file as the library reads it, through a 64 KiB buffer of pread: reading past the end
+// (a truncated file, an offset pointing nowhere) throws, as the library's own streams do.
+class FdStream : public Imf::IStream {
+  public:
+    FdStream(const char *path, int fd, int64_t size) : Imf::IStream(path), fd_(fd), size_((uint64_t)size) {}
+
+    bool read(char c[], int n) override {
+        if (n < 0 || pos_ > size_ || (uint64_t)n > size_ - pos_) throw Iex::InputExc("unexpected end of file");
+        uint64_t at = pos_, end = pos_ + (uint64_t)n;
+        if (at >= buf_at_ && end <= buf_at_ + buf_len_) {
+            std::memcpy(c, buf_.data() + (at - buf_at_), (size_t)n);
+        } else if ((size_t)n >= buf_.size()) {
+            pread_all(c, (size_t)n, at);
+        } else {
+            buf_len_ = (size_t)(size_ - at < buf_.size() ? size_ - at : buf_.size());
+            buf_at_ = at;
+            pread_all(buf_.data(), buf_len_, at);
+            std::memcpy(c, buf_.data(), (size_t)n);
+        }
+        pos_ = end;
+        return pos_ < size_;
+    }
+    uint64_t tellg() override { return pos_; }
+    void seekg(uint64_t pos) override { pos_ = pos; }
+    uint64_t size() const { return size_; }
+
+  private:
+    void pread_all(char *dst, size_t n, uint64_t at) {
+        for (size_t done = 0; done < n;) {
+            ssize_t got = pread(fd_, dst + done, n - done, (off_t)(at + done));
+            if (got < 0 && errno == EINTR) continue;
+            if (got < 0) throw Iex::InputExc(std::string("read error: ") + std::strerror(errno));
+            if (got == 0) throw Iex::InputExc("unexpected end of file");
+            done += (size_t)got;
+        }
+    }
+
+    int fd_;
+    uint64_t size_, pos_ = 0, buf_at_ = 0;
+    size_t buf_len_ = 0;
+    std::vector<char> buf_ = std::vector<char>(65536);
+};
+
+// A NUL-terminated name of at most 255 characters, as the header stores them.
+std::string read_name(FdStream &in) {
+    std::string s;
+    for (;;) {
+        char c;
+        in.read(&c, 1);
+        if (c == '\0') return s;
+        if (s.size() == 255) throw Iex::InputExc("an attribute name in the header is too long");
+        s += c;
+    }
+}
+
+// OpenEXR 3.1's header reader makes room for an attribute's value at the size the file declares
+// before reading it (a string is resized, so zero-filled, first): 40 bytes declaring a 2 GB string
+// would cost 2 GB. So every declared size is checked against the bytes left in the file first.
+void check_attribute_sizes(FdStream &in) {
+    char version[4];
+    in.seekg(4);
+    in.read(version, 4);
+    bool multipart = (version[1] & 0x10) != 0; // bit 12 of the version field
+    for (bool more = true; more;) {            // one header, or a multi-part file's up to an empty one
+        int attrs = 0;
+        for (std::string name; !(name = read_name(in)).empty(); attrs++) {
+            read_name(in); // the type
+            unsigned char b[4];
+            in.read(reinterpret_cast<char *>(b), 4);
+            int64_t n = (int32_t)((uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24);
+            if (n < 0 || (uint64_t)n > in.size() - in.tellg())
+                throw Iex::InputExc("header attribute " + name + " claims " + std::to_string(n) +
+                                    " bytes, more than the file holds");
+            in.seekg(in.tellg() + (uint64_t)n);
+        }
+        more = multipart && attrs > 0;
+    }
+    in.seekg(0);
+}
+
+int64_t box_width(const Imath::Box2i &b) { return (int64_t)b.max.x - b.min.x + 1; }
+int64_t box_height(const Imath::Box2i &b) { return (int64_t)b.max.y - b.min.y + 1; }
+
+bool size_ok(int64_t w, int64_t h) {
+    return w > 0 && h > 0 && w <= MAX_IMAGE_DIM && h <= MAX_IMAGE_DIM && w * h <= MAX_IMAGE_PIXELS;
+}
+
+// Re-frames img from its data window onto the display window: pixels outside the data window are
+// zero (as EXR defines them), data outside the display window is dropped.
+void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2i &disp) {
+    int dispw = (int)box_width(disp), disph = (int)box_height(disp);
+    int64_t x_lo = dw.min.x > disp.min.x ? dw.min.x : disp.min.x;
+    int64_t x_hi = dw.max.x < disp.max.x ? dw.max.x : disp.max.x;
+    for (int k = 0; k < img->num_channels; k++) {
+        float *dst = static_cast<float *>(std::calloc((size_t)dispw * (size_t)disph, sizeof(float)));
+        if (!dst) throw std::bad_alloc();
+        const float *src = img->planes[k];
+        for (int64_t y = disp.min.y; y <= disp.max.y && x_lo <= x_hi; y++) {
+            if (y < dw.min.y || y > dw.max.y) continue;
+            std::memcpy(dst + (size_t)(y - disp.min.y) * (size_t)dispw + (size_t)(x_lo - disp.min.x),
+                        src + (size_t)(y - dw.min.y) * (size_t)img->width + (size_t)(x_lo - dw.min.x),
+                        sizeof(float) * (size_t)(x_hi - x_lo + 1));
+        }
+        std::free(img->planes[k]);
+        img->planes[k] = dst;
+    }
+    img->width = dispw;
+    img->height = disph;
+}
+
+// The channels to read, in output order.
+std::vector<std::string> pick_channels(const Imf::ChannelList &chans, exr_read_select select) {
+    std::vector<std::string> pick;
+    if (select == EXR_READ_RGB) {
+        if (chans.findChannel("R") && chans.findChannel("G") && chans.findChannel("B"))
+            pick = {"R", "G", "B"};
+        else if (chans.findChannel("Y"))
+            pick = {"Y"};
+    } else {
+        for (auto it = chans.begin(); it != chans.end(); ++it) pick.emplace_back(it.name());
+    }
+    if (pick.empty()) throw Refused(select == EXR_READ_RGB ? "no R, G, B or Y channel" : "no channels");
+    return pick;
+}
+
+// Refuses what glint does not read (subsampled channels), and layouts whose buffers would be
+// absurd before the library allocates them: its buffer for one chunk of every channel (up to 256
+// scanlines for DWAB, or one tile).
+void check_layout(const Imf::Header &h) {
+    const Imath::Box2i &dw = h.dataWindow(), &disp = h.displayWindow();
+    int64_t w = box_width(dw), ht = box_height(dw);
+    if (!size_ok(w, ht) || !size_ok(box_width(disp), box_height(disp)))
+        throw Refused("unsupported image size (data window " + std::to_string(w) + "x" + std::to_string(ht) +
+                      ", display window " + std::to_string(box_width(disp)) + "x" +
+                      std::to_string(box_height(disp)) + ")");
+    uint64_t pixel_bytes = 0;
+    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+        const Imf::Channel &c = it.channel();
+        // Subsampled channels come from luminance/chroma images, which would need reconstructing.
+        if (c.xSampling != 1 || c.ySampling != 1)
+            throw Refused(std::string("channel ") + it.name() +
+                          " is subsampled (luminance/chroma images are not supported)");
+        pixel_bytes += c.type == Imf::HALF ? 2 : 4;
+    }
+    const Imf::TileDescription *tile = h.hasTileDescription() ? &h.tileDescription() : nullptr;
+    uint64_t chunk = tile ? (uint64_t)tile->xSize * tile->ySize * pixel_bytes : (uint64_t)w * 256 * pixel_bytes;
+    if (chunk > ((uint64_t)1 << 30)) {
+        std::string what = std::to_string(pixel_bytes) + " bytes a pixel over " + std::to_string(w) + "x" +
+                           std::to_string(ht);
+        if (tile) what += " in tiles of " + std::to_string(tile->xSize) + "x" + std::to_string(tile->ySize);
+        throw Refused("unsupported image size (" + what + ")");
+    }
+}
+
+void read_file(const char *path, int fd, int64_t size, exr_read_select select, exr_image *out, int *lossy_dct,
+               const char **stage) {
+    FdStream in(path, fd, size);
+    check_attribute_sizes(in);
+    // No worker threads: the renderer has its own. No rebuilt offset table: a damaged file is
+    // refused with its error rather than loaded with holes.
+    Imf::MultiPartInputFile file(in, 0, false);
+    int part = -1;
+    for (int p = 0; p < file.parts() && part < 0; p++)
+        if (!Imf::isDeepData(file.header(p).type())) part = p;
+    if (part < 0) throw Refused("no flat image part (deep data is not supported)");
+    const Imf::Header &h = file.header(part);
+    check_layout(h);
+    std::vector<std::string> pick = pick_channels(h.channels(), select);
+    const Imath::Box2i dw = h.dataWindow(), disp = h.displayWindow();
+    for (const Imath::Box2i &b : {dw, disp}) // the planes as read, and as re-framed
+        if ((uint64_t)box_width(b) * (uint64_t)box_height(b) * pick.size() > ((uint64_t)1 << 30))
+            throw Refused("unsupported image size (" + std::to_string(pick.size()) + " channels of " +
+                          std::to_string(box_width(b)) + "x" + std::to_string(box_height(b)) + ")");
+
+    out->width = (int)box_width(dw);
+    out->height = (int)box_height(dw);
+    out->names = static_cast<char **>(std::calloc(pick.size(), sizeof(char *)));
+    out->planes = static_cast<float **>(std::calloc(pick.size(), sizeof(float *)));
+    if (!out->names || !out->planes) throw std::bad_alloc();
+    Imf::FrameBuffer fb;
+    for (size_t k = 0; k < pick.size(); k++) {
+        out->num_channels = (int)k + 1;
+        out->names[k] = strdup(pick[k].c_str());
+        out->planes[k] = static_cast<float *>(std::calloc((size_t)out->width * (size_t)out->height, sizeof(float)));
+        if (!out->names[k] || !out->planes[k]) throw std::bad_alloc();
+        fb.insert(pick[k], Imf::Slice::Make(Imf::FLOAT, out->planes[k], dw)); // half and uint convert
+    }
+
+    *stage = "corrupt or truncated file";
+    if (h.hasTileDescription()) { // level 0 of tiled files, straight into the planes
+        Imf::TiledInputPart tiles(file, part);
+        tiles.setFrameBuffer(fb);
+        tiles.readTiles(0, tiles.numXTiles(0) - 1, 0, tiles.numYTiles(0) - 1, 0, 0);
+    } else {
+        Imf::InputPart lines(file, part);
+        lines.setFrameBuffer(fb);
+        lines.readPixels(dw.min.y, dw.max.y);
+    }
+    if (lossy_dct) *lossy_dct = h.compression() == Imf::DWAA_COMPRESSION || h.compression() == Imf::DWAB_COMPRESSION;
+    if (dw != disp) to_display_window(out, dw, disp);
+}
+
+} // namespace
+
+extern "C" int exr_read_fd(const char *path, int fd, int64_t size, exr_read_select select, exr_image *out,
+                           int *lossy_dct, char *err, size_t errlen) {
+    std::memset(out, 0, sizeof *out);
+    if (lossy_dct) *lossy_dct = 0;
+    static const unsigned char magic[4] = {0x76, 0x2f, 0x31, 0x01};
+    unsigned char head[4] = {0, 0, 0, 0};
+    if (size == 0) return fail(err, errlen, path, "empty file");
+    if (pread(fd, head, 4, 0) != 4 || std::memcmp(head, magic, 4) != 0)
+        return fail(err, errlen, path, "not an OpenEXR file");
+    const char *stage = "not a readable OpenEXR file";
+    int status = 0;
+    try {
+        read_file(path, fd, size, select, out, lossy_dct, &stage);
+    } catch (const Refused &e) {
+        status = fail(err, errlen, path, "%s", e.what());
+    } catch (const std::bad_alloc &) {
+        status = out->width > 0 ? fail(err, errlen, path, "out of memory for a %dx%d image", out->width, out->height)
+                                : fail(err, errlen, path, "out of memory");
+    } catch (const std::exception &e) {
+        // The library names the file in its messages, which follow ours: once is enough.
+        std::string why = e.what();
+        for (const std::string &named : {"image file \"" + std::string(path) + "\"", "\"" + std::string(path) + "\""})
+            for (size_t at; (at = why.find(named)) != std::string::npos;) why.replace(at, named.size(), "the file");
+        status = fail(err, errlen, path, "%s: %s", stage, why.c_str());
+    } catch (...) {
+        status = fail(err, errlen, path, "%s", stage);
+    }
+    if (status != 0) exr_image_free(out);
+    return status;
+}

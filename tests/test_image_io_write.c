@@ -1,0 +1,187 @@
+/* The writing side of image I/O: the atomic writer's guarantees (no replace, no partial file, no
+ * temporary left behind, only regular files replaced, the umask honoured), errors that name the
+ * path, free names for exports, and PNGs as stb_image decodes them. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <stb/stb_image.h>
+
+#include "check.h"
+#include "image_io.h"
+#include "scratch.h"
+
+/* ---- atomic writes --------------------------------------------------------------------------- */
+
+static void test_write_modes(void) {
+    char path[1200], err[512] = "";
+    path_in(path, sizeof path, "atomic.bin");
+    CHECK(write_file_atomic(path, "first", 5, WRITE_NO_REPLACE, err, sizeof err) == 0, "first write: %s", err);
+    err[0] = '\0';
+    int rc = write_file_atomic(path, "second", 6, WRITE_NO_REPLACE, err, sizeof err);
+    CHECK(rc == -1, "WRITE_NO_REPLACE replaced an existing file");
+    char expect[1300];
+    snprintf(expect, sizeof expect, "%s: file exists", path);
+    CHECK(strcmp(err, expect) == 0, "error '%s', expected '%s'", err, expect);
+    size_t size = 0;
+    unsigned char *got = get_file(path, &size);
+    CHECK(got && size == 5 && memcmp(got, "first", 5) == 0, "the refused write changed the file");
+    free(got);
+
+    CHECK(write_file_atomic(path, "third!", 6, WRITE_REPLACE, err, sizeof err) == 0, "replace: %s", err);
+    got = get_file(path, &size);
+    CHECK(got && size == 6 && memcmp(got, "third!", 6) == 0, "WRITE_REPLACE did not replace");
+    free(got);
+
+    /* Only regular files are replaced: a FIFO (like a device such as /dev/null) stays what it is. */
+    path_in(path, sizeof path, "fifo");
+    CHECK(mkfifo(path, 0666) == 0, "mkfifo: %s", strerror(errno));
+    err[0] = '\0';
+    CHECK(write_file_atomic(path, "data", 4, WRITE_REPLACE, err, sizeof err) == -1, "a FIFO was replaced");
+    snprintf(expect, sizeof expect, "%s: not a regular file; not replacing it", path);
+    CHECK(strcmp(err, expect) == 0, "error '%s', expected '%s'", err, expect);
+    struct stat fifo_st;
+    CHECK(lstat(path, &fifo_st) == 0 && S_ISFIFO(fifo_st.st_mode), "the FIFO is gone");
+    unlink(path);
+
+    /* An empty file is a valid output; so is a large one written in one go. */
+    path_in(path, sizeof path, "empty.bin");
+    CHECK(write_file_atomic(path, "", 0, WRITE_NO_REPLACE, err, sizeof err) == 0, "empty write: %s", err);
+    got = get_file(path, &size);
+    CHECK(got && size == 0, "empty file");
+    free(got);
+    size_t big = (size_t)3 << 20;
+    unsigned char *data = malloc(big);
+    for (size_t i = 0; i < big; i++) data[i] = (unsigned char)(i * 2654435761u >> 13);
+    path_in(path, sizeof path, "big.bin");
+    CHECK(write_file_atomic(path, data, big, WRITE_REPLACE, err, sizeof err) == 0, "big write: %s", err);
+    got = get_file(path, &size);
+    CHECK(got && size == big && memcmp(got, data, big) == 0, "big file content");
+    free(got);
+    free(data);
+
+    /* New files get the usual permissions (umask), not a temporary file's 0600. */
+    mode_t mask = umask(022);
+    path_in(path, sizeof path, "perm.bin");
+    write_file_atomic(path, "x", 1, WRITE_NO_REPLACE, err, sizeof err);
+    struct stat st;
+    CHECK(stat(path, &st) == 0 && (st.st_mode & 0777) == 0644, "mode %o, expected 644", (unsigned)(st.st_mode & 0777));
+    umask(mask);
+
+    /* A missing directory: an error naming it, and nothing created. */
+    path_in(path, sizeof path, "no-such-dir/out.exr");
+    err[0] = '\0';
+    rc = write_file_atomic(path, "x", 1, WRITE_REPLACE, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, path) && strstr(err, "no-such-dir") && one_line(err), "missing dir: '%s'", err);
+    float px[3] = {1, 2, 3};
+    exr_layer layer = {"", px};
+    err[0] = '\0';
+    rc = exr_save_layers(path, 1, 1, &layer, 1, WRITE_REPLACE, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, path), "exr into a missing dir: '%s'", err);
+    unsigned char rgb8[3] = {1, 2, 3};
+    path_in(path, sizeof path, "no-such-dir/out.png");
+    err[0] = '\0';
+    rc = png_save_rgb8(path, 1, 1, rgb8, WRITE_NO_REPLACE, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, path), "png into a missing dir: '%s'", err);
+
+    /* Replacing a directory fails, and leaves no temporary behind. */
+    path_in(path, sizeof path, "a-directory");
+    mkdir(path, 0777);
+    err[0] = '\0';
+    rc = write_file_atomic(path, "x", 1, WRITE_REPLACE, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, path), "replacing a directory: '%s'", err);
+    rc = exr_save_layers(path, 1, 1, &layer, 1, WRITE_NO_REPLACE, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, "file exists"), "exr over a directory, no replace: '%s'", err);
+
+    /* Invalid arguments are errors, not crashes. */
+    path_in(path, sizeof path, "invalid.exr");
+    CHECK(exr_save_layers(path, 0, 5, &layer, 1, WRITE_REPLACE, err, sizeof err) == -1, "zero width accepted");
+    exr_layer twice[2] = {{"x", px}, {"x", px}};
+    CHECK(exr_save_layers(path, 1, 1, twice, 2, WRITE_REPLACE, err, sizeof err) == -1 && strstr(err, "twice"),
+          "duplicate layer names accepted: '%s'", err);
+    CHECK(!file_exists(path), "an invalid save created a file");
+
+    /* A tiny error buffer is filled, truncated and terminated (ASan watches the bounds). */
+    char small[8];
+    memset(small, 'x', sizeof small);
+    path_in(path, sizeof path, "atomic.bin");
+    CHECK(write_file_atomic(path, "y", 1, WRITE_NO_REPLACE, small, sizeof small) == -1 && small[7] == '\0',
+          "short error buffer");
+
+    CHECK(stray_temp_files(scratch_dir) == 0, "temporary files left behind");
+}
+
+/* ---- unique_path ----------------------------------------------------------------------------- */
+
+static void test_unique_path(void) {
+    char path[1200], out[1200], expect[1300];
+    path_in(path, sizeof path, "render.png");
+    CHECK(unique_path(path, out, sizeof out) == 0 && strcmp(out, path) == 0, "free name: %s", out);
+    put_file(path, "", 0);
+    snprintf(expect, sizeof expect, "%s/render-1.png", scratch_dir);
+    CHECK(unique_path(path, out, sizeof out) == 0 && strcmp(out, expect) == 0, "got %s, expected %s", out, expect);
+    put_file(expect, "", 0);
+    snprintf(expect, sizeof expect, "%s/render-2.png", scratch_dir);
+    CHECK(unique_path(path, out, sizeof out) == 0 && strcmp(out, expect) == 0, "got %s, expected %s", out, expect);
+
+    /* No extension, a dot in the directory name, a hidden file. */
+    char sub[1100];
+    path_in(sub, sizeof sub, "out.d");
+    mkdir(sub, 0777);
+    snprintf(path, sizeof path, "%s/name", sub);
+    put_file(path, "", 0);
+    snprintf(expect, sizeof expect, "%s/name-1", sub);
+    CHECK(unique_path(path, out, sizeof out) == 0 && strcmp(out, expect) == 0, "got %s, expected %s", out, expect);
+    snprintf(path, sizeof path, "%s/.hidden", sub);
+    put_file(path, "", 0);
+    snprintf(expect, sizeof expect, "%s/.hidden-1", sub);
+    CHECK(unique_path(path, out, sizeof out) == 0 && strcmp(out, expect) == 0, "got %s, expected %s", out, expect);
+    snprintf(path, sizeof path, "%s/a.b.exr", sub);
+    put_file(path, "", 0);
+    snprintf(expect, sizeof expect, "%s/a.b-1.exr", sub);
+    CHECK(unique_path(path, out, sizeof out) == 0 && strcmp(out, expect) == 0, "got %s, expected %s", out, expect);
+
+    /* An output buffer too small for the name. */
+    path_in(path, sizeof path, "render.png");
+    char tiny[10];
+    CHECK(unique_path(path, tiny, sizeof tiny) == -1, "unique_path overflowed a small buffer");
+    CHECK(unique_path("x.png", tiny, 5) == -1, "no room for the terminator");
+}
+
+/* ---- PNG ------------------------------------------------------------------------------------- */
+
+static void test_png(void) {
+    enum { W = 4, H = 3 };
+    unsigned char px[W * H * 3];
+    for (int i = 0; i < W * H * 3; i++) px[i] = (unsigned char)(i * 37 + 11);
+    px[0] = 0;
+    px[1] = 255;
+    char path[1200], err[512] = "";
+    path_in(path, sizeof path, "small.png");
+    CHECK(png_save_rgb8(path, W, H, px, WRITE_NO_REPLACE, err, sizeof err) == 0, "png_save_rgb8: %s", err);
+    size_t size = 0;
+    unsigned char *file = get_file(path, &size);
+    CHECK(file && size > 8 && memcmp(file, "\x89PNG\r\n\x1a\n", 8) == 0, "PNG signature");
+    int w = 0, h = 0, n = 0;
+    unsigned char *back = file ? stbi_load_from_memory(file, (int)size, &w, &h, &n, 0) : NULL;
+    CHECK(back && w == W && h == H && n == 3, "decoded %dx%d with %d channels", w, h, n);
+    if (back && w == W && h == H && n == 3) CHECK(memcmp(back, px, sizeof px) == 0, "PNG pixels differ");
+    stbi_image_free(back);
+    free(file);
+    CHECK(png_save_rgb8(path, W, H, px, WRITE_NO_REPLACE, err, sizeof err) == -1 && strstr(err, "file exists"),
+          "png over an existing file: '%s'", err);
+    CHECK(stray_temp_files(scratch_dir) == 0, "temporary files left behind");
+}
+
+int main(void) {
+    if (scratch_open("test_image_io_write") != 0) return 1;
+    test_write_modes();
+    test_unique_path();
+    test_png();
+    CHECK(stray_temp_files(scratch_dir) == 0, "temporary files left behind");
+    return scratch_close(check_exit("test_image_io_write"));
+}
