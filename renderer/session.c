@@ -36,6 +36,12 @@ typedef struct {
     char pad[64];
 } worker_stats;
 
+/* Direct-light samples at each camera hit in a many-light frame. Such a frame costs several path
+ * tracer frames (the gather), so one direct sample a frame leaves the direct light noisier than
+ * the path tracer's at equal time; at 8 the whole image's noise x time fell 2.3x on doorway and
+ * 3x on showcase and stayed level on atelier (docs/benchmarks.md). */
+#define MANYLIGHT_DIRECT_SAMPLES 8
+
 struct render_session {
     const scene *scene;
     camera cam;
@@ -116,7 +122,10 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
          * highlights, each pass timed. */
         for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
         uint64_t t0 = clock_ns();
-        L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first, rng, st->rays);
+        L[COMP_DIRECT] = v3(0, 0, 0);
+        for (int k = 0; k < MANYLIGHT_DIRECT_SAMPLES; k++)
+            L[COMP_DIRECT] = add3(L[COMP_DIRECT], pt_direct(s, rs->cam.position, d, first, rng, st->rays));
+        L[COMP_DIRECT] = scale3(L[COMP_DIRECT], 1.0f / (float)MANYLIGHT_DIRECT_SAMPLES);
         uint64_t t1 = clock_ns();
         st->pass_ns[PASS_DIRECT] += t1 - t0;
         if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
