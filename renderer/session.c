@@ -38,9 +38,10 @@ typedef struct {
 
 /* Direct-light samples at each camera hit in a many-light frame. Such a frame costs several path
  * tracer frames (the gather), so one direct sample a frame leaves the direct light noisier than
- * the path tracer's at equal time; at 8 the whole image's noise x time fell 2.3x on doorway and
- * 3x on showcase and stayed level on atelier (docs/benchmarks.md). */
-#define MANYLIGHT_DIRECT_SAMPLES 8
+ * the path tracer's at equal time. 4 took the whole image's noise x time down 1.7x on doorway and
+ * 2.4x on showcase at 14% more time a frame; 8 did better there but cost atelier (whose direct
+ * light is easy) a third of its frames for little (docs/benchmarks.md). */
+#define MANYLIGHT_DIRECT_SAMPLES 4
 
 struct render_session {
     const scene *scene;
