@@ -19,8 +19,10 @@ void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, ve
                  rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
 
 /* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
- * max depth 1, so every method shares one direct estimator); first as for pt_radiance. */
-vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, rng_state *rng, uint64_t rays[RAY_KIND_COUNT]);
+ * max depth 1, so every method shares one direct estimator), the mean of `samples` estimates at
+ * that hit; first as for pt_radiance. */
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, rng_state *rng,
+               uint64_t rays[RAY_KIND_COUNT]);
 
 /* The same without the emission at the hit (nor the environment when the ray escapes): only
  * light that reaches the hit directly from an emitter and is reflected back along the ray by the

@@ -123,10 +123,7 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
          * highlights, each pass timed. */
         for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
         uint64_t t0 = clock_ns();
-        L[COMP_DIRECT] = v3(0, 0, 0);
-        for (int k = 0; k < MANYLIGHT_DIRECT_SAMPLES; k++)
-            L[COMP_DIRECT] = add3(L[COMP_DIRECT], pt_direct(s, rs->cam.position, d, first, rng, st->rays));
-        L[COMP_DIRECT] = scale3(L[COMP_DIRECT], 1.0f / (float)MANYLIGHT_DIRECT_SAMPLES);
+        L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first, MANYLIGHT_DIRECT_SAMPLES, rng, st->rays);
         uint64_t t1 = clock_ns();
         st->pass_ns[PASS_DIRECT] += t1 - t0;
         if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
