@@ -266,11 +266,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
             vec3 wi = to_world(x.frame, bs.wi);
             if (dot3(wi, x.ng) <= 0.0f) continue;
             vec3 b = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
-            if (k >= 3) { /* Russian roulette, as the path tracer does */
-                float q = fminf(0.95f, max_comp3(b));
-                if (rng_float(rng) >= q) continue;
-                b = scale3(b, 1.0f / q);
-            }
+            if (k - 1 >= RR_FIRST_VERTEX && !russian_roulette(&b, rng_float(rng))) continue;
             if (is_black3(b) || !is_finite3(b)) continue;
             st->glossy_bounces++;
             /* Emission at the next hit is the direct light at x, which the shared estimator has. */

@@ -107,12 +107,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
         o = offset_origin(s, h.p, h.ng, wi);
         d = wi;
 
-        /* Russian roulette after a few bounces, by throughput. */
-        if (depth >= 3) {
-            float q = fminf(0.95f, max_comp3(beta));
-            if (rng_float(rng) >= q) break;
-            beta = scale3(beta, 1.0f / q);
-        }
+        if (depth >= RR_FIRST_VERTEX && !russian_roulette(&beta, rng_float(rng))) break;
     }
 }
 

@@ -66,6 +66,19 @@ static inline float mis_power(float pdf_a, float pdf_b) {
     return 1.0f / (1.0f + r * r);
 }
 
+/* Russian roulette, the one rule every path follows: a path whose weight w (its throughput, or a
+ * light path's gain) has fallen goes on with probability q = min(0.95, max component of w), its
+ * weight divided by q, so its expectation is unchanged. u is uniform in [0,1); returns 0 when
+ * the path stops. Camera paths play it when they leave vertex RR_FIRST_VERTEX or a later one (the
+ * camera hit is vertex 0). */
+#define RR_FIRST_VERTEX 3
+static inline int russian_roulette(vec3 *w, float u) {
+    float q = fminf(0.95f, max_comp3(*w));
+    if (!(u < q)) return 0;
+    *w = scale3(*w, 1.0f / q);
+    return 1;
+}
+
 /* Piecewise-constant 1D distribution over [0,1) with n bins. Owns its arrays (init/deinit). */
 typedef struct {
     int n;

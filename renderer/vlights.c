@@ -65,12 +65,9 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
             vec3 wi = to_world(vl.frame, bs.wi);
             if (dot3(wi, h.ng) <= 0.0f) break;
             vec3 gain = scale3(bs.f, bs.wi.z / bs.pdf);
-            /* Russian roulette by the bounce's gain, after a couple of bounces. */
-            if (depth >= 2) {
-                float q = fminf(0.95f, max_comp3(gain));
-                if (!(rng_float(&rng) < q)) break;
-                gain = scale3(gain, 1.0f / q);
-            }
+            /* By the bounce's gain (the path's weight is the light's power), after a couple of
+             * bounces. */
+            if (depth >= 2 && !russian_roulette(&gain, rng_float(&rng))) break;
             beta = mul3(beta, gain);
             if (is_black3(beta) || !is_finite3(beta)) break;
             o = offset_origin(s, h.p, h.ng, wi);

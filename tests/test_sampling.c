@@ -338,6 +338,30 @@ static void test_dist2d(void) {
     dist2d_deinit(&d);
 }
 
+/* Russian roulette keeps a weight's expectation: over u on a fine grid, the survivors' weights
+ * average to the weight, and the share that survives is min(0.95, largest component). */
+static void test_russian_roulette(void) {
+    const vec3 ws[3] = {v3(0.3f, 0.2f, 0.1f), v3(0.01f, 0.0f, 0.004f), v3(2.0f, 0.5f, 0.0f)};
+    for (int k = 0; k < 3; k++) {
+        const int n = 100000;
+        double sum[3] = {0, 0, 0};
+        int survived = 0;
+        for (int i = 0; i < n; i++) {
+            vec3 w = ws[k];
+            if (!russian_roulette(&w, ((float)i + 0.5f) / (float)n)) continue;
+            survived++;
+            sum[0] += w.x, sum[1] += w.y, sum[2] += w.z;
+        }
+        CHECK(fabs(sum[0] / n - ws[k].x) < 1e-3 * ws[k].x + 1e-7 && fabs(sum[1] / n - ws[k].y) < 1e-3 * ws[k].y + 1e-7 &&
+                  fabs(sum[2] / n - ws[k].z) < 1e-3 * ws[k].z + 1e-7,
+              "roulette: weight %d's mean (%g %g %g) against (%g %g %g)", k, sum[0] / n, sum[1] / n, sum[2] / n,
+              (double)ws[k].x, (double)ws[k].y, (double)ws[k].z);
+        double q = fmin(0.95, max_comp3(ws[k]));
+        CHECK(fabs((double)survived / n - q) < 2.0 / n, "roulette: weight %d survives %d of %d, expected %g", k, survived,
+              n, q);
+    }
+}
+
 static void test_mis(void) {
     float pdfs[] = {0.0f, 1e-30f, 0.5f, 1.0f, 3.0f, 1e20f, 3e38f};
     int bad = 0;
@@ -357,6 +381,7 @@ static void test_mis(void) {
 int main(void) {
     significance = chi2_significance(0.01, NUM_CHI2_TESTS);
     test_chi2_machinery();
+    test_russian_roulette();
     test_directions();
     test_sharp();
     test_cone_one_minus_cos();
