@@ -2,6 +2,7 @@
  * material evaluation at hits. */
 #include "scene.h"
 
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,14 +42,19 @@ void scene_warn(scene *s, const char *fmt, ...) {
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    /* Embree reports its errors from whichever thread hit them. */
+    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+    pthread_mutex_lock(&lock);
     /* Keep the first few for display, and do not repeat the same warning. */
     int kept = s->num_warnings < 8 ? s->num_warnings : 8;
     for (int i = 0; i < kept; i++)
-        if (strncmp(s->warnings[i], msg, sizeof s->warnings[i] - 1) == 0) return;
+        if (strncmp(s->warnings[i], msg, sizeof s->warnings[i] - 1) == 0) goto done;
     if (s->num_warnings < 8) snprintf(s->warnings[s->num_warnings], sizeof s->warnings[0], "%.255s", msg);
     s->num_warnings++;
     scene_box *box = (scene_box *)s;
     if (box->warn.fn) box->warn.fn(box->warn.user, msg);
+done:
+    pthread_mutex_unlock(&lock);
 }
 
 void scene_destroy(scene *s) {
@@ -334,9 +340,9 @@ oom:
 
 /* ---- finalize ------------------------------------------------------------------------------ */
 
+/* Embree's own errors go where the scene's warnings go: the library does not print. */
 static void embree_error(void *user, enum RTCError code, const char *str) {
-    (void)user;
-    fprintf(stderr, "glint: error: embree: %s (code %d)\n", str ? str : "unknown error", (int)code);
+    scene_warn(user, "embree: %s (code %d)", str ? str : "unknown error", (int)code);
 }
 
 /* The scene's size from its triangles: bounds, diagonal, and the ray offset that scales with it.
@@ -374,7 +380,7 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
 
     s->device = rtcNewDevice(NULL);
     if (!s->device) return snprintf(err, errlen, "%s: cannot create an Embree device", s->path), -1;
-    rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
+    rtcSetDeviceErrorFunction(s->device, embree_error, s);
     s->rtc = rtcNewScene(s->device);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry geom = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
