@@ -30,13 +30,24 @@ static int write_text(FILE *f, char **buf, size_t *size, const char *dir, const 
     return status;
 }
 
+/* A CSV written in memory first (write_text replaces the file in one step), its header line
+ * written. NULL: out of memory (said). */
+static FILE *open_csv(const char *dir, char **buf, size_t *size, const char *header) {
+    *buf = NULL;
+    *size = 0;
+    FILE *f = open_memstream(buf, size);
+    if (!f) return cli_error("%s: out of memory", dir), NULL;
+    fputs(header, f);
+    return f;
+}
+
 int bench_write_csv(const char *dir, const bench_run *runs, int num_runs, int num_times, write_mode mode) {
-    char *buf = NULL;
-    size_t size = 0;
-    FILE *f = open_memstream(&buf, &size);
-    if (!f) return cli_error("%s: out of memory", dir), -1;
-    fputs("method,params,seed,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,direct_relmse,indirect_rel_l2,"
-          "indirect_relmse,highlights_rel_l2,highlights_relmse\n", f);
+    char *buf;
+    size_t size;
+    FILE *f = open_csv(dir, &buf, &size,
+                       "method,params,seed,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,direct_relmse,"
+                       "indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse\n");
+    if (!f) return -1;
     for (int r = 0; r < num_runs; r++)
         for (int i = 0; i < runs[r].seeds_done; i++)
             for (int k = 0; k < num_times; k++) {
@@ -58,12 +69,12 @@ int bench_write_csv(const char *dir, const bench_run *runs, int num_runs, int nu
 
 int bench_write_summary(const bench_options *o, const char *dir, const bench_ref *ref, const bench_run *runs,
                         int num_runs, write_mode mode) {
-    char *buf = NULL;
-    size_t size = 0;
-    FILE *f = open_memstream(&buf, &size);
-    if (!f) return cli_error("%s: out of memory", dir), -1;
-    fputs("method,params,component,budget,seeds,seconds,frames,rel_l2,relmse,noise,bias,ref_noise,rel_l2_min,"
-          "rel_l2_max\n", f);
+    char *buf;
+    size_t size;
+    FILE *f = open_csv(dir, &buf, &size,
+                       "method,params,component,budget,seeds,seconds,frames,rel_l2,relmse,noise,bias,ref_noise,"
+                       "rel_l2_min,rel_l2_max\n");
+    if (!f) return -1;
     for (int r = 0; r < num_runs; r++)
         for (int k = 0; k < runs[r].num_points; k++) {
             const bench_run *u = &runs[r];

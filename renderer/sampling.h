@@ -40,7 +40,6 @@ vec2 sample_uniform_triangle(vec2 u);
 /* Concentric map of the unit square onto the unit disk (Shirley-Chiu). */
 vec2 sample_concentric_disk(vec2 u);
 
-/* Multiple importance sampling weights for strategy a against b (n samples each). */
 /* Point k of the R2 sequence (Roberts 2018: additive recurrence on the plastic number) shifted by
  * u mod 1: N of them cover [0,1)^2 evenly for any N, and the shift keeps each unbiased. */
 static inline vec2 sample_r2(int k, vec2 u) {
@@ -52,6 +51,7 @@ static inline vec2 sample_r2(int k, vec2 u) {
     return r;
 }
 
+/* Multiple importance sampling weights for strategy a against b (one sample each). */
 static inline float mis_balance(float pdf_a, float pdf_b) {
     /* As a ratio: the sum of two pdfs near FLT_MAX would overflow. */
     if (pdf_a <= 0.0f) return 0.0f;
