@@ -150,6 +150,12 @@ static void handle_load(render_thread *rt, int kind, const char *path, const cam
             set_message(rt, "%s%s", err, "");
             return;
         }
+        /* The plan depends on the map (its prefiltering, its light) */
+        if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0) {
+            cli_error("%s", session_error(rt->full));
+            set_message(rt, "%s%s", session_error(rt->full), "");
+            return;
+        }
         session_set_camera(rt->full, cam);
         session_set_camera(rt->preview, cam);
         set_message(rt, "environment %s%s", path, "");

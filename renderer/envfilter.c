@@ -8,7 +8,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "lights.h"
 #include "threadpool.h"
 
 #define PI_D 3.14159265358979323846

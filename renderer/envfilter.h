@@ -13,7 +13,7 @@
 
 #include <stddef.h>
 
-#include "scene.h" /* env_map, vec3 */
+#include "envmap.h"
 #include "vmf.h"
 
 typedef struct env_vmf_filter env_vmf_filter;

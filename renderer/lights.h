@@ -57,14 +57,4 @@ float light_pdf_env(const scene *s, vec3 d);
  * selection distribution. Returns 0 or -1 with err set. */
 int scene_build_lights(scene *s, char *err, size_t errlen);
 
-/* Environment maps. */
-env_map *env_map_create(image_rgb *image, float rotation, char *err, size_t errlen); /* takes the image */
-void env_map_destroy(env_map *env);
-/* The map prefiltered for vMF lobes (envfilter.h), built on the first call (thread-safe) and kept
- * with the map. NULL with err set when it cannot be built. */
-struct env_vmf_filter;
-const struct env_vmf_filter *env_map_vmf_filter(const env_map *env, char *err, size_t errlen);
-vec3 env_direction(const env_map *env, vec2 uv);
-vec2 env_uv(const env_map *env, vec3 d);
-
 #endif

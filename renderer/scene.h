@@ -7,13 +7,13 @@
 #ifndef GLINT_SCENE_H
 #define GLINT_SCENE_H
 
-#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include <embree3/rtcore.h>
 
 #include "bsdf.h"
+#include "envmap.h"
 #include "gmath.h"
 #include "image_io.h"
 #include "sampling.h"
@@ -104,18 +104,6 @@ typedef struct {
     float yfov;              /* radians */
 } camera;
 
-/* Environment map: equirectangular, linear RGB. Direction convention (Blender's): image centre
- * u = 0.5 is +X, u = 0.75 is +Z, the top row is +Y. */
-typedef struct {
-    image_rgb image;
-    dist2d dist;        /* over (u, v), luminance * sin(theta), dilated for bilinear lookups */
-    float rotation;     /* radians about +Y */
-    float mean_luminance;
-    /* The map prefiltered for vMF lobes (the highlight estimator), built on first use: a scene
-     * that never asks for it never pays for it. env_map_vmf_filter() guards it. */
-    pthread_mutex_t filter_lock;
-    struct env_vmf_filter *filter;
-} env_map;
 
 /* ---- the scene ----------------------------------------------------------------------------- */
 

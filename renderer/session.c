@@ -7,6 +7,7 @@
 
 #include "camera.h"
 #include "clock.h"
+#include "envfilter.h"
 #include "highlights.h"
 #include "lights.h"
 #include "manylight.h"
@@ -55,6 +56,8 @@ struct render_session {
     int tiles_x, tiles_y;
     manylight ml; /* vpl, vsl, vsl+hl: this frame's virtual lights */
     hl_setup hl;  /* vsl+hl: this frame's highlight settings */
+    env_vmf_filter *envf; /* vsl+hl under a map: the map prefiltered, built on first use */
+    const env_map *envf_map; /* ... the map it was built from */
     scene_analysis analysis;
     effect_plan plan;
     const atomic_int *abort_flag; /* polled per tile; NULL: none */
@@ -99,6 +102,7 @@ void session_destroy(render_session *rs) {
     if (!rs) return;
     threadpool_destroy(rs->pool);
     manylight_deinit(&rs->ml);
+    env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
     film_deinit(&rs->film);
@@ -201,9 +205,13 @@ static void render_tile(void *ctx, int tile, int worker) {
 
 int session_render_frame(render_session *rs) {
     if (rs->plan.highlights) {
-        const struct env_vmf_filter *envf = NULL;
-        if (rs->plan.env_prefilter && !(envf = env_map_vmf_filter(rs->scene->env, rs->error, sizeof rs->error))) return -1;
-        rs->hl = hl_setup_from(rs->scene, &rs->params.vl, envf);
+        if (rs->plan.env_prefilter && (!rs->envf || rs->envf_map != rs->scene->env)) {
+            env_vmf_filter_destroy(rs->envf);
+            rs->envf_map = rs->scene->env;
+            if (!(rs->envf = env_vmf_filter_create(rs->scene->env, rs->error, sizeof rs->error))) return -1;
+        }
+        rs->totals.env_filter_bytes = rs->plan.env_prefilter ? env_vmf_filter_bytes(rs->envf) : 0;
+        rs->hl = hl_setup_from(rs->scene, &rs->params.vl, rs->plan.env_prefilter ? rs->envf : NULL);
     }
     if (rs->plan.virtual_lights) {
         uint64_t t0 = clock_ns();
@@ -253,6 +261,10 @@ int session_scene_changed(render_session *rs) {
     if (scene_analyse(rs->scene, &a, rs->error, sizeof rs->error) != 0) return -1;
     scene_analysis_free(&rs->analysis);
     rs->analysis = a;
+    if (rs->envf_map != rs->scene->env) { /* another map (a light edit keeps the filter) */
+        env_vmf_filter_destroy(rs->envf);
+        rs->envf = NULL;
+    }
     rs->plan = plan_make(&rs->analysis, rs->params.method, rs->params.max_depth, rs->params.plan);
     session_reset(rs);
     return 0;

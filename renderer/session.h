@@ -124,6 +124,7 @@ typedef struct {
     uint64_t hl_secondary_rays;/* rays sampled from their glossy lobes */
     uint64_t hl_lobes;         /* lobes lit (merged, or one per secondary hit without merging) */
     uint64_t hl_merge_ns;      /* thread time spent clustering and merging (the paper's Table 1, C) */
+    uint64_t env_filter_bytes; /* memory of the prefiltered environment map (vsl+hl under a map; 0: none) */
     uint64_t pass_ns[PASS_COUNT];
 } render_stats;
 
@@ -147,7 +148,8 @@ const char *session_error(const render_session *rs);
 /* Clears the accumulation (the next frame starts a new mean) and the statistics with it. */
 void session_reset(render_session *rs);
 void session_set_camera(render_session *rs, const camera *cam);
-/* The scene changed (a light moved or dimmed): analyses it again, re-makes the plan and resets.
+/* The scene changed (a light moved or dimmed, another environment map): analyses it again,
+ * re-makes the plan, drops what was derived from the old map and resets.
  * Returns 0, or -1 with session_error() set (out of memory; the old analysis stays). */
 int session_scene_changed(render_session *rs);
 /* Takes new estimator parameters (method, max_depth, seed; the size and thread count stay) and

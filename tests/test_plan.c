@@ -224,15 +224,24 @@ static void test_environment_only(void) {
     CHECK(scene_set_env_image(s, &img, 0.0f, err, sizeof err) == 0, "env: %s", err);
     ts_finalize(s);
     cam = camera_look_at(v3(0, 0.6f, 2.2f), v3(0, 0.05f, 0), v3(0, 1, 0), 0.9f);
-    CHECK(s->env->filter == NULL, "nothing prefiltered before a highlight pass needs it");
     run_result vsl = run(s, &cam, params(METHOD_VSL, PLAN_AUTO), 2, ALL);
-    CHECK(s->env->filter == NULL && !vsl.plan.env_prefilter, "vsl must not prefilter the environment");
+    CHECK(vsl.stats.env_filter_bytes == 0 && !vsl.plan.env_prefilter, "vsl must not prefilter the environment");
     CHECK(vsl.stats.light_paths > 0 && vsl.plan.virtual_lights, "virtual lights from the sky alone");
     run_result hl = run(s, &cam, params(METHOD_VSL_HL, PLAN_AUTO), 2, ALL);
-    const struct env_vmf_filter *first = s->env->filter;
-    CHECK(hl.plan.env_prefilter && first != NULL, "vsl+hl under a sky must prefilter it");
-    run(s, &cam, params(METHOD_VSL_HL, PLAN_AUTO), 1, ALL);
-    CHECK(s->env->filter == first, "a second session must reuse the prefiltered map");
+    CHECK(hl.plan.env_prefilter && hl.stats.env_filter_bytes > 0, "vsl+hl under a sky must prefilter it");
+    /* The session's filter follows the scene's map: made again from another map (a larger one
+     * here, so a larger filter). */
+    render_params hp = params(METHOD_VSL_HL, PLAN_AUTO);
+    render_session *rs = session_create(s, &cam, &hp, err, sizeof err);
+    CHECK(rs && session_render_frame(rs) == 0, "session: %s", rs ? session_error(rs) : err);
+    uint64_t before = session_stats(rs).env_filter_bytes;
+    img = (image_rgb){4 * EW, 4 * EH, malloc(sizeof(float) * 3 * 16 * EW * EH)};
+    for (int i = 0; i < 3 * 16 * EW * EH; i++) img.rgb[i] = 0.5f;
+    CHECK(scene_set_env_image(s, &img, 0.0f, err, sizeof err) == 0, "env: %s", err);
+    CHECK(session_scene_changed(rs) == 0 && session_render_frame(rs) == 0, "frame: %s", session_error(rs));
+    CHECK(session_stats(rs).env_filter_bytes > before, "another map must be prefiltered again: %llu bytes, before %llu",
+          (unsigned long long)session_stats(rs).env_filter_bytes, (unsigned long long)before);
+    session_destroy(rs);
     scene_destroy(s);
 }
 

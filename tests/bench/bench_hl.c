@@ -20,6 +20,7 @@
 
 #include "camera.h"
 #include "clock.h"
+#include "envfilter.h"
 #include "highlights.h"
 #include "image_io.h"
 #include "lights.h"
@@ -131,6 +132,8 @@ int main(int argc, char **argv) {
     size_t n = (size_t)proto.w * (size_t)proto.h * 3;
     float *ref = malloc(sizeof(float) * n), *img = malloc(sizeof(float) * n);
     if (!ref || !img) die("out of memory");
+    env_vmf_filter *envf = s->env ? env_vmf_filter_create(s->env, err, sizeof err) : NULL;
+    if (s->env && !envf) die(err);
 
     exr_image ex;
     double share;
@@ -146,7 +149,7 @@ int main(int argc, char **argv) {
     } else {
         fprintf(stderr, "bench_hl: rendering the reference for %.0f s\n", ref_seconds);
         vl_params vp = {.merge = HL_MERGE_TRACE, .secondary_rays = 64};
-        proto.hl = hl_setup_from(s, &vp, s->env ? env_map_vmf_filter(s->env, err, sizeof err) : NULL);
+        proto.hl = hl_setup_from(s, &vp, envf);
         long long frames = render_for(&proto, pool, ref_seconds, ref, &share);
         fprintf(stderr, "bench_hl: reference %lld frames\n", frames);
         exr_layer layer = {"highlights", ref};
@@ -170,7 +173,7 @@ int main(int argc, char **argv) {
         printf("| %s |", rows[r].label);
         for (int k = 0; k < 3; k++) {
             vl_params vp = {.merge = rows[r].merge, .clusters = rows[r].clusters, .secondary_rays = rays[k]};
-            proto.hl = hl_setup_from(s, &vp, s->env ? env_map_vmf_filter(s->env, err, sizeof err) : NULL);
+            proto.hl = hl_setup_from(s, &vp, envf);
             long long frames = render_for(&proto, pool, seconds, img, &shares[r][k]);
             printf(" %.4f (%lld) |", metric_rel_l2(img, ref, n), frames);
             fflush(stdout);
@@ -193,7 +196,7 @@ int main(int argc, char **argv) {
     for (int i = 0; i < 3; i++) {
         int r = split_rows[i];
         vl_params vp = {.merge = rows[r].merge, .clusters = rows[r].clusters, .secondary_rays = 8};
-        proto.hl = hl_setup_from(s, &vp, s->env ? env_map_vmf_filter(s->env, err, sizeof err) : NULL);
+        proto.hl = hl_setup_from(s, &vp, envf);
         proto.seed = 1;
         long long fa = render_for(&proto, pool, 0.5 * seconds, img, &share);
         proto.seed = 2;
@@ -232,6 +235,7 @@ int main(int argc, char **argv) {
     free(ref);
     free(img);
     threadpool_destroy(pool);
+    env_vmf_filter_destroy(envf);
     scene_destroy(s);
     return 0;
 }
