@@ -214,7 +214,7 @@ int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err,
     if (!ok) {
         char off[64] = "";
         if (d->off_word) snprintf(off, sizeof off, " or %s", d->off_word);
-        return snprintf(err, errlen, "expected %s in [%g, %g%s%s, got '%s'", d->type == PARAM_INT ? "an integer" : "a number",
+        return snprintf(err, errlen, "expected %s in [%.15g, %.15g%s%s, got '%s'", d->type == PARAM_INT ? "an integer" : "a number",
                         d->lo, d->hi, d->below_hi ? ")" : "]", off, text), -1;
     }
     param_put(d, vl, d->zero_is_off && v == 0.0 ? -1.0 : v);
@@ -267,7 +267,7 @@ const char *params_help(void) {
             param_format(d, &v, def, sizeof def);
         }
         /* Options in a column of 23, the help beside them; its later lines under its first. */
-        len += (size_t)snprintf(text + len, sizeof text - len, "%s%*s", option, olen < 22 ? 23 - olen : 1, "");
+        len += (size_t)snprintf(text + len, sizeof text - len, "%s%*s", option, olen < 22 ? 23 - olen : olen == 22 ? 1 : 2, "");
         for (const char *h = d->help; *h && len < sizeof text;) {
             const char *nl = strchr(h, '\n');
             int n = nl ? (int)(nl - h) : (int)strlen(h);
