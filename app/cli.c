@@ -138,132 +138,24 @@ int cli_check_output_dir(const char *option, const char *path) {
     return 0;
 }
 
-/* ---- many-light parameters ------------------------------------------------------------------- */
+/* ---- many-light parameters: the table in params.c ------------------------------------------- */
 
-const char *cli_vl_help(void) {
-    static char text[4096];
-    snprintf(text, sizeof text,
-             "many-light methods (vpl, vsl):\n"
-             "  --vsl-count N        virtual lights traced per frame [%d]\n"
-             "  --clamp on|off       clamp each light's contribution [on for vpl, off for vsl]\n"
-             "  --clamp-value C      the clamp bound, in radiance [%g]\n"
-             "  --clamp-growth A|off the bound grows as C * frame^A, so clamped VPLs converge [%g]\n"
-             "  --vpl-glossy         VPLs reflect with their full BSDF, not only its diffuse part\n"
-             "  --radius-mult M      VSL radius: M x distance to the 10th nearest light [%g]\n"
-             "  --radius-shrink A|off  0 < A < 1: M shrinks over frames (progressive photon mapping's\n"
-             "                       schedule), so VSLs converge to the path-traced answer [%g]\n"
-             "  --rows R             matrix row-column sampling: sampled rows (pixels) [%d]\n"
-             "  --columns C          ... and clusters; 0 = no clustering [0]\n"
-             "  --per-pixel N|all    lights (cluster representatives) each pixel shades per frame,\n"
-             "                       picked by power (cluster norm) [%d; all with --columns]\n"
-             "  --light-select power|tree  where a pixel's light draws come from: by power, or\n"
-             "                       through a light tree by an estimate of what each sends there [power]\n"
-             "  --candidates M       draws per pixel, from which its lights are resampled by that\n"
-             "                       estimate; 1 = the draws are shaded as they come [%d]\n"
-             "  --trace-glossy A|off receivers' glossy lobes with roughness alpha below A are not\n"
-             "                       gathered from the lights: the path goes on through them [%g]\n"
-             "  --glossy-rays N      directions traced through such a lobe at the camera hit, 1..%d [%d]\n"
-             "indirect highlights (vsl+hl):\n"
-             "  --secondary-rays N   rays sampled from a camera hit's glossy lobe, 1..%d [%d]\n"
-             "  --clusters K         merged vMF lobes per camera hit, 1..%d [%d]\n"
-             "  --merge on|off|trace off: every secondary hit's own vMF lobe is lit by itself (the\n"
-             "                       paper's comparison); trace: no vMFs, each hit's true glossy lobe\n"
-             "                       (the path tracer's answer for the same paths) [on]\n",
-             VL_DEFAULT_COUNT, (double)VL_DEFAULT_CLAMP, (double)VL_DEFAULT_CLAMP_GROWTH, (double)VL_DEFAULT_RADIUS_MULT,
-             (double)VL_DEFAULT_RADIUS_SHRINK, VL_DEFAULT_ROWS,
-             VL_DEFAULT_PER_PIXEL, VL_DEFAULT_CANDIDATES, (double)VL_DEFAULT_TRACE_GLOSSY, VL_MAX_GLOSSY_RAYS, VL_DEFAULT_GLOSSY_RAYS,
-             HL_MAX_SECONDARY_RAYS, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_CLUSTERS, HL_DEFAULT_CLUSTERS);
-    return text;
-}
-
-static int on_off(const char *option, const char *value, int *out) {
-    if (strcmp(value, "on") == 0) *out = 1;
-    else if (strcmp(value, "off") == 0) *out = 0;
-    else return cli_error("%s: expected on or off, got '%s'", option, value), -1;
-    return 0;
-}
+const char *cli_vl_help(void) { return params_help(); }
 
 int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
-    char option[64];
-    snprintf(option, sizeof option, "--%s", name);
-    long long n;
-    double x;
-    int b;
-    if (strcmp(name, "vsl-count") == 0) {
-        if (cli_parse_int(option, value, 1, 50000000, &n)) return -1;
-        vl->count = (int)n;
-    } else if (strcmp(name, "clamp") == 0) {
-        if (on_off(option, value, &b)) return -1;
-        vl->clamp = b ? VL_CLAMP_ON : VL_CLAMP_OFF;
-    } else if (strcmp(name, "clamp-value") == 0) {
-        if (cli_parse_float(option, value, 1e-12, 1e30, &x)) return -1;
-        vl->clamp_value = (float)x;
-    } else if (strcmp(name, "clamp-growth") == 0) {
-        if (strcmp(value, "off") == 0) x = 0.0;
-        else if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
-        vl->clamp_growth = x > 0.0 ? (float)x : -1.0f; /* 0 is off too, not the default */
-    } else if (strcmp(name, "vpl-glossy") == 0) {
-        if (on_off(option, value, &b)) return -1;
-        vl->vpl_glossy = b;
-    } else if (strcmp(name, "radius-mult") == 0) {
-        if (cli_parse_float(option, value, 1e-6, 1e6, &x)) return -1;
-        vl->radius_mult = (float)x;
-    } else if (strcmp(name, "radius-shrink") == 0) {
-        if (strcmp(value, "off") == 0) x = 0.0;
-        else if (cli_parse_float(option, value, 0.0, 1.0, &x)) return -1;
-        if (x >= 1.0) return cli_error("%s: must be below 1 (0 or off turns it off), got '%s'", option, value), -1;
-        vl->radius_shrink = x > 0.0 ? (float)x : -1.0f;
-    } else if (strcmp(name, "rows") == 0) {
-        if (cli_parse_int(option, value, 1, 100000, &n)) return -1;
-        vl->rows = (int)n;
-    } else if (strcmp(name, "columns") == 0) {
-        if (cli_parse_int(option, value, 0, 10000000, &n)) return -1;
-        vl->columns = (int)n;
-    } else if (strcmp(name, "per-pixel") == 0) {
-        if (strcmp(value, "all") == 0) vl->per_pixel = -1;
-        else if (cli_parse_int(option, value, 1, 1000000, &n)) return -1;
-        else vl->per_pixel = (int)n;
-    } else if (strcmp(name, "light-select") == 0) {
-        if (strcmp(value, "tree") == 0) vl->select = VL_SELECT_TREE;
-        else if (strcmp(value, "power") == 0) vl->select = VL_SELECT_POWER;
-        else return cli_error("%s: expected tree or power, got '%s'", option, value), -1;
-    } else if (strcmp(name, "candidates") == 0) {
-        if (cli_parse_int(option, value, 1, VL_MAX_CANDIDATES, &n)) return -1;
-        vl->candidates = (int)n;
-    } else if (strcmp(name, "trace-glossy") == 0) {
-        if (strcmp(value, "off") == 0) vl->trace_glossy = -1.0f;
-        else if (cli_parse_float(option, value, 0.0, 10.0, &x)) return -1;
-        else vl->trace_glossy = x > 0.0 ? (float)x : -1.0f; /* 0 is off too, not the default */
-    } else if (strcmp(name, "glossy-rays") == 0) {
-        if (cli_parse_int(option, value, 1, VL_MAX_GLOSSY_RAYS, &n)) return -1;
-        vl->glossy_rays = (int)n;
-    } else if (strcmp(name, "secondary-rays") == 0) {
-        if (cli_parse_int(option, value, 1, HL_MAX_SECONDARY_RAYS, &n)) return -1;
-        vl->secondary_rays = (int)n;
-    } else if (strcmp(name, "clusters") == 0) {
-        if (cli_parse_int(option, value, 1, HL_MAX_CLUSTERS, &n)) return -1;
-        vl->clusters = (int)n;
-    } else if (strcmp(name, "merge") == 0) {
-        if (strcmp(value, "trace") == 0) vl->merge = HL_MERGE_TRACE;
-        else if (on_off(option, value, &b)) return -1;
-        else vl->merge = b ? HL_MERGE_ON : HL_MERGE_OFF;
-    } else {
-        return 0;
-    }
-    return 1;
+    char err[256];
+    int r = params_set(vl, name, value, err, sizeof err);
+    if (r < 0) cli_error("--%s: %s", name, err);
+    return r;
 }
 
 int cli_vl_option(int argc, char **argv, int *i, vl_params *vl) {
     const char *a = argv[*i];
     if (strncmp(a, "--", 2) != 0) return 0;
-    if (strcmp(a, "--vpl-glossy") == 0) return cli_set_vl_param("vpl-glossy", "on", vl);
-    static const char *const names[] = {"vsl-count", "clamp", "clamp-value", "clamp-growth", "radius-mult",
-                                         "radius-shrink", "rows", "columns", "per-pixel", "light-select", "candidates",
-                                         "trace-glossy", "glossy-rays", "secondary-rays", "clusters", "merge"};
-    int ours = 0;
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) ours |= strcmp(a + 2, names[k]) == 0;
-    if (!ours) return 0;
+    const param_desc *d = param_find(a + 2);
+    if (!d) return 0;
+    if (d->flag) return cli_set_vl_param(d->name, "on", vl);
     const char *v = cli_value(argc, argv, i);
     if (!v) return -1;
-    return cli_set_vl_param(a + 2, v, vl);
+    return cli_set_vl_param(d->name, v, vl);
 }

@@ -34,12 +34,11 @@ void cli_print_scenes(void);
 /* Fetches the value of option argv[*i] (advancing *i); prints a usage error when missing. */
 const char *cli_value(int argc, char **argv, int *i);
 
-/* The many-light parameters, shared by glint render, the viewer's options and its script's `set`.
- * cli_set_vl_param takes a name without the leading "--" (vsl-count, clamp, clamp-value,
- * clamp-growth, vpl-glossy, radius-mult, radius-shrink, rows, columns, per-pixel, candidates,
- * trace-glossy) and
- * a value (vpl-glossy: on/off). Returns 1 when applied, 0 when name is not one of them, -1 on a
- * bad value (reported). cli_vl_option does the same for argv[*i] and its value, advancing *i. */
+/* The many-light parameters (params_table), shared by glint render, bench, the viewer's options
+ * and its script's `set`. cli_set_vl_param takes a name without the leading "--" and a value
+ * (a flag such as vpl-glossy: on/off). Returns 1 when applied, 0 when name is not one of them, -1
+ * on a bad value (reported). cli_vl_option does the same for argv[*i] and its value (none for a
+ * flag), advancing *i. */
 int cli_set_vl_param(const char *name, const char *value, vl_params *vl);
 int cli_vl_option(int argc, char **argv, int *i, vl_params *vl);
 /* Their help text, one option per line. */

@@ -207,15 +207,15 @@ static int write_stats(const char *path, const render_options *o, const render_s
     fprintf(f, "  \"rays_per_second\": %.1f,\n", seconds > 0 ? (double)total / seconds : 0.0);
     fprintf(f, "  \"rejected_samples\": %llu", (unsigned long long)st.rejected_samples);
     if (p->method != METHOD_PT) {
-        const vl_params *vp = &p->vl;
+        const vl_params vp = vl_params_resolve(&p->vl); /* the values the frames used */
         fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"virtual_lights_total\": %llu,\n",
-                vp->count > 0 ? vp->count : VL_DEFAULT_COUNT, (unsigned long long)st.virtual_lights);
+                vp.count, (unsigned long long)st.virtual_lights);
         fprintf(f, "  \"light_paths_total\": %llu,\n  \"connections\": %llu,\n  \"vsl_samples\": %llu,\n",
                 (unsigned long long)st.light_paths, (unsigned long long)st.vl_connections,
                 (unsigned long long)st.vsl_samples);
         fprintf(f, "  \"glossy_bounces\": %llu,\n", (unsigned long long)st.glossy_bounces);
         fprintf(f, "  \"clamped\": %llu,\n  \"rows\": %d,\n  \"columns\": %d", (unsigned long long)st.clamped,
-                vp->columns > 0 ? (vp->rows > 0 ? vp->rows : VL_DEFAULT_ROWS) : 0, vp->columns);
+                vp.columns > 0 ? vp.rows : 0, vp.columns);
     }
     if (p->method == METHOD_VSL_HL) {
         hl_setup hl = hl_setup_from(s, &p->vl, NULL);

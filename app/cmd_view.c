@@ -177,14 +177,14 @@ int cmd_view(int argc, char **argv) {
     u.win = win;
     fill_scene_info(&u.info, s);
     sh.info = u.info;
-    u.ctl = (ui_controls){.method = o.params.method,
-                          .max_depth = o.params.max_depth,
+    /* The panel shows the values in use, so it edits the parameters with their defaults resolved. */
+    u.ctl = (ui_controls){.params = o.params,
                           .camera = o.camera,
                           .exposure = (float)o.exposure,
                           .tonemap = o.tonemap,
                           .show = UI_SHOW_ALL,
                           .show_panel = 1};
-    controls_from_vl(&u.ctl, &o.params.vl);
+    u.ctl.params.vl = vl_params_resolve(&o.params.vl);
     u.applied_ctl = u.ctl;
     reset_lights(&u);
     bookmarks_load(&u);

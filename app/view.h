@@ -218,8 +218,6 @@ int bookmark_restore(ui_thread *u, int slot);
 void describe_bookmarks(ui_thread *u);
 
 /* view_input.c: controls, lights, keys and mouse; the requests they make of the render thread */
-vl_params vl_from_controls(const ui_controls *c, vl_params vl);
-void controls_from_vl(ui_controls *c, const vl_params *vl);
 void send_change(ui_thread *u);
 void apply_controls(ui_thread *u, int camera_changed);
 long long frames_of_current_state(const ui_thread *u);

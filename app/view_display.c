@@ -59,12 +59,12 @@ int load_reference(ui_thread *u, const char *path) {
 
 /* The plot's name for the current method and settings. */
 static void curve_label(const ui_thread *u, char *out, size_t n) {
-    const ui_controls *c = &u->ctl;
-    int len = snprintf(out, n, "%s, depth %d", method_name((render_method)c->method), c->max_depth);
+    const render_params *c = &u->ctl.params;
+    int len = snprintf(out, n, "%s, depth %d", method_name(c->method), c->max_depth);
     if (c->method != METHOD_PT && len < (int)n)
-        len += snprintf(out + len, n - (size_t)len, ", %d lights, radius x%g", c->vl_count, (double)c->radius_mult);
+        len += snprintf(out + len, n - (size_t)len, ", %d lights, radius x%g", c->vl.count, (double)c->vl.radius_mult);
     if (c->method == METHOD_VSL_HL && len < (int)n)
-        snprintf(out + len, n - (size_t)len, ", N %d, K %d", c->secondary_rays, c->clusters);
+        snprintf(out + len, n - (size_t)len, ", N %d, K %d", c->vl.secondary_rays, c->vl.clusters);
 }
 
 /* A new error measurement. A new accumulation starts its curve afresh, replacing an earlier one of
@@ -266,11 +266,9 @@ void draw_image_and_panel(ui_thread *u) {
                    .frame_ms = u->stats.frame_ms,
                    .rays_per_second = u->stats.rays_per_second,
                    .rejected_samples = u->stats.rejected,
-                   .many_light = u->ctl.method != METHOD_PT,
+                   .many_light = u->ctl.params.method != METHOD_PT,
                    .virtual_lights = u->stats.virtual_lights,
-                   .highlights = u->ctl.method == METHOD_VSL_HL,
-                   .max_secondary_rays = HL_MAX_SECONDARY_RAYS,
-                   .max_clusters = HL_MAX_CLUSTERS,
+                   .highlights = u->ctl.params.method == METHOD_VSL_HL,
                    .hl_points = u->stats.hl_points,
                    .hl_lobes = u->stats.hl_lobes,
                    .hl_merge_share = u->stats.hl_merge_share,

@@ -21,59 +21,15 @@ static unsigned show_mask_of(int show) {
     }
 }
 
-/* The many-light settings the panel edits, onto the parameters (fields it lacks are kept). */
-vl_params vl_from_controls(const ui_controls *c, vl_params vl) {
-    vl.clamp = c->clamp;
-    vl.clamp_value = c->clamp_value;
-    vl.radius_mult = c->radius_mult;
-    vl.radius_shrink = c->radius_shrink > 0.0f ? c->radius_shrink : -1.0f;
-    vl.count = c->vl_count;
-    vl.columns = c->columns;
-    vl.per_pixel = c->per_pixel;
-    vl.select = c->light_select == 1 ? VL_SELECT_TREE : VL_SELECT_POWER;
-    vl.candidates = c->candidates;
-    vl.trace_glossy = c->trace_glossy > 0.0f ? c->trace_glossy : -1.0f;
-    vl.glossy_rays = c->glossy_rays;
-    vl.secondary_rays = c->secondary_rays;
-    vl.clusters = c->clusters;
-    vl.merge = c->merge == 1 ? HL_MERGE_OFF : c->merge == 2 ? HL_MERGE_TRACE : HL_MERGE_ON;
-    return vl;
-}
-
-void controls_from_vl(ui_controls *c, const vl_params *vl) {
-    c->clamp = vl->clamp;
-    c->clamp_value = vl->clamp_value > 0.0f ? vl->clamp_value : VL_DEFAULT_CLAMP;
-    c->radius_mult = vl->radius_mult > 0.0f ? vl->radius_mult : VL_DEFAULT_RADIUS_MULT;
-    c->radius_shrink = vl->radius_shrink > 0.0f ? vl->radius_shrink : vl->radius_shrink < 0.0f ? 0.0f : VL_DEFAULT_RADIUS_SHRINK;
-    c->vl_count = vl->count > 0 ? vl->count : VL_DEFAULT_COUNT;
-    c->columns = vl->columns;
-    c->per_pixel = vl->per_pixel != 0 ? vl->per_pixel : (vl->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL);
-    c->light_select = vl->select == VL_SELECT_TREE;
-    c->candidates = vl->candidates > 0 ? vl->candidates : VL_DEFAULT_CANDIDATES;
-    c->trace_glossy = vl->trace_glossy > 0.0f ? vl->trace_glossy : vl->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
-    c->glossy_rays = vl->glossy_rays > 0 ? vl->glossy_rays : VL_DEFAULT_GLOSSY_RAYS;
-    c->secondary_rays = vl->secondary_rays > 0 ? vl->secondary_rays : HL_DEFAULT_SECONDARY_RAYS;
-    c->clusters = vl->clusters > 0 ? vl->clusters : HL_DEFAULT_CLUSTERS;
-    c->merge = vl->merge == HL_MERGE_OFF ? 1 : vl->merge == HL_MERGE_TRACE ? 2 : 0;
-}
-
-static int vl_controls_differ(const ui_controls *a, const ui_controls *b) {
-    return a->clamp != b->clamp || a->clamp_value != b->clamp_value || a->radius_mult != b->radius_mult ||
-           a->radius_shrink != b->radius_shrink || a->vl_count != b->vl_count || a->columns != b->columns ||
-           a->per_pixel != b->per_pixel || a->light_select != b->light_select || a->candidates != b->candidates ||
-           a->trace_glossy != b->trace_glossy || a->glossy_rays != b->glossy_rays ||
-           a->secondary_rays != b->secondary_rays || a->clusters != b->clusters || a->merge != b->merge;
-}
-
 /* Sends the camera and estimator settings to the render thread; each call is a change that
  * resets the accumulation. */
 void send_change(ui_thread *u) {
     shared_state *sh = u->sh;
     pthread_mutex_lock(&sh->lock);
     sh->cam = ctl_camera(&u->cam);
-    sh->params.max_depth = u->ctl.max_depth;
-    sh->params.method = (render_method)u->ctl.method;
-    sh->params.vl = vl_from_controls(&u->ctl, sh->params.vl);
+    sh->params.max_depth = u->ctl.params.max_depth;
+    sh->params.method = u->ctl.params.method;
+    sh->params.vl = u->ctl.params.vl;
     sh->lights = u->lights;
     sh->lights_scene = u->info_serial;
     u->sent_generation = ++sh->generation;
@@ -90,8 +46,8 @@ long long frames_of_current_state(const ui_thread *u) {
 /* Sends what changed in the controls since the last call: estimator settings reset the
  * accumulation; display settings only change how the image is shown. */
 void apply_controls(ui_thread *u, int camera_changed) {
-    if (u->ctl.method != u->applied_ctl.method || u->ctl.max_depth != u->applied_ctl.max_depth ||
-        vl_controls_differ(&u->ctl, &u->applied_ctl))
+    const render_params *p = &u->ctl.params, *was = &u->applied_ctl.params;
+    if (p->method != was->method || p->max_depth != was->max_depth || memcmp(&p->vl, &was->vl, sizeof p->vl) != 0)
         camera_changed = 1;
     /* Picking another light shows its intensity; changing the intensity changes the light. */
     if (u->ctl.light < 0 || u->ctl.light >= u->info.num_lights) u->ctl.light = -1;

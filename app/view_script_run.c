@@ -32,17 +32,22 @@ static void print_stats(ui_thread *u) {
            u->preview_h, seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
            nb ? marks : "-");
     printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
-           "max_depth=%d method=%s rejected=%llu radius_mult=%g clamp=%d vsl_count=%d columns=%d per_pixel=%d "
-           "light_select=%d candidates=%d trace_glossy=%g glossy_rays=%d virtual_lights=%llu secondary_rays=%d clusters=%d "
-           "merge=%s hl_lobes=%llu "
-           "plan_highlights=%d\n",
+           "max_depth=%d method=%s rejected=%llu virtual_lights=%llu hl_lobes=%llu plan_highlights=%d",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->stats.frames_total,
            (unsigned long long)u->stats.resets, u->front.width, u->front.height, u->front.preview, (double)u->ctl.exposure,
-           u->ctl.show, u->ctl.max_depth,
-           method_name((render_method)u->ctl.method), u->stats.rejected, (double)u->ctl.radius_mult, u->ctl.clamp,
-           u->ctl.vl_count, u->ctl.columns, u->ctl.per_pixel, u->ctl.light_select, u->ctl.candidates,
-           (double)u->ctl.trace_glossy, u->ctl.glossy_rays, u->stats.virtual_lights, u->ctl.secondary_rays, u->ctl.clusters,
-           u->ctl.merge == 1 ? "off" : u->ctl.merge == 2 ? "trace" : "on", u->stats.hl_lobes, u->stats.plan_highlights);
+           u->ctl.show, u->ctl.params.max_depth, method_name(u->ctl.params.method), u->stats.rejected,
+           u->stats.virtual_lights, u->stats.hl_lobes, u->stats.plan_highlights);
+    /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
+    int nparams;
+    const param_desc *table = params_table(&nparams);
+    for (int i = 0; i < nparams; i++) {
+        char name[64], value[64];
+        snprintf(name, sizeof name, "%s", table[i].name);
+        for (char *c = name; *c; c++) *c = *c == '-' ? '_' : *c;
+        param_format(&table[i], &u->ctl.params.vl, value, sizeof value);
+        printf(" %s=%s", name, value);
+    }
+    printf("\n");
     fflush(stdout);
 }
 
@@ -52,22 +57,18 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     snprintf(opt, sizeof opt, "--%s", name);
     long long n;
     double x;
-    if (strcmp(name, "vpl-glossy") != 0) { /* the many-light settings, as glint render's options */
-        vl_params vl = vl_from_controls(&u->ctl, (vl_params){0});
-        int applied = cli_set_vl_param(name, value, &vl);
-        if (applied < 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
-        if (applied > 0) {
-            controls_from_vl(&u->ctl, &vl);
-            return 0;
-        }
-    }
+    /* The many-light settings, as glint render's options (the parameter table). */
+    char why[256];
+    int applied = params_set(&u->ctl.params.vl, name, value, why, sizeof why);
+    if (applied < 0) return snprintf(err, errlen, "%s: %s", name, why), -1;
+    if (applied > 0) return 0;
     if (strcmp(name, "method") == 0) {
         int m = method_from_name(value);
         if (m < 0) return snprintf(err, errlen, "unknown method '%s'", value), -1;
-        u->ctl.method = m;
+        u->ctl.params.method = (render_method)m;
     } else if (strcmp(name, "max-depth") == 0) {
         if (cli_parse_int(opt, value, 1, 1000, &n) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
-        u->ctl.max_depth = (int)n;
+        u->ctl.params.max_depth = (int)n;
     } else if (strcmp(name, "exposure") == 0) {
         if (cli_parse_float(opt, value, -30, 30, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
         u->ctl.exposure = (float)x;

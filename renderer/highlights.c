@@ -17,11 +17,10 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
         if (t == LIGHT_POINT || t == LIGHT_SPOT || t == LIGHT_DIRECTIONAL) h.num_punctual = li + 1;
         else if (t == LIGHT_TRIANGLE) h.area_lights = 1;
     }
-    h.mode = vp->merge == HL_MERGE_OFF ? HL_UNMERGED : vp->merge == HL_MERGE_TRACE ? HL_TRACED : HL_MERGED;
-    h.secondary_rays = vp->secondary_rays > 0 ? vp->secondary_rays : HL_DEFAULT_SECONDARY_RAYS;
-    if (h.secondary_rays > HL_MAX_SECONDARY_RAYS) h.secondary_rays = HL_MAX_SECONDARY_RAYS;
-    h.clusters = vp->clusters > 0 ? vp->clusters : HL_DEFAULT_CLUSTERS;
-    if (h.clusters > HL_MAX_CLUSTERS) h.clusters = HL_MAX_CLUSTERS;
+    vl_params r = vl_params_resolve(vp);
+    h.mode = r.merge == HL_MERGE_OFF ? HL_UNMERGED : r.merge == HL_MERGE_TRACE ? HL_TRACED : HL_MERGED;
+    h.secondary_rays = r.secondary_rays;
+    h.clusters = r.clusters;
     h.env_filter = env_filter;
     return h;
 }

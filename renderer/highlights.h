@@ -13,7 +13,7 @@
 #define GLINT_HIGHLIGHTS_H
 
 #include "rng.h"
-#include "session.h"
+#include "params.h"
 #include "vsl.h"
 
 struct env_vmf_filter;

@@ -201,7 +201,7 @@ static int reserve_entries(manylight *m, int n) {
 
 static int cluster_lights(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
                           threadpool *pool, render_stats *st) {
-    int n = m->set.count, rows = p->vl.rows > 0 ? p->vl.rows : VL_DEFAULT_ROWS;
+    int n = m->set.count, rows = vl_params_resolve(&p->vl).rows;
     float *matrix = malloc(sizeof(float) * (size_t)rows * (size_t)n);
     render_stats *row_stats = calloc((size_t)rows, sizeof(render_stats));
     mrcs_cluster *clusters = malloc(sizeof(mrcs_cluster) * (size_t)p->vl.columns);
@@ -286,23 +286,23 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
 int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const render_params *p,
                           const effect_plan *plan, long long frame, threadpool *pool, render_stats *st, char *err,
                           size_t errlen) {
-    const vl_params *vp = &p->vl;
+    const render_params r = render_params_resolve(p); /* the defaults, in one place */
+    const vl_params *vp = &r.vl;
     long long i = frame + 1;
     m->kernel = p->method == METHOD_VSL || p->method == METHOD_VSL_HL ? VL_KERNEL_VSL
                 : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
     m->terms = plan->highlights ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
     m->all_strategies = plan->vsl_all_strategies;
-    m->clamp = vp->clamp == VL_CLAMP_ON || (vp->clamp == VL_CLAMP_DEFAULT && p->method == METHOD_VPL);
-    float growth = vp->clamp_growth > 0.0f ? vp->clamp_growth : vp->clamp_growth < 0.0f ? 0.0f : VL_DEFAULT_CLAMP_GROWTH;
-    float shrink = vp->radius_shrink > 0.0f ? vp->radius_shrink : vp->radius_shrink < 0.0f ? 0.0f : VL_DEFAULT_RADIUS_SHRINK;
-    m->clamp_bound = vpl_clamp_at(vp->clamp_value > 0.0f ? vp->clamp_value : VL_DEFAULT_CLAMP, growth, i);
-    m->radius_mult = vsl_radius_mult_at(vp->radius_mult > 0.0f ? vp->radius_mult : VL_DEFAULT_RADIUS_MULT,
-                                        shrink, i);
+    m->clamp = vp->clamp == VL_CLAMP_ON;
+    float growth = vp->clamp_growth > 0.0f ? vp->clamp_growth : 0.0f; /* negative: off */
+    float shrink = vp->radius_shrink > 0.0f ? vp->radius_shrink : 0.0f;
+    m->clamp_bound = vpl_clamp_at(vp->clamp_value, growth, i);
+    m->radius_mult = vsl_radius_mult_at(vp->radius_mult, shrink, i);
     m->num_entries = 0;
     m->clustered = 0;
     m->use_tree = 0;
     m->tree.num_lights = 0;
-    int count = vp->count > 0 ? vp->count : VL_DEFAULT_COUNT;
+    int count = vp->count;
     if (vlights_trace(s, count, plan->max_depth, p->seed, (uint64_t)frame, &m->set, &st->rays[RAY_BOUNCE]) != 0)
         return snprintf(err, errlen, "out of memory for %d virtual lights", count), -1;
     st->virtual_lights += (uint64_t)m->set.count;
@@ -312,12 +312,10 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
         return snprintf(err, errlen, "out of memory for the lights' radii"), -1;
 
     int clustering = vp->columns > 0 && vp->columns < m->set.count;
-    m->per_pixel = vp->per_pixel > 0 ? vp->per_pixel : (clustering || vp->per_pixel < 0 ? 0 : VL_DEFAULT_PER_PIXEL);
-    m->candidates = vp->candidates > 0 ? vp->candidates : VL_DEFAULT_CANDIDATES;
-    if (m->candidates > VL_MAX_CANDIDATES) m->candidates = VL_MAX_CANDIDATES;
-    m->glossy_split = vp->glossy_rays > 0 ? (vp->glossy_rays < VL_MAX_GLOSSY_RAYS ? vp->glossy_rays : VL_MAX_GLOSSY_RAYS)
-                                          : VL_DEFAULT_GLOSSY_RAYS;
-    m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : vp->trace_glossy < 0.0f ? 0.0f : VL_DEFAULT_TRACE_GLOSSY;
+    m->per_pixel = vl_frame_per_pixel(&p->vl, clustering);
+    m->candidates = vp->candidates;
+    m->glossy_split = vp->glossy_rays;
+    m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : 0.0f;
     /* The light tree's per-light estimates serve resampling; its hierarchy, drawing through it. */
     if (m->per_pixel > 0 && (vp->select == VL_SELECT_TREE || m->candidates > 1) && lighttree_build(&m->tree, &m->set) != 0)
         return snprintf(err, errlen, "out of memory for the light tree"), -1;

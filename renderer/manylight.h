@@ -6,7 +6,8 @@
 
 #include "camera.h"
 #include "lighttree.h"
-#include "session.h"
+#include "params.h"
+#include "plan.h"
 #include "threadpool.h"
 #include "vsl.h"
 

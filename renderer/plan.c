@@ -8,7 +8,7 @@
 #include "lights.h"
 #include "rng.h"
 #include "sampling.h"
-#include "session.h"
+#include "params.h"
 
 /* Probes: about this many in all, shared by area, and at least PROBES_PER_MATERIAL on each
  * material with any area, so a small mirror is not missed. */

@@ -7,7 +7,7 @@
 #include "film.h"
 #include "rng.h"
 #include "scene.h"
-#include "session.h"
+#include "params.h"
 
 /* Radiance along the camera ray (o, d) whose closest hit the caller has traced (first; NULL when
  * the ray escaped), split by path-space component: out[COMP_DIRECT] gets emission

@@ -15,18 +15,6 @@
 #include "rng.h"
 #include "threadpool.h"
 
-static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl", "vsl+hl"};
-const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
-const char *const pass_names[PASS_COUNT] = {"paths", "direct", "virtual_lights", "gather", "highlights"};
-
-const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? method_names[m] : "?"; }
-
-int method_from_name(const char *name) {
-    for (int i = 0; i < METHOD_COUNT; i++)
-        if (strcmp(name, method_names[i]) == 0) return i;
-    return -1;
-}
-
 #define TILE 16
 #define PACKET_W 4 /* PACKET_W x PACKET_H = SCENE_PACKET, dividing TILE */
 #define PACKET_H 4

@@ -177,6 +177,26 @@ done
 [ -s highlights.exr ] || fail "vsl+hl EXR export missing"
 head -c 2000 highlights.exr | grep -q 'highlights.R' || fail "the vsl+hl export lacks the highlights layer"
 
+# Every many-light option is a `set` parameter (the table in params.c), those the panel never had
+# included, and the stats show each one by its name.
+cat >params.txt <<'EOF'
+set method vpl
+set rows 64
+set clamp-growth off
+set vpl-glossy on
+set per-pixel all
+wait 1
+stats
+quit
+EOF
+view --size 48x27 --script params.txt
+rc=$?
+[ $rc -eq 0 ] || fail "setting rows, clamp-growth, vpl-glossy, per-pixel: exit $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(field 1 rows)" = "64" ] && [ "$(field 1 clamp_growth)" = "off" ] && [ "$(field 1 vpl_glossy)" = "on" ] &&
+  [ "$(field 1 per_pixel)" = "all" ] || fail "rows, clamp-growth, vpl-glossy or per-pixel not applied: $(cat stats.txt)"
+[ "$(field 1 virtual_lights)" -gt 0 ] || fail "vpl with glossy VPLs traced no virtual lights"
+
 # Lights: dimming and moving the default scene's first light reset the accumulation and change the
 # image; a tone mapper change does not reset; a camera bookmark saved, the view moved, the
 # bookmark restored gives the saved view back, from NAME.glint-bookmarks for builtin:NAME.

@@ -106,6 +106,46 @@ static void error_plot(const ui_stats *s) {
         ImGui::TextColored(ImColor(curve_colours[c % 6]), "%s", s->curves[c].label);
 }
 
+// One widget per many-light parameter of the group, from the table (params.h): choices as combo
+// boxes, numbers as sliders whose lowest position stands for "off" where the parameter has one.
+static void param_widgets(param_group group, vl_params *vl) {
+    int n;
+    const param_desc *table = params_table(&n);
+    for (int i = 0; i < n; i++) {
+        const param_desc *d = &table[i];
+        if (d->group != group) continue;
+        double v = param_get(d, vl);
+        if (d->type == PARAM_CHOICE) {
+            const char *labels[8];
+            int k = 0, cur = 0;
+            for (; k < d->num_choices && k < 8; k++) {
+                labels[k] = d->choices[k].label;
+                if (d->choices[k].value == (int)v) cur = k;
+            }
+            if (ImGui::Combo(d->label, &cur, labels, k)) param_put(d, vl, d->choices[cur].value);
+            continue;
+        }
+        int has_off = d->off_word || d->zero_is_off;
+        ImGuiSliderFlags flags = d->panel_log ? ImGuiSliderFlags_Logarithmic : 0;
+        double shown = has_off && v < 0.0 ? d->panel_lo : v;
+        const char *format = d->panel_lo_text && shown <= d->panel_lo ? d->panel_lo_text : d->panel_format;
+        double edited;
+        if (d->type == PARAM_INT) {
+            int x = (int)shown;
+            if (!ImGui::SliderInt(d->label, &x, (int)d->panel_lo, (int)d->panel_hi, format, flags)) continue;
+            edited = x;
+        } else {
+            float x = (float)shown;
+            if (!ImGui::SliderFloat(d->label, &x, (float)d->panel_lo, (float)d->panel_hi, format, flags)) continue;
+            edited = x;
+        }
+        // The lowest position is "off" where there is one; anything else stays in the accepted range.
+        if (has_off && edited <= d->panel_lo) edited = -1.0;
+        else edited = std::fmin(std::fmax(edited, d->lo), d->below_hi ? std::nextafter(d->hi, 0.0) : d->hi);
+        param_put(d, vl, edited);
+    }
+}
+
 extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
     if (!c->show_panel) return;
     ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
@@ -119,38 +159,15 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
 
     if (ImGui::CollapsingHeader("Estimator", ImGuiTreeNodeFlags_DefaultOpen)) {
         if (s->num_methods > 0) {
-            int m = c->method;
-            if (ImGui::Combo("method", &m, s->method_names, s->num_methods)) c->method = m;
+            int m = (int)c->params.method;
+            if (ImGui::Combo("method", &m, s->method_names, s->num_methods)) c->params.method = (render_method)m;
         }
-        ImGui::SliderInt("max depth", &c->max_depth, 1, 64);
-        if (s->many_light) {
-            static const char *clamps[3] = {"method default", "on", "off"};
-            ImGui::Combo("clamping", &c->clamp, clamps, 3);
-            ImGui::SliderFloat("clamp value", &c->clamp_value, 1e-3f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
-            ImGui::SliderFloat("radius mult", &c->radius_mult, 0.05f, 32.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
-            ImGui::SliderFloat("radius shrink", &c->radius_shrink, 0.0f, 0.99f, c->radius_shrink > 0 ? "%.2f" : "off");
-            ImGui::SliderInt("lights/frame", &c->vl_count, 16, 1 << 20, "%d", ImGuiSliderFlags_Logarithmic);
-            ImGui::SliderInt("clusters", &c->columns, 0, 1 << 14, c->columns > 0 ? "%d" : "none",
-                             ImGuiSliderFlags_Logarithmic);
-            ImGui::SliderInt("lights/pixel", &c->per_pixel, -1, 256, c->per_pixel < 0 ? "all" : "%d");
-            if (c->per_pixel == 0) c->per_pixel = 1;
-            static const char *const selects[] = {"by power", "light tree"};
-            ImGui::Combo("light draws", &c->light_select, selects, 2);
-            ImGui::SliderInt("candidates", &c->candidates, 1, 128, c->candidates > 1 ? "%d" : "1 (as drawn)",
-                             ImGuiSliderFlags_Logarithmic);
-            ImGui::SliderFloat("trace glossy below", &c->trace_glossy, 0.0f, 1.0f,
-                               c->trace_glossy > 0.0f ? "alpha %.2f" : "never");
-            ImGui::SliderInt("glossy rays", &c->glossy_rays, 1, 64);
-        }
+        ImGui::SliderInt("max depth", &c->params.max_depth, 1, 64);
+        if (s->many_light) param_widgets(PARAM_MANY_LIGHT, &c->params.vl);
     }
 
-    if (s->highlights && ImGui::CollapsingHeader("Highlights", ImGuiTreeNodeFlags_DefaultOpen)) {
-        ImGui::SliderInt("secondary rays", &c->secondary_rays, 1, s->max_secondary_rays, "%d",
-                         ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
-        ImGui::SliderInt("clusters (K)", &c->clusters, 1, s->max_clusters, "%d", ImGuiSliderFlags_AlwaysClamp);
-        static const char *merges[3] = {"on", "off", "trace"};
-        ImGui::Combo("merge", &c->merge, merges, 3);
-    }
+    if (s->highlights && ImGui::CollapsingHeader("Highlights", ImGuiTreeNodeFlags_DefaultOpen))
+        param_widgets(PARAM_HIGHLIGHTS, &c->params.vl);
 
     if (s->num_lights > 0 && ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) {
         int l = c->light;

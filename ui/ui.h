@@ -6,6 +6,8 @@
 
 #include <stddef.h>
 
+#include "params.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -17,26 +19,10 @@ struct GLFWwindow;
 enum { UI_SHOW_ALL = 0, UI_SHOW_DIRECT, UI_SHOW_INDIRECT, UI_SHOW_HIGHLIGHTS, UI_SHOW_ERROR, UI_SHOW_COUNT };
 
 typedef struct {
-    /* estimator settings: a change resets the accumulation */
-    int method;        /* index into the method names given to ui_panel */
-    int max_depth;
+    /* estimator settings: a change resets the accumulation. The panel edits method, max_depth and
+     * vl (its defaults resolved, vl_params_resolve), the many-light fields through params_table. */
+    render_params params;
     int camera;        /* scene camera index, -1 for the free camera */
-    /* many-light settings (methods vpl, vsl), as glint render's options */
-    int clamp;         /* 0: the method's default, 1: on, 2: off */
-    float clamp_value;
-    float radius_mult;
-    float radius_shrink; /* 0: off */
-    int vl_count;      /* virtual lights per frame */
-    int columns;       /* clusters; 0: none */
-    int per_pixel;     /* lights shaded per pixel per frame; -1: all */
-    int light_select;  /* 0: draws by power, 1: through the light tree */
-    int candidates;    /* light draws per pixel, resampled by estimate; 1: shaded as drawn */
-    float trace_glossy; /* glossy lobes with alpha below this are traced through; 0: never */
-    int glossy_rays;   /* directions traced through such a lobe at the camera hit */
-    /* indirect highlights (method vsl+hl), as glint render's options */
-    int secondary_rays; /* rays sampled from a camera hit's glossy lobe */
-    int clusters;       /* merged vMF lobes per camera hit (K) */
-    int merge;          /* 0: on, 1: off (each hit's own lobe), 2: trace (no vMFs) */
     /* the selected light and its intensity: a change of intensity resets */
     int light;         /* light group, -1 for none */
     float light_gain;  /* its intensity multiplier */
@@ -73,7 +59,6 @@ typedef struct {
     int many_light;            /* the current method uses virtual lights: show their settings */
     unsigned long long virtual_lights; /* deposited since the last reset */
     int highlights;            /* the current method is vsl+hl: show the highlight settings */
-    int max_secondary_rays, max_clusters; /* the highlight settings' upper bounds */
     /* the last full-resolution frame's highlight work (vsl+hl) */
     unsigned long long hl_points, hl_lobes; /* camera hits worked at, lobes lit */
     double hl_merge_share;     /* of the frame's thread time spent clustering and merging */

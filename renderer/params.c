@@ -1,0 +1,282 @@
+#include "params.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl", "vsl+hl"};
+const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
+const char *const pass_names[PASS_COUNT] = {"paths", "direct", "virtual_lights", "gather", "highlights"};
+
+const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? method_names[m] : "?"; }
+
+int method_from_name(const char *name) {
+    for (int i = 0; i < METHOD_COUNT; i++)
+        if (strcmp(name, method_names[i]) == 0) return i;
+    return -1;
+}
+
+/* ---- defaults ---------------------------------------------------------------------------------- */
+
+static int int_or(int v, int def, int max) { return v > 0 ? (v < max ? v : max) : def; }
+/* 0 is the default; a negative value is "off" and stays. */
+static float float_or(float v, float def) { return v != 0.0f ? v : def; }
+
+vl_params vl_params_resolve(const vl_params *vp) {
+    vl_params r = *vp;
+    r.count = int_or(vp->count, VL_DEFAULT_COUNT, INT32_MAX);
+    r.clamp_value = vp->clamp_value > 0.0f ? vp->clamp_value : VL_DEFAULT_CLAMP;
+    r.clamp_growth = float_or(vp->clamp_growth, VL_DEFAULT_CLAMP_GROWTH);
+    r.radius_mult = vp->radius_mult > 0.0f ? vp->radius_mult : VL_DEFAULT_RADIUS_MULT;
+    r.radius_shrink = float_or(vp->radius_shrink, VL_DEFAULT_RADIUS_SHRINK);
+    r.rows = int_or(vp->rows, VL_DEFAULT_ROWS, INT32_MAX);
+    if (vp->per_pixel == 0) r.per_pixel = vp->columns > 0 ? -1 : VL_DEFAULT_PER_PIXEL;
+    r.candidates = int_or(vp->candidates, VL_DEFAULT_CANDIDATES, VL_MAX_CANDIDATES);
+    if (vp->select == VL_SELECT_DEFAULT) r.select = VL_SELECT_POWER;
+    r.trace_glossy = float_or(vp->trace_glossy, VL_DEFAULT_TRACE_GLOSSY);
+    r.glossy_rays = int_or(vp->glossy_rays, VL_DEFAULT_GLOSSY_RAYS, VL_MAX_GLOSSY_RAYS);
+    r.secondary_rays = int_or(vp->secondary_rays, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_SECONDARY_RAYS);
+    r.clusters = int_or(vp->clusters, HL_DEFAULT_CLUSTERS, HL_MAX_CLUSTERS);
+    if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_ON;
+    return r;
+}
+
+render_params render_params_resolve(const render_params *p) {
+    render_params r = *p;
+    if (r.width <= 0) r.width = 960;
+    if (r.height <= 0) r.height = 540;
+    if (r.max_depth <= 0) r.max_depth = DEFAULT_MAX_DEPTH;
+    if ((unsigned)r.method >= METHOD_COUNT) r.method = METHOD_PT;
+    r.vl = vl_params_resolve(&p->vl);
+    if (r.vl.clamp == VL_CLAMP_DEFAULT) r.vl.clamp = r.method == METHOD_VPL ? VL_CLAMP_ON : VL_CLAMP_OFF;
+    return r;
+}
+
+int vl_frame_per_pixel(const vl_params *vp, int clustering) {
+    return vp->per_pixel > 0 ? vp->per_pixel : (clustering || vp->per_pixel < 0 ? 0 : VL_DEFAULT_PER_PIXEL);
+}
+
+/* ---- the table --------------------------------------------------------------------------------- */
+
+#define STR_(x) #x
+#define STR(x) STR_(x)
+#define F(field) offsetof(vl_params, field)
+
+static const param_choice on_off[] = {{"on", 1, "on"}, {"off", 0, "off"}};
+static const param_choice clamps[] = {{NULL, VL_CLAMP_DEFAULT, "method default"}, {"on", VL_CLAMP_ON, "on"},
+                                      {"off", VL_CLAMP_OFF, "off"}};
+static const param_choice selects[] = {{"power", VL_SELECT_POWER, "by power"}, {"tree", VL_SELECT_TREE, "light tree"}};
+static const param_choice merges[] = {{"on", HL_MERGE_ON, "on"}, {"off", HL_MERGE_OFF, "off"},
+                                      {"trace", HL_MERGE_TRACE, "trace"}};
+
+/* In the help's order. Numbers' ranges are what the command line accepts; the panel's sliders span
+ * the useful part of them. */
+static const param_desc table[] = {
+    {.name = "vsl-count", .type = PARAM_INT, .offset = F(count), .lo = 1, .hi = 50000000, .def = VL_DEFAULT_COUNT,
+     .value_name = "N", .help = "virtual lights traced per frame", .label = "lights/frame", .panel_lo = 16,
+     .panel_hi = 1 << 20, .panel_log = 1, .panel_format = "%d"},
+    {.name = "clamp", .type = PARAM_CHOICE, .offset = F(clamp), .choices = clamps, .num_choices = 3,
+     .def = VL_CLAMP_DEFAULT, .def_text = "on for vpl, off for vsl", .help = "clamp each light's contribution",
+     .label = "clamping"},
+    {.name = "clamp-value", .type = PARAM_FLOAT, .offset = F(clamp_value), .lo = 1e-12, .hi = 1e30,
+     .def = VL_DEFAULT_CLAMP, .value_name = "C", .help = "the clamp bound, in radiance", .label = "clamp value",
+     .panel_lo = 1e-3, .panel_hi = 100, .panel_log = 1, .panel_format = "%.3g"},
+    {.name = "clamp-growth", .type = PARAM_FLOAT, .offset = F(clamp_growth), .lo = 0, .hi = 10, .off_word = "off",
+     .zero_is_off = 1, .def = VL_DEFAULT_CLAMP_GROWTH, .value_name = "A",
+     .help = "the bound grows as C * frame^A, so clamped VPLs converge", .label = "clamp growth", .panel_lo = 0,
+     .panel_hi = 2, .panel_format = "%.2f", .panel_lo_text = "off"},
+    {.name = "vpl-glossy", .type = PARAM_CHOICE, .offset = F(vpl_glossy), .choices = on_off, .num_choices = 2,
+     .flag = 1, .def = 0, .help = "VPLs reflect with their full BSDF, not only its diffuse part",
+     .label = "vpl glossy"},
+    {.name = "radius-mult", .type = PARAM_FLOAT, .offset = F(radius_mult), .lo = 1e-6, .hi = 1e6,
+     .def = VL_DEFAULT_RADIUS_MULT, .value_name = "M", .help = "VSL radius: M x distance to the 10th nearest light",
+     .label = "radius mult", .panel_lo = 0.05, .panel_hi = 32, .panel_log = 1, .panel_format = "%.2f"},
+    {.name = "radius-shrink", .type = PARAM_FLOAT, .offset = F(radius_shrink), .lo = 0, .hi = 1, .below_hi = 1,
+     .off_word = "off", .zero_is_off = 1, .def = VL_DEFAULT_RADIUS_SHRINK, .value_name = "A",
+     .help = "0 < A < 1: M shrinks over frames (progressive photon mapping's\n"
+             "schedule), so VSLs converge to the path-traced answer",
+     .label = "radius shrink", .panel_lo = 0, .panel_hi = 0.99, .panel_format = "%.2f", .panel_lo_text = "off"},
+    {.name = "rows", .type = PARAM_INT, .offset = F(rows), .lo = 1, .hi = 100000, .def = VL_DEFAULT_ROWS,
+     .value_name = "R", .help = "matrix row-column sampling: sampled rows (pixels)", .label = "rows", .panel_lo = 16,
+     .panel_hi = 4096, .panel_log = 1, .panel_format = "%d"},
+    {.name = "columns", .type = PARAM_INT, .offset = F(columns), .lo = 0, .hi = 10000000, .def = 0,
+     .value_name = "C", .help = "... and clusters; 0 = no clustering", .label = "clusters", .panel_lo = 0,
+     .panel_hi = 1 << 14, .panel_log = 1, .panel_format = "%d", .panel_lo_text = "none"},
+    {.name = "per-pixel", .type = PARAM_INT, .offset = F(per_pixel), .lo = 1, .hi = 1000000, .off_word = "all",
+     .def = VL_DEFAULT_PER_PIXEL, .value_name = "N",
+     .help = "lights (cluster representatives) each pixel shades per frame,\n"
+             "picked by power (cluster norm); all by default with --columns",
+     .label = "lights/pixel", .panel_lo = -1, .panel_hi = 256, .panel_format = "%d", .panel_lo_text = "all"},
+    {.name = "light-select", .type = PARAM_CHOICE, .offset = F(select), .choices = selects, .num_choices = 2,
+     .def = VL_SELECT_POWER,
+     .help = "where a pixel's light draws come from: by power, or\n"
+             "through a light tree by an estimate of what each sends there",
+     .label = "light draws"},
+    {.name = "candidates", .type = PARAM_INT, .offset = F(candidates), .lo = 1, .hi = VL_MAX_CANDIDATES,
+     .def = VL_DEFAULT_CANDIDATES, .value_name = "M",
+     .help = "draws per pixel, from which its lights are resampled by that\n"
+             "estimate; 1 = the draws are shaded as they come",
+     .label = "candidates", .panel_lo = 1, .panel_hi = 128, .panel_log = 1, .panel_format = "%d",
+     .panel_lo_text = "1 (as drawn)"},
+    {.name = "trace-glossy", .type = PARAM_FLOAT, .offset = F(trace_glossy), .lo = 0, .hi = 10, .off_word = "off",
+     .zero_is_off = 1, .def = VL_DEFAULT_TRACE_GLOSSY, .value_name = "A",
+     .help = "receivers' glossy lobes with roughness alpha below A are not\n"
+             "gathered from the lights: the path goes on through them",
+     .label = "trace glossy below", .panel_lo = 0, .panel_hi = 1, .panel_format = "alpha %.2f",
+     .panel_lo_text = "never"},
+    {.name = "glossy-rays", .type = PARAM_INT, .offset = F(glossy_rays), .lo = 1, .hi = VL_MAX_GLOSSY_RAYS,
+     .def = VL_DEFAULT_GLOSSY_RAYS, .value_name = "N",
+     .help = "directions traced through such a lobe at the camera hit, 1.." STR(VL_MAX_GLOSSY_RAYS),
+     .label = "glossy rays", .panel_lo = 1, .panel_hi = VL_MAX_GLOSSY_RAYS, .panel_format = "%d"},
+    {.name = "secondary-rays", .type = PARAM_INT, .group = PARAM_HIGHLIGHTS, .offset = F(secondary_rays), .lo = 1,
+     .hi = HL_MAX_SECONDARY_RAYS, .def = HL_DEFAULT_SECONDARY_RAYS, .value_name = "N",
+     .help = "rays sampled from a camera hit's glossy lobe, 1.." STR(HL_MAX_SECONDARY_RAYS),
+     .label = "secondary rays", .panel_lo = 1, .panel_hi = HL_MAX_SECONDARY_RAYS, .panel_log = 1,
+     .panel_format = "%d"},
+    {.name = "clusters", .type = PARAM_INT, .group = PARAM_HIGHLIGHTS, .offset = F(clusters), .lo = 1,
+     .hi = HL_MAX_CLUSTERS, .def = HL_DEFAULT_CLUSTERS, .value_name = "K",
+     .help = "merged vMF lobes per camera hit, 1.." STR(HL_MAX_CLUSTERS), .label = "clusters (K)", .panel_lo = 1,
+     .panel_hi = HL_MAX_CLUSTERS, .panel_format = "%d"},
+    {.name = "merge", .type = PARAM_CHOICE, .group = PARAM_HIGHLIGHTS, .offset = F(merge), .choices = merges,
+     .num_choices = 3, .def = HL_MERGE_ON,
+     .help = "off: every secondary hit's own vMF lobe is lit by itself (the\n"
+             "paper's comparison); trace: no vMFs, each hit's true glossy lobe\n"
+             "(the path tracer's answer for the same paths)",
+     .label = "merge"},
+};
+
+const param_desc *params_table(int *count) {
+    *count = (int)(sizeof table / sizeof table[0]);
+    return table;
+}
+
+const param_desc *param_find(const char *name) {
+    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++)
+        if (strcmp(name, table[i].name) == 0) return &table[i];
+    return NULL;
+}
+
+double param_get(const param_desc *d, const vl_params *vl) {
+    const char *field = (const char *)vl + d->offset;
+    if (d->type == PARAM_FLOAT) {
+        float v;
+        memcpy(&v, field, sizeof v);
+        return v;
+    }
+    int v;
+    memcpy(&v, field, sizeof v);
+    return v;
+}
+
+void param_put(const param_desc *d, vl_params *vl, double v) {
+    char *field = (char *)vl + d->offset;
+    if (d->type == PARAM_FLOAT) {
+        float f = (float)v;
+        memcpy(field, &f, sizeof f);
+    } else {
+        int i = (int)v;
+        memcpy(field, &i, sizeof i);
+    }
+}
+
+/* The accepted values in words, for messages and the help: "on|off", "A|off". */
+static void value_words(const param_desc *d, const char *sep, char *out, size_t n) {
+    out[0] = 0;
+    size_t len = 0;
+    if (d->type == PARAM_CHOICE) {
+        for (int c = 0; c < d->num_choices; c++) {
+            if (!d->choices[c].name) continue;
+            len += (size_t)snprintf(out + len, n - len, "%s%s", len ? sep : "", d->choices[c].name);
+            if (len >= n) return;
+        }
+    } else {
+        snprintf(out, n, "%s%s%s", d->value_name ? d->value_name : "X", d->off_word ? sep : "",
+                 d->off_word ? d->off_word : "");
+    }
+}
+
+int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err, size_t errlen) {
+    if (d->type == PARAM_CHOICE) {
+        for (int c = 0; c < d->num_choices; c++)
+            if (d->choices[c].name && strcmp(text, d->choices[c].name) == 0)
+                return param_put(d, vl, d->choices[c].value), 0;
+        char words[128];
+        value_words(d, ", ", words, sizeof words);
+        return snprintf(err, errlen, "expected one of %s, got '%s'", words, text), -1;
+    }
+    if (d->off_word && strcmp(text, d->off_word) == 0) return param_put(d, vl, -1.0), 0;
+    char *end = NULL;
+    errno = 0;
+    double v = d->type == PARAM_INT ? (double)strtoll(text, &end, 10) : strtod(text, &end);
+    int ok = !errno && end != text && *end == '\0' && isfinite(v) && v >= d->lo && (d->below_hi ? v < d->hi : v <= d->hi);
+    if (!ok) {
+        char off[64] = "";
+        if (d->off_word) snprintf(off, sizeof off, " or %s", d->off_word);
+        return snprintf(err, errlen, "expected %s in [%.15g, %.15g%s%s, got '%s'", d->type == PARAM_INT ? "an integer" : "a number",
+                        d->lo, d->hi, d->below_hi ? ")" : "]", off, text), -1;
+    }
+    param_put(d, vl, d->zero_is_off && v == 0.0 ? -1.0 : v);
+    return 0;
+}
+
+int params_set(vl_params *vl, const char *name, const char *text, char *err, size_t errlen) {
+    const param_desc *d = param_find(name);
+    if (!d) return 0;
+    return param_parse(d, text, vl, err, errlen) == 0 ? 1 : -1;
+}
+
+void param_format(const param_desc *d, const vl_params *vl, char *out, size_t n) {
+    double v = param_get(d, vl);
+    if (d->type == PARAM_CHOICE) {
+        for (int c = 0; c < d->num_choices; c++)
+            if (d->choices[c].value == (int)v) {
+                snprintf(out, n, "%s", d->choices[c].name ? d->choices[c].name : "default");
+                return;
+            }
+        snprintf(out, n, "%d", (int)v);
+    } else if (v < 0.0 && d->off_word) {
+        snprintf(out, n, "%s", d->off_word);
+    } else {
+        snprintf(out, n, "%g", v);
+    }
+}
+
+const char *params_help(void) {
+    static char text[8192];
+    static const char *const headings[] = {"many-light methods (vpl, vsl):\n", "indirect highlights (vsl+hl):\n"};
+    size_t len = 0;
+    int group = -1;
+    for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++) {
+        const param_desc *d = &table[i];
+        if ((int)d->group != group) {
+            group = (int)d->group;
+            len += (size_t)snprintf(text + len, sizeof text - len, "%s", headings[group]);
+        }
+        char option[64], words[64], def[64];
+        value_words(d, "|", words, sizeof words);
+        int olen = d->flag ? snprintf(option, sizeof option, "  --%s", d->name)
+                           : snprintf(option, sizeof option, "  --%s %s", d->name, words);
+        if (d->def_text) snprintf(def, sizeof def, "%s", d->def_text);
+        else if (d->type == PARAM_INT) snprintf(def, sizeof def, "%d", (int)d->def);
+        else if (d->type == PARAM_FLOAT) snprintf(def, sizeof def, "%g", d->def);
+        else {
+            vl_params v = {0};
+            param_put(d, &v, d->def);
+            param_format(d, &v, def, sizeof def);
+        }
+        /* Options in a column of 23, the help beside them; its later lines under its first. */
+        len += (size_t)snprintf(text + len, sizeof text - len, "%s%*s", option, olen < 22 ? 23 - olen : olen == 22 ? 1 : 2, "");
+        for (const char *h = d->help; *h && len < sizeof text;) {
+            const char *nl = strchr(h, '\n');
+            int n = nl ? (int)(nl - h) : (int)strlen(h);
+            len += (size_t)snprintf(text + len, sizeof text - len, "%.*s", n, h);
+            if (!nl) break;
+            h = nl + 1;
+            if (len < sizeof text) len += (size_t)snprintf(text + len, sizeof text - len, "\n%23s", "");
+        }
+        if (len < sizeof text) len += (size_t)snprintf(text + len, sizeof text - len, " [%s]\n", def);
+    }
+    return text;
+}

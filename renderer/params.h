@@ -1,0 +1,202 @@
+/* glint — what a render is asked to do: the method, its parameters and their defaults, and the
+ * statistics a session reports. Every estimator and front end includes this header (not
+ * session.h) for these types. The many-light parameters are described once, in a table
+ * (params_table) that the command line, the viewer's script `set`, its panel and the help text
+ * all read, so a new parameter is one vl_params field and one entry (docs/design.md, "Parameters"). */
+#ifndef GLINT_PARAMS_H
+#define GLINT_PARAMS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    METHOD_PT = 0, /* unbiased path tracing: the reference */
+    METHOD_VPL,    /* virtual point lights (instant radiosity), clamped */
+    METHOD_VSL,    /* virtual spherical lights */
+    METHOD_VSL_HL, /* virtual spherical lights plus vMF-merged indirect highlights */
+    METHOD_COUNT
+} render_method;
+
+/* "pt", "vpl", "vsl", "vsl+hl"; method_from_name returns -1 for an unknown name. */
+const char *method_name(render_method m);
+int method_from_name(const char *name);
+
+#define DEFAULT_MAX_DEPTH 16
+
+/* The many-light methods (vpl, vsl, vsl+hl). Zero means default for every field but the switches. */
+typedef struct {
+    int count;           /* virtual lights per frame [VL_DEFAULT_COUNT] */
+    int clamp;           /* VL_CLAMP_*: clamp each light's contribution [on for vpl, off for vsl] */
+    float clamp_value;   /* the bound on one light's contribution [VL_DEFAULT_CLAMP] */
+    float clamp_growth;  /* > 0: the bound grows as c * frame^growth (consistent VPLs); < 0: a fixed
+                          * bound [VL_DEFAULT_CLAMP_GROWTH] */
+    int vpl_glossy;      /* vpl: the light's full BSDF instead of its diffuse lobe */
+    float radius_mult;   /* vsl: radius = mult x distance to the 10th nearest light [VL_DEFAULT_RADIUS_MULT] */
+    float radius_shrink; /* vsl, in (0,1): mult shrinks as r_{i+1} = r_i sqrt((i + a) / (i + 1)), so
+                          * VSLs converge to the path-traced answer; < 0: a fixed radius
+                          * [VL_DEFAULT_RADIUS_SHRINK] */
+    int rows, columns;   /* matrix row-column sampling; columns 0: no clustering [rows 300] */
+    int per_pixel;       /* lights (or cluster representatives) sampled per pixel per frame, by
+                          * power (or cluster norm); -1: every one; 0: the default, which is
+                          * VL_DEFAULT_PER_PIXEL without clustering and every representative with */
+    int candidates;      /* per pixel: lights drawn (by power, cluster norm or the tree) from which
+                          * the pixel's per_pixel lights are resampled in proportion to an estimate
+                          * of what each sends there; 1: the draws are shaded as they come
+                          * [VL_DEFAULT_CANDIDATES] */
+    int select;          /* VL_SELECT_*: where a pixel's light draws come from (without clustering) [power] */
+    float trace_glossy;  /* a receiver's glossy lobe with roughness alpha below this is not
+                          * gathered from the lights: the camera path goes on through it (BSDF
+                          * sampling, direct light at the next hit, gathering there); < 0: never
+                          * [VL_DEFAULT_TRACE_GLOSSY] */
+    int glossy_rays;     /* directions traced through such a lobe at the camera hit, each taking the
+                          * direct light at its next hit, one carrying the path on
+                          * [VL_DEFAULT_GLOSSY_RAYS] */
+    /* vsl+hl: the highlight estimator (which owns the camera - glossy - glossy - light paths) */
+    int secondary_rays;  /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
+    int clusters;        /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
+    int merge;           /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
+} vl_params;
+
+enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
+/* Where a pixel's light draws come from: VL_SELECT_POWER by power (or cluster norm); VL_SELECT_TREE
+ * through the light tree (lighttree.h), by an estimate of each group's contribution there. */
+enum { VL_SELECT_DEFAULT = 0, VL_SELECT_TREE, VL_SELECT_POWER };
+#define VL_DEFAULT_COUNT 1024
+#define VL_DEFAULT_CLAMP 1.0f
+/* The paper's multipliers (4-12) go with 10^5 lights in one set; radii scale as mult/sqrt(count),
+ * so with ~10^3 fresh lights a frame a multiplier of 1 gives the same radii as 8 at 6.4 10^4. */
+#define VL_DEFAULT_RADIUS_MULT 1.0f
+/* The consistent schedules are on by default: progressive rendering should converge to the
+ * answer, not to the answer at one radius (docs/design.md; the values measured in
+ * docs/benchmarks.md). */
+#define VL_DEFAULT_RADIUS_SHRINK 0.9f
+#define VL_DEFAULT_CLAMP_GROWTH 0.5f
+#define VL_DEFAULT_ROWS 300
+#define VL_DEFAULT_PER_PIXEL 2
+#define VL_DEFAULT_CANDIDATES 16
+#define VL_MAX_CANDIDATES 256 /* they live on the stack */
+#define VL_DEFAULT_TRACE_GLOSSY 0.35f
+#define VL_DEFAULT_GLOSSY_RAYS 4
+#define VL_MAX_GLOSSY_RAYS 64
+/* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the
+ * path tracer's estimate of the same paths, to see what the approximation costs) */
+enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };
+#define HL_DEFAULT_SECONDARY_RAYS 8
+#define HL_DEFAULT_CLUSTERS 4
+#define HL_MAX_CLUSTERS 8
+#define HL_MAX_SECONDARY_RAYS 256 /* the paper uses 32-64; per-hit records live on the stack */
+
+/* Zero means default for every field. */
+typedef struct {
+    int width, height;    /* 0: 960 x 540 */
+    render_method method;
+    int max_depth;        /* scattering events per path; 0: DEFAULT_MAX_DEPTH; 1 is direct light only */
+    uint64_t seed;
+    int threads;          /* 0: one per core */
+    int pt_highlights;    /* pt: camera - glossy - glossy - light paths in their own component */
+    int plan;             /* PLAN_AUTO: only the passes the scene calls for; PLAN_FULL: all */
+    vl_params vl;
+} render_params;
+
+/* Work done, by kind of ray; summed over the frames since the last reset. */
+typedef enum { RAY_CAMERA = 0, RAY_SHADOW, RAY_BOUNCE, RAY_KIND_COUNT } ray_kind;
+extern const char *const ray_kind_names[RAY_KIND_COUNT];
+
+/* The passes a frame runs, each timed (thread time; the virtual lights' preparation wall time):
+ * path tracing (pt), or the camera rays with the direct light, the virtual lights' tracing and
+ * clustering, gathering from them, and the highlights. */
+typedef enum { PASS_PATHS = 0, PASS_DIRECT, PASS_VIRTUAL_LIGHTS, PASS_GATHER, PASS_HIGHLIGHTS, PASS_COUNT } pass_kind;
+extern const char *const pass_names[PASS_COUNT];
+
+typedef struct {
+    uint64_t rays[RAY_KIND_COUNT];
+    uint64_t rejected_samples; /* samples dropped because they were NaN or Inf */
+    uint64_t virtual_lights;   /* deposited, summed over frames (the effective light count) */
+    uint64_t light_paths;      /* traced to deposit them */
+    uint64_t vl_connections;   /* shading point - virtual light evaluations */
+    uint64_t vsl_samples;      /* integration samples of the VSL integrals */
+    uint64_t clamped;          /* contributions the clamp cut down */
+    uint64_t glossy_bounces;   /* camera paths continued through a sharp glossy lobe (--trace-glossy) */
+    uint64_t hl_points;        /* camera hits the highlight estimator worked at */
+    uint64_t hl_secondary_rays;/* rays sampled from their glossy lobes */
+    uint64_t hl_lobes;         /* lobes lit (merged, or one per secondary hit without merging) */
+    uint64_t hl_merge_ns;      /* thread time spent clustering and merging (the paper's Table 1, C) */
+    uint64_t env_filter_bytes; /* memory of the prefiltered environment map (vsl+hl under a map; 0: none) */
+    uint64_t pass_ns[PASS_COUNT];
+} render_stats;
+
+/* ---- defaults ---------------------------------------------------------------------------------- */
+
+/* vp with every default made explicit, as the renderer uses it: zero fields get their defaults,
+ * counts are capped at their maxima, "off" stays negative (so resolving twice changes nothing).
+ * Two fields stay open: clamp keeps VL_CLAMP_DEFAULT (the method's choice, render_params_resolve)
+ * and per_pixel 0 becomes -1 (every representative) with columns, VL_DEFAULT_PER_PIXEL without;
+ * a frame with fewer lights than columns does not cluster and then takes the default
+ * (vl_frame_per_pixel). */
+vl_params vl_params_resolve(const vl_params *vp);
+/* p with its size, depth, method and vl resolved, clamp included (on for vpl, off otherwise). */
+render_params render_params_resolve(const render_params *p);
+/* Lights a pixel shades in a frame from vp as given (unresolved); 0: every one. clustering: the
+ * frame clusters its lights (columns below its light count). */
+int vl_frame_per_pixel(const vl_params *vp, int clustering);
+
+/* ---- the parameter table --------------------------------------------------------------------- */
+
+typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE } param_type;
+/* Which methods read a parameter: the panel shows it with them, the help groups by it. */
+typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS } param_group;
+
+typedef struct {
+    const char *name;  /* the word on the command line and in scripts; NULL: the panel's only */
+    int value;
+    const char *label; /* the panel's */
+} param_choice;
+
+/* One many-light parameter: an int or float field of vl_params (a choice is an int field). */
+typedef struct {
+    const char *name;       /* the option without "--", and the script's `set` name */
+    param_type type;
+    param_group group;
+    size_t offset;          /* of the field in vl_params */
+    double lo, hi;          /* numbers accepted */
+    int below_hi;           /* hi itself is refused */
+    const char *off_word;   /* a word stored as -1 ("off", "all"); NULL: none */
+    int zero_is_off;        /* 0 is stored as -1 too (0 in vl_params means the default) */
+    const param_choice *choices;
+    int num_choices;
+    int flag;               /* the command line takes it alone, as "on" */
+    double def;             /* the default, as vl_params_resolve gives it */
+    const char *def_text;   /* the help's default when it is no one value */
+    const char *value_name; /* the help's name for the value */
+    const char *help;       /* lines for --help, '\n' between them */
+    const char *label;      /* the panel's */
+    double panel_lo, panel_hi;
+    int panel_log;          /* a logarithmic slider */
+    const char *panel_format;
+    const char *panel_lo_text; /* shown at or below panel_lo (off, none, all) */
+} param_desc;
+
+const param_desc *params_table(int *count);
+/* The entry named name (without "--"), or NULL. */
+const param_desc *param_find(const char *name);
+/* Sets d's field in vl from text. Returns 0, or -1 with err = "NAME: problem" and vl unchanged. */
+int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err, size_t errlen);
+/* Like param_parse by name: 1 applied, 0 no such parameter, -1 a bad value (err set). */
+int params_set(vl_params *vl, const char *name, const char *text, char *err, size_t errlen);
+/* The field's value as param_parse reads it back (a choice's name, the off word, a number). */
+void param_format(const param_desc *d, const vl_params *vl, char *out, size_t n);
+/* The field as a number (choices their value, off -1). */
+double param_get(const param_desc *d, const vl_params *vl);
+void param_put(const param_desc *d, vl_params *vl, double v);
+/* The options' help text, one section per group; the returned text is static. */
+const char *params_help(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,161 @@
+/* glint tests — the parameter table (params.h): every entry is accepted by the command line's
+ * parser and by the script's `set` (both through the table), listed in the help, complete for the
+ * panel; its default is what vl_params_resolve gives; every vl_params field has an entry; the
+ * README's option list is the help's. With
+ * the glint program as argument, each entry is also given to `glint render` as a user would. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "cli.h"
+#include "cli_harness.h"
+#include "params.h"
+
+/* A value for d other than its default, as text, and the number it is stored as. */
+static double example(const param_desc *d, char *text, size_t n) {
+    if (d->type == PARAM_CHOICE) {
+        for (int c = 0; c < d->num_choices; c++)
+            if (d->choices[c].name && d->choices[c].value != (int)d->def) {
+                snprintf(text, n, "%s", d->choices[c].name);
+                return d->choices[c].value;
+            }
+        return snprintf(text, n, "?"), 0.0;
+    }
+    if (d->type == PARAM_INT) {
+        int v = (int)d->lo != (int)d->def ? (int)d->lo : (int)d->lo + 1;
+        snprintf(text, n, "%d", v);
+        return v;
+    }
+    double v = d->lo > 0.0 ? 2.0 * d->lo : 0.5 * d->hi;
+    snprintf(text, n, "%.17g", v);
+    return (float)v;
+}
+
+static void test_entry(const param_desc *d, const char *help) {
+    char text[64], err[256];
+    double want = example(d, text, sizeof text);
+    const vl_params zero = {0};
+
+    /* The script's `set` (params_set) and the command line (cli_set_vl_param, cli_vl_option). */
+    vl_params a = zero, b = zero, c = zero;
+    CHECK(params_set(&a, d->name, text, err, sizeof err) == 1, "set %s %s: %s", d->name, text, err);
+    CHECK(param_get(d, &a) == want, "set %s %s stored %g", d->name, text, param_get(d, &a));
+    vl_params other = a;
+    param_put(d, &other, 0.0);
+    CHECK(memcmp(&other, &zero, sizeof zero) == 0, "set %s changed another field", d->name);
+    CHECK(cli_set_vl_param(d->name, text, &b) == 1 && memcmp(&a, &b, sizeof a) == 0, "--%s %s", d->name, text);
+    char option[80];
+    snprintf(option, sizeof option, "--%s", d->name);
+    char *argv[] = {option, d->flag ? (char *)"--next" : text, NULL};
+    int i = 0;
+    CHECK(cli_vl_option(2, argv, &i, &c) == 1, "cli_vl_option %s", option);
+    CHECK(i == (d->flag ? 0 : 1), "%s took %d arguments", option, i);
+    if (d->flag) CHECK(param_get(d, &c) == 1.0, "%s alone is not on", option);
+    else CHECK(memcmp(&a, &c, sizeof a) == 0, "cli_vl_option %s %s differs from set", option, text);
+    CHECK(strstr(help, option) != NULL, "the help does not list %s", option);
+
+    /* A bad value is refused with a message and changes nothing; the off word is -1. */
+    vl_params bad = a;
+    CHECK(params_set(&bad, d->name, "banana", err, sizeof err) == -1 && memcmp(&bad, &a, sizeof a) == 0,
+          "set %s banana accepted", d->name);
+    if (d->off_word) {
+        CHECK(params_set(&bad, d->name, d->off_word, err, sizeof err) == 1 && param_get(d, &bad) == -1.0,
+              "set %s %s is not -1", d->name, d->off_word);
+    }
+    if (d->zero_is_off)
+        CHECK(params_set(&bad, d->name, "0", err, sizeof err) == 1 && param_get(d, &bad) == -1.0, "%s 0 is not off",
+              d->name);
+
+    /* The default is what the renderer resolves a zero field to, and what is set reads back. */
+    vl_params r = vl_params_resolve(&zero);
+    CHECK(param_get(d, &r) == (double)(d->type == PARAM_FLOAT ? (float)d->def : d->def),
+          "%s: table default %g, resolved %g", d->name, d->def, param_get(d, &r));
+    param_format(d, &a, text, sizeof text);
+    vl_params back = zero;
+    CHECK(params_set(&back, d->name, text, err, sizeof err) == 1 && param_get(d, &back) == param_get(d, &a),
+          "%s: '%s' does not read back", d->name, text);
+
+    /* The panel's widget. */
+    CHECK(d->label && d->label[0] && d->help && d->help[0], "%s: no label or help", d->name);
+    if (d->type == PARAM_CHOICE) {
+        for (int k = 0; k < d->num_choices; k++) CHECK(d->choices[k].label != NULL, "%s: a choice without a label", d->name);
+    } else {
+        CHECK(d->panel_lo < d->panel_hi && d->panel_format, "%s: no slider range", d->name);
+        CHECK(d->panel_hi <= d->hi, "%s: the slider goes past the accepted range", d->name);
+    }
+}
+
+static void test_table(void) {
+    int n;
+    const param_desc *t = params_table(&n);
+    const char *help = cli_vl_help();
+    CHECK(n > 0, "an empty table");
+    size_t covered = 0;
+    for (int i = 0; i < n; i++) {
+        test_entry(&t[i], help);
+        CHECK(param_find(t[i].name) == &t[i], "%s: not found by name (or named twice)", t[i].name);
+        for (int j = 0; j < i; j++)
+            CHECK(strcmp(t[i].label, t[j].label) != 0 && t[i].offset != t[j].offset, "%s and %s share a label or field",
+                  t[i].name, t[j].name);
+        covered += t[i].type == PARAM_FLOAT ? sizeof(float) : sizeof(int);
+    }
+    /* A vl_params field without an entry would be out of reach of every front end. */
+    CHECK(covered == sizeof(vl_params), "the table covers %zu of vl_params' %zu bytes", covered, sizeof(vl_params));
+    vl_params v = {0};
+    char err[64];
+    CHECK(params_set(&v, "no-such-parameter", "1", err, sizeof err) == 0, "an unknown name was taken");
+}
+
+/* Resolving is idempotent, leaves explicit values and "off" alone, and decides the clamp by method. */
+static void test_resolve(void) {
+    const vl_params zero = {0};
+    vl_params r = vl_params_resolve(&zero), rr = vl_params_resolve(&r);
+    CHECK(memcmp(&r, &rr, sizeof r) == 0, "resolving twice changes the parameters");
+    vl_params set = {.count = 77, .radius_shrink = -1.0f, .trace_glossy = -1.0f, .per_pixel = -1, .candidates = 100000};
+    r = vl_params_resolve(&set);
+    CHECK(r.count == 77 && r.radius_shrink < 0.0f && r.trace_glossy < 0.0f && r.per_pixel == -1, "explicit values changed");
+    CHECK(r.candidates == VL_MAX_CANDIDATES, "candidates not capped: %d", r.candidates);
+    vl_params clustered = {.columns = 100};
+    CHECK(vl_params_resolve(&clustered).per_pixel == -1, "with columns every representative is shaded");
+    CHECK(vl_frame_per_pixel(&clustered, 0) == VL_DEFAULT_PER_PIXEL && vl_frame_per_pixel(&clustered, 1) == 0,
+          "a frame's lights per pixel");
+    for (int m = 0; m < METHOD_COUNT; m++) {
+        render_params p = render_params_resolve(&(render_params){.method = (render_method)m});
+        CHECK(p.vl.clamp == (m == METHOD_VPL ? VL_CLAMP_ON : VL_CLAMP_OFF), "%s: clamp %d", method_name(p.method), p.vl.clamp);
+        CHECK(p.max_depth == DEFAULT_MAX_DEPTH && p.width > 0 && p.height > 0, "%s: size or depth", method_name(p.method));
+    }
+}
+
+/* The README lists the options as --help prints them. */
+static void test_readme(void) {
+    static char text[1 << 20];
+    FILE *f = fopen(GLINT_README, "rb");
+    CHECK(f != NULL, "cannot open %s", GLINT_README);
+    if (!f) return;
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    text[n] = 0;
+    fclose(f);
+    CHECK(strstr(text, cli_vl_help()) != NULL, "README.md's option list differs from --help's:\n%s", cli_vl_help());
+}
+
+/* Each entry given to glint render as a user would: a tiny vsl image. */
+static void test_program(void) {
+    int n;
+    const param_desc *t = params_table(&n);
+    for (int i = 0; i < n; i++) {
+        char text[64], args[512];
+        example(&t[i], text, sizeof text);
+        snprintf(args, sizeof args, "render --method %s --size 8x6 --spp 1 --vsl-count 16 --quiet --png p.png --%s %s",
+                 t[i].group == PARAM_HIGHLIGHTS ? "vsl+hl" : "vsl", t[i].name, t[i].flag ? "" : text);
+        int rc = run(args);
+        CHECK(rc == 0, "glint %s: exit %d: %s", args, rc, err_text);
+    }
+}
+
+int main(int argc, char **argv) {
+    test_table();
+    test_resolve();
+    test_readme();
+    if (argc >= 2 && harness_start(argc, argv, "params") == 0) test_program();
+    return check_exit("test_params");
+}
