@@ -105,30 +105,32 @@ int bench_parse_options(int argc, char **argv, bench_options *o) {
     o->camera_index = -2;
     o->seeds = 1;
     const char *methods = "pt,vpl,vsl,vsl+hl", *times = "1,2,4,8";
+    const cli_opt opts[] = {
+        {.name = "--quiet", .kind = CLI_FLAG, .out = &o->quiet},
+        {.name = "--force", .kind = CLI_FLAG, .out = &o->force},
+        {.name = "--reference", .kind = CLI_TEXT, .out = &o->ref_path},
+        {.name = "--methods", .kind = CLI_TEXT, .out = &methods},
+        {.name = "--times", .kind = CLI_TEXT, .out = &times},
+        {.name = "--size", .kind = CLI_SIZE, .out = &o->width, .out2 = &o->height},
+        {.name = "--camera", .kind = CLI_LONG, .out = &o->camera_index, .lo = 0, .hi = CLI_CAMERA_MAX},
+        {.name = "--max-depth", .kind = CLI_INT, .out = &o->max_depth, .lo = 1, .hi = CLI_MAX_DEPTH_MAX},
+        {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
+        {.name = "--env-rotation", .kind = CLI_FLOAT, .out = &o->env_rotation_deg, .lo = -36000.0, .hi = 36000.0},
+        {.name = "--seed", .kind = CLI_U64, .out = &o->seed, .given = &o->seed_given},
+        {.name = "--seeds", .kind = CLI_INT, .out = &o->seeds, .lo = 1, .hi = MAX_SEEDS},
+        {.name = "--threads", .kind = CLI_INT, .out = &o->threads, .lo = 0, .hi = CLI_THREADS_MAX},
+        {.name = "--out", .kind = CLI_TEXT, .out = &o->out_dir},
+    };
     for (int i = 0; i < argc; i++) {
-        const char *a = argv[i], *v = NULL;
-        long long n;
-        int vl, at = i;
-#define VALUE() \
-    if (!(v = cli_value(argc, argv, &i))) return -1
+        const char *a = argv[i], *v;
+        int r, at = i;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             print_bench_help();
             return 1;
-        } else if (strcmp(a, "--quiet") == 0) {
-            o->quiet = 1;
-        } else if (strcmp(a, "--force") == 0) {
-            o->force = 1;
-        } else if (strcmp(a, "--reference") == 0) {
-            VALUE();
-            o->ref_path = v;
-        } else if (strcmp(a, "--methods") == 0) {
-            VALUE();
-            methods = v;
-        } else if (strcmp(a, "--times") == 0) {
-            VALUE();
-            times = v;
+        } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0) {
+            if (r < 0) return -1;
         } else if (strcmp(a, "--sweep") == 0) {
-            VALUE();
+            if (!(v = cli_value(argc, argv, &i))) return -1;
             if (o->num_sweeps >= MAX_SWEEPS) return cli_error("--sweep: at most %d sweeps", MAX_SWEEPS), -1;
             if (parse_sweep(v, &o->sweeps[o->num_sweeps])) return -1;
             for (int k = 0; k < o->num_sweeps; k++)
@@ -136,50 +138,18 @@ int bench_parse_options(int argc, char **argv, bench_options *o) {
                     return cli_error("--sweep: %s is swept twice", o->sweeps[k].name), -1;
             o->num_sweeps++;
         } else if (strcmp(a, "--component") == 0) {
-            VALUE();
+            if (!(v = cli_value(argc, argv, &i))) return -1;
             int c = -1;
             for (int k = 0; k < ERR_COUNT; k++)
                 if (strcmp(v, bench_err_names[k]) == 0) c = k;
             if (c < 0) return cli_error("--component: expected all, direct, indirect or highlights, got '%s'", v), -1;
             o->component = c;
-        } else if (strcmp(a, "--size") == 0) {
-            VALUE();
-            if (cli_parse_size(a, v, &o->width, &o->height)) return -1;
-        } else if (strcmp(a, "--camera") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 0, 1000000, &o->camera_index)) return -1;
-        } else if (strcmp(a, "--max-depth") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 1, 10000, &n)) return -1;
-            o->max_depth = (int)n;
-        } else if (strcmp(a, "--env") == 0) {
-            VALUE();
-            o->env_path = v;
-        } else if (strcmp(a, "--env-rotation") == 0) {
-            VALUE();
-            if (cli_parse_float(a, v, -36000.0, 36000.0, &o->env_rotation_deg)) return -1;
-        } else if (strcmp(a, "--seed") == 0) {
-            VALUE();
-            if (cli_parse_u64(a, v, &o->seed)) return -1;
-            o->seed_given = 1;
-        } else if (strcmp(a, "--seeds") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 1, MAX_SEEDS, &n)) return -1;
-            o->seeds = (int)n;
-        } else if (strcmp(a, "--threads") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 0, 1024, &n)) return -1;
-            o->threads = (int)n;
-        } else if (strcmp(a, "--out") == 0) {
-            VALUE();
-            o->out_dir = v;
-        } else if ((vl = cli_vl_option(argc, argv, &i, &o->vl)) != 0) {
-            if (vl < 0) return -1;
+        } else if ((r = cli_vl_option(argc, argv, &i, &o->vl)) != 0) {
+            if (r < 0) return -1;
             append_base(o, a, i > at ? argv[i] : NULL);
         } else if (cli_scene_argument("bench", a, &o->scene_path) != 0) {
             return -1;
         }
-#undef VALUE
     }
     if (!o->ref_path) return cli_error("glint bench needs --reference REF.exr (see glint bench --help)"), -1;
 

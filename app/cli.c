@@ -119,6 +119,39 @@ const char *cli_value(int argc, char **argv, int *i) {
     return argv[++*i];
 }
 
+int cli_table_option(int argc, char **argv, int *i, const cli_opt *opts, int n) {
+    const char *a = argv[*i];
+    const cli_opt *o = NULL;
+    for (int k = 0; k < n && !o; k++)
+        if (strcmp(a, opts[k].name) == 0) o = &opts[k];
+    if (!o) return 0;
+    if (o->given) *o->given = 1;
+    if (o->kind == CLI_FLAG) return *(int *)o->out = 1, 1;
+    const char *v = cli_value(argc, argv, i);
+    if (!v) return -1;
+    long long n_ll;
+    int m;
+    switch (o->kind) {
+    case CLI_INT:
+        if (cli_parse_int(a, v, (long long)o->lo, (long long)o->hi, &n_ll)) return -1;
+        *(int *)o->out = (int)n_ll;
+        return 1;
+    case CLI_LONG: return cli_parse_int(a, v, (long long)o->lo, (long long)o->hi, o->out) ? -1 : 1;
+    case CLI_U64: return cli_parse_u64(a, v, o->out) ? -1 : 1;
+    case CLI_FLOAT: return cli_parse_float(a, v, o->lo, o->hi, o->out) ? -1 : 1;
+    case CLI_SIZE: return cli_parse_size(a, v, o->out, o->out2) ? -1 : 1;
+    case CLI_TEXT: return *(const char **)o->out = v, 1;
+    case CLI_PLAN: return cli_parse_plan(a, v, o->out) ? -1 : 1;
+    case CLI_METHOD:
+        if ((m = method_from_name(v)) < 0)
+            return cli_error("%s: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", a, v), -1;
+        *(render_method *)o->out = (render_method)m;
+        return 1;
+    case CLI_FLAG: break;
+    }
+    return 0;
+}
+
 double cli_now(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);

@@ -34,6 +34,34 @@ void cli_print_scenes(void);
 /* Fetches the value of option argv[*i] (advancing *i); prints a usage error when missing. */
 const char *cli_value(int argc, char **argv, int *i);
 
+/* One option of a command's table (cli_table_option): its name, what its value is, where it goes
+ * (and, for sizes, where the height goes), its range, and a flag set when it was given. */
+typedef enum {
+    CLI_FLAG,   /* no value: *(int *)out = 1 */
+    CLI_INT,    /* an integer in [lo, hi]: int */
+    CLI_LONG,   /* ... long long */
+    CLI_U64,    /* uint64_t */
+    CLI_FLOAT,  /* a number in [lo, hi]: double */
+    CLI_SIZE,   /* WxH: int width at out, int height at out2 */
+    CLI_TEXT,   /* the value as given: const char * */
+    CLI_PLAN,   /* auto|full: int */
+    CLI_METHOD, /* pt, vpl, vsl, vsl+hl: render_method */
+} cli_kind;
+typedef struct {
+    const char *name;
+    cli_kind kind;
+    void *out, *out2;
+    double lo, hi;
+    int *given;
+} cli_opt;
+/* The ranges the commands share. */
+#define CLI_MAX_DEPTH_MAX 10000
+#define CLI_CAMERA_MAX 1000000
+#define CLI_THREADS_MAX 1024
+/* argv[*i] if it is one of the n options: 1 taken (with its value, advancing *i), 0 not one of
+ * them, -1 a bad or missing value (reported). */
+int cli_table_option(int argc, char **argv, int *i, const cli_opt *opts, int n);
+
 /* The many-light parameters (params_table), shared by glint render, bench, the viewer's options
  * and its script's `set`. cli_set_vl_param takes a name without the leading "--" and a value
  * (a flag such as vpl-glossy: on/off). Returns 1 when applied, 0 when name is not one of them, -1

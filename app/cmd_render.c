@@ -75,77 +75,37 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
     o->spp = -1;
     o->camera_index = -1;
     int spp_given = 0, time_given = 0;
+    render_params *p = &o->params;
+    const cli_opt opts[] = {
+        {.name = "--quiet", .kind = CLI_FLAG, .out = &o->quiet},
+        {.name = "--highlights-layer", .kind = CLI_FLAG, .out = &p->pt_highlights},
+        {.name = "--method", .kind = CLI_METHOD, .out = &p->method},
+        {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000, .given = &spp_given},
+        {.name = "--time", .kind = CLI_FLOAT, .out = &o->seconds, .lo = 1e-3, .hi = 1e7, .given = &time_given},
+        {.name = "--size", .kind = CLI_SIZE, .out = &p->width, .out2 = &p->height},
+        {.name = "--max-depth", .kind = CLI_INT, .out = &p->max_depth, .lo = 1, .hi = CLI_MAX_DEPTH_MAX},
+        {.name = "--plan", .kind = CLI_PLAN, .out = &p->plan},
+        {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
+        {.name = "--env-rotation", .kind = CLI_FLOAT, .out = &o->env_rotation_deg, .lo = -36000.0, .hi = 36000.0},
+        {.name = "--camera", .kind = CLI_LONG, .out = &o->camera_index, .lo = 0, .hi = CLI_CAMERA_MAX},
+        {.name = "--seed", .kind = CLI_U64, .out = &p->seed},
+        {.name = "--threads", .kind = CLI_INT, .out = &p->threads, .lo = 0, .hi = CLI_THREADS_MAX},
+        {.name = "--out", .kind = CLI_TEXT, .out = &o->out_exr},
+        {.name = "--png", .kind = CLI_TEXT, .out = &o->out_png},
+        {.name = "--stats", .kind = CLI_TEXT, .out = &o->out_stats},
+        {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -50.0, .hi = 50.0},
+    };
     for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = NULL;
-        long long n;
-        int vl;
-#define VALUE() \
-    if (!(v = cli_value(argc, argv, &i))) return -1
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+        int r;
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             print_render_help();
             return 1;
-        } else if (strcmp(a, "--quiet") == 0) {
-            o->quiet = 1;
-        } else if (strcmp(a, "--highlights-layer") == 0) {
-            o->params.pt_highlights = 1;
-        } else if (strcmp(a, "--method") == 0) {
-            VALUE();
-            int m = method_from_name(v);
-            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", v), -1;
-            o->params.method = (render_method)m;
-        } else if (strcmp(a, "--spp") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 1, 100000000, &o->spp)) return -1;
-            spp_given = 1;
-        } else if (strcmp(a, "--time") == 0) {
-            VALUE();
-            if (cli_parse_float(a, v, 1e-3, 1e7, &o->seconds)) return -1;
-            time_given = 1;
-        } else if (strcmp(a, "--size") == 0) {
-            VALUE();
-            if (cli_parse_size(a, v, &o->params.width, &o->params.height)) return -1;
-        } else if (strcmp(a, "--max-depth") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 1, 10000, &n)) return -1;
-            o->params.max_depth = (int)n;
-        } else if (strcmp(a, "--plan") == 0) {
-            VALUE();
-            if (cli_parse_plan(a, v, &o->params.plan)) return -1;
-        } else if (strcmp(a, "--env") == 0) {
-            VALUE();
-            o->env_path = v;
-        } else if (strcmp(a, "--env-rotation") == 0) {
-            VALUE();
-            if (cli_parse_float(a, v, -36000.0, 36000.0, &o->env_rotation_deg)) return -1;
-        } else if (strcmp(a, "--camera") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 0, 1000000, &o->camera_index)) return -1;
-        } else if (strcmp(a, "--seed") == 0) {
-            VALUE();
-            if (cli_parse_u64(a, v, &o->params.seed)) return -1;
-        } else if (strcmp(a, "--threads") == 0) {
-            VALUE();
-            if (cli_parse_int(a, v, 0, 1024, &n)) return -1;
-            o->params.threads = (int)n;
-        } else if (strcmp(a, "--out") == 0) {
-            VALUE();
-            o->out_exr = v;
-        } else if (strcmp(a, "--png") == 0) {
-            VALUE();
-            o->out_png = v;
-        } else if (strcmp(a, "--stats") == 0) {
-            VALUE();
-            o->out_stats = v;
-        } else if (strcmp(a, "--exposure") == 0) {
-            VALUE();
-            if (cli_parse_float(a, v, -50.0, 50.0, &o->exposure)) return -1;
-        } else if ((vl = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
-            if (vl < 0) return -1;
-        } else if (cli_scene_argument("render", a, &o->scene_path) != 0) {
+        } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0 ||
+                   (r = cli_vl_option(argc, argv, &i, &p->vl)) != 0) {
+            if (r < 0) return -1;
+        } else if (cli_scene_argument("render", argv[i], &o->scene_path) != 0) {
             return -1;
         }
-#undef VALUE
     }
     if (spp_given && time_given) return cli_error("--spp and --time exclude each other"), -1;
     if (o->params.pt_highlights && o->params.method != METHOD_PT && o->params.method != METHOD_VSL_HL)

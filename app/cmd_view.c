@@ -56,44 +56,31 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     o->height = 540;
     o->camera = -1;
     o->params.max_depth = DEFAULT_MAX_DEPTH;
+    const cli_opt opts[] = {
+        {.name = "--size", .kind = CLI_SIZE, .out = &o->width, .out2 = &o->height},
+        {.name = "--method", .kind = CLI_METHOD, .out = &o->params.method},
+        {.name = "--max-depth", .kind = CLI_INT, .out = &o->params.max_depth, .lo = 1, .hi = CLI_MAX_DEPTH_MAX},
+        {.name = "--plan", .kind = CLI_PLAN, .out = &o->params.plan},
+        {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
+        {.name = "--camera", .kind = CLI_INT, .out = &o->camera, .lo = 0, .hi = CLI_CAMERA_MAX},
+        {.name = "--seed", .kind = CLI_U64, .out = &o->params.seed},
+        {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -30.0, .hi = 30.0},
+        {.name = "--reference", .kind = CLI_TEXT, .out = &o->reference_path},
+        {.name = "--script", .kind = CLI_TEXT, .out = &o->script_path},
+    };
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *v;
-        long long n;
-        int vl;
+        int r;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             print_view_help();
             return 1;
-        } else if (strcmp(a, "--size") == 0) {
-            if (!(v = cli_value(argc, argv, &i)) || cli_parse_size(a, v, &o->width, &o->height)) return -1;
-        } else if (strcmp(a, "--method") == 0) {
-            if (!(v = cli_value(argc, argv, &i))) return -1;
-            int m = method_from_name(v);
-            if (m < 0) return cli_error("--method: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", v), -1;
-            o->params.method = (render_method)m;
-        } else if ((vl = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
-            if (vl < 0) return -1;
-        } else if (strcmp(a, "--max-depth") == 0) {
-            if (!(v = cli_value(argc, argv, &i)) || cli_parse_int(a, v, 1, 1000, &n)) return -1;
-            o->params.max_depth = (int)n;
-        } else if (strcmp(a, "--plan") == 0) {
-            if (!(v = cli_value(argc, argv, &i)) || cli_parse_plan(a, v, &o->params.plan)) return -1;
-        } else if (strcmp(a, "--env") == 0) {
-            if (!(o->env_path = cli_value(argc, argv, &i))) return -1;
-        } else if (strcmp(a, "--camera") == 0) {
-            if (!(v = cli_value(argc, argv, &i)) || cli_parse_int(a, v, 0, 1 << 20, &n)) return -1;
-            o->camera = (int)n;
-        } else if (strcmp(a, "--seed") == 0) {
-            if (!(v = cli_value(argc, argv, &i)) || cli_parse_u64(a, v, &o->params.seed)) return -1;
-        } else if (strcmp(a, "--exposure") == 0) {
-            if (!(v = cli_value(argc, argv, &i)) || cli_parse_float(a, v, -30, 30, &o->exposure)) return -1;
+        } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0 ||
+                   (r = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
+            if (r < 0) return -1;
         } else if (strcmp(a, "--tonemap") == 0) {
             if (!(v = cli_value(argc, argv, &i))) return -1;
             if ((o->tonemap = tonemap_from_name(v)) < 0)
                 return cli_error("--tonemap: unknown tone mapper '%s' (available: reinhard, clamp, exponential)", v), -1;
-        } else if (strcmp(a, "--reference") == 0) {
-            if (!(o->reference_path = cli_value(argc, argv, &i))) return -1;
-        } else if (strcmp(a, "--script") == 0) {
-            if (!(o->script_path = cli_value(argc, argv, &i))) return -1;
         } else if (cli_scene_argument("view", a, &o->scene_path) != 0) {
             return -1;
         }
