@@ -761,8 +761,57 @@ static void test_film_means(void) {
     film_deinit(&f);
 }
 
+/* Files made by OpenEXR's own tools (the openexr package): a scanline file turned into tiled PIZ
+ * and tiled DWAA by exrmaketiled, and the two combined into one multi-part file by exrmultipart
+ * (its first part read). Each loads as an image and as an environment map with the values the
+ * scanline file holds (DWA's half channels within its loss). */
+static void test_openexr_tools(void) {
+    enum { W = 37, H = 21 };
+    const exr_attr_box2i_t win = box(0, 0, W - 1, H - 1);
+    char src[1200], piz[1200], dwaa[1200], multi[1200], cmd[5000], err[512] = "";
+    path_in(src, sizeof src, "tools-source.exr");
+    path_in(piz, sizeof piz, "tools-piz-tiled.exr");
+    path_in(dwaa, sizeof dwaa, "tools-dwaa-tiled.exr");
+    path_in(multi, sizeof multi, "tools-multipart.exr");
+    CHECK(write_test_exr(src, EXR_STORAGE_SCANLINE, EXR_COMPRESSION_NONE, codec_chans, 6, win, win, codec_value) == 0,
+          "writing the source");
+    snprintf(cmd, sizeof cmd,
+             "exrmaketiled -z piz '%s' '%s' >/dev/null && exrmaketiled -z dwaa '%s' '%s' >/dev/null && "
+             "exrmultipart -combine -i '%s' '%s' -o '%s' >/dev/null",
+             src, piz, src, dwaa, piz, dwaa, multi);
+    int rc = system(cmd);
+    CHECK(rc == 0, "OpenEXR's tools (the openexr package) failed or are missing: %s", cmd);
+    if (rc != 0) return;
+    const char *files[3] = {piz, dwaa, multi};
+    for (int f = 0; f < 3; f++) {
+        int dwa = f == 1;
+        exr_image img;
+        int ok = exr_image_load(files[f], &img, err, sizeof err) == 0;
+        CHECK(ok && img.width == W && img.height == H, "%s: %s", files[f], err);
+        image_rgb im;
+        int ok_rgb = image_rgb_load(files[f], &im, err, sizeof err) == 0;
+        CHECK(ok_rgb && im.width == W && im.height == H, "%s as an environment map: %s", files[f], err);
+        int bad = 0;
+        for (int c = 0; ok && c < 6; c++) {
+            const float *p = exr_image_channel(&img, codec_chans[c].name);
+            int lossy = dwa && c >= 1 && c <= 3;
+            for (int i = 0; i < W * H; i++) {
+                double e = codec_value(c, i % W, i / W);
+                bad += !p || !(fabs(p[i] - e) <= (lossy ? 0.03 * e + 1e-3 : 0.0));
+                /* B, G, R are channels 1..3: the environment map's rgb in reverse */
+                if (ok_rgb && c >= 1 && c <= 3)
+                    bad += !(fabs(im.rgb[3 * i + (size_t)(3 - c)] - fmax(e, 0.0)) <= (lossy ? 0.03 * e + 1e-3 : 0.0));
+            }
+        }
+        CHECK(bad == 0, "%s: %d values differ from the source's", files[f], bad);
+        if (ok) exr_image_free(&img);
+        if (ok_rgb) image_rgb_free(&im);
+    }
+}
+
 int main(void) {
     if (scratch_open("test_image_io") != 0) return 1;
+    test_openexr_tools();
     test_exr_roundtrip();
     test_exr_foreign();
     test_compressions();
