@@ -768,7 +768,7 @@ static void test_film_means(void) {
 static void test_openexr_tools(void) {
     enum { W = 37, H = 21 };
     const exr_attr_box2i_t win = box(0, 0, W - 1, H - 1);
-    char src[1200], piz[1200], dwaa[1200], multi[1200], cmd[5000], err[512] = "";
+    char src[1200], piz[1200], dwaa[1200], multi[1200], cmd[8192], err[512] = "";
     path_in(src, sizeof src, "tools-source.exr");
     path_in(piz, sizeof piz, "tools-piz-tiled.exr");
     path_in(dwaa, sizeof dwaa, "tools-dwaa-tiled.exr");
