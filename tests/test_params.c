@@ -1,8 +1,8 @@
 /* glint tests — the parameter table (params.h): every entry is accepted by the command line's
  * parser and by the script's `set` (both through the table), listed in the help, complete for the
  * panel; its default is what vl_params_resolve gives; every vl_params field has an entry; the
- * README's option list is the help's. With
- * the glint program as argument, each entry is also given to `glint render` as a user would. */
+ * option list in docs/methods.md is the help's. With the glint program as argument, each entry is
+ * also given to `glint render` as a user would. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -126,16 +126,16 @@ static void test_resolve(void) {
     }
 }
 
-/* The README lists the options as --help prints them. */
-static void test_readme(void) {
+/* docs/methods.md lists the options as --help prints them. */
+static void test_options_doc(void) {
     static char text[1 << 20];
-    FILE *f = fopen(GLINT_README, "rb");
-    CHECK(f != NULL, "cannot open %s", GLINT_README);
+    FILE *f = fopen(GLINT_OPTIONS_DOC, "rb");
+    CHECK(f != NULL, "cannot open %s", GLINT_OPTIONS_DOC);
     if (!f) return;
     size_t n = fread(text, 1, sizeof text - 1, f);
     text[n] = 0;
     fclose(f);
-    CHECK(strstr(text, cli_vl_help()) != NULL, "README.md's option list differs from --help's:\n%s", cli_vl_help());
+    CHECK(strstr(text, cli_vl_help()) != NULL, "%s: the option list differs from --help's:\n%s", GLINT_OPTIONS_DOC, cli_vl_help());
 }
 
 /* Each entry given to glint render as a user would: a tiny vsl image. */
@@ -155,7 +155,7 @@ static void test_program(void) {
 int main(int argc, char **argv) {
     test_table();
     test_resolve();
-    test_readme();
+    test_options_doc();
     if (argc >= 2 && harness_start(argc, argv, "params") == 0) test_program();
     return check_exit("test_params");
 }
