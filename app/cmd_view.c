@@ -38,7 +38,7 @@ static void print_view_help(void) {
            "  --exposure STOPS     display exposure [0]\n"
            "  --tonemap NAME       display tone mapper: reinhard, clamp, exponential [reinhard]\n"
            "  --reference FILE.exr an image of the render's size: error view and plot\n"
-           "  --script FILE        replay a script of viewer actions (see README)\n"
+           "  --script FILE        replay a script of viewer actions (docs/viewer.md)\n"
            "\n"
            "%s"
            "\n"
