@@ -10,21 +10,24 @@
 #include <time.h>
 #include <unistd.h>
 
+/* One line on stderr, written at once so lines from two threads do not interleave. */
+static void message(const char *kind, const char *fmt, va_list ap) {
+    char text[2048];
+    vsnprintf(text, sizeof text, fmt, ap);
+    fprintf(stderr, "glint: %s: %s\n", kind, text);
+}
+
 void cli_error(const char *fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
-    fputs("glint: error: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    message("error", fmt, ap);
     va_end(ap);
 }
 
 void cli_warning(const char *fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
-    fputs("glint: warning: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    message("warning", fmt, ap);
     va_end(ap);
 }
 
