@@ -149,13 +149,14 @@ static void param_widgets(param_group group, vl_params *vl) {
 extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
     if (!c->show_panel) return;
     ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowBgAlpha(0.85f);
     if (!ImGui::Begin("glint", nullptr)) {
         ImGui::End();
         return;
     }
     ImGui::TextUnformatted(s->scene_name ? s->scene_name : "");
+    ImGui::PushItemWidth(-ImGui::GetFontSize() * 10.0f); /* room for the longest label */
 
     if (ImGui::CollapsingHeader("Estimator", ImGuiTreeNodeFlags_DefaultOpen)) {
         if (s->num_methods > 0) {
@@ -249,6 +250,7 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
             ImGui::TreePop();
         }
     }
+    ImGui::PopItemWidth();
     ImGui::End();
 }
 
