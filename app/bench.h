@@ -14,8 +14,15 @@
 /* MAX_RENDERS bounds runs x seeds (each a render of the last budget's length); MAX_SPLIT_BYTES
  * the sum images the noise and bias split keeps, one per budget (320x240 at 64 budgets takes
  * 113 MiB). */
-enum { MAX_METHODS = 8, MAX_TIMES = 64, MAX_SWEEPS = 8, MAX_VALUES = 32, MAX_RUNS = 256, MAX_SEEDS = 1000,
-       MAX_RENDERS = 4096 };
+enum {
+    MAX_METHODS = 8,
+    MAX_TIMES = 64,
+    MAX_SWEEPS = 8,
+    MAX_VALUES = 32,
+    MAX_RUNS = 256,
+    MAX_SEEDS = 1000,
+    MAX_RENDERS = 4096
+};
 #define MAX_SPLIT_BYTES ((double)(512u << 20))
 
 /* The error columns: the image and its components. Indirect always means all light after the
@@ -39,13 +46,13 @@ typedef struct {
     int num_times;
     sweep sweeps[MAX_SWEEPS];
     int num_sweeps;
-    int component; /* ERR_* */
+    int component;          /* ERR_* */
     int width, height;      /* 0: the reference's */
     long long camera_index; /* -2: the reference's */
     int max_depth;          /* 0: the reference's */
-    uint64_t seed; /* the first seed's */
+    uint64_t seed;          /* the first seed's */
     int seed_given;
-    int seeds;     /* renders per run, with seeds seed, seed + 1, ... */
+    int seeds; /* renders per run, with seeds seed, seed + 1, ... */
     int threads;
     vl_params vl; /* the many-light options given: every run's base */
     char base_text[512];

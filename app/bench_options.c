@@ -81,13 +81,17 @@ static int parse_sweep(const char *text, sweep *sw) {
     snprintf(sw->name, sizeof sw->name, "%.*s", (int)(eq - text), text);
     char items[MAX_VALUES][32];
     int n = split_list(eq + 1, items, MAX_VALUES);
-    if (n < 0) return cli_error("--sweep %s: expected 1 to %d comma-separated values, got '%s'", sw->name, MAX_VALUES, eq + 1), -1;
+    if (n < 0)
+        return cli_error("--sweep %s: expected 1 to %d comma-separated values, got '%s'", sw->name, MAX_VALUES, eq + 1),
+               -1;
     for (int k = 0; k < n; k++) {
         vl_params scratch = {0};
         int r = cli_set_vl_param(sw->name, items[k], &scratch);
         if (r == 0)
             return cli_error("--sweep: '%s' is not a many-light option (radius-mult, columns, vsl-count, clusters, "
-                             "secondary-rays, clamp, clamp-value, radius-shrink, ...)", sw->name), -1;
+                             "secondary-rays, clamp, clamp-value, radius-shrink, ...)",
+                             sw->name),
+                   -1;
         if (r < 0) return -1;
         memcpy(sw->values[k], items[k], sizeof sw->values[k]);
     }
@@ -155,7 +159,8 @@ int bench_parse_options(int argc, char **argv, bench_options *o) {
 
     char items[MAX_TIMES][32];
     int n = split_list(methods, items, MAX_METHODS);
-    if (n < 0) return cli_error("--methods: expected 1 to %d comma-separated methods, got '%s'", MAX_METHODS, methods), -1;
+    if (n < 0)
+        return cli_error("--methods: expected 1 to %d comma-separated methods, got '%s'", MAX_METHODS, methods), -1;
     for (int k = 0; k < n; k++) {
         int m = method_from_name(items[k]);
         if (m < 0) return cli_error("--methods: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", items[k]), -1;

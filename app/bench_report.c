@@ -15,8 +15,10 @@
 
 static void csv_number(FILE *f, double v) {
     if (isnan(v)) return;
-    if (isinf(v)) fputs("inf", f);
-    else fprintf(f, "%.6g", v);
+    if (isinf(v))
+        fputs("inf", f);
+    else
+        fprintf(f, "%.6g", v);
 }
 
 /* Closes the memory stream f and writes its text to DIR/name atomically. */
@@ -81,7 +83,7 @@ int bench_write_summary(const bench_options *o, const char *dir, const bench_ref
             fprintf(f, "%s,%s,%s,%g,%d,%.6f,%.6g,", method_name(u->params.method), u->setting,
                     bench_err_names[o->component], o->times[k], u->seeds_done, u->seconds[k], u->frames[k]);
             const double v[7] = {u->rms[k], u->relmse[k], u->noise[k], u->bias[k], bench_ref_noise(ref, o->component),
-                                 u->lo[k], u->hi[k]};
+                                 u->lo[k],  u->hi[k]};
             for (int j = 0; j < 7; j++) {
                 if (j) fputc(',', f);
                 csv_number(f, v[j]);
@@ -118,8 +120,8 @@ static int write_time_plot(const bench_options *o, const char *dir, const bench_
     for (int r = 0; r < num_runs; r++) {
         const bench_run *u = &runs[r];
         /* With several seeds, a light band from the best seed to the worst. */
-        series[r] = (plot_series){u->label, u->num_points, u->seconds, u->rms, o->seeds > 1 ? u->lo : NULL,
-                                  o->seeds > 1 ? u->hi : NULL};
+        series[r] = (plot_series){
+            u->label, u->num_points, u->seconds, u->rms, o->seeds > 1 ? u->lo : NULL, o->seeds > 1 ? u->hi : NULL};
     }
     int last = o->num_times - 1, best = best_run(runs, num_runs, last);
     char title[160], ylabel[128], xmark[64], ymark[192];
@@ -131,7 +133,8 @@ static int write_time_plot(const bench_options *o, const char *dir, const bench_
         snprintf(ylabel, sizeof ylabel, "relative L2 error, %s", bench_err_names[o->component]);
     snprintf(xmark, sizeof xmark, "equal time: %g s", o->times[last]);
     double ey = best >= 0 ? err_at(&runs[best], last) : (double)NAN;
-    snprintf(ymark, sizeof ymark, "equal error: %.3g (%s at %g s)", ey, best >= 0 ? runs[best].label : "", o->times[last]);
+    snprintf(ymark, sizeof ymark, "equal error: %.3g (%s at %g s)", ey, best >= 0 ? runs[best].label : "",
+             o->times[last]);
     plot_desc pd = {title, "render time (s)", ylabel, 1, 1, series, num_runs, o->times[last], ey, xmark, ymark};
     return write_plot(dir, "error-vs-time", &pd);
 }
@@ -167,8 +170,8 @@ static int write_sweep_plot(const bench_options *o, const char *dir, const bench
     }
     if (ns == 0) return 0;
     char title[160], ylabel[96], stem[64];
-    snprintf(title, sizeof title, "Relative L2 error (%s) against %s, %g s each", bench_err_names[o->component], sw->name,
-             o->times[last]);
+    snprintf(title, sizeof title, "Relative L2 error (%s) against %s, %g s each", bench_err_names[o->component],
+             sw->name, o->times[last]);
     snprintf(ylabel, sizeof ylabel, "relative L2 error, %s", bench_err_names[o->component]);
     snprintf(stem, sizeof stem, "sweep-%s", sw->name);
     plot_desc pd = {title, sw->name, ylabel, pos, 1, series, ns, (double)NAN, (double)NAN, "", ""};
@@ -176,14 +179,19 @@ static int write_sweep_plot(const bench_options *o, const char *dir, const bench
 }
 
 static void md_error(FILE *f, double e) {
-    if (isnan(e)) fputs("–", f);
-    else if (isinf(e)) fputs("inf", f);
-    else fprintf(f, "%.4f", e);
+    if (isnan(e))
+        fputs("–", f);
+    else if (isinf(e))
+        fputs("inf", f);
+    else
+        fprintf(f, "%.4f", e);
 }
 
 static void md_slope(FILE *f, double slope) {
-    if (isfinite(slope)) fprintf(f, " %.2f |", slope);
-    else fputs(" – |", f);
+    if (isfinite(slope))
+        fprintf(f, " %.2f |", slope);
+    else
+        fputs(" – |", f);
 }
 
 static void report_header(FILE *f, const bench_options *o, const bench_ref *ref, const reference_info *want) {
@@ -210,8 +218,10 @@ static void report_header(FILE *f, const bench_options *o, const bench_ref *ref,
         fprintf(f, "- reference: `%s`, %s, %lld spp, %.0f s", o->ref_path, ref->info.method, ref->info.spp,
                 ref->info.seconds);
         if (ref->info.has_noise)
-            fprintf(f, "; its own noise, estimated from two halves of its frames: relative L2 %.4f (errors near "
-                       "that are the reference's, not the method's)", ref->info.rel_l2_noise);
+            fprintf(f,
+                    "; its own noise, estimated from two halves of its frames: relative L2 %.4f (errors near "
+                    "that are the reference's, not the method's)",
+                    ref->info.rel_l2_noise);
         fputs("\n", f);
     } else {
         fprintf(f, "- reference: `%s` without a sidecar (--force): scene, camera and size were not checked\n",
@@ -229,8 +239,10 @@ static void report_header(FILE *f, const bench_options *o, const bench_ref *ref,
 static void report_errors(FILE *f, const bench_options *o, const bench_run *runs, int num_runs) {
     const char *comp = bench_err_names[o->component];
     if (o->seeds > 1)
-        fprintf(f, "## Error at each time budget\n\nRMS over %d seeds of the relative L2 error (%s), mean frames in "
-                   "brackets.\n\n| method |", o->seeds, comp);
+        fprintf(f,
+                "## Error at each time budget\n\nRMS over %d seeds of the relative L2 error (%s), mean frames in "
+                "brackets.\n\n| method |",
+                o->seeds, comp);
     else
         fprintf(f, "## Error at each time budget\n\nRelative L2 error (%s), frames in brackets.\n\n| method |", comp);
     for (int k = 0; k < o->num_times; k++) fprintf(f, " %g s |", o->times[k]);
@@ -254,26 +266,32 @@ static void report_noise_bias(FILE *f, const bench_options *o, const bench_ref *
                               int num_runs) {
     if (o->seeds < 2) return;
     double rn = bench_ref_noise(ref, o->component);
-    fprintf(f, "\n## Noise and bias\n\nAt each budget the %d renders' error splits into the noise of one render "
-               "(their spread about their mean image M) and the bias: what is left of ‖M − R‖² once the mean's "
-               "noise (noise²/%d) and the reference's own noise r are taken off, clamped at 0. Relative to ‖R‖₂ "
-               "like the error, so RMS² = noise² + bias² + r² (exactly, unless the bias was clamped). Noise falls "
-               "as time^−0.5; a consistent estimator's bias falls too, a biased one's stays. With few seeds "
-               "the split is itself uncertain (fireflies above all): a bias well below the noise cannot be told "
-               "from 0, and more seeds narrow it. ",
+    fprintf(f,
+            "\n## Noise and bias\n\nAt each budget the %d renders' error splits into the noise of one render "
+            "(their spread about their mean image M) and the bias: what is left of ‖M − R‖² once the mean's "
+            "noise (noise²/%d) and the reference's own noise r are taken off, clamped at 0. Relative to ‖R‖₂ "
+            "like the error, so RMS² = noise² + bias² + r² (exactly, unless the bias was clamped). Noise falls "
+            "as time^−0.5; a consistent estimator's bias falls too, a biased one's stays. With few seeds "
+            "the split is itself uncertain (fireflies above all): a bias well below the noise cannot be told "
+            "from 0, and more seeds narrow it. ",
             o->seeds, o->seeds);
     if (o->component == ERR_ALL && ref->has_info && ref->info.has_noise)
         fprintf(f, "Here r = %.4f, from the reference's sidecar.\n", rn);
     else if (ref->has_info && ref->info.has_noise)
-        fprintf(f, "The sidecar records the reference's noise for the whole image only: for the %s component r is "
-                   "taken as 0, so the bias includes it.\n", bench_err_names[o->component]);
+        fprintf(f,
+                "The sidecar records the reference's noise for the whole image only: for the %s component r is "
+                "taken as 0, so the bias includes it.\n",
+                bench_err_names[o->component]);
     else
         fputs("The reference's own noise is not known (no estimate in its sidecar): r is taken as 0, so the bias "
-              "includes it.\n", f);
+              "includes it.\n",
+              f);
     for (int r = 0; r < num_runs; r++) {
         const bench_run *u = &runs[r];
-        fprintf(f, "\n### %s\n\n| budget | time | frames | RMS error | min – max | noise | bias |\n"
-                   "|---|---|---|---|---|---|---|\n", u->label);
+        fprintf(f,
+                "\n### %s\n\n| budget | time | frames | RMS error | min – max | noise | bias |\n"
+                "|---|---|---|---|---|---|---|\n",
+                u->label);
         for (int k = 0; k < u->num_points; k++) {
             fprintf(f, "| %g s | %.3g s | %.0f | ", o->times[k], u->seconds[k], u->frames[k]);
             md_error(f, u->rms[k]);
@@ -303,8 +321,10 @@ static void report_winners(FILE *f, const bench_options *o, const bench_run *run
         fprintf(f, "- %g s: **%s**, %.4f", o->times[k], runs[best].label, eb);
         if (second >= 0) {
             double es = err_at(&runs[second], k);
-            if (eb > 0.0) fprintf(f, ", %.2f× lower than the next, %s (%.4f)", es / eb, runs[second].label, es);
-            else fprintf(f, "; next %s (%.4f)", runs[second].label, es);
+            if (eb > 0.0)
+                fprintf(f, ", %.2f× lower than the next, %s (%.4f)", es / eb, runs[second].label, es);
+            else
+                fprintf(f, "; next %s (%.4f)", runs[second].label, es);
         }
         fputs("\n", f);
     }
@@ -313,9 +333,10 @@ static void report_winners(FILE *f, const bench_options *o, const bench_run *run
     int best = best_run(runs, num_runs, last);
     if (best < 0 || num_runs < 2) return;
     double eb = err_at(&runs[best], last), tb = runs[best].seconds[last];
-    fprintf(f, "\n## Equal error\n\nTime each curve needs to reach %.4f, the error of **%s** at %g s "
-               "(interpolated in log–log; `~` extrapolated along the curve's fitted slope).\n\n"
-               "| method | time to reach it | × %s's time |\n|---|---|---|\n",
+    fprintf(f,
+            "\n## Equal error\n\nTime each curve needs to reach %.4f, the error of **%s** at %g s "
+            "(interpolated in log–log; `~` extrapolated along the curve's fitted slope).\n\n"
+            "| method | time to reach it | × %s's time |\n|---|---|---|\n",
             eb, runs[best].label, o->times[last], runs[best].label);
     for (int r = 0; r < num_runs; r++) {
         const bench_run *u = &runs[r];
@@ -328,8 +349,10 @@ static void report_winners(FILE *f, const bench_options *o, const bench_run *run
                 approx = "~";
             }
         }
-        if (isfinite(t)) fprintf(f, "| %s | %s%.3g s | %s%.2f |\n", u->label, approx, t, approx, t / tb);
-        else fprintf(f, "| %s | not reached (the curve does not fall) | – |\n", u->label);
+        if (isfinite(t))
+            fprintf(f, "| %s | %s%.3g s | %s%.2f |\n", u->label, approx, t, approx, t / tb);
+        else
+            fprintf(f, "| %s | not reached (the curve does not fall) | – |\n", u->label);
     }
 }
 
@@ -337,15 +360,20 @@ static void report_winners(FILE *f, const bench_options *o, const bench_run *run
  * still falling at the end?) and, with several seeds, of the noise and the bias. */
 static void report_convergence(FILE *f, const bench_options *o, const bench_run *runs, int num_runs) {
     const int last = o->num_times - 1, tail = metric_last_doubling(o->times, o->num_times), split = o->seeds > 1;
-    fprintf(f, "\n## Convergence\n\nSlope of each curve%s in log–log, least squares over the budgets: unbiased "
-               "Monte Carlo falls as time^−0.5; a flatter curve is dominated by bias (or by the reference's own "
-               "noise).", split ? " (the RMS over seeds)" : "");
+    fprintf(f,
+            "\n## Convergence\n\nSlope of each curve%s in log–log, least squares over the budgets: unbiased "
+            "Monte Carlo falls as time^−0.5; a flatter curve is dominated by bias (or by the reference's own "
+            "noise).",
+            split ? " (the RMS over seeds)" : "");
     if (tail > 0)
-        fprintf(f, " The slope over the last doubling of the time, %g s to %g s, tells whether the error still "
-                   "falls at the end (negative: it does).", o->times[tail], o->times[last]);
+        fprintf(f,
+                " The slope over the last doubling of the time, %g s to %g s, tells whether the error still "
+                "falls at the end (negative: it does).",
+                o->times[tail], o->times[last]);
     if (split)
         fputs(" Noise and bias: the slopes of the two parts of the split over all budgets (budgets where the "
-              "bias is 0 left out).", f);
+              "bias is 0 left out).",
+              f);
     fputs("\n\n| method | slope |", f);
     if (tail > 0) fprintf(f, " %g–%g s |", o->times[tail], o->times[last]);
     if (split) fputs(" noise | bias |", f);
@@ -358,9 +386,9 @@ static void report_convergence(FILE *f, const bench_options *o, const bench_run 
         fprintf(f, "| %s |", u->label);
         md_slope(f, metric_loglog_slope(u->seconds, u->rms, u->num_points));
         if (tail > 0)
-            md_slope(f, u->num_points > tail ? metric_loglog_slope(u->seconds + tail, u->rms + tail,
-                                                                   u->num_points - tail)
-                                             : (double)NAN);
+            md_slope(f, u->num_points > tail
+                            ? metric_loglog_slope(u->seconds + tail, u->rms + tail, u->num_points - tail)
+                            : (double)NAN);
         if (split) {
             md_slope(f, metric_loglog_slope(u->seconds, u->noise, u->num_points));
             md_slope(f, metric_loglog_slope(u->seconds, u->bias, u->num_points));
@@ -400,8 +428,8 @@ static void report_sweeps(FILE *f, const bench_options *o, const bench_run *runs
     }
 }
 
-static int write_report(const bench_options *o, const char *dir, const bench_ref *ref,
-                        const reference_info *want, const bench_run *runs, int num_runs) {
+static int write_report(const bench_options *o, const char *dir, const bench_ref *ref, const reference_info *want,
+                        const bench_run *runs, int num_runs) {
     char *buf = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&buf, &size);
@@ -417,7 +445,8 @@ static int write_report(const bench_options *o, const char *dir, const bench_ref
           "noise and bias, the reference's own noise, the least and largest rel_l2\n"
           "- `error-vs-time.svg`, `error-vs-time.png`: the curves (log–log); squares mark the equal-time "
           "reading at the last budget, diamonds the equal-error reading (the PNG's legend is numbered in the "
-          "SVG's order)\n\n![error against time](error-vs-time.svg)\n", f);
+          "SVG's order)\n\n![error against time](error-vs-time.svg)\n",
+          f);
     return write_text(f, &buf, &size, dir, "report.md", WRITE_NO_REPLACE);
 }
 

@@ -73,9 +73,12 @@ int cli_parse_float(const char *option, const char *text, double lo, double hi, 
 }
 
 int cli_parse_plan(const char *option, const char *text, int *plan) {
-    if (strcmp(text, "auto") == 0) *plan = PLAN_AUTO;
-    else if (strcmp(text, "full") == 0) *plan = PLAN_FULL;
-    else return cli_error("%s: expected auto or full, got '%s'", option, text), -1;
+    if (strcmp(text, "auto") == 0)
+        *plan = PLAN_AUTO;
+    else if (strcmp(text, "full") == 0)
+        *plan = PLAN_FULL;
+    else
+        return cli_error("%s: expected auto or full, got '%s'", option, text), -1;
     return 0;
 }
 
@@ -110,7 +113,8 @@ void cli_print_scenes(void) {
     int n;
     const builtin_scene *b = scene_builtins(&n);
     printf("SCENE is a glTF 2.0 file (.gltf or .glb) or builtin:NAME, one of the scenes compiled into\n"
-           "the program; without one, builtin:%s. The built-in scenes:\n", b[0].name);
+           "the program; without one, builtin:%s. The built-in scenes:\n",
+           b[0].name);
     for (int i = 0; i < n; i++) printf("  %-10s %s\n", b[i].name, b[i].description);
 }
 
@@ -164,9 +168,12 @@ double cli_now(void) {
 int cli_check_output_dir(const char *option, const char *path) {
     char dir[4096];
     const char *slash = strrchr(path, '/');
-    if (!slash) snprintf(dir, sizeof dir, ".");
-    else if (slash == path) snprintf(dir, sizeof dir, "/");
-    else snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (slash == path)
+        snprintf(dir, sizeof dir, "/");
+    else
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     if (access(dir, W_OK | X_OK) != 0) {
         cli_error("%s: %s: cannot write into directory '%s' (%s)", option, path, dir, strerror(errno));
         return -1;

@@ -79,13 +79,16 @@ static int ref_load(const bench_options *o, bench_ref *r) {
     if (st > 0 && !o->force) {
         ref_free(r);
         return cli_error("%s: no sidecar %s, so its scene, camera and size are unknown (render references with "
-                         "glint render --out; --force uses it anyway)", o->ref_path, side), -1;
+                         "glint render --out; --force uses it anyway)",
+                         o->ref_path, side),
+               -1;
     }
     r->has_info = st == 0;
     if (r->has_info && (r->info.width != r->width || r->info.height != r->height)) {
         ref_free(r);
         return cli_error("%s: the image is %dx%d but its sidecar says %dx%d", o->ref_path, r->width, r->height,
-                         r->info.width, r->info.height), -1;
+                         r->info.width, r->info.height),
+               -1;
     }
     return 0;
 }
@@ -122,8 +125,8 @@ static void measure(meter *m, const render_session *rs, bench_point *pt, int k) 
 }
 
 /* Renders run with its seed-th seed, measuring at every budget. */
-static int render_seed(const bench_options *o, const scene *s, const camera *cam, meter *m, bench_run *run,
-                       int seed, int index, int total) {
+static int render_seed(const bench_options *o, const scene *s, const camera *cam, meter *m, bench_run *run, int seed,
+                       int index, int total) {
     char err[1024];
     render_params params = run->params;
     params.seed = run->params.seed + (uint64_t)seed;
@@ -151,9 +154,10 @@ static int render_seed(const bench_options *o, const scene *s, const camera *cam
         if (o->quiet) continue;
         char which[64] = "";
         if (o->seeds > 1)
-            snprintf(which, sizeof which, ", seed %llu (%d of %d)", (unsigned long long)params.seed, seed + 1, o->seeds);
-        fprintf(stderr, "glint: bench %d/%d %s%s: %.2f s, %lld frames, %s rel. L2 %.4g\n", index + 1, total,
-                run->label, which, rendered, pt->frames, bench_err_names[o->component], pt->rel_l2[o->component]);
+            snprintf(which, sizeof which, ", seed %llu (%d of %d)", (unsigned long long)params.seed, seed + 1,
+                     o->seeds);
+        fprintf(stderr, "glint: bench %d/%d %s%s: %.2f s, %lld frames, %s rel. L2 %.4g\n", index + 1, total, run->label,
+                which, rendered, pt->frames, bench_err_names[o->component], pt->rel_l2[o->component]);
     }
     session_destroy(rs);
     return 0;
@@ -233,7 +237,8 @@ static int prepare_dir(const bench_options *o, char *dir, size_t dirlen) {
             snprintf(p, sizeof p, "%.4096s/%.64s", dir, names[k]);
             if (lstat(p, &st) == 0)
                 return cli_error("--out: %s: already holds %s (nothing is overwritten; choose another directory)", dir,
-                                 names[k]), -1;
+                                 names[k]),
+                       -1;
         }
         if (access(dir, W_OK | X_OK) != 0) return cli_error("--out: %s: not writable (%s)", dir, strerror(errno)), -1;
         return 0;
@@ -303,9 +308,11 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     if (have && have->seed - base.seed < (uint64_t)o->seeds) {
         if (o->seeds == 1)
             return cli_error("--seed %llu: is the reference's seed; the bench would repeat its samples",
-                             (unsigned long long)base.seed), EXIT_USAGE;
+                             (unsigned long long)base.seed),
+                   EXIT_USAGE;
         return cli_error("--seeds %d: the seeds %llu to %llu hold the reference's seed %llu; the bench would repeat "
-                         "its samples (choose another --seed)", o->seeds, (unsigned long long)base.seed,
+                         "its samples (choose another --seed)",
+                         o->seeds, (unsigned long long)base.seed,
                          (unsigned long long)(base.seed + (uint64_t)o->seeds - 1), (unsigned long long)have->seed),
                EXIT_USAGE;
     }
@@ -315,8 +322,8 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     double split_bytes = o->seeds > 1 ? (double)values * sizeof(double) * o->num_times : 0.0;
     if (split_bytes > MAX_SPLIT_BYTES)
         return cli_error("--seeds %d: the noise and bias split keeps a %dx%d image of doubles per budget, %.0f MiB for "
-                         "%d budgets, more than %.0f MiB (use fewer --times or a smaller size)", o->seeds, width,
-                         height, split_bytes / (1 << 20), o->num_times, MAX_SPLIT_BYTES / (1 << 20)),
+                         "%d budgets, more than %.0f MiB (use fewer --times or a smaller size)",
+                         o->seeds, width, height, split_bytes / (1 << 20), o->num_times, MAX_SPLIT_BYTES / (1 << 20)),
                EXIT_USAGE;
     if (o->component != ERR_ALL && !ref->layer[o->component])
         return cli_error("%s: no %s layer%s", o->ref_path, bench_err_names[o->component],
@@ -331,7 +338,8 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
                          num_runs, o->seeds, num_runs * o->seeds, MAX_RENDERS),
                EXIT_USAGE;
 
-    scene *s = load_scene_or_default(o->scene_path, o->env_path, (float)(o->env_rotation_deg * 3.14159265358979 / 180.0));
+    scene *s =
+        load_scene_or_default(o->scene_path, o->env_path, (float)(o->env_rotation_deg * 3.14159265358979 / 180.0));
     if (!s) return EXIT_FAILURE_;
     if (cam_index >= s->num_cameras && !(cam_index == -1)) {
         cli_error("%s: --camera %d: the scene has %d camera%s", s->path, cam_index, s->num_cameras,

@@ -18,7 +18,7 @@
 typedef struct {
     const char *scene_path;
     render_params params;
-    long long spp;      /* frames to render; 0 with seconds > 0 means "until time is up" */
+    long long spp; /* frames to render; 0 with seconds > 0 means "until time is up" */
     double seconds;
     const char *env_path;
     double env_rotation_deg;
@@ -110,7 +110,8 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
     if (spp_given && time_given) return cli_error("--spp and --time exclude each other"), -1;
     if (o->params.pt_highlights && o->params.method != METHOD_PT && o->params.method != METHOD_VSL_HL)
         return cli_error("--highlights-layer: only pt and vsl+hl split highlights off (vpl and vsl count them "
-                         "as indirect)"), -1;
+                         "as indirect)"),
+               -1;
     if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
     return 0;
 }
@@ -129,10 +130,11 @@ static void progress_update(progress *pg, const render_options *o, long long fra
     if (pg->tty) {
         if (!final && now - pg->last < 0.1) return;
         if (o->spp > 0)
-            fprintf(stderr, "\r\033[Kglint: frame %lld/%lld  %lld spp  %.1f s elapsed  %.1f s left", frames, o->spp, frames,
-                    elapsed, left);
+            fprintf(stderr, "\r\033[Kglint: frame %lld/%lld  %lld spp  %.1f s elapsed  %.1f s left", frames, o->spp,
+                    frames, elapsed, left);
         else
-            fprintf(stderr, "\r\033[Kglint: frame %lld  %lld spp  %.1f s elapsed  %.1f s left", frames, frames, elapsed, left);
+            fprintf(stderr, "\r\033[Kglint: frame %lld  %lld spp  %.1f s elapsed  %.1f s left", frames, frames, elapsed,
+                    left);
         if (final) fputc('\n', stderr);
     } else {
         if (!final && now - pg->last < 5.0) return;
@@ -168,8 +170,8 @@ static int write_stats(const char *path, const render_options *o, const render_s
     fprintf(f, "  \"rejected_samples\": %llu", (unsigned long long)st.rejected_samples);
     if (p->method != METHOD_PT) {
         const vl_params vp = vl_params_resolve(&p->vl); /* the values the frames used */
-        fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"virtual_lights_total\": %llu,\n",
-                vp.count, (unsigned long long)st.virtual_lights);
+        fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"virtual_lights_total\": %llu,\n", vp.count,
+                (unsigned long long)st.virtual_lights);
         fprintf(f, "  \"light_paths_total\": %llu,\n  \"connections\": %llu,\n  \"vsl_samples\": %llu,\n",
                 (unsigned long long)st.light_paths, (unsigned long long)st.vl_connections,
                 (unsigned long long)st.vsl_samples);
@@ -180,7 +182,10 @@ static int write_stats(const char *path, const render_options *o, const render_s
     if (p->method == METHOD_VSL_HL) {
         hl_setup hl = hl_setup_from(s, &p->vl, NULL);
         fprintf(f, ",\n  \"highlights\": {\"secondary_rays\": %d, \"clusters\": %d, \"merge\": %s, ", hl.secondary_rays,
-                hl.clusters, hl.mode == HL_MERGED ? "\"on\"" : hl.mode == HL_UNMERGED ? "\"off\"" : "\"trace\"");
+                hl.clusters,
+                hl.mode == HL_MERGED     ? "\"on\""
+                : hl.mode == HL_UNMERGED ? "\"off\""
+                                         : "\"trace\"");
         fprintf(f, "\"points\": %llu, \"secondary_rays_total\": %llu, \"lobes_lit\": %llu, \"merge_seconds\": %.6f, ",
                 (unsigned long long)st.hl_points, (unsigned long long)st.hl_secondary_rays,
                 (unsigned long long)st.hl_lobes, 1e-9 * (double)st.hl_merge_ns);
@@ -188,8 +193,9 @@ static int write_stats(const char *path, const render_options *o, const render_s
     }
     /* The effect plan and what each pass cost: a skipped pass shows zero seconds. */
     const effect_plan *plan = session_plan(rs);
-    fprintf(f, ",\n  \"plan\": {\"mode\": \"%s\", \"max_depth\": %d, \"virtual_lights\": %s, "
-               "\"vsl_all_strategies\": %s, \"highlights\": %s, \"env_prefilter\": %s},\n",
+    fprintf(f,
+            ",\n  \"plan\": {\"mode\": \"%s\", \"max_depth\": %d, \"virtual_lights\": %s, "
+            "\"vsl_all_strategies\": %s, \"highlights\": %s, \"env_prefilter\": %s},\n",
             plan->full ? "full" : "auto", plan->max_depth, plan->virtual_lights ? "true" : "false",
             plan->vsl_all_strategies ? "true" : "false", plan->highlights ? "true" : "false",
             plan->env_prefilter ? "true" : "false");
@@ -279,7 +285,8 @@ int cmd_render(int argc, char **argv) {
     render_options o;
     int parsed = parse_render_options(argc, argv, &o);
     if (parsed != 0) return parsed > 0 ? EXIT_OK : EXIT_USAGE;
-    if ((o.out_exr && cli_check_output_dir("--out", o.out_exr)) || (o.out_png && cli_check_output_dir("--png", o.out_png)) ||
+    if ((o.out_exr && cli_check_output_dir("--out", o.out_exr)) ||
+        (o.out_png && cli_check_output_dir("--png", o.out_png)) ||
         (o.out_stats && cli_check_output_dir("--stats", o.out_stats)))
         return EXIT_FAILURE_;
 

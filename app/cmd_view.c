@@ -80,7 +80,8 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         } else if (strcmp(a, "--tonemap") == 0) {
             if (!(v = cli_value(argc, argv, &i))) return -1;
             if ((o->tonemap = tonemap_from_name(v)) < 0)
-                return cli_error("--tonemap: unknown tone mapper '%s' (available: reinhard, clamp, exponential)", v), -1;
+                return cli_error("--tonemap: unknown tone mapper '%s' (available: reinhard, clamp, exponential)", v),
+                       -1;
         } else if (cli_scene_argument("view", a, &o->scene_path) != 0) {
             return -1;
         }

@@ -37,7 +37,8 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "view") == 0) return cmd_view(argc - 2, argv + 2);
     /* `glint SCENE [options]` and `glint --option ...` open the viewer too. */
     struct stat st;
-    if (argv[1][0] == '-' || stat(argv[1], &st) == 0 || scene_builtin_name(argv[1])) return cmd_view(argc - 1, argv + 1);
+    if (argv[1][0] == '-' || stat(argv[1], &st) == 0 || scene_builtin_name(argv[1]))
+        return cmd_view(argc - 1, argv + 1);
     cli_error("unknown command or missing scene file '%s' (see glint --help)", argv[1]);
     return EXIT_USAGE;
 }

@@ -15,8 +15,8 @@
 enum { FIG_W = 860, FIG_H = 500, AREA_X0 = 80, AREA_X1 = 580, AREA_Y0 = 40, AREA_Y1 = 430, LEGEND_X = 600 };
 
 /* Tableau 10: distinct on white, and for the common kinds of colour blindness. */
-static const uint8_t palette[10][3] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
-                                       {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127},
+static const uint8_t palette[10][3] = {{31, 119, 180},  {255, 127, 14}, {44, 160, 44},   {214, 39, 40},
+                                       {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127},
                                        {188, 189, 34},  {23, 190, 207}};
 
 typedef struct {
@@ -62,8 +62,10 @@ static void axis_fit(axis *a, int log, double vmin, double vmax) {
             for (int m = 1; m <= 9; m++) {
                 double t = d + log10((double)m);
                 if (t < a->lo - 1e-9 || t > a->hi + 1e-9) continue;
-                if ((m == 1 || (few && (m == 2 || m == 5))) && a->num_ticks < 64) a->ticks[a->num_ticks++] = t;
-                else if (a->num_minor < 256) a->minor[a->num_minor++] = t;
+                if ((m == 1 || (few && (m == 2 || m == 5))) && a->num_ticks < 64)
+                    a->ticks[a->num_ticks++] = t;
+                else if (a->num_minor < 256)
+                    a->minor[a->num_minor++] = t;
             }
     } else {
         double span = vmax - vmin;
@@ -74,9 +76,12 @@ static void axis_fit(axis *a, int log, double vmin, double vmax) {
             span = vmax - vmin;
         }
         double raw = span / 5.0, mag = pow(10.0, floor(log10(raw))), step = mag;
-        if (raw / mag > 5.0) step = 10.0 * mag;
-        else if (raw / mag > 2.0) step = 5.0 * mag;
-        else if (raw / mag > 1.0) step = 2.0 * mag;
+        if (raw / mag > 5.0)
+            step = 10.0 * mag;
+        else if (raw / mag > 2.0)
+            step = 5.0 * mag;
+        else if (raw / mag > 1.0)
+            step = 2.0 * mag;
         a->lo = floor(vmin / step) * step;
         a->hi = ceil(vmax / step) * step;
         for (double t = a->lo; t <= a->hi + 0.5 * step && a->num_ticks < 64; t += step) a->ticks[a->num_ticks++] = t;
@@ -137,11 +142,16 @@ static int mark_label_left(double X, const char *label) {
 
 static void xml_text(FILE *f, const char *s) {
     for (; s && *s; s++) {
-        if (*s == '<') fputs("&lt;", f);
-        else if (*s == '>') fputs("&gt;", f);
-        else if (*s == '&') fputs("&amp;", f);
-        else if (*s == '"') fputs("&quot;", f);
-        else fputc(*s, f);
+        if (*s == '<')
+            fputs("&lt;", f);
+        else if (*s == '>')
+            fputs("&gt;", f);
+        else if (*s == '&')
+            fputs("&amp;", f);
+        else if (*s == '"')
+            fputs("&quot;", f);
+        else
+            fputc(*s, f);
     }
 }
 
@@ -155,8 +165,10 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
         snprintf(err, errlen, "%s: out of memory", path);
         return -1;
     }
-    fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" "
-               "font-family=\"sans-serif\" font-size=\"12\">\n", FIG_W, FIG_H, FIG_W, FIG_H);
+    fprintf(f,
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" "
+            "font-family=\"sans-serif\" font-size=\"12\">\n",
+            FIG_W, FIG_H, FIG_W, FIG_H);
     fprintf(f, "<rect width=\"%d\" height=\"%d\" fill=\"white\"/>\n", FIG_W, FIG_H);
     /* grid and ticks */
     for (int k = 0; k < l.x.num_minor; k++) {
@@ -172,21 +184,24 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
         double X = px(&l, tick_value(&l.x, l.x.ticks[k]));
         tick_text(&l.x, l.x.ticks[k], t, sizeof t);
         fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#d8d8d8\"/>\n", X, AREA_Y0, X, AREA_Y1);
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"black\"/>\n", X, AREA_Y1, X, AREA_Y1 + 5);
+        fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"black\"/>\n", X, AREA_Y1, X,
+                AREA_Y1 + 5);
         fprintf(f, "<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", X, AREA_Y1 + 19, t);
     }
     for (int k = 0; k < l.y.num_ticks; k++) {
         double Y = py(&l, tick_value(&l.y, l.y.ticks[k]));
         tick_text(&l.y, l.y.ticks[k], t, sizeof t);
         fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#d8d8d8\"/>\n", AREA_X0, Y, AREA_X1, Y);
-        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"black\"/>\n", AREA_X0 - 5, Y, AREA_X0, Y);
+        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"black\"/>\n", AREA_X0 - 5, Y, AREA_X0,
+                Y);
         fprintf(f, "<text x=\"%d\" y=\"%.1f\" text-anchor=\"end\">%s</text>\n", AREA_X0 - 8, Y + 4, t);
     }
     fprintf(f, "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n", AREA_X0,
             AREA_Y0, AREA_X1 - AREA_X0, AREA_Y1 - AREA_Y0);
     fprintf(f, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">", (AREA_X0 + AREA_X1) / 2, AREA_Y1 + 42);
     xml_text(f, p->x_label);
-    fprintf(f, "</text>\n<text transform=\"translate(22 %d) rotate(-90)\" text-anchor=\"middle\">", (AREA_Y0 + AREA_Y1) / 2);
+    fprintf(f, "</text>\n<text transform=\"translate(22 %d) rotate(-90)\" text-anchor=\"middle\">",
+            (AREA_Y0 + AREA_Y1) / 2);
     xml_text(f, p->y_label);
     fprintf(f, "</text>\n<text x=\"%d\" y=\"24\" text-anchor=\"middle\" font-size=\"14\">", (AREA_X0 + AREA_X1) / 2);
     xml_text(f, p->title);
@@ -198,8 +213,8 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
         fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#555\" stroke-dasharray=\"6 4\"/>\n", X,
                 AREA_Y0, X, AREA_Y1);
         int left = mark_label_left(X, p->mark_x_label);
-        fprintf(f, "<text x=\"%.1f\" y=\"%d\" font-size=\"11\" fill=\"#555\"%s>", left ? X - 4 : X + 4,
-                AREA_Y0 + 12, left ? " text-anchor=\"end\"" : "");
+        fprintf(f, "<text x=\"%.1f\" y=\"%d\" font-size=\"11\" fill=\"#555\"%s>", left ? X - 4 : X + 4, AREA_Y0 + 12,
+                left ? " text-anchor=\"end\"" : "");
         xml_text(f, p->mark_x_label);
         fputs("</text>\n", f);
     }
@@ -237,16 +252,20 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
         fputs("\"/>\n", f);
         for (int i = 0; i < se->n; i++)
             if (in_area(&l, se->x[i], se->y[i]))
-                fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", px(&l, se->x[i]), py(&l, se->y[i]),
-                        col);
+                fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", px(&l, se->x[i]),
+                        py(&l, se->y[i]), col);
         double yx = cross_x(se, p->mark_x), xy = cross_y(se, p->mark_y);
         if (in_area(&l, p->mark_x, yx))
-            fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"9\" height=\"9\" fill=\"white\" stroke=\"%s\" "
-                       "stroke-width=\"2\"/>\n", px(&l, p->mark_x) - 4.5, py(&l, yx) - 4.5, col);
+            fprintf(f,
+                    "<rect x=\"%.1f\" y=\"%.1f\" width=\"9\" height=\"9\" fill=\"white\" stroke=\"%s\" "
+                    "stroke-width=\"2\"/>\n",
+                    px(&l, p->mark_x) - 4.5, py(&l, yx) - 4.5, col);
         if (in_area(&l, xy, p->mark_y)) {
             double X = px(&l, xy), Y = py(&l, p->mark_y);
-            fprintf(f, "<polygon points=\"%.1f,%.1f %.1f,%.1f %.1f,%.1f %.1f,%.1f\" fill=\"white\" stroke=\"%s\" "
-                       "stroke-width=\"2\"/>\n", X, Y - 6, X + 6, Y, X, Y + 6, X - 6, Y, col);
+            fprintf(f,
+                    "<polygon points=\"%.1f,%.1f %.1f,%.1f %.1f,%.1f %.1f,%.1f\" fill=\"white\" stroke=\"%s\" "
+                    "stroke-width=\"2\"/>\n",
+                    X, Y - 6, X + 6, Y, X, Y + 6, X - 6, Y, col);
         }
         /* legend entry */
         int ly = AREA_Y0 + 10 + 20 * s;
@@ -259,13 +278,17 @@ int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *e
     }
     int ly = AREA_Y0 + 10 + 20 * p->num_series + 10;
     if (isfinite(p->mark_x))
-        fprintf(f, "<rect x=\"%d\" y=\"%d\" width=\"9\" height=\"9\" fill=\"white\" stroke=\"#555\" stroke-width=\"2\"/>"
-                   "<text x=\"%d\" y=\"%d\" fill=\"#555\">equal time</text>\n", LEGEND_X + 8, ly - 4, LEGEND_X + 30, ly + 4),
+        fprintf(f,
+                "<rect x=\"%d\" y=\"%d\" width=\"9\" height=\"9\" fill=\"white\" stroke=\"#555\" stroke-width=\"2\"/>"
+                "<text x=\"%d\" y=\"%d\" fill=\"#555\">equal time</text>\n",
+                LEGEND_X + 8, ly - 4, LEGEND_X + 30, ly + 4),
             ly += 20;
     if (isfinite(p->mark_y))
-        fprintf(f, "<polygon points=\"%d,%d %d,%d %d,%d %d,%d\" fill=\"white\" stroke=\"#555\" stroke-width=\"2\"/>"
-                   "<text x=\"%d\" y=\"%d\" fill=\"#555\">equal error</text>\n", LEGEND_X + 12, ly - 6, LEGEND_X + 18, ly,
-                LEGEND_X + 12, ly + 6, LEGEND_X + 6, ly, LEGEND_X + 30, ly + 4);
+        fprintf(f,
+                "<polygon points=\"%d,%d %d,%d %d,%d %d,%d\" fill=\"white\" stroke=\"#555\" stroke-width=\"2\"/>"
+                "<text x=\"%d\" y=\"%d\" fill=\"#555\">equal error</text>\n",
+                LEGEND_X + 12, ly - 6, LEGEND_X + 18, ly, LEGEND_X + 12, ly + 6, LEGEND_X + 6, ly, LEGEND_X + 30,
+                ly + 4);
     fputs("</svg>\n", f);
     fclose(f);
     int status = write_file_atomic(path, buf, size, mode, err, errlen);

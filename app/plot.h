@@ -11,7 +11,7 @@
 typedef struct {
     const char *label;
     int n;
-    const double *x, *y; /* points with a non-positive or non-finite coordinate on a log axis are skipped */
+    const double *x, *y;   /* points with a non-positive or non-finite coordinate on a log axis are skipped */
     const double *lo, *hi; /* optional: a light band from lo to hi at each x; NULL for none */
 } plot_series;
 

@@ -89,9 +89,12 @@ void reference_json_string(FILE *f, const char *s) {
     fputc('"', f);
     for (; *s; s++) {
         unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
-        else if (c < 0x20) fprintf(f, "\\u%04x", c);
-        else fputc(c, f);
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
     }
     fputc('"', f);
 }
@@ -125,8 +128,9 @@ int reference_save(const char *path, const reference_info *r, char *err, size_t 
             r->seconds, r->max_depth);
     fprintf(f, "  \"seed\": %llu,\n  \"threads\": %d,\n", (unsigned long long)r->seed, r->threads);
     if (r->has_noise)
-        fprintf(f, "  \"variance\": {\"mean_pixel_variance\": %.9g, \"rel_l2_noise\": %.9g, "
-                   "\"estimate\": \"two halves of the frames\"}\n}\n",
+        fprintf(f,
+                "  \"variance\": {\"mean_pixel_variance\": %.9g, \"rel_l2_noise\": %.9g, "
+                "\"estimate\": \"two halves of the frames\"}\n}\n",
                 r->mean_variance, r->rel_l2_noise);
     else
         fprintf(f, "  \"variance\": null\n}\n");
@@ -249,7 +253,7 @@ int reference_load(const char *path, reference_info *r, char *err, size_t errlen
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
     const char *missing = NULL;
     long long ll = 0;
-#define NEED(ok, key) \
+#define NEED(ok, key)                                                                                                  \
     if (!missing && !(ok)) missing = key
     NEED(cJSON_GetObjectItemCaseSensitive(root, "glint_reference") != NULL, "glint_reference");
     NEED(json_str(root, "scene", r->scene, sizeof r->scene) == 0, "scene");
@@ -341,8 +345,8 @@ void reference_noise_finish(reference_noise *rn, const render_session *rs, refer
     }
     if (best < 0) return;
     film_resolve(session_film(rs), COMP_MASK_ALL, rn->scratch);
-    info->mean_variance =
-        metric_mean_variance_halves(rn->snap[best], rn->scratch, rn->n, rn->snap_frames[best], total, &info->rel_l2_noise);
+    info->mean_variance = metric_mean_variance_halves(rn->snap[best], rn->scratch, rn->n, rn->snap_frames[best], total,
+                                                      &info->rel_l2_noise);
     info->has_noise = 1;
 }
 
@@ -356,9 +360,9 @@ int reference_check(const char *ref, const reference_info *have, const reference
         return fail(err, errlen, "%s: rendered from another scene ('%s', %s), not '%s' (%s)", ref, have->scene,
                     have->scene_hash, want->scene, want->scene_hash);
     if (strcmp(have->env_hash, want->env_hash) != 0)
-        return fail(err, errlen, "%s: rendered with environment %s%s%s, not %s%s%s", ref,
-                    have->env[0] ? "'" : "", have->env[0] ? have->env : "none", have->env[0] ? "'" : "",
-                    want->env[0] ? "'" : "", want->env[0] ? want->env : "none", want->env[0] ? "'" : "");
+        return fail(err, errlen, "%s: rendered with environment %s%s%s, not %s%s%s", ref, have->env[0] ? "'" : "",
+                    have->env[0] ? have->env : "none", have->env[0] ? "'" : "", want->env[0] ? "'" : "",
+                    want->env[0] ? want->env : "none", want->env[0] ? "'" : "");
     if (fabs(have->env_rotation - want->env_rotation) > 1e-6)
         return fail(err, errlen, "%s: rendered with --env-rotation %g, not %g", ref, have->env_rotation,
                     want->env_rotation);
@@ -370,9 +374,10 @@ int reference_check(const char *ref, const reference_info *have, const reference
     const camera *a = &have->cam, *b = &want->cam;
     if (!near3(a->position, b->position) || !near3(a->right, b->right) || !near3(a->up, b->up) ||
         !near3(a->forward, b->forward) || !near(a->yfov, b->yfov))
-        return fail(err, errlen, "%s: camera %d has moved since the reference was rendered (position %g %g %g, "
-                                 "now %g %g %g)", ref, have->camera_index, (double)a->position.x,
-                    (double)a->position.y, (double)a->position.z, (double)b->position.x, (double)b->position.y,
-                    (double)b->position.z);
+        return fail(err, errlen,
+                    "%s: camera %d has moved since the reference was rendered (position %g %g %g, "
+                    "now %g %g %g)",
+                    ref, have->camera_index, (double)a->position.x, (double)a->position.y, (double)a->position.z,
+                    (double)b->position.x, (double)b->position.y, (double)b->position.z);
     return 0;
 }

@@ -11,17 +11,17 @@
 #include "session.h"
 
 typedef struct {
-    char scene[1024];      /* as given on the command line, "builtin:NAME" for a built-in scene */
-    char scene_hash[64];   /* "fnv1a64:..." of the file's bytes, "builtin:NAME:fnv1a64:..." */
-    char env[1024];        /* "" without an environment map */
+    char scene[1024];    /* as given on the command line, "builtin:NAME" for a built-in scene */
+    char scene_hash[64]; /* "fnv1a64:..." of the file's bytes, "builtin:NAME:fnv1a64:..." */
+    char env[1024];      /* "" without an environment map */
     char env_hash[64];
-    double env_rotation;   /* degrees */
-    int camera_index;      /* -1: the scene's first camera or the framing view */
-    camera cam;            /* the camera actually rendered from */
+    double env_rotation; /* degrees */
+    int camera_index;    /* -1: the scene's first camera or the framing view */
+    camera cam;          /* the camera actually rendered from */
     int width, height;
     char method[16];
-    int highlights_layer;  /* the EXR has a highlights.* layer */
-    long long spp;         /* = frames: one sample per pixel per frame */
+    int highlights_layer; /* the EXR has a highlights.* layer */
+    long long spp;        /* = frames: one sample per pixel per frame */
     double seconds;
     int max_depth;
     uint64_t seed;
@@ -29,8 +29,8 @@ typedef struct {
     /* Noise of the reference itself, from two halves of its frames (reference_noise()); has_noise
      * is 0 when it rendered a single frame. */
     int has_noise;
-    double mean_variance;  /* mean over pixels and channels of the variance of the pixel mean */
-    double rel_l2_noise;   /* expected relative L2 error of the reference against the truth */
+    double mean_variance; /* mean over pixels and channels of the variance of the pixel mean */
+    double rel_l2_noise;  /* expected relative L2 error of the reference against the truth */
 } reference_info;
 
 /* The content hash of a scene or environment file (FNV-1a 64 of its bytes; for builtin:NAME,
@@ -62,7 +62,7 @@ int reference_load(const char *path, reference_info *info, char *err, size_t err
  * power-of-two frame counts, so the finish uses a split of the frames between 1/2 and 3/4 (no
  * cost on the hot path: log2(frames) resolves). */
 typedef struct {
-    float *snap[2];        /* the last two snapshots, at frames snap_frames[k] */
+    float *snap[2]; /* the last two snapshots, at frames snap_frames[k] */
     long long snap_frames[2];
     float *scratch;
     size_t n;

@@ -31,9 +31,9 @@
 #include "view_script.h"
 
 #define MAX_VIEW_CAMERAS 32
-#define MAX_LIGHT_GROUPS 64    /* lights the viewer lists and edits; more are rendered, not listed */
-#define MAX_CURVES 6           /* error curves kept for comparison */
-#define MAX_CURVE_POINTS 512   /* per curve; halved (every other point) when full */
+#define MAX_LIGHT_GROUPS 64  /* lights the viewer lists and edits; more are rendered, not listed */
+#define MAX_CURVES 6         /* error curves kept for comparison */
+#define MAX_CURVE_POINTS 512 /* per curve; halved (every other point) when full */
 
 static inline double seconds_since(double t) { return cli_now() - t; }
 
@@ -65,18 +65,18 @@ typedef struct {
  * copies them as a whole with each image it takes. */
 typedef struct {
     uint64_t frames_generation; /* the request generation those frames show */
-    long long frames;        /* full-resolution frames since the last reset */
-    uint64_t frames_total;   /* full-resolution frames ever */
+    long long frames;           /* full-resolution frames since the last reset */
+    uint64_t frames_total;      /* full-resolution frames ever */
     uint64_t resets;
     double reset_at, frame_ms, rays_per_second;
     unsigned long long rejected;
     unsigned long long virtual_lights;
-    char plan[1200];         /* the full-resolution session's effect plan, one pass a line */
+    char plan[1200]; /* the full-resolution session's effect plan, one pass a line */
     int plan_highlights;
     unsigned long long hl_points, hl_lobes; /* the last full-resolution frame's (vsl+hl) */
-    double hl_merge_share;   /* its thread time spent merging, as a fraction */
-    double rel_error;        /* the last full-resolution frame's against the reference */
-    double rel_error_at;     /* ... and its seconds since the reset */
+    double hl_merge_share;                  /* its thread time spent merging, as a fraction */
+    double rel_error;                       /* the last full-resolution frame's against the reference */
+    double rel_error_at;                    /* ... and its seconds since the reset */
     uint64_t rel_error_serial, rel_error_resets;
     uint64_t preview_frames; /* reduced-resolution frames published, ever */
 } view_stats;
@@ -87,14 +87,14 @@ typedef struct {
     /* requests: UI -> render thread */
     camera cam;
     render_params params;
-    uint64_t generation;     /* bumped by every change that resets the accumulation */
-    double changed_at;       /* when the last such change happened (cli_now) */
+    uint64_t generation; /* bumped by every change that resets the accumulation */
+    double changed_at;   /* when the last such change happened (cli_now) */
     unsigned show_mask;
-    int render_w, render_h;  /* requested full resolution */
+    int render_w, render_h; /* requested full resolution */
     char export_path[1024];
     int export_pending;
     char load_path[1024];
-    int load_kind;           /* 0 none, 1 scene, 2 environment map */
+    int load_kind; /* 0 none, 1 scene, 2 environment map */
     int quit;
     uint64_t lights_scene;   /* the scene (info_serial) the light requests below refer to */
     light_edits lights;      /* wanted */

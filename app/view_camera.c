@@ -63,8 +63,10 @@ void reset_view(ui_thread *u) {
 void bookmarks_load(ui_thread *u) {
     memset(u->bookmark_set, 0, sizeof u->bookmark_set);
     const char *builtin = scene_builtin_name(u->info.name);
-    if (builtin) snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.glint-bookmarks", builtin);
-    else snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.bookmarks", u->info.name);
+    if (builtin)
+        snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.glint-bookmarks", builtin);
+    else
+        snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.bookmarks", u->info.name);
     FILE *f = fopen(u->bookmarks_path, "r");
     if (!f) {
         if (errno != ENOENT) {
@@ -95,8 +97,8 @@ void bookmarks_load(ui_thread *u) {
     }
     fclose(f);
     if (bad) {
-        snprintf(u->message, sizeof u->message, "%s:%d: not a bookmark line (N x y z yaw pitch distance fov); file ignored",
-                 u->bookmarks_path, bad);
+        snprintf(u->message, sizeof u->message,
+                 "%s:%d: not a bookmark line (N x y z yaw pitch distance fov); file ignored", u->bookmarks_path, bad);
         cli_warning("%s", u->message);
         return;
     }
@@ -115,10 +117,12 @@ int bookmark_save(ui_thread *u, int slot) {
     for (int i = 1; i <= 9; i++) {
         const cam_ctl *c = &u->bookmarks[i];
         if (u->bookmark_set[i] && len < (int)sizeof buf)
-            len += snprintf(buf + len, sizeof buf - (size_t)len, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", i, (double)c->pos.x,
-                            (double)c->pos.y, (double)c->pos.z, (double)c->yaw, (double)c->pitch, (double)c->dist, (double)c->yfov);
+            len += snprintf(buf + len, sizeof buf - (size_t)len, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", i,
+                            (double)c->pos.x, (double)c->pos.y, (double)c->pos.z, (double)c->yaw, (double)c->pitch,
+                            (double)c->dist, (double)c->yfov);
     }
-    if (len >= (int)sizeof buf || write_file_atomic(u->bookmarks_path, buf, (size_t)len, WRITE_REPLACE, err, sizeof err) != 0) {
+    if (len >= (int)sizeof buf ||
+        write_file_atomic(u->bookmarks_path, buf, (size_t)len, WRITE_REPLACE, err, sizeof err) != 0) {
         if (len >= (int)sizeof buf) snprintf(err, sizeof err, "%s: bookmarks too long", u->bookmarks_path);
         snprintf(u->message, sizeof u->message, "%s", err);
         cli_error("%s", err);
@@ -144,7 +148,8 @@ int bookmark_restore(ui_thread *u, int slot) {
 void describe_bookmarks(ui_thread *u) {
     int len = 0;
     for (int i = 1; i <= 9; i++)
-        if (u->bookmark_set[i]) len += snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%d ", i);
-    snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%s(%s)", len ? "" : "none ", u->bookmarks_path);
+        if (u->bookmark_set[i])
+            len += snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%d ", i);
+    snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%s(%s)", len ? "" : "none ",
+             u->bookmarks_path);
 }
-

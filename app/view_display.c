@@ -117,7 +117,8 @@ static void false_colour_error(const float *img, const float *ref, int num_pixel
         }
         float e = sqrtf(d2) / (sqrtf(r2) + eps);
         float t = isfinite(e) ? clampf(0.5f * (log10f(fmaxf(e, 1e-6f)) + 2.0f), 0.0f, 1.0f) : 1.0f;
-        float rgb[3] = {clampf(2.0f * t - 1.0f, 0.0f, 1.0f), 1.0f - fabsf(2.0f * t - 1.0f), clampf(1.0f - 2.0f * t, 0.0f, 1.0f)};
+        float rgb[3] = {clampf(2.0f * t - 1.0f, 0.0f, 1.0f), 1.0f - fabsf(2.0f * t - 1.0f),
+                        clampf(1.0f - 2.0f * t, 0.0f, 1.0f)};
         for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
     }
 }
@@ -240,8 +241,10 @@ void capture_window(ui_thread *u, int w, int h) {
             memcpy(px + 3 * (size_t)w * (size_t)y, px + 3 * (size_t)w * (size_t)(h - 1 - y), 3 * (size_t)w);
             memcpy(px + 3 * (size_t)w * (size_t)(h - 1 - y), row, 3 * (size_t)w);
         }
-        if (png_save_rgb8(path, w, h, px, WRITE_NO_REPLACE, err, sizeof err) != 0) cli_error("%s", err);
-        else printf("glint: wrote %s\n", path);
+        if (png_save_rgb8(path, w, h, px, WRITE_NO_REPLACE, err, sizeof err) != 0)
+            cli_error("%s", err);
+        else
+            printf("glint: wrote %s\n", path);
     }
     free(px);
     free(row);

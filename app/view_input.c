@@ -94,9 +94,7 @@ void request_load(ui_thread *u, int kind, const char *path) {
 
 /* ---- lights ---------------------------------------------------------------------------------- */
 
-vec3 light_position(const ui_thread *u, int g) {
-    return add3(u->info.lights[g].center, u->lights.offset[g]);
-}
+vec3 light_position(const ui_thread *u, int g) { return add3(u->info.lights[g].center, u->lights.offset[g]); }
 
 int light_movable(const ui_thread *u, int g) {
     return g >= 0 && g < u->info.num_lights && u->info.lights[g].type != LIGHT_DIRECTIONAL;
@@ -283,9 +281,12 @@ int handle_input(ui_thread *u, double dt) {
         int pressed = u->keys_pressed[GLFW_KEY_0 + k];
         int mods = pressed - 1;
         if (!pressed) continue;
-        if (mods & GLFW_MOD_CONTROL) bookmark_save(u, k);
-        else if (mods & GLFW_MOD_SHIFT) bookmark_restore(u, k);
-        else if (k - 1 < u->info.num_cameras) u->ctl.camera = k - 1;
+        if (mods & GLFW_MOD_CONTROL)
+            bookmark_save(u, k);
+        else if (mods & GLFW_MOD_SHIFT)
+            bookmark_restore(u, k);
+        else if (k - 1 < u->info.num_cameras)
+            u->ctl.camera = k - 1;
     }
     memset(u->keys_pressed, 0, sizeof u->keys_pressed);
 

@@ -10,7 +10,7 @@
 #include "metrics.h"
 #include "view.h"
 
-#define PREVIEW_DIVISOR 3      /* preview resolution = full / 3 on each axis, or coarser... */
+#define PREVIEW_DIVISOR 3 /* preview resolution = full / 3 on each axis, or coarser... */
 #define PREVIEW_MAX_DIVISOR 8
 #define PREVIEW_TARGET_MS 70.0 /* ...so that a preview frame takes about this long */
 #define PREVIEW_HOLD_SECONDS 0.3
@@ -21,14 +21,14 @@ struct render_thread {
     pthread_t thread;
     scene *scene;
     render_session *full, *preview;
-    image_buf back;                     /* the next image, swapped with the shared one when published */
-    light_edits lights_applied;         /* the edits the scene has */
-    image_rgb reference;                /* for the error of each frame */
-    float *combined;                    /* the whole image when another part is shown */
+    image_buf back;             /* the next image, swapped with the shared one when published */
+    light_edits lights_applied; /* the edits the scene has */
+    image_rgb reference;        /* for the error of each frame */
+    float *combined;            /* the whole image when another part is shown */
     size_t combined_len;
     int preview_divisor;
-    int scene_edited;                   /* lights changed since the plan was made */
-    int full_film_partial;              /* a stopped frame left samples in the full film; cleared
+    int scene_edited;      /* lights changed since the plan was made */
+    int full_film_partial; /* a stopped frame left samples in the full film; cleared
                                          * by the next full frame that completes */
 };
 
@@ -109,8 +109,10 @@ static int make_sessions(render_thread *rt, int w, int h, const camera *cam, con
  * 0.77, less than their ratio. */
 static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam, const render_params *params) {
     int d = rt->preview_divisor;
-    if (frame_ms > 1.3 * PREVIEW_TARGET_MS && d < PREVIEW_MAX_DIVISOR) d++;
-    else if (frame_ms < 0.45 * PREVIEW_TARGET_MS && d > PREVIEW_DIVISOR) d--;
+    if (frame_ms > 1.3 * PREVIEW_TARGET_MS && d < PREVIEW_MAX_DIVISOR)
+        d++;
+    else if (frame_ms < 0.45 * PREVIEW_TARGET_MS && d > PREVIEW_DIVISOR)
+        d--;
     if (d == rt->preview_divisor) return;
     char err[512];
     render_session *p = create_preview(rt, d, cam, params, err, sizeof err);

@@ -45,7 +45,7 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
     static const struct {
         const char *name;
         script_action_kind kind;
-        int args; /* words after the command */
+        int args;    /* words after the command */
         int numbers; /* how many of them are numbers */
         int path;    /* the one argument is a path */
     } commands[] = {
@@ -81,8 +81,7 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
                 return snprintf(err, errlen, "'%s': '%s' is not a number", w[0], w[1 + k]), -1;
         if (out->kind == ACT_WAIT && (out->a < 0 || out->a > 1e6 || out->a != floor(out->a)))
             return snprintf(err, errlen, "'wait' needs a whole number of frames (0 to 1000000)"), -1;
-        if (out->kind == ACT_ZOOM && !(out->a > 0))
-            return snprintf(err, errlen, "'zoom' needs a positive factor"), -1;
+        if (out->kind == ACT_ZOOM && !(out->a > 0)) return snprintf(err, errlen, "'zoom' needs a positive factor"), -1;
         if (out->kind == ACT_MOVE_LIGHT && (out->a < 0 || out->a > 1e6 || out->a != floor(out->a)))
             return snprintf(err, errlen, "'move-light' needs a light index (0, 1, ...)"), -1;
         if ((out->kind == ACT_SAVE_BOOKMARK || out->kind == ACT_RESTORE_BOOKMARK) &&

@@ -45,8 +45,8 @@ typedef struct {
     script_action_kind kind;
     int line;
     double a, b, c, d; /* numbers: frames, degrees, offsets, factor, light index and offset */
-    char name[64];   /* set: parameter; key: key name */
-    char text[1024]; /* set: value; screenshot, export, load, env, window-shot, reference: path */
+    char name[64];     /* set: parameter; key: key name */
+    char text[1024];   /* set: value; screenshot, export, load, env, window-shot, reference: path */
 } script_action;
 
 typedef struct {

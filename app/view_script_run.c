@@ -25,18 +25,19 @@ static void print_stats(ui_thread *u) {
     for (int i = 1; i <= 9; i++)
         if (u->bookmark_set[i]) marks[nb++] = (char)('0' + i);
     marks[nb] = 0;
-    printf("stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
-           "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
-           u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z, (double)lx, (double)ly,
-           tonemap_names[u->ctl.tonemap], mean, u->rel_error, (unsigned long long)u->stats.preview_frames, u->preview_w,
-           u->preview_h, seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
-           nb ? marks : "-");
+    printf(
+        "stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
+        "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
+        u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z,
+        (double)lx, (double)ly, tonemap_names[u->ctl.tonemap], mean, u->rel_error,
+        (unsigned long long)u->stats.preview_frames, u->preview_w, u->preview_h, seconds_since(u->started_at),
+        (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z, nb ? marks : "-");
     printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu virtual_lights=%llu hl_lobes=%llu plan_highlights=%d",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->stats.frames_total,
-           (unsigned long long)u->stats.resets, u->front.width, u->front.height, u->front.preview, (double)u->ctl.exposure,
-           u->ctl.show, u->ctl.params.max_depth, method_name(u->ctl.params.method), u->stats.rejected,
-           u->stats.virtual_lights, u->stats.hl_lobes, u->stats.plan_highlights);
+           (unsigned long long)u->stats.resets, u->front.width, u->front.height, u->front.preview,
+           (double)u->ctl.exposure, u->ctl.show, u->ctl.params.max_depth, method_name(u->ctl.params.method),
+           u->stats.rejected, u->stats.virtual_lights, u->stats.hl_lobes, u->stats.plan_highlights);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
     const param_desc *table = params_table(&nparams);
@@ -78,14 +79,16 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
         for (int i = 0; i < UI_SHOW_COUNT; i++)
             if (strcmp(value, names[i]) == 0) found = i;
         if (found < 0) return snprintf(err, errlen, "show: one of all, direct, indirect, highlights, error"), -1;
-        if (found == UI_SHOW_ERROR && !u->reference.rgb) return snprintf(err, errlen, "show error: no reference loaded"), -1;
+        if (found == UI_SHOW_ERROR && !u->reference.rgb)
+            return snprintf(err, errlen, "show error: no reference loaded"), -1;
         u->ctl.show = found;
     } else if (strcmp(name, "tonemap") == 0) {
         int t = tonemap_from_name(value);
         if (t < 0) return snprintf(err, errlen, "tonemap: one of reinhard, clamp, exponential"), -1;
         u->ctl.tonemap = t;
     } else if (strcmp(name, "light") == 0) {
-        if (cli_parse_int(opt, value, 0, u->info.num_lights - 1, &n) != 0) return snprintf(err, errlen, "no light %s", value), -1;
+        if (cli_parse_int(opt, value, 0, u->info.num_lights - 1, &n) != 0)
+            return snprintf(err, errlen, "no light %s", value), -1;
         u->ctl.light = (int)n;
     } else if (strcmp(name, "light-intensity") == 0) {
         if (u->ctl.light < 0) return snprintf(err, errlen, "light-intensity: no light selected"), -1;
@@ -107,8 +110,10 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
 /* A key by name, with "ctrl+" or "shift+" in front for the modifier (into *mods). */
 static int key_from_name(const char *name, int *mods) {
     *mods = 0;
-    if (strncmp(name, "ctrl+", 5) == 0) *mods = GLFW_MOD_CONTROL, name += 5;
-    else if (strncmp(name, "shift+", 6) == 0) *mods = GLFW_MOD_SHIFT, name += 6;
+    if (strncmp(name, "ctrl+", 5) == 0)
+        *mods = GLFW_MOD_CONTROL, name += 5;
+    else if (strncmp(name, "shift+", 6) == 0)
+        *mods = GLFW_MOD_SHIFT, name += 6;
     if (strcmp(name, "r") == 0) return GLFW_KEY_R;
     if (strcmp(name, "f11") == 0) return GLFW_KEY_F11;
     if (strcmp(name, "f12") == 0) return GLFW_KEY_F12;

@@ -155,9 +155,7 @@ static float ggx_d(const bsdf *b, vec3 h) {
 
 /* s(w) = wz (1 + 2 Lambda(w)) = sqrt(wz^2 + ax^2 wx^2 + ay^2 wy^2): Smith's Lambda without the
  * division by wz, so grazing directions do not overflow. */
-static float ggx_s(const bsdf *b, vec3 w) {
-    return sqrtf(w.z * w.z + sqr(b->alpha_x * w.x) + sqr(b->alpha_y * w.y));
-}
+static float ggx_s(const bsdf *b, vec3 w) { return sqrtf(w.z * w.z + sqr(b->alpha_x * w.x) + sqr(b->alpha_y * w.y)); }
 
 /* Height-correlated G2 / (4 zo zi) = 1 / (2 (zi so + zo si)). */
 static float ggx_visibility(const bsdf *b, vec3 wo, vec3 wi) {
@@ -166,9 +164,7 @@ static float ggx_visibility(const bsdf *b, vec3 wo, vec3 wi) {
 }
 
 /* pdf of wi under visible-normal sampling: G1(wo) D(h) / (4 zo) = D(h) / (2 (zo + so)). */
-static float ggx_pdf(const bsdf *b, vec3 wo, vec3 h) {
-    return ggx_d(b, h) / (2.0f * (wo.z + ggx_s(b, wo)));
-}
+static float ggx_pdf(const bsdf *b, vec3 wo, vec3 h) { return ggx_d(b, h) / (2.0f * (wo.z + ggx_s(b, wo))); }
 
 /* Heitz (2018), "Sampling the GGX distribution of visible normals". */
 static vec3 ggx_sample_h(const bsdf *b, vec3 wo, vec2 u) {
@@ -237,17 +233,14 @@ static vec3 eval_glossy(const bsdf *b, vec3 wo, vec3 wi) {
         float v = length_sq3(h) * expf(-ward_exponent(b, h)) / (PI_F * b->alpha_x * b->alpha_y * hz2 * hz2);
         return scale3(b->specular, v);
     }
-    default:
-        return v3s(0.0f);
+    default: return v3s(0.0f);
     }
 }
 
 static float pdf_glossy(const bsdf *b, vec3 wo, vec3 wi) {
     switch (b->model) {
-    case GLOSSY_GGX:
-        return ggx_pdf(b, wo, normalize3(add3(wo, wi)));
-    case GLOSSY_PHONG:
-        return pdf_power_cosine(phong_one_minus_cos(wo, wi), b->exponent);
+    case GLOSSY_GGX: return ggx_pdf(b, wo, normalize3(add3(wo, wi)));
+    case GLOSSY_PHONG: return pdf_power_cosine(phong_one_minus_cos(wo, wi), b->exponent);
     case GLOSSY_WARD: {
         /* wo . h_normalised = |wo + wi| / 2 exactly; the dot product itself cancels to noise (or
          * the wrong sign) when wo and wi face each other at grazing angles, where eval does not. */
@@ -255,17 +248,14 @@ static float pdf_glossy(const bsdf *b, vec3 wo, vec3 wi) {
         float wo_h = 0.5f * length3(h);
         return wo_h > 0.0f ? ward_pdf_h(b, scale3(h, 0.5f / wo_h)) / (4.0f * wo_h) : 0.0f;
     }
-    default:
-        return 0.0f;
+    default: return 0.0f;
     }
 }
 
 /* Returns 0 when the sample leaves the upper hemisphere. */
 static int sample_glossy(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
     switch (b->model) {
-    case GLOSSY_GGX:
-        *wi = reflect3(wo, ggx_sample_h(b, wo, u));
-        break;
+    case GLOSSY_GGX: *wi = reflect3(wo, ggx_sample_h(b, wo, u)); break;
     case GLOSSY_PHONG: {
         frame3 f = frame_from_normal(v3(-wo.x, -wo.y, wo.z));
         *wi = to_world(f, sample_power_cosine(u, b->exponent));
@@ -279,8 +269,7 @@ static int sample_glossy(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
         *wi = reflect3(wo, h);
         break;
     }
-    default:
-        return 0;
+    default: return 0;
     }
     return wi->z > 0.0f;
 }

@@ -14,7 +14,6 @@
 extern "C" {
 #endif
 
-
 /* Lobe masks: estimators that split path space ask for one lobe or both. BSDF_NOT_HIGHLIGHT,
  * for estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe. */
 enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_ALL = 3, BSDF_NOT_HIGHLIGHT = 4 };
@@ -38,13 +37,13 @@ typedef enum {
 #define BSDF_MAX_PHONG_EXPONENT 1e6f
 
 typedef struct {
-    vec3 diffuse;        /* Lambert albedo (already multiplied by 1 - metallic for glTF) */
-    float diffuse_f0;    /* > 0: diffuse scaled by (1 - F(wo.z)) (1 - F(wi.z)), Schlick with this F0 (glTF dielectric) */
+    vec3 diffuse;     /* Lambert albedo (already multiplied by 1 - metallic for glTF) */
+    float diffuse_f0; /* > 0: diffuse scaled by (1 - F(wo.z)) (1 - F(wi.z)), Schlick with this F0 (glTF dielectric) */
     glossy_model model;
-    vec3 specular;       /* GGX: F0 of Schlick's Fresnel; Phong and Ward: ks (no Fresnel) */
-    float alpha_x;       /* GGX, Ward: roughness along +x */
-    float alpha_y;       /* GGX, Ward: roughness along +y */
-    float exponent;      /* Phong exponent */
+    vec3 specular;  /* GGX: F0 of Schlick's Fresnel; Phong and Ward: ks (no Fresnel) */
+    float alpha_x;  /* GGX, Ward: roughness along +x */
+    float alpha_y;  /* GGX, Ward: roughness along +y */
+    float exponent; /* Phong exponent */
 } bsdf;
 
 typedef struct {

@@ -4,8 +4,8 @@
 
 #include "scene.h"
 
-#define EMBEDDED(name)                                      \
-    extern const unsigned char glint_scene_##name##_gltf[]; \
+#define EMBEDDED(name)                                                                                                 \
+    extern const unsigned char glint_scene_##name##_gltf[];                                                            \
     extern const size_t glint_scene_##name##_gltf_size;
 EMBEDDED(atelier)
 EMBEDDED(doorway)

@@ -36,7 +36,7 @@
 typedef struct {
     double kappa;
     int w, h;
-    float *rgb;  /* interleaved linear RGB, rows top (+Y) first like the map */
+    float *rgb;   /* interleaved linear RGB, rows top (+Y) first like the map */
     vec3 pole[2]; /* E at +Y and -Y, which the first and last rows' centres miss by half a texel */
 } filter_level;
 
@@ -111,8 +111,10 @@ vec3 env_vmf_filter_lookup(const env_vmf_filter *f, vmf lobe) {
     int lo = 0, hi = f->num_levels;
     while (hi - lo > 1) {
         int mid = (lo + hi) / 2;
-        if (f->log_kappa[mid] <= lk) lo = mid;
-        else hi = mid;
+        if (f->log_kappa[mid] <= lk)
+            lo = mid;
+        else
+            hi = mid;
     }
     float t = (float)((lk - f->log_kappa[lo]) / (f->log_kappa[hi] - f->log_kappa[lo]));
     return mix3(level_sample(f, lo, uv), level_sample(f, hi, uv), t);
@@ -121,7 +123,8 @@ vec3 env_vmf_filter_lookup(const env_vmf_filter *f, vmf lobe) {
 size_t env_vmf_filter_bytes(const env_vmf_filter *f) {
     if (!f) return 0;
     size_t bytes = sizeof *f;
-    for (int i = 0; i < f->num_levels; i++) bytes += sizeof(float) * 3 * (size_t)f->levels[i].w * (size_t)f->levels[i].h;
+    for (int i = 0; i < f->num_levels; i++)
+        bytes += sizeof(float) * 3 * (size_t)f->levels[i].w * (size_t)f->levels[i].h;
     return bytes;
 }
 
@@ -309,7 +312,7 @@ static size_t grid_layout(double kappa, int w, int h, size_t *base, int *margin)
 typedef struct {
     const float *src; /* interleaved input: the map or the next sharper level */
     int src_w, src_h;
-    float *tmp;       /* planar, 3 planes of src_h x w: columns resampled */
+    float *tmp; /* planar, 3 planes of src_h x w: columns resampled */
     int w, h;
     const span *xs, *ys;
     const float *xw, *yw;
@@ -358,7 +361,7 @@ static void resample_rows(void *ctx, int y, int worker) {
 
 typedef struct {
     int row, nl, len, len8; /* source row, first column offset -nl, kernel length (padded to 8) */
-    size_t offset;     /* into the worker's kernel buffer */
+    size_t offset;          /* into the worker's kernel buffer */
 } kernel_row;
 
 typedef struct {
@@ -496,7 +499,8 @@ static vec3 pole_value(const padded_grid *g, int w, int h, double kappa, int sou
 /* ---- create --------------------------------------------------------------------------------- */
 
 static void run(threadpool *pool, task_fn fn, void *ctx, int n) {
-    if (pool) threadpool_run(pool, fn, ctx, n);
+    if (pool)
+        threadpool_run(pool, fn, ctx, n);
     else
         for (int i = 0; i < n; i++) fn(ctx, i, 0);
 }

@@ -13,9 +13,9 @@
 #include "sampling.h"
 
 typedef struct {
-    image_rgb image;    /* linear RGB */
-    dist2d dist;        /* over (u, v), luminance * sin(theta), dilated for bilinear lookups */
-    float rotation;     /* radians about +Y */
+    image_rgb image; /* linear RGB */
+    dist2d dist;     /* over (u, v), luminance * sin(theta), dilated for bilinear lookups */
+    float rotation;  /* radians about +Y */
     float mean_luminance;
 } env_map;
 

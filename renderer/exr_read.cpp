@@ -184,8 +184,8 @@ void check_layout(const Imf::Header &h) {
     int64_t w = box_width(dw), ht = box_height(dw);
     if (!size_ok(w, ht) || !size_ok(box_width(disp), box_height(disp)))
         throw Refused("unsupported image size (data window " + std::to_string(w) + "x" + std::to_string(ht) +
-                      ", display window " + std::to_string(box_width(disp)) + "x" +
-                      std::to_string(box_height(disp)) + ")");
+                      ", display window " + std::to_string(box_width(disp)) + "x" + std::to_string(box_height(disp)) +
+                      ")");
     uint64_t pixel_bytes = 0;
     for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
         const Imf::Channel &c = it.channel();
@@ -198,8 +198,8 @@ void check_layout(const Imf::Header &h) {
     const Imf::TileDescription *tile = h.hasTileDescription() ? &h.tileDescription() : nullptr;
     uint64_t chunk = tile ? (uint64_t)tile->xSize * tile->ySize * pixel_bytes : (uint64_t)w * 256 * pixel_bytes;
     if (chunk > ((uint64_t)1 << 30)) {
-        std::string what = std::to_string(pixel_bytes) + " bytes a pixel over " + std::to_string(w) + "x" +
-                           std::to_string(ht);
+        std::string what =
+            std::to_string(pixel_bytes) + " bytes a pixel over " + std::to_string(w) + "x" + std::to_string(ht);
         if (tile) what += " in tiles of " + std::to_string(tile->xSize) + "x" + std::to_string(tile->ySize);
         throw Refused("unsupported image size (" + what + ")");
     }

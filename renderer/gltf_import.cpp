@@ -122,16 +122,17 @@ std::vector<double> read_accessor(const Model &m, int index, int want, const std
             view_elements(m, a.bufferView, a.byteOffset, a.count, (size_t)(nc * cs), &stride, what);
         for (size_t i = 0; i < a.count; i++)
             for (int c = 0; c < nc; c++)
-                out[i * (size_t)want + (size_t)c] = read_component(p + i * stride + (size_t)(c * cs), a.componentType, a.normalized);
+                out[i * (size_t)want + (size_t)c] =
+                    read_component(p + i * stride + (size_t)(c * cs), a.componentType, a.normalized);
     }
     if (a.sparse.isSparse) {
         size_t n = (size_t)a.sparse.count, istride, vstride;
         int ics = component_size(a.sparse.indices.componentType);
         if (ics == 0 || n > a.count) fail(what + ": invalid sparse accessor " + std::to_string(index));
-        const unsigned char *ip =
-            view_elements(m, a.sparse.indices.bufferView, (size_t)a.sparse.indices.byteOffset, n, (size_t)ics, &istride, what);
-        const unsigned char *vp =
-            view_elements(m, a.sparse.values.bufferView, (size_t)a.sparse.values.byteOffset, n, (size_t)(nc * cs), &vstride, what);
+        const unsigned char *ip = view_elements(m, a.sparse.indices.bufferView, (size_t)a.sparse.indices.byteOffset, n,
+                                                (size_t)ics, &istride, what);
+        const unsigned char *vp = view_elements(m, a.sparse.values.bufferView, (size_t)a.sparse.values.byteOffset, n,
+                                                (size_t)(nc * cs), &vstride, what);
         istride = (size_t)ics; // sparse arrays are tightly packed
         vstride = (size_t)(nc * cs);
         for (size_t i = 0; i < n; i++) {
@@ -181,7 +182,7 @@ struct importer {
     std::vector<int> texture_map; // glTF texture -> scene texture (-1 until used)
     std::vector<int> image_map;   // glTF image -> scene image
     std::vector<int> material_map;
-    std::vector<char> on_stack;   // node recursion guard: cycles are an error
+    std::vector<char> on_stack; // node recursion guard: cycles are an error
 
     importer(scene *sc, const Model &model, const std::string &n) : s(sc), m(model), name(n) {}
 
@@ -198,7 +199,8 @@ struct importer {
             const tinygltf::Texture &t = m.textures[(size_t)index];
             int src = t.source;
             if (src < 0 || (size_t)src >= m.images.size())
-                fail(what + ": texture " + std::to_string(index) + " has no valid image (source " + std::to_string(src) + ")");
+                fail(what + ": texture " + std::to_string(index) + " has no valid image (source " +
+                     std::to_string(src) + ")");
             int &img = image_map[(size_t)src];
             if (img < 0) {
                 const tinygltf::Image &im = m.images[(size_t)src];
@@ -213,7 +215,7 @@ struct importer {
             scene_texture st{img, WRAP_REPEAT, WRAP_REPEAT};
             if (t.sampler >= 0 && (size_t)t.sampler < m.samplers.size()) {
                 auto wrap = [](int w) {
-                    return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE  ? WRAP_CLAMP
+                    return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? WRAP_CLAMP
                            : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? WRAP_MIRROR
                                                                         : WRAP_REPEAT;
                 };
@@ -238,7 +240,8 @@ struct importer {
             mat.metallic = (float)pbr.metallicFactor;
             mat.roughness = (float)pbr.roughnessFactor;
             mat.base_color_tex = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what);
-            mat.metal_rough_tex = texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what);
+            mat.metal_rough_tex =
+                texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what);
             mat.emission = vec3_from(gm.emissiveFactor, v3s(0.0f));
             mat.emissive_tex = texture(gm.emissiveTexture.index, gm.emissiveTexture.texCoord, what);
             mat.double_sided = gm.doubleSided;
@@ -251,14 +254,16 @@ struct importer {
                     mat.anisotropy_rotation = (float)number_or(e, "anisotropyRotation", 0.0);
                     if (e.Has("anisotropyTexture")) {
                         const Value &t = e.Get("anisotropyTexture");
-                        mat.anisotropy_tex = texture((int)number_or(t, "index", -1), (int)number_or(t, "texCoord", 0), what);
+                        mat.anisotropy_tex =
+                            texture((int)number_or(t, "index", -1), (int)number_or(t, "texCoord", 0), what);
                     }
                 }
             }
             // The papers' lobes: extras.glint = {model: "phong"|"ward", kd, ks, exponent, alpha_x, alpha_y, rotation}
             if (gm.extras.IsObject() && gm.extras.Has("glint")) {
                 const Value &g = gm.extras.Get("glint");
-                std::string model = g.Has("model") && g.Get("model").IsString() ? g.Get("model").Get<std::string>() : "";
+                std::string model =
+                    g.Has("model") && g.Get("model").IsString() ? g.Get("model").Get<std::string>() : "";
                 if (model == "phong" || model == "ward") {
                     mat.model = model == "phong" ? MATERIAL_PHONG : MATERIAL_WARD;
                     mat.kd = color_or(g, "kd", v3s(0.0f));
@@ -274,7 +279,8 @@ struct importer {
                 }
             }
             if (gm.alphaMode == "BLEND" || gm.alphaMode == "MASK")
-                scene_warn(s, "%s: alphaMode %s is not supported; surfaces are opaque", name.c_str(), gm.alphaMode.c_str());
+                scene_warn(s, "%s: alphaMode %s is not supported; surfaces are opaque", name.c_str(),
+                           gm.alphaMode.c_str());
             if (gm.normalTexture.index >= 0)
                 scene_warn(s, "%s: normal maps are not supported yet; using interpolated normals", name.c_str());
             material_map[i] = scene_add_material(s, &mat);
@@ -297,7 +303,8 @@ struct importer {
         if (n.rotation.size() == 4)
             for (int i = 0; i < 4; i++) q[i] = n.rotation[(size_t)i];
         double qn = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-        if (qn > 0) for (double &c : q) c /= qn;
+        if (qn > 0)
+            for (double &c : q) c /= qn;
         double x = q[0], y = q[1], z = q[2], w = q[3];
         double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
                           {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
@@ -318,11 +325,15 @@ struct importer {
             const tinygltf::Primitive &p = gm.primitives[pi];
             std::string what = "mesh " + std::to_string(index) + " primitive " + std::to_string(pi);
             int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
-            if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+            if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+                mode != TINYGLTF_MODE_TRIANGLE_FAN) {
                 scene_warn(s, "%s: skipping %s: points and lines are not rendered", name.c_str(), what.c_str());
                 continue;
             }
-            auto attr = [&](const char *key) { auto it = p.attributes.find(key); return it == p.attributes.end() ? -1 : it->second; };
+            auto attr = [&](const char *key) {
+                auto it = p.attributes.find(key);
+                return it == p.attributes.end() ? -1 : it->second;
+            };
             if (attr("POSITION") < 0) fail(what + " has no POSITION");
             std::vector<float> pos = to_float(read_accessor(m, attr("POSITION"), 3, what + " POSITION"));
             size_t nv = pos.size() / 3;
@@ -359,15 +370,19 @@ struct importer {
             if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN) {
                 std::vector<uint32_t> tri;
                 for (size_t i = 2; i < idx.size(); i++) {
-                    if (mode == TINYGLTF_MODE_TRIANGLE_FAN) tri.insert(tri.end(), {idx[0], idx[i - 1], idx[i]});
-                    else if (i % 2 == 0) tri.insert(tri.end(), {idx[i - 2], idx[i - 1], idx[i]});
-                    else tri.insert(tri.end(), {idx[i - 1], idx[i - 2], idx[i]});
+                    if (mode == TINYGLTF_MODE_TRIANGLE_FAN)
+                        tri.insert(tri.end(), {idx[0], idx[i - 1], idx[i]});
+                    else if (i % 2 == 0)
+                        tri.insert(tri.end(), {idx[i - 2], idx[i - 1], idx[i]});
+                    else
+                        tri.insert(tri.end(), {idx[i - 1], idx[i - 2], idx[i]});
                 }
                 idx.swap(tri);
             }
             size_t ncount = p.indices >= 0 || mode != TINYGLTF_MODE_TRIANGLES ? idx.size() : nv;
             if (ncount % 3 != 0) {
-                scene_warn(s, "%s: %s has %zu indices, not a multiple of 3; dropping the rest", name.c_str(), what.c_str(), ncount);
+                scene_warn(s, "%s: %s has %zu indices, not a multiple of 3; dropping the rest", name.c_str(),
+                           what.c_str(), ncount);
                 ncount -= ncount % 3;
                 if (!idx.empty()) idx.resize(ncount);
             }
@@ -375,7 +390,8 @@ struct importer {
             if (ncount > (1u << 30) || nv > (1u << 30)) fail(what + " is too large");
             int material = -1;
             if (p.material >= 0) {
-                if ((size_t)p.material >= material_map.size()) fail(what + ": material " + std::to_string(p.material) + " out of range");
+                if ((size_t)p.material >= material_map.size())
+                    fail(what + ": material " + std::to_string(p.material) + " out of range");
                 material = material_map[(size_t)p.material];
             }
             mesh_desc md{};
@@ -396,11 +412,13 @@ struct importer {
 
     void punctual(const Value &ext, const mat4 &xf) {
         int li = (int)number_or(ext, "light", -1);
-        if (li < 0 || (size_t)li >= m.lights.size()) fail("KHR_lights_punctual: light " + std::to_string(li) + " out of range");
+        if (li < 0 || (size_t)li >= m.lights.size())
+            fail("KHR_lights_punctual: light " + std::to_string(li) + " out of range");
         const tinygltf::Light &gl = m.lights[(size_t)li];
         light l;
         std::memset(&l, 0, sizeof l);
-        std::snprintf(l.name, sizeof l.name, "%s", gl.name.empty() ? ("light " + std::to_string(li)).c_str() : gl.name.c_str());
+        std::snprintf(l.name, sizeof l.name, "%s",
+                      gl.name.empty() ? ("light " + std::to_string(li)).c_str() : gl.name.c_str());
         l.color = scale3(vec3_from(gl.color, v3s(1.0f)), (float)gl.intensity);
         l.position = xform_point(&xf, v3(0, 0, 0));
         l.direction = normalize3(xform_vector(&xf, v3(0, 0, -1)));
@@ -419,7 +437,8 @@ struct importer {
             scene_warn(s, "%s: light '%s' has unknown type '%s'; ignored", name.c_str(), l.name, gl.type.c_str());
             return;
         }
-        if (!is_finite3(l.color) || !is_finite3(l.position) || !is_finite3(l.direction) || length_sq3(l.direction) == 0.0f)
+        if (!is_finite3(l.color) || !is_finite3(l.position) || !is_finite3(l.direction) ||
+            length_sq3(l.direction) == 0.0f)
             fail(std::string("light '") + l.name + "' has an invalid transform or intensity");
         if (scene_add_light(s, &l) < 0) fail("out of memory");
     }
@@ -428,19 +447,22 @@ struct importer {
         if (ci < 0 || (size_t)ci >= m.cameras.size()) fail("camera " + std::to_string(ci) + " out of range");
         const tinygltf::Camera &gc = m.cameras[(size_t)ci];
         if (gc.type != "perspective") {
-            scene_warn(s, "%s: camera %d is %s; only perspective cameras are supported", name.c_str(), ci, gc.type.c_str());
+            scene_warn(s, "%s: camera %d is %s; only perspective cameras are supported", name.c_str(), ci,
+                       gc.type.c_str());
             return;
         }
         camera c;
         std::memset(&c, 0, sizeof c);
-        std::snprintf(c.name, sizeof c.name, "%s", gc.name.empty() ? ("camera " + std::to_string(ci)).c_str() : gc.name.c_str());
+        std::snprintf(c.name, sizeof c.name, "%s",
+                      gc.name.empty() ? ("camera " + std::to_string(ci)).c_str() : gc.name.c_str());
         c.position = xform_point(&xf, v3(0, 0, 0));
         c.forward = normalize3(xform_vector(&xf, v3(0, 0, -1)));
         vec3 up = xform_vector(&xf, v3(0, 1, 0));
         c.right = normalize3(cross3(c.forward, up));
         c.up = cross3(c.right, c.forward);
         c.yfov = (float)gc.perspective.yfov;
-        if (!(c.yfov > 1e-4f && c.yfov < 3.1f) || !is_finite3(c.position) || !is_finite3(c.right) || length_sq3(c.right) < 0.5f) {
+        if (!(c.yfov > 1e-4f && c.yfov < 3.1f) || !is_finite3(c.position) || !is_finite3(c.right) ||
+            length_sq3(c.right) < 0.5f) {
             scene_warn(s, "%s: camera %d has an invalid transform or field of view; ignored", name.c_str(), ci);
             return;
         }
@@ -449,7 +471,8 @@ struct importer {
 
     void node(int index, const mat4 &parent, int depth) {
         if (index < 0 || (size_t)index >= m.nodes.size()) fail("node " + std::to_string(index) + " out of range");
-        if (on_stack[(size_t)index] || depth > 1000) fail("node hierarchy has a cycle at node " + std::to_string(index));
+        if (on_stack[(size_t)index] || depth > 1000)
+            fail("node hierarchy has a cycle at node " + std::to_string(index));
         on_stack[(size_t)index] = 1;
         const tinygltf::Node &n = m.nodes[(size_t)index];
         mat4 xf = mat4_mul(parent, node_local(n));
@@ -494,14 +517,18 @@ bool load_image(tinygltf::Image *image, const int index, std::string *err, std::
                 const unsigned char *bytes, int size, void *) {
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, size, &w, &h, &comp) || w <= 0 || h <= 0 || (long long)w * h > (1LL << 28)) {
-        if (err) *err += "image " + std::to_string(index) + " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown format") + "\n";
+        if (err)
+            *err += "image " + std::to_string(index) +
+                    " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown format") + "\n";
         return false;
     }
     bool sixteen = stbi_is_16_bit_from_memory(bytes, size) != 0;
     void *pixels = sixteen ? (void *)stbi_load_16_from_memory(bytes, size, &w, &h, &comp, 0)
                            : (void *)stbi_load_from_memory(bytes, size, &w, &h, &comp, 0);
     if (!pixels) {
-        if (err) *err += "image " + std::to_string(index) + " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt data") + "\n";
+        if (err)
+            *err += "image " + std::to_string(index) +
+                    " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt data") + "\n";
         return false;
     }
     size_t n = (size_t)w * (size_t)h * (size_t)comp * (sixteen ? 2u : 1u);
@@ -582,5 +609,6 @@ extern "C" int gltf_import_file(scene *s, const char *path, char *err, size_t er
 
 extern "C" int gltf_import_memory(scene *s, const void *data, size_t size, const char *base_dir, const char *name,
                                   char *err, size_t errlen) {
-    return import(s, (const unsigned char *)data, size, base_dir ? base_dir : ".", name ? name : "<memory>", err, errlen);
+    return import(s, (const unsigned char *)data, size, base_dir ? base_dir : ".", name ? name : "<memory>", err,
+                  errlen);
 }

@@ -14,8 +14,8 @@ extern "C" {
  * or -1 with err = "NAME: problem". Does not finalize the scene. */
 int gltf_import_file(scene *s, const char *path, char *err, size_t errlen);
 /* The same from memory; base_dir resolves relative URIs, name appears in messages. */
-int gltf_import_memory(scene *s, const void *data, size_t size, const char *base_dir, const char *name,
-                       char *err, size_t errlen);
+int gltf_import_memory(scene *s, const void *data, size_t size, const char *base_dir, const char *name, char *err,
+                       size_t errlen);
 
 #ifdef __cplusplus
 }

@@ -10,14 +10,26 @@
 #define INV_2PI_F 0.15915494309189533577f
 #define INV_4PI_F 0.07957747154594766788f
 
-typedef struct { float x, y; } vec2;
-typedef struct { float x, y, z; } vec3;
-typedef struct { float x, y, z, w; } vec4;
+typedef struct {
+    float x, y;
+} vec2;
+typedef struct {
+    float x, y, z;
+} vec3;
+typedef struct {
+    float x, y, z, w;
+} vec4;
 /* Row-major affine transform: p' = m[r][0]*x + m[r][1]*y + m[r][2]*z + m[r][3]. */
-typedef struct { float m[4][4]; } mat4;
-typedef struct { vec3 lo, hi; } bounds3;
+typedef struct {
+    float m[4][4];
+} mat4;
+typedef struct {
+    vec3 lo, hi;
+} bounds3;
 /* Orthonormal frame: t (tangent, x), b (bitangent, y), n (normal, z). */
-typedef struct { vec3 t, b, n; } frame3;
+typedef struct {
+    vec3 t, b, n;
+} frame3;
 
 static inline vec2 v2(float x, float y) { return (vec2){x, y}; }
 static inline vec3 v3(float x, float y, float z) { return (vec3){x, y, z}; }

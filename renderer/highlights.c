@@ -14,8 +14,10 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
     h.area_lights = 0;
     for (int li = 0; li < s->num_lights; li++) {
         light_type t = s->lights[li].type;
-        if (t == LIGHT_POINT || t == LIGHT_SPOT || t == LIGHT_DIRECTIONAL) h.num_punctual = li + 1;
-        else if (t == LIGHT_TRIANGLE) h.area_lights = 1;
+        if (t == LIGHT_POINT || t == LIGHT_SPOT || t == LIGHT_DIRECTIONAL)
+            h.num_punctual = li + 1;
+        else if (t == LIGHT_TRIANGLE)
+            h.area_lights = 1;
     }
     vl_params r = vl_params_resolve(vp);
     h.mode = r.merge == HL_MERGE_OFF ? HL_UNMERGED : r.merge == HL_MERGE_TRACE ? HL_TRACED : HL_MERGED;
@@ -27,9 +29,9 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
 
 /* One secondary hit's record: where it lies and its glossy lobe as vMF bands. */
 typedef struct {
-    vec3 p, n;  /* position, geometric normal toward x */
-    vec3 mu;    /* the lobe's mean direction (world) */
-    vec3 across; /* unit, across the plane of incidence (along which a microfacet lobe is narrower) */
+    vec3 p, n;                  /* position, geometric normal toward x */
+    vec3 mu;                    /* the lobe's mean direction (world) */
+    vec3 across;                /* unit, across the plane of incidence (along which a microfacet lobe is narrower) */
     vec3 color[VMF_LOBE_BANDS]; /* per band: x's weight / N x the lobe's albedo x the band's weight,
                                  * over the band's mass above the surface (the lobe's energy lies above it) */
     float lum[VMF_LOBE_BANDS];  /* their luminances: the members' weights in the merge */
@@ -150,8 +152,8 @@ static void members_add(band_moments *bm, const hl_hit *h, vec3 mu, vec3 across,
         if (!(h->x_share[xb] > 0.0f)) continue;
         double gx = g * (double)h->x_share[xb];
         for (int b = 0; b < h->bands; b++)
-            moments_add(&bm[xb * VMF_LOBE_BANDS + b], mu, across, scale3(h->color[b], (float)gx), (double)h->lum[b] * gx,
-                        h->rbar[b], h->var_along[b], h->var_across[b]);
+            moments_add(&bm[xb * VMF_LOBE_BANDS + b], mu, across, scale3(h->color[b], (float)gx),
+                        (double)h->lum[b] * gx, h->rbar[b], h->var_along[b], h->var_across[b]);
     }
 }
 
@@ -323,7 +325,8 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
                 float pdf;
                 vec3 f = is_black3(le) ? le : lobe_eval(l, wi, e.p, 0, &pdf);
                 if (!is_black3(f) && pdf > 0.0f)
-                    sum = add3(sum, scale3(mul3(f, le), mis_power(pdf, light_pdf_triangle(s, li, l->origin, &e)) / pdf));
+                    sum =
+                        add3(sum, scale3(mul3(f, le), mis_power(pdf, light_pdf_triangle(s, li, l->origin, &e)) / pdf));
             } else if (env_by_sampling) {
                 float pdf;
                 vec3 f = lobe_eval(l, wi, wi, 1, &pdf);

@@ -12,8 +12,8 @@
 #ifndef GLINT_HIGHLIGHTS_H
 #define GLINT_HIGHLIGHTS_H
 
-#include "rng.h"
 #include "params.h"
+#include "rng.h"
 #include "vsl.h"
 
 struct env_vmf_filter;
@@ -28,11 +28,11 @@ typedef enum {
 
 typedef struct {
     hl_mode mode;
-    int secondary_rays; /* N, 1..HL_MAX_SECONDARY_RAYS */
-    int clusters;       /* K, 1..HL_MAX_CLUSTERS */
+    int secondary_rays;                      /* N, 1..HL_MAX_SECONDARY_RAYS */
+    int clusters;                            /* K, 1..HL_MAX_CLUSTERS */
     const struct env_vmf_filter *env_filter; /* the scene's environment, prefiltered; NULL: none */
-    int num_punctual;   /* the scene's point, spot and directional lights (first in its list) */
-    int area_lights;    /* whether it has emissive triangles */
+    int num_punctual;                        /* the scene's point, spot and directional lights (first in its list) */
+    int area_lights;                         /* whether it has emissive triangles */
 } hl_setup;
 
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */

@@ -29,7 +29,8 @@
 #if defined(__GNUC__)
 __attribute__((format(printf, 4, 5)))
 #endif
-static int fail(char *err, size_t errlen, const char *path, const char *fmt, ...) {
+static int
+fail(char *err, size_t errlen, const char *path, const char *fmt, ...) {
     if (!err || errlen == 0) return -1;
     int n = snprintf(err, errlen, "%s: ", path ? path : "(null)");
     if (n >= 0 && (size_t)n < errlen) {
@@ -374,8 +375,7 @@ static int exr_encode(const char *path, int width, int height, const exr_layer *
 
     exr_result_t rv = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
-    if (rv == EXR_ERR_SUCCESS)
-        rv = exr_initialize_required_attr_simple(ctx, part, width, height, EXR_COMPRESSION_ZIP);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_initialize_required_attr_simple(ctx, part, width, height, EXR_COMPRESSION_ZIP);
     int longest = 0;
     for (int k = 0; k < nchan; k++)
         if ((int)strlen(names[k]) > longest) longest = (int)strlen(names[k]);
@@ -427,7 +427,8 @@ static int exr_encode(const char *path, int width, int height, const exr_layer *
         /* finish writes the chunk offset table, so its result matters. */
         exr_result_t frv = exr_finish(&ctx);
         if (status == 0 && frv != EXR_ERR_SUCCESS)
-            status = buf->failed ? fail(err, errlen, path, "out of memory") : exr_fail(err, errlen, path, what, frv, &box);
+            status =
+                buf->failed ? fail(err, errlen, path, "out of memory") : exr_fail(err, errlen, path, what, frv, &box);
     }
     if (status == 0 && buf->failed) status = fail(err, errlen, path, "out of memory");
     exr_sink = NULL;
@@ -529,7 +530,8 @@ int write_file_atomic(const char *path, const void *data, size_t size, write_mod
     /* Only a regular file is ever replaced: renaming over a device (--stats /dev/null), a
      * directory or a FIFO would destroy it (a session once turned /dev/null into a file). */
     struct stat existing;
-    if (mode == WRITE_REPLACE && lstat(path, &existing) == 0 && !S_ISREG(existing.st_mode) && !S_ISLNK(existing.st_mode))
+    if (mode == WRITE_REPLACE && lstat(path, &existing) == 0 && !S_ISREG(existing.st_mode) &&
+        !S_ISLNK(existing.st_mode))
         return fail(err, errlen, path, "not a regular file; not replacing it");
     /* The temporary file is created next to the target (so rename and link stay within one file
      * system), named after it with ".tmp-" so a leftover is recognisable. mkstemp is not used

@@ -13,7 +13,6 @@
 extern "C" {
 #endif
 
-
 /* Interleaved linear RGB float image (3 floats per pixel). */
 typedef struct {
     int width, height;
@@ -56,18 +55,17 @@ typedef enum {
 } write_mode;
 
 /* Writes a scanline EXR of 32-bit float channels (ZIP compression) atomically. */
-int exr_save_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers,
-                    write_mode mode, char *err, size_t errlen);
+int exr_save_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers, write_mode mode,
+                    char *err, size_t errlen);
 
 /* Writes 8-bit sRGB (already encoded) RGB pixels as PNG atomically. */
-int png_save_rgb8(const char *path, int width, int height, const unsigned char *rgb, write_mode mode,
-                  char *err, size_t errlen);
+int png_save_rgb8(const char *path, int width, int height, const unsigned char *rgb, write_mode mode, char *err,
+                  size_t errlen);
 
 /* Writes size bytes to path atomically: a temporary file in the same directory, fsync, then
  * rename (WRITE_REPLACE) or link (WRITE_NO_REPLACE, so an existing file is never replaced even
  * in a race). Never leaves a partial file at path, and removes its temporary file on failure. */
-int write_file_atomic(const char *path, const void *data, size_t size, write_mode mode, char *err,
-                      size_t errlen);
+int write_file_atomic(const char *path, const void *data, size_t size, write_mode mode, char *err, size_t errlen);
 
 /* Finds a free name for an export that must never overwrite: "dir/stem.ext" if it does not
  * exist, else "dir/stem-1.ext", "dir/stem-2.ext", ... Writes the chosen path to out. Returns 0,

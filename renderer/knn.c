@@ -45,9 +45,12 @@ static void select_nth(const kd_tree *t, int *idx, int lo, int hi, int nth, int 
                 i++;
             }
         }
-        if (nth < lt) hi = lt;
-        else if (nth >= gt) lo = gt;
-        else return;
+        if (nth < lt)
+            hi = lt;
+        else if (nth >= gt)
+            lo = gt;
+        else
+            return;
     }
 }
 

@@ -32,7 +32,8 @@ int scene_set_env(scene *s, const char *path, float rotation, char *err, size_t 
     image_rgb img;
     if (image_rgb_load(path, &img, err, errlen) != 0) return -1;
     char sub[256];
-    if (scene_set_env_image(s, &img, rotation, sub, sizeof sub) != 0) return snprintf(err, errlen, "%s: %s", path, sub), -1;
+    if (scene_set_env_image(s, &img, rotation, sub, sizeof sub) != 0)
+        return snprintf(err, errlen, "%s: %s", path, sub), -1;
     return 0;
 }
 

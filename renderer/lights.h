@@ -6,16 +6,16 @@
 #include "scene.h"
 
 typedef struct {
-    int light;      /* index into scene.lights */
-    vec3 wi;        /* unit direction from the shading point toward the light */
-    float dist;     /* distance to the sampled point; INFINITY for directional and environment */
-    vec3 p_light;   /* the sampled point (area lights, point and spot lights) */
-    vec3 n_light;   /* its geometric normal, facing the shading point (area lights) */
-    vec3 radiance;  /* area/environment: radiance arriving along -wi; delta lights: the
+    int light;     /* index into scene.lights */
+    vec3 wi;       /* unit direction from the shading point toward the light */
+    float dist;    /* distance to the sampled point; INFINITY for directional and environment */
+    vec3 p_light;  /* the sampled point (area lights, point and spot lights) */
+    vec3 n_light;  /* its geometric normal, facing the shading point (area lights) */
+    vec3 radiance; /* area/environment: radiance arriving along -wi; delta lights: the
                      * irradiance-like value intensity/d^2 (or lux) */
-    float pdf;      /* solid-angle pdf times the selection probability; for delta lights just
+    float pdf;     /* solid-angle pdf times the selection probability; for delta lights just
                      * the selection probability */
-    int delta;      /* a point, spot or directional light: no MIS possible */
+    int delta;     /* a point, spot or directional light: no MIS possible */
 } light_sample;
 
 /* Picks a light by power (u_select) and a point or direction on it (u) as seen from p.

@@ -35,7 +35,8 @@ static cone cone_union(cone a, cone b) {
     float theta = 0.5f * (a.theta + between + b.theta);
     vec3 w = cross3(a.axis, b.axis);
     float wl = length3(w);
-    if (theta >= PI_F || !(wl > 1e-7f)) return (cone){a.axis, theta >= PI_F || dot3(a.axis, b.axis) < 0.0f ? PI_F : theta};
+    if (theta >= PI_F || !(wl > 1e-7f))
+        return (cone){a.axis, theta >= PI_F || dot3(a.axis, b.axis) < 0.0f ? PI_F : theta};
     /* Turn a's axis toward b's by what the half-angle grew (Rodrigues, w perpendicular to it). */
     float turn = theta - a.theta;
     vec3 axis = add3(scale3(a.axis, cosf(turn)), scale3(cross3(scale3(w, 1.0f / wl), a.axis), sinf(turn)));
@@ -64,7 +65,10 @@ static inline float exp_neg(float x) {
     if (fl > t) fl -= 1.0f;
     float f = t - fl;
     float p = 1.0f + f * (0.69314718f + f * (0.24022651f + f * (0.05550411f + f * (0.00961813f + f * 0.00133336f))));
-    union { float f; int32_t i; } u = {p};
+    union {
+        float f;
+        int32_t i;
+    } u = {p};
     u.i += (int32_t)fl * (1 << 23);
     return u.f;
 }
@@ -305,9 +309,12 @@ static void select_median(int *order, int lo, int hi, int mid, const float *keys
                 order[j--] = tmp;
             }
         }
-        if (mid <= j) hi = j + 1;
-        else if (mid >= i) lo = i;
-        else return;
+        if (mid <= j)
+            hi = j + 1;
+        else if (mid >= i)
+            lo = i;
+        else
+            return;
     }
     if (hi - lo == 2 && KEY(lo) > KEY(lo + 1)) {
         int tmp = order[lo];

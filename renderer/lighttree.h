@@ -18,27 +18,27 @@
 #include "vsl.h"
 
 typedef struct {
-    vec3 centre;        /* the box bounding the lights' centres: its centre, */
-    float half_diag2;   /* ... half-diagonal squared */
-    vec3 extent;        /* ... and half-extents */
-    float radius;       /* largest sphere radius below (0 for point lights) */
-    vec3 n_axis;        /* cone of the geometric normals: axis, cos and sin of its half-angle */
+    vec3 centre;      /* the box bounding the lights' centres: its centre, */
+    float half_diag2; /* ... half-diagonal squared */
+    vec3 extent;      /* ... and half-extents */
+    float radius;     /* largest sphere radius below (0 for point lights) */
+    vec3 n_axis;      /* cone of the geometric normals: axis, cos and sin of its half-angle */
     float n_cos;
-    vec3 g_axis;        /* cone of the glossy lobes' mirror directions */
+    vec3 g_axis; /* cone of the glossy lobes' mirror directions */
     float g_cos;
     float n_sin, g_sin;
-    float phi_diffuse;  /* luminance of power x diffuse albedo, summed */
-    float phi_glossy;   /* luminance of power x glossy albedo, summed (0: no glossy lobe below) */
-    float kappa;        /* the sharpest glossy lobe's vMF concentration */
-    int child;          /* internal: first child (the second is child + 1); leaf: -1 - light index */
-    int parent;         /* -1 at the root */
+    float phi_diffuse; /* luminance of power x diffuse albedo, summed */
+    float phi_glossy;  /* luminance of power x glossy albedo, summed (0: no glossy lobe below) */
+    float kappa;       /* the sharpest glossy lobe's vMF concentration */
+    int child;         /* internal: first child (the second is child + 1); leaf: -1 - light index */
+    int parent;        /* -1 at the root */
 } lt_node;
 
 typedef struct {
     lt_node *nodes;
     int num_nodes, cap_nodes;
-    int *leaf_of;       /* light index -> its leaf node */
-    int *order;         /* scratch for the build: the lights' order, split keys and leaves */
+    int *leaf_of; /* light index -> its leaf node */
+    int *order;   /* scratch for the build: the lights' order, split keys and leaves */
     float *keys;
     lt_node *leaves;
     int num_lights, cap_lights;
@@ -47,11 +47,11 @@ typedef struct {
 /* What the tree needs to know of a receiver, made once per shading point. */
 typedef struct {
     vec3 p, ng;
-    float eps;          /* distances to a plane below this count as in it (the scene's ray offset) */
-    float diffuse;      /* luminance of the Lambert albedo / pi */
-    float glossy;       /* luminance of the glossy lobe's albedo; 0: none */
-    vec3 g_axis;        /* the glossy lobe's mirror direction (world) */
-    float kappa;        /* ... and its vMF concentration */
+    float eps;     /* distances to a plane below this count as in it (the scene's ray offset) */
+    float diffuse; /* luminance of the Lambert albedo / pi */
+    float glossy;  /* luminance of the glossy lobe's albedo; 0: none */
+    vec3 g_axis;   /* the glossy lobe's mirror direction (world) */
+    float kappa;   /* ... and its vMF concentration */
 } lt_receiver;
 
 /* Builds the tree over set's lights (their radii already set). Returns 0, or -1 out of memory. */

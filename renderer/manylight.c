@@ -105,7 +105,8 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
             float pmf;
             int e = draw_entry(m, &r, fminf(((float)k + shift) / (float)m->per_pixel, 0x1.fffffep-1f), &pmf);
             if (e >= 0 && pmf > 0.0f)
-                sum = madd3(sum, shade_one(m, s, &m->set.v[m->entries[e].light], x, terms, rng, st), m->entries[e].scale / pmf);
+                sum = madd3(sum, shade_one(m, s, &m->set.v[m->entries[e].light], x, terms, rng, st),
+                            m->entries[e].scale / pmf);
         }
         return scale3(sum, 1.0f / (float)m->per_pixel);
     }
@@ -152,7 +153,7 @@ typedef struct {
     const render_params *p;
     long long frame;
     int rows;
-    float *matrix;        /* rows x lights, luminance */
+    float *matrix;           /* rows x lights, luminance */
     render_stats *row_stats; /* one per row, summed afterwards */
 } row_job;
 
@@ -255,13 +256,15 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
         /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (docs/design.md) when both
          * lobes are highlight lobes. */
-        int lobes = k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT : BSDF_ALL;
+        int lobes =
+            k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT : BSDF_ALL;
         vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1);
         surface_hit next;
         int have_next = 0;
         for (int j = 0; j < split; j++) {
             bsdf_sample_result bs;
-            if (!bsdf_sample(&x.b, x.wo, BSDF_GLOSSY, 0.0f, split > 1 ? sample_r2(j, shift) : shift, &bs) || !(bs.pdf > 0.0f))
+            if (!bsdf_sample(&x.b, x.wo, BSDF_GLOSSY, 0.0f, split > 1 ? sample_r2(j, shift) : shift, &bs) ||
+                !(bs.pdf > 0.0f))
                 continue;
             vec3 wi = to_world(x.frame, bs.wi);
             if (dot3(wi, x.ng) <= 0.0f) continue;
@@ -272,7 +275,8 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
             /* Emission at the next hit is the direct light at x, which the shared estimator has. */
             surface_hit h;
             vec3 direct;
-            if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, lobes, rng, &direct, &h, st->rays)) continue;
+            if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, lobes, rng, &direct, &h, st->rays))
+                continue;
             sum = madd3(sum, mul3(b, direct), 1.0f / (float)split);
             if (j == chosen) next_beta = b, next = h, next_wi = wi, have_next = 1;
         }
@@ -289,8 +293,9 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     const render_params r = render_params_resolve(p); /* the defaults, in one place */
     const vl_params *vp = &r.vl;
     long long i = frame + 1;
-    m->kernel = p->method == METHOD_VSL || p->method == METHOD_VSL_HL ? VL_KERNEL_VSL
-                : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
+    m->kernel = p->method == METHOD_VSL || p->method == METHOD_VSL_HL
+                    ? VL_KERNEL_VSL
+                    : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
     m->terms = plan->highlights ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;
     m->all_strategies = plan->vsl_all_strategies;
     m->clamp = vp->clamp == VL_CLAMP_ON;
@@ -317,10 +322,12 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     m->glossy_split = vp->glossy_rays;
     m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : 0.0f;
     /* The light tree's per-light estimates serve resampling; its hierarchy, drawing through it. */
-    if (m->per_pixel > 0 && (vp->select == VL_SELECT_TREE || m->candidates > 1) && lighttree_build(&m->tree, &m->set) != 0)
+    if (m->per_pixel > 0 && (vp->select == VL_SELECT_TREE || m->candidates > 1) &&
+        lighttree_build(&m->tree, &m->set) != 0)
         return snprintf(err, errlen, "out of memory for the light tree"), -1;
     if (clustering) {
-        if (cluster_lights(m, s, cam, p, frame, pool, st) != 0) return snprintf(err, errlen, "out of memory for the light clusters"), -1;
+        if (cluster_lights(m, s, cam, p, frame, pool, st) != 0)
+            return snprintf(err, errlen, "out of memory for the light clusters"), -1;
         m->clustered = 1;
         return 0;
     }

@@ -32,10 +32,10 @@ typedef struct {
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;
-    alias_table pick;   /* per-pixel choice of entries: by cluster norm, or by light power */
-    lighttree tree;     /* ... or by the light tree (use_tree) */
+    alias_table pick; /* per-pixel choice of entries: by cluster norm, or by light power */
+    lighttree tree;   /* ... or by the light tree (use_tree) */
     int use_tree;
-    int clustered;      /* entries came from matrix row-column sampling this frame */
+    int clustered; /* entries came from matrix row-column sampling this frame */
 } manylight;
 
 void manylight_deinit(manylight *m);

@@ -74,8 +74,8 @@ static double relative(double x, double norm) {
     return x > 0.0 ? (double)INFINITY : 0.0;
 }
 
-void metric_noise_bias(double sum_err2, double mean_err2, double ref_norm2, int count, double ref_noise,
-                       double *noise, double *bias) {
+void metric_noise_bias(double sum_err2, double mean_err2, double ref_norm2, int count, double ref_noise, double *noise,
+                       double *bias) {
     *noise = *bias = (double)NAN;
     if (count < 2) return;
     double n = (double)count;

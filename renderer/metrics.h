@@ -43,8 +43,8 @@ double metric_norm2(const float *v, size_t n);
  * ||I_k||^2 would cancel far larger ones. Then the RMS over the runs of their rel_l2 satisfies rms^2 = noise^2 + bias^2 +
  * ref_noise^2 exactly unless bias^2 was clamped. count < 2: both NAN (one run cannot tell noise
  * from bias). A zero reference follows metric_rel_l2: 0 for a zero numerator, else INFINITY. */
-void metric_noise_bias(double sum_err2, double mean_err2, double ref_norm2, int count, double ref_noise,
-                       double *noise, double *bias);
+void metric_noise_bias(double sum_err2, double mean_err2, double ref_norm2, int count, double ref_noise, double *noise,
+                       double *bias);
 
 /* Least-squares slope of log y against log x over the points with x > 0 and finite y > 0 (the
  * convergence rate of an error curve: -0.5 for unbiased Monte Carlo). NAN with fewer than two

@@ -28,9 +28,12 @@ typedef struct {
     int *member;         /* a permutation of 0..count-1; clusters are its ranges */
     /* Scratch for splits. */
     float *line;
-    double *sum;         /* rows */
+    double *sum;                           /* rows */
     double *left, *right, *wleft, *wright; /* count + 1 */
-    struct proj { float p; int k; } *proj;
+    struct proj {
+        float p;
+        int k;
+    } * proj;
 } ctx;
 
 static float dotf(const float *a, const float *b, int n) {
@@ -166,7 +169,6 @@ static void sift_up(mcluster *h, int i) {
 }
 
 static float clamp_float(double x) { return x < (double)FLT_MAX ? (float)x : FLT_MAX; }
-
 
 typedef struct {
     double key;
@@ -313,7 +315,8 @@ int mrcs_cluster_columns(const float *m, int rows, int n, int C, rng_state *rng,
         int k1 = k0 + 64 < count ? k0 + 64 : count;
         for (int i = 0; i < R; i++) {
             const float *row = m + (size_t)i * (size_t)n;
-            for (int k = k0; k < k1; k++) dir[(size_t)k * (size_t)R + (size_t)i] = (float)((double)row[column[k]] / norm[k]);
+            for (int k = k0; k < k1; k++)
+                dir[(size_t)k * (size_t)R + (size_t)i] = (float)((double)row[column[k]] / norm[k]);
         }
     }
     for (int k = 0; k < count; k++) {

@@ -64,6 +64,8 @@ int vl_frame_per_pixel(const vl_params *vp, int clustering) {
 #define STR(x) STR_(x)
 #define F(field) offsetof(vl_params, field)
 
+/* One row per parameter reads better than one line per field. */
+/* clang-format off */
 static const param_choice on_off[] = {{"on", 1, "on"}, {"off", 0, "off"}};
 static const param_choice clamps[] = {{NULL, VL_CLAMP_DEFAULT, "method default"}, {"on", VL_CLAMP_ON, "on"},
                                       {"off", VL_CLAMP_OFF, "off"}};
@@ -146,6 +148,7 @@ static const param_desc table[] = {
              "(the path tracer's answer for the same paths)",
      .label = "merge"},
 };
+/* clang-format on */
 
 const param_desc *params_table(int *count) {
     *count = (int)(sizeof table / sizeof table[0]);
@@ -210,12 +213,15 @@ int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err,
     char *end = NULL;
     errno = 0;
     double v = d->type == PARAM_INT ? (double)strtoll(text, &end, 10) : strtod(text, &end);
-    int ok = !errno && end != text && *end == '\0' && isfinite(v) && v >= d->lo && (d->below_hi ? v < d->hi : v <= d->hi);
+    int ok =
+        !errno && end != text && *end == '\0' && isfinite(v) && v >= d->lo && (d->below_hi ? v < d->hi : v <= d->hi);
     if (!ok) {
         char off[64] = "";
         if (d->off_word) snprintf(off, sizeof off, " or %s", d->off_word);
-        return snprintf(err, errlen, "expected %s in [%.15g, %.15g%s%s, got '%s'", d->type == PARAM_INT ? "an integer" : "a number",
-                        d->lo, d->hi, d->below_hi ? ")" : "]", off, text), -1;
+        return snprintf(err, errlen, "expected %s in [%.15g, %.15g%s%s, got '%s'",
+                        d->type == PARAM_INT ? "an integer" : "a number", d->lo, d->hi, d->below_hi ? ")" : "]", off,
+                        text),
+               -1;
     }
     param_put(d, vl, d->zero_is_off && v == 0.0 ? -1.0 : v);
     return 0;
@@ -258,16 +264,23 @@ const char *params_help(void) {
         value_words(d, "|", words, sizeof words);
         int olen = d->flag ? snprintf(option, sizeof option, "  --%s", d->name)
                            : snprintf(option, sizeof option, "  --%s %s", d->name, words);
-        if (d->def_text) snprintf(def, sizeof def, "%s", d->def_text);
-        else if (d->type == PARAM_INT) snprintf(def, sizeof def, "%d", (int)d->def);
-        else if (d->type == PARAM_FLOAT) snprintf(def, sizeof def, "%g", d->def);
+        if (d->def_text)
+            snprintf(def, sizeof def, "%s", d->def_text);
+        else if (d->type == PARAM_INT)
+            snprintf(def, sizeof def, "%d", (int)d->def);
+        else if (d->type == PARAM_FLOAT)
+            snprintf(def, sizeof def, "%g", d->def);
         else {
             vl_params v = {0};
             param_put(d, &v, d->def);
             param_format(d, &v, def, sizeof def);
         }
         /* Options in a column of 23, the help beside them; its later lines under its first. */
-        len += (size_t)snprintf(text + len, sizeof text - len, "%s%*s", option, olen < 22 ? 23 - olen : olen == 22 ? 1 : 2, "");
+        len += (size_t)snprintf(text + len, sizeof text - len, "%s%*s", option,
+                                olen < 22    ? 23 - olen
+                                : olen == 22 ? 1
+                                             : 2,
+                                "");
         for (const char *h = d->help; *h && len < sizeof text;) {
             const char *nl = strchr(h, '\n');
             int n = nl ? (int)(nl - h) : (int)strlen(h);

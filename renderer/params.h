@@ -56,9 +56,9 @@ typedef struct {
                           * direct light at its next hit, one carrying the path on
                           * [VL_DEFAULT_GLOSSY_RAYS] */
     /* vsl+hl: the highlight estimator (which owns the camera - glossy - glossy - light paths) */
-    int secondary_rays;  /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
-    int clusters;        /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
-    int merge;           /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
+    int secondary_rays; /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
+    int clusters;       /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
+    int merge;          /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
 } vl_params;
 
 enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
@@ -92,13 +92,13 @@ enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };
 
 /* Zero means default for every field. */
 typedef struct {
-    int width, height;    /* 0: 960 x 540 */
+    int width, height; /* 0: 960 x 540 */
     render_method method;
-    int max_depth;        /* scattering events per path; 0: DEFAULT_MAX_DEPTH; 1 is direct light only */
+    int max_depth; /* scattering events per path; 0: DEFAULT_MAX_DEPTH; 1 is direct light only */
     uint64_t seed;
-    int threads;          /* 0: one per core */
-    int pt_highlights;    /* pt: camera - glossy - glossy - light paths in their own component */
-    int plan;             /* PLAN_AUTO: only the passes the scene calls for; PLAN_FULL: all */
+    int threads;       /* 0: one per core */
+    int pt_highlights; /* pt: camera - glossy - glossy - light paths in their own component */
+    int plan;          /* PLAN_AUTO: only the passes the scene calls for; PLAN_FULL: all */
     vl_params vl;
 } render_params;
 
@@ -114,18 +114,18 @@ extern const char *const pass_names[PASS_COUNT];
 
 typedef struct {
     uint64_t rays[RAY_KIND_COUNT];
-    uint64_t rejected_samples; /* samples dropped because they were NaN or Inf */
-    uint64_t virtual_lights;   /* deposited, summed over frames (the effective light count) */
-    uint64_t light_paths;      /* traced to deposit them */
-    uint64_t vl_connections;   /* shading point - virtual light evaluations */
-    uint64_t vsl_samples;      /* integration samples of the VSL integrals */
-    uint64_t clamped;          /* contributions the clamp cut down */
-    uint64_t glossy_bounces;   /* camera paths continued through a sharp glossy lobe (--trace-glossy) */
-    uint64_t hl_points;        /* camera hits the highlight estimator worked at */
-    uint64_t hl_secondary_rays;/* rays sampled from their glossy lobes */
-    uint64_t hl_lobes;         /* lobes lit (merged, or one per secondary hit without merging) */
-    uint64_t hl_merge_ns;      /* thread time spent clustering and merging (the paper's Table 1, C) */
-    uint64_t env_filter_bytes; /* memory of the prefiltered environment map (vsl+hl under a map; 0: none) */
+    uint64_t rejected_samples;  /* samples dropped because they were NaN or Inf */
+    uint64_t virtual_lights;    /* deposited, summed over frames (the effective light count) */
+    uint64_t light_paths;       /* traced to deposit them */
+    uint64_t vl_connections;    /* shading point - virtual light evaluations */
+    uint64_t vsl_samples;       /* integration samples of the VSL integrals */
+    uint64_t clamped;           /* contributions the clamp cut down */
+    uint64_t glossy_bounces;    /* camera paths continued through a sharp glossy lobe (--trace-glossy) */
+    uint64_t hl_points;         /* camera hits the highlight estimator worked at */
+    uint64_t hl_secondary_rays; /* rays sampled from their glossy lobes */
+    uint64_t hl_lobes;          /* lobes lit (merged, or one per secondary hit without merging) */
+    uint64_t hl_merge_ns;       /* thread time spent clustering and merging (the paper's Table 1, C) */
+    uint64_t env_filter_bytes;  /* memory of the prefiltered environment map (vsl+hl under a map; 0: none) */
     uint64_t pass_ns[PASS_COUNT];
 } render_stats;
 
@@ -151,21 +151,21 @@ typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE } param_type;
 typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS } param_group;
 
 typedef struct {
-    const char *name;  /* the word on the command line and in scripts; NULL: the panel's only */
+    const char *name; /* the word on the command line and in scripts; NULL: the panel's only */
     int value;
     const char *label; /* the panel's */
 } param_choice;
 
 /* One many-light parameter: an int or float field of vl_params (a choice is an int field). */
 typedef struct {
-    const char *name;       /* the option without "--", and the script's `set` name */
+    const char *name; /* the option without "--", and the script's `set` name */
     param_type type;
     param_group group;
-    size_t offset;          /* of the field in vl_params */
-    double lo, hi;          /* numbers accepted */
-    int below_hi;           /* hi itself is refused */
-    const char *off_word;   /* a word stored as -1 ("off", "all"); NULL: none */
-    int zero_is_off;        /* 0 is stored as -1 too (0 in vl_params means the default) */
+    size_t offset;        /* of the field in vl_params */
+    double lo, hi;        /* numbers accepted */
+    int below_hi;         /* hi itself is refused */
+    const char *off_word; /* a word stored as -1 ("off", "all"); NULL: none */
+    int zero_is_off;      /* 0 is stored as -1 too (0 in vl_params means the default) */
     const param_choice *choices;
     int num_choices;
     int flag;               /* the command line takes it alone, as "on" */
@@ -175,7 +175,7 @@ typedef struct {
     const char *help;       /* lines for --help, '\n' between them */
     const char *label;      /* the panel's */
     double panel_lo, panel_hi;
-    int panel_log;          /* a logarithmic slider */
+    int panel_log; /* a logarithmic slider */
     const char *panel_format;
     const char *panel_lo_text; /* shown at or below panel_lo (off, none, all) */
 } param_desc;

@@ -6,9 +6,9 @@
 
 #include "clock.h"
 #include "lights.h"
+#include "params.h"
 #include "rng.h"
 #include "sampling.h"
-#include "params.h"
 
 /* Probes: about this many in all, shared by area, and at least PROBES_PER_MATERIAL on each
  * material with any area, so a small mirror is not missed. */
@@ -36,7 +36,8 @@ static void note_material(material_summary *m, const bsdf *b) {
 /* Whether h is on a side anything can see: the front, or either side of a double-sided
  * material. The inside of a closed object is neither. */
 static int seen_side(const scene *s, const surface_hit *h) {
-    return !h->backface || (h->material >= 0 && h->material < s->num_materials && s->materials[h->material].double_sided);
+    return !h->backface ||
+           (h->material >= 0 && h->material < s->num_materials && s->materials[h->material].double_sided);
 }
 
 /* What a cosine-distributed ray from b (BSDF bb) meets: light b reflects there can be reflected
@@ -141,8 +142,10 @@ int scene_analyse(const scene *s, scene_analysis *a, char *err, size_t errlen) {
             int lo = 0, hi = count - 1;
             while (lo < hi) {
                 int mid = (lo + hi) / 2;
-                if (cum[first + mid] > u) hi = mid;
-                else lo = mid + 1;
+                if (cum[first + mid] > u)
+                    hi = mid;
+                else
+                    lo = mid + 1;
             }
             probe_surface(s, a, order[first + lo], &rng);
         }
@@ -202,9 +205,13 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
         const char *forced = "forced on (--plan full)";
         snprintf(p.why_depth, sizeof p.why_depth, "%d, as asked (--plan full)", max_depth);
         snprintf(p.why_virtual, sizeof p.why_virtual, "%s", many ? forced : "not this method");
-        snprintf(p.why_kernel, sizeof p.why_kernel, "%s", vsl ? "three strategies for every pair (--plan full)" : "not this method");
+        snprintf(p.why_kernel, sizeof p.why_kernel, "%s",
+                 vsl ? "three strategies for every pair (--plan full)" : "not this method");
         snprintf(p.why_highlights, sizeof p.why_highlights, "%s", p.highlights ? forced : "not this method");
-        snprintf(p.why_env, sizeof p.why_env, "%s", p.env_prefilter ? forced : !a->env ? "no environment map" : "no highlight pass");
+        snprintf(p.why_env, sizeof p.why_env, "%s",
+                 p.env_prefilter ? forced
+                 : !a->env       ? "no environment map"
+                                 : "no highlight pass");
         return p;
     }
     /* The path tracer is the reference: it keeps the depth asked, whatever the probes found. */
@@ -219,7 +226,8 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
         snprintf(p.why_depth, sizeof p.why_depth, "%d, as asked", max_depth);
     }
     p.virtual_lights = many && p.max_depth > 1;
-    snprintf(p.why_virtual, sizeof p.why_virtual, "%s", !many ? "not this method"
+    snprintf(p.why_virtual, sizeof p.why_virtual, "%s",
+             !many              ? "not this method"
              : p.virtual_lights ? "on: reflecting surfaces see each other"
                                 : "off: no indirect light to carry");
     if (!vsl || !p.virtual_lights)
@@ -229,8 +237,8 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
                  "three strategies where a glossy lobe (alpha < %g) takes part, cone sampling for the rest",
                  (double)BSDF_HIGHLIGHT_ALPHA);
     else
-        snprintf(p.why_kernel, sizeof p.why_kernel, "diffuse-only (cone sampling): no glossy lobe sharper than alpha %g",
-                 (double)BSDF_HIGHLIGHT_ALPHA);
+        snprintf(p.why_kernel, sizeof p.why_kernel,
+                 "diffuse-only (cone sampling): no glossy lobe sharper than alpha %g", (double)BSDF_HIGHLIGHT_ALPHA);
     if (method != METHOD_VSL_HL) {
         snprintf(p.why_highlights, sizeof p.why_highlights, "not this method");
     } else if (p.max_depth < 2 || !emitters) {
@@ -243,8 +251,10 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
         snprintf(p.why_highlights, sizeof p.why_highlights, "on: glossy surfaces see each other");
     }
     p.env_prefilter = p.highlights && a->env;
-    snprintf(p.why_env, sizeof p.why_env, "%s", p.env_prefilter ? "on: highlights lit by the environment"
-                                                : !a->env ? "off: no environment map" : "off: no highlight pass");
+    snprintf(p.why_env, sizeof p.why_env, "%s",
+             p.env_prefilter ? "on: highlights lit by the environment"
+             : !a->env       ? "off: no environment map"
+                             : "off: no highlight pass");
     return p;
 }
 

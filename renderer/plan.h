@@ -19,10 +19,10 @@
 
 /* One material as the probes saw it. */
 typedef struct {
-    int probes;          /* surface samples on it (0: no area) */
-    int lobes;           /* BSDF_DIFFUSE | BSDF_GLOSSY seen anywhere on it (textures included) */
+    int probes;                 /* surface samples on it (0: no area) */
+    int lobes;                  /* BSDF_DIFFUSE | BSDF_GLOSSY seen anywhere on it (textures included) */
     float alpha_min, alpha_max; /* its glossy lobes' roughness (0, 0 without one) */
-    int anisotropic;     /* a glossy lobe whose two roughnesses differ */
+    int anisotropic;            /* a glossy lobe whose two roughnesses differ */
 } material_summary;
 
 typedef struct {
@@ -31,13 +31,13 @@ typedef struct {
     /* materials per class: diffuse (no glossy lobe), rough (glossy lobes no sharper than
      * BSDF_HIGHLIGHT_ALPHA), glossy; near-specular and anisotropic are kinds of glossy */
     int diffuse, rough, glossy, near_specular, anisotropic;
-    float alpha_min, alpha_max;  /* over the glossy class */
-    int punctual, area, env;     /* emitters: punctual lights, emissive triangles, a map */
-    int reflective;      /* some surface reflects light at all */
-    int indirect;        /* a reflecting surface sees another: indirect light can exist */
-    int glossy_to_glossy;/* a glossy surface sees a glossy surface */
-    long probe_rays;     /* rays the visibility probes traced */
-    double seconds;      /* the analysis's wall time */
+    float alpha_min, alpha_max; /* over the glossy class */
+    int punctual, area, env;    /* emitters: punctual lights, emissive triangles, a map */
+    int reflective;             /* some surface reflects light at all */
+    int indirect;               /* a reflecting surface sees another: indirect light can exist */
+    int glossy_to_glossy;       /* a glossy surface sees a glossy surface */
+    long probe_rays;            /* rays the visibility probes traced */
+    double seconds;             /* the analysis's wall time */
 } scene_analysis;
 
 /* Analyses s (read-only, thread-safe queries): probes random surface points on both sides,
@@ -52,13 +52,13 @@ enum { PLAN_AUTO = 0, PLAN_FULL };
 
 /* The passes of one session. */
 typedef struct {
-    int full;            /* PLAN_FULL: every pass on */
-    int max_depth;       /* scattering events the scene needs (at most what was asked) */
-    int virtual_lights;  /* vpl, vsl, vsl+hl: trace virtual lights and gather from them */
+    int full;               /* PLAN_FULL: every pass on */
+    int max_depth;          /* scattering events the scene needs (at most what was asked) */
+    int virtual_lights;     /* vpl, vsl, vsl+hl: trace virtual lights and gather from them */
     int vsl_all_strategies; /* the three-strategy VSL integral for every pair (else only where a
                              * glossy lobe is involved; diffuse pairs by cone sampling) */
-    int highlights;      /* vsl+hl: the highlight pass (else the VSL gather keeps those paths) */
-    int env_prefilter;   /* vsl+hl: the vMF-prefiltered environment */
+    int highlights;         /* vsl+hl: the highlight pass (else the VSL gather keeps those paths) */
+    int env_prefilter;      /* vsl+hl: the vMF-prefiltered environment */
     /* why, one line each */
     char why_depth[160], why_virtual[160], why_kernel[160], why_highlights[160], why_env[160], why_direct[200];
 } effect_plan;

@@ -21,8 +21,10 @@ static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
  * highlights for the paths that reach the light at their third vertex. */
 static void add_emission(vec3 out[COMP_COUNT], int depth, int split_highlights, vec3 beta, vec3 beta_hl, vec3 le,
                          float w) {
-    if (split_highlights && depth == 2) add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
-    else out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+    if (split_highlights && depth == 2)
+        add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
+    else
+        out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
 }
 
 /* The path tracer, for a ray (o, d) whose closest hit the caller has traced: *first, or NULL when
@@ -36,14 +38,16 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     vec3 beta_hl = v3s(0.0f); /* the throughput through glossy lobes only (depths 1 and 2) */
-    float prev_pdf = 0.0f; /* solid-angle pdf of the BSDF sample that produced the current ray */
+    float prev_pdf = 0.0f;    /* solid-angle pdf of the BSDF sample that produced the current ray */
     vec3 prev_p = o;
     for (int depth = 0;; depth++) {
         surface_hit h;
         rays[depth == 0 && !continuation ? RAY_CAMERA : RAY_BOUNCE]++;
         int hit;
-        if (depth > 0) hit = scene_intersect(s, o, d, INFINITY, &h);
-        else if ((hit = first != NULL)) h = *first;
+        if (depth > 0)
+            hit = scene_intersect(s, o, d, INFINITY, &h);
+        else if ((hit = first != NULL))
+            h = *first;
         if (!hit) {
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (depth > 0 || !continuation)) {
@@ -66,7 +70,9 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
         frame3 fr;
         bsdf b = material_bsdf(s, &h, &fr);
         vec3 wo = to_local(fr, neg3(d));
-        int lobes = depth > 0 ? BSDF_ALL : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~bsdf_highlight_lobe(&b) : first_lobes;
+        int lobes = depth > 0                           ? BSDF_ALL
+                    : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~bsdf_highlight_lobe(&b)
+                                                        : first_lobes;
 
         /* Next-event estimation. */
         light_sample ls;

@@ -5,9 +5,9 @@
 #define GLINT_PT_H
 
 #include "film.h"
+#include "params.h"
 #include "rng.h"
 #include "scene.h"
-#include "params.h"
 
 /* Radiance along the camera ray (o, d) whose closest hit the caller has traced (first; NULL when
  * the ray escaped), split by path-space component: out[COMP_DIRECT] gets emission

@@ -7,7 +7,9 @@
 
 #include "gmath.h"
 
-typedef struct { uint64_t state, inc; } rng_state;
+typedef struct {
+    uint64_t state, inc;
+} rng_state;
 
 static inline uint32_t rng_next_u32(rng_state *r) {
     uint64_t old = r->state;

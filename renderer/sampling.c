@@ -132,8 +132,10 @@ int alias_init(alias_table *a, const float *weights, int n) {
      * bin takes its alias from a large one, which gives up what the small one lacks. */
     int small = 0, large = n;
     for (int i = 0; i < n; i++) {
-        if (scaled[i] < 1.0) work[small++] = i;
-        else work[--large] = i;
+        if (scaled[i] < 1.0)
+            work[small++] = i;
+        else
+            work[--large] = i;
     }
     int s = 0;
     while (s < small && large < n) {
@@ -172,8 +174,10 @@ static int find_bin(const dist1d *d, double u) {
     int lo = 0, hi = d->n; /* invariant: cdf[lo] <= u < cdf[hi] (cdf[n] = 1 > u) */
     while (hi - lo > 1) {
         int mid = (lo + hi) >> 1;
-        if (d->cdf[mid] <= u) lo = mid;
-        else hi = mid;
+        if (d->cdf[mid] <= u)
+            lo = mid;
+        else
+            hi = mid;
     }
     return lo;
 }

@@ -9,7 +9,6 @@
 extern "C" {
 #endif
 
-
 /* Cosine-weighted hemisphere around +z; pdf = cos(theta) / pi. */
 vec3 sample_cosine_hemisphere(vec2 u);
 static inline float pdf_cosine_hemisphere(vec3 w) { return w.z > 0.0f ? w.z * INV_PI_F : 0.0f; }
@@ -82,8 +81,8 @@ static inline int russian_roulette(vec3 *w, float u) {
 /* Piecewise-constant 1D distribution over [0,1) with n bins. Owns its arrays (init/deinit). */
 typedef struct {
     int n;
-    float *func;   /* n non-negative values (copied; non-finite or negative input counted as 0) */
-    double *cdf;   /* n + 1 values, cdf[0] = 0, cdf[n] = 1 */
+    float *func;     /* n non-negative values (copied; non-finite or negative input counted as 0) */
+    double *cdf;     /* n + 1 values, cdf[0] = 0, cdf[n] = 1 */
     double integral; /* sum(func) / n; 0 means the input was all zero and sampling is uniform */
 } dist1d;
 
@@ -101,9 +100,9 @@ float dist1d_pdf(const dist1d *d, float x);
  * n bins, each split between itself and one alias. Owns its arrays (init/deinit). */
 typedef struct {
     int n;
-    float *pmf;   /* n probabilities (non-finite or negative weights count as 0; all zero: uniform) */
-    float *keep;  /* the share of bin i's slot that draws i itself */
-    int *alias;   /* what the rest of the slot draws */
+    float *pmf;  /* n probabilities (non-finite or negative weights count as 0; all zero: uniform) */
+    float *keep; /* the share of bin i's slot that draws i itself */
+    int *alias;  /* what the rest of the slot draws */
 } alias_table;
 
 /* Returns 0, or -1 when out of memory or n < 1. */

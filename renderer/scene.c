@@ -123,7 +123,8 @@ static int reserve_triangles(scene *s, int need) {
     if (need <= s->cap_triangles) return 0;
     long long c = s->cap_triangles ? s->cap_triangles : 1024;
     while (c < need) c *= 2;
-    if (realloc_to((void **)&s->indices, 3 * sizeof(uint32_t), c) || realloc_to((void **)&s->tri_material, sizeof(int32_t), c) ||
+    if (realloc_to((void **)&s->indices, 3 * sizeof(uint32_t), c) ||
+        realloc_to((void **)&s->tri_material, sizeof(int32_t), c) ||
         realloc_to((void **)&s->tri_light, sizeof(int32_t), c))
         return -1;
     s->cap_triangles = (int)c;
@@ -384,10 +385,10 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
     s->rtc = rtcNewScene(s->device);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry geom = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->positions, 0,
-                               sizeof(vec3), (size_t)s->num_vertices);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->indices, 0,
-                               3 * sizeof(uint32_t), (size_t)s->num_triangles);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->positions, 0, sizeof(vec3),
+                               (size_t)s->num_vertices);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->indices, 0, 3 * sizeof(uint32_t),
+                               (size_t)s->num_triangles);
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(s->rtc, geom, 0);
     rtcReleaseGeometry(geom);
@@ -414,8 +415,10 @@ int scene_light_groups(const scene *s, light_group *out, int max) {
         if (n < max) {
             light_group *g = &out[n];
             memset(g, 0, sizeof *g);
-            if (l->name[0]) snprintf(g->name, sizeof g->name, "%s", l->name);
-            else snprintf(g->name, sizeof g->name, "light %d", i);
+            if (l->name[0])
+                snprintf(g->name, sizeof g->name, "%s", l->name);
+            else
+                snprintf(g->name, sizeof g->name, "light %d", i);
             g->type = l->type;
             g->index = i;
             g->center = l->type == LIGHT_DIRECTIONAL ? v3(0, 0, 0) : l->position;
@@ -446,8 +449,10 @@ int scene_light_groups(const scene *s, light_group *out, int max) {
         if (n < max) {
             light_group *g = &out[n];
             memset(g, 0, sizeof *g);
-            if (s->materials[m].name[0]) snprintf(g->name, sizeof g->name, "%s", s->materials[m].name);
-            else snprintf(g->name, sizeof g->name, "emissive material %d", m);
+            if (s->materials[m].name[0])
+                snprintf(g->name, sizeof g->name, "%s", s->materials[m].name);
+            else
+                snprintf(g->name, sizeof g->name, "emissive material %d", m);
             g->type = LIGHT_TRIANGLE;
             g->index = m;
             g->center = v3((float)(k[1] / k[0]), (float)(k[2] / k[0]), (float)(k[3] / k[0]));
@@ -467,8 +472,10 @@ static int find_group(const scene *s, int g, light_group *out, char *err, size_t
     /* Punctual groups come first and are cheap; an area group needs the list up to it. */
     light_group *all = malloc(sizeof(light_group) * (size_t)(g + 1));
     int status = all && scene_light_groups(s, all, g + 1) > g ? 0 : -1;
-    if (status == 0) *out = all[g];
-    else snprintf(err, errlen, "out of memory");
+    if (status == 0)
+        *out = all[g];
+    else
+        snprintf(err, errlen, "out of memory");
     free(all);
     return status;
 }
@@ -531,14 +538,17 @@ int scene_set_light_gain(scene *s, int g, float gain, char *err, size_t errlen) 
         for (int i = 0; i < n; i++) {
             box->gains[i] = 1.0f;
             const light_group *gi = &all[i];
-            box->gain_bases[i] = gi->type == LIGHT_TRIANGLE ? s->materials[gi->index].emission : s->lights[gi->index].color;
+            box->gain_bases[i] =
+                gi->type == LIGHT_TRIANGLE ? s->materials[gi->index].emission : s->lights[gi->index].color;
         }
         box->num_gains = n;
         free(all);
     }
     vec3 value = scale3(box->gain_bases[g], gain);
-    if (lg.type == LIGHT_TRIANGLE) s->materials[lg.index].emission = value;
-    else s->lights[lg.index].color = value;
+    if (lg.type == LIGHT_TRIANGLE)
+        s->materials[lg.index].emission = value;
+    else
+        s->lights[lg.index].color = value;
     box->gains[g] = gain;
     /* Powers and the selection distribution follow the new intensity. */
     return scene_build_lights(s, err, errlen);
@@ -574,8 +584,8 @@ scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *e
     return finish_load(s, gltf_import_file(s, path, err, errlen), err, errlen);
 }
 
-scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name,
-                         scene_warn_fn warn, void *warn_user, char *err, size_t errlen) {
+scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name, scene_warn_fn warn,
+                         void *warn_user, char *err, size_t errlen) {
     scene *s = scene_create(warn, warn_user);
     if (!s) return snprintf(err, errlen, "%s: out of memory", name), NULL;
     snprintf(s->path, sizeof s->path, "%s", name);
@@ -645,8 +655,9 @@ static void complete_hit(const scene *s, vec3 d, int t, float b1, float b2, floa
         return;
     }
     const vec4 *tg = s->tangents;
-    vec3 tan = add3(add3(scale3(v3(tg[v[0]].x, tg[v[0]].y, tg[v[0]].z), b0), scale3(v3(tg[v[1]].x, tg[v[1]].y, tg[v[1]].z), b1)),
-                    scale3(v3(tg[v[2]].x, tg[v[2]].y, tg[v[2]].z), b2));
+    vec3 tan = add3(
+        add3(scale3(v3(tg[v[0]].x, tg[v[0]].y, tg[v[0]].z), b0), scale3(v3(tg[v[1]].x, tg[v[1]].y, tg[v[1]].z), b1)),
+        scale3(v3(tg[v[2]].x, tg[v[2]].y, tg[v[2]].z), b2));
     h->shading = frame_from_normal_tangent(ns, tan);
     /* glTF bitangent = cross(n, t) * w; keep the handedness so anisotropy rotations turn the right way. */
     if (tg[v[0]].w < 0.0f) h->shading.b = neg3(h->shading.b);

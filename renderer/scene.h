@@ -22,7 +22,6 @@
 extern "C" {
 #endif
 
-
 /* ---- textures ------------------------------------------------------------------------------ */
 
 typedef enum { WRAP_REPEAT = 0, WRAP_CLAMP, WRAP_MIRROR } wrap_mode;
@@ -57,19 +56,19 @@ typedef struct {
     /* glTF metallic-roughness */
     vec3 base_color;
     float metallic, roughness;
-    texture_slot base_color_tex;    /* sRGB */
-    texture_slot metal_rough_tex;   /* linear: G roughness, B metallic */
-    float anisotropy_strength;      /* KHR_materials_anisotropy */
-    float anisotropy_rotation;      /* radians about the normal, from the tangent (also Ward's) */
-    texture_slot anisotropy_tex;    /* linear: RG direction, B strength */
+    texture_slot base_color_tex;  /* sRGB */
+    texture_slot metal_rough_tex; /* linear: G roughness, B metallic */
+    float anisotropy_strength;    /* KHR_materials_anisotropy */
+    float anisotropy_rotation;    /* radians about the normal, from the tangent (also Ward's) */
+    texture_slot anisotropy_tex;  /* linear: RG direction, B strength */
     /* Phong and Ward (the papers' lobes) */
     vec3 kd, ks;
-    float exponent;                 /* Phong */
-    float alpha_x, alpha_y;         /* Ward */
+    float exponent;         /* Phong */
+    float alpha_x, alpha_y; /* Ward */
     /* emission: radiance = emission * emissive texture */
-    vec3 emission;                  /* emissiveFactor * KHR_materials_emissive_strength */
-    texture_slot emissive_tex;      /* sRGB */
-    int double_sided;               /* emits from both faces */
+    vec3 emission;             /* emissiveFactor * KHR_materials_emissive_strength */
+    texture_slot emissive_tex; /* sRGB */
+    int double_sided;          /* emits from both faces */
 } material;
 
 /* ---- lights and cameras -------------------------------------------------------------------- */
@@ -88,13 +87,13 @@ typedef struct {
     /* Radiometric stand-ins for the glTF units, one consistent scale: candela -> W/sr (point,
      * spot), lux -> W/m^2 (directional). color already includes the intensity. */
     vec3 color;
-    vec3 position;      /* point, spot */
-    vec3 direction;     /* spot, directional: where the light shines (unit) */
-    float cos_inner;    /* spot */
-    float cos_outer;    /* spot */
-    float range;        /* point, spot: glTF range (0 = infinite) */
-    int triangle;       /* LIGHT_TRIANGLE */
-    float power;        /* estimate of emitted power (luminance), for light selection */
+    vec3 position;   /* point, spot */
+    vec3 direction;  /* spot, directional: where the light shines (unit) */
+    float cos_inner; /* spot */
+    float cos_outer; /* spot */
+    float range;     /* point, spot: glTF range (0 = infinite) */
+    int triangle;    /* LIGHT_TRIANGLE */
+    float power;     /* estimate of emitted power (luminance), for light selection */
 } light;
 
 typedef struct {
@@ -104,7 +103,6 @@ typedef struct {
     float yfov;              /* radians */
 } camera;
 
-
 /* ---- the scene ----------------------------------------------------------------------------- */
 
 typedef struct scene {
@@ -112,9 +110,9 @@ typedef struct scene {
 
     /* world-space geometry, flattened: vertex arrays parallel, 3 indices per triangle */
     int num_vertices, cap_vertices;
-    vec3 *positions;  /* padded by one element for Embree's 16-byte reads */
+    vec3 *positions; /* padded by one element for Embree's 16-byte reads */
     vec3 *normals;
-    vec4 *tangents;   /* xyz tangent, w = bitangent sign */
+    vec4 *tangents; /* xyz tangent, w = bitangent sign */
     vec2 *uv0, *uv1;
     int num_triangles, cap_triangles;
     uint32_t *indices;
@@ -132,7 +130,7 @@ typedef struct scene {
     int num_lights, cap_lights;
     camera *cameras;
     int num_cameras, cap_cameras;
-    env_map *env; /* NULL without one */
+    env_map *env;  /* NULL without one */
     int env_light; /* index into lights, or -1 */
 
     dist1d light_dist; /* light selection by power */
@@ -160,15 +158,15 @@ scene *scene_load(const char *path, scene_warn_fn warn, void *warn_user, char *e
 /* Loads the default built-in scene. */
 scene *scene_load_default(scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
 /* Loads glTF JSON or GLB from memory; base_dir resolves external URIs; name is used in messages. */
-scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name,
-                         scene_warn_fn warn, void *warn_user, char *err, size_t errlen);
+scene *scene_load_memory(const void *data, size_t size, const char *base_dir, const char *name, scene_warn_fn warn,
+                         void *warn_user, char *err, size_t errlen);
 
 /* The scenes compiled into the program (builtins.c), glTF with embedded buffers. */
 typedef struct {
     const char *name;        /* loaded as builtin:NAME */
     const char *description; /* one line, for --help */
     const unsigned char *gltf;
-    const size_t *size;      /* of gltf, in bytes */
+    const size_t *size; /* of gltf, in bytes */
 } builtin_scene;
 /* All of them, the default first; *count set. */
 const builtin_scene *scene_builtins(int *count);
@@ -240,14 +238,14 @@ int scene_set_light_gain(scene *s, int g, float gain, char *err, size_t errlen);
 
 typedef struct {
     float t;
-    int tri;       /* triangle index */
+    int tri; /* triangle index */
     int material;
-    vec3 p;        /* position */
-    vec3 ng;       /* geometric normal, facing the incoming ray */
-    frame3 shading;/* shading frame: n faces the incoming ray's side; t along the tangent for anisotropic
+    vec3 p;         /* position */
+    vec3 ng;        /* geometric normal, facing the incoming ray */
+    frame3 shading; /* shading frame: n faces the incoming ray's side; t along the tangent for anisotropic
                     * materials, any direction for the rest */
     vec2 uv0, uv1;
-    int backface;  /* the ray hit the triangle's back (winding) side */
+    int backface; /* the ray hit the triangle's back (winding) side */
 } surface_hit;
 
 /* Closest hit along o + t d for t in (0, tmax]. Returns 1 on hit and fills h. */

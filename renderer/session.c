@@ -42,9 +42,9 @@ struct render_session {
     worker_stats *workers;
     render_stats totals;
     int tiles_x, tiles_y;
-    manylight ml; /* vpl, vsl, vsl+hl: this frame's virtual lights */
-    hl_setup hl;  /* vsl+hl: this frame's highlight settings */
-    env_vmf_filter *envf; /* vsl+hl under a map: the map prefiltered, built on first use */
+    manylight ml;            /* vpl, vsl, vsl+hl: this frame's virtual lights */
+    hl_setup hl;             /* vsl+hl: this frame's highlight settings */
+    env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
     scene_analysis analysis;
     effect_plan plan;
@@ -185,7 +185,8 @@ static void render_tile(void *ctx, int tile, int worker) {
             uint64_t t0 = timed ? clock_ns() : 0;
             unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
             if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
-            for (int i = 0; i < n; i++) render_sample(rs, st, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
+            for (int i = 0; i < n; i++)
+                render_sample(rs, st, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
         }
     }
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;
@@ -203,8 +204,8 @@ int session_render_frame(render_session *rs) {
     }
     if (rs->plan.virtual_lights) {
         uint64_t t0 = clock_ns();
-        if (manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, &rs->plan, rs->frames, rs->pool, &rs->totals,
-                                  rs->error, sizeof rs->error) != 0)
+        if (manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, &rs->plan, rs->frames, rs->pool,
+                                  &rs->totals, rs->error, sizeof rs->error) != 0)
             return -1;
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
     }

@@ -19,8 +19,7 @@ static void build_tables(void) {
 }
 
 int scene_add_image(scene *s, int width, int height, int channels, int bits, const void *pixels) {
-    if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || (bits != 8 && bits != 16) || !pixels)
-        return -1;
+    if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || (bits != 8 && bits != 16) || !pixels) return -1;
     if ((size_t)width * (size_t)height > ((size_t)1 << 28)) return -1;
     pthread_once(&tables_once, build_tables);
     if (s->num_images == s->cap_images) {

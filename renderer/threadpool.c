@@ -10,14 +10,14 @@ struct threadpool {
     int num_threads;
     pthread_t *threads;
     pthread_mutex_t lock;
-    pthread_cond_t wake;  /* workers wait here for a new job */
-    pthread_cond_t done;  /* the caller waits here for the job's end */
+    pthread_cond_t wake; /* workers wait here for a new job */
+    pthread_cond_t done; /* the caller waits here for the job's end */
     /* the current job, published under lock */
     task_fn fn;
     void *ctx;
     int num_tasks;
     unsigned long generation;
-    int active;           /* workers still inside the current job */
+    int active; /* workers still inside the current job */
     int quit;
     atomic_int next_task;
 };

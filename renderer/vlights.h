@@ -11,14 +11,14 @@
 #include "scene.h"
 
 typedef struct {
-    vec3 p;        /* position */
-    vec3 ng;       /* geometric normal on the side the light arrived from */
-    frame3 frame;  /* shading frame there (n on the same side) */
-    vec3 wi;       /* i_j: unit direction back toward where the light came from, local frame */
-    bsdf b;        /* the material there */
-    vec3 power;    /* Phi_j: flux, already divided by the number of light paths */
-    float radius;  /* r_j of the spherical light (0 until set) */
-    int depth;     /* bounce: 1 = the first surface a light path hit */
+    vec3 p;       /* position */
+    vec3 ng;      /* geometric normal on the side the light arrived from */
+    frame3 frame; /* shading frame there (n on the same side) */
+    vec3 wi;      /* i_j: unit direction back toward where the light came from, local frame */
+    bsdf b;       /* the material there */
+    vec3 power;   /* Phi_j: flux, already divided by the number of light paths */
+    float radius; /* r_j of the spherical light (0 until set) */
+    int depth;    /* bounce: 1 = the first surface a light path hit */
 } virtual_light;
 
 typedef struct {

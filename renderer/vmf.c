@@ -106,8 +106,10 @@ static double kappa_of_median(double t) {
     for (int i = 0; i < 30; i++) {
         double e = exp(-2.0 * k), m = -log1p(0.5 * (e - 1.0)) / k;
         double dm = (2.0 / (1.0 / e + 1.0) - m) / k; /* (L' k - L) / k^2 with L = m k, L' = 2 / (e^{2k} + 1) */
-        if (m > t) lo = k; /* m decreases: the root is above k */
-        else hi = k;
+        if (m > t)
+            lo = k; /* m decreases: the root is above k */
+        else
+            hi = k;
         double next = dm < 0.0 ? k - (m - t) / dm : 0.5 * (lo + hi);
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
         if (fabs(next - k) <= 1e-10 * k) return next;
@@ -179,7 +181,8 @@ int vmf_glossy_band_shares(const bsdf *b, vec3 wo, vec3 wi, float share[VMF_LOBE
     if (!(h.z > 0.0f)) return VMF_LOBE_BANDS;
     /* Band t's Beckmann density is proportional to t e^{-t u}, u = tan^2(theta_h) / alpha^2 (per axis) */
     double hz2 = (double)h.z * (double)h.z, ax = fmax((double)b->alpha_x, 1e-4), ay = fmax((double)b->alpha_y, 1e-4);
-    double hx = (double)h.x, hy = (double)h.y, u = (hx * hx / (ax * ax) + hy * hy / (ay * ay)) / hz2, d[VMF_LOBE_BANDS], sum = 0.0;
+    double hx = (double)h.x, hy = (double)h.y, u = (hx * hx / (ax * ax) + hy * hy / (ay * ay)) / hz2, d[VMF_LOBE_BANDS],
+           sum = 0.0;
     for (int k = 0; k < VMF_LOBE_BANDS; k++) {
         d[k] = ggx_band_w[k] * ggx_band_t[k] * exp(-ggx_band_t[k] * u);
         sum += d[k];
@@ -234,7 +237,8 @@ static void em_set(em_cluster *c, double alpha, float kappa) {
 }
 
 static double em_score(const em_cluster *c, vec3 s) {
-    double dx = (double)c->lobe.mu.x - (double)s.x, dy = (double)c->lobe.mu.y - (double)s.y, dz = (double)c->lobe.mu.z - (double)s.z;
+    double dx = (double)c->lobe.mu.x - (double)s.x, dy = (double)c->lobe.mu.y - (double)s.y,
+           dz = (double)c->lobe.mu.z - (double)s.z;
     return c->log_scale - (double)c->lobe.kappa * 0.5 * (dx * dx + dy * dy + dz * dz);
 }
 

@@ -13,8 +13,8 @@
 #define VMF_MAX_KAPPA 1e6
 
 typedef struct {
-    vec3 mu;      /* unit mean direction */
-    float kappa;  /* concentration, 0 (uniform) .. VMF_MAX_KAPPA */
+    vec3 mu;     /* unit mean direction */
+    float kappa; /* concentration, 0 (uniform) .. VMF_MAX_KAPPA */
 } vmf;
 
 /* log c(kappa). */

@@ -8,8 +8,9 @@
  * the highlights' part is the product of both ends' highlight lobes. */
 static vec3 bsdf_pair(const virtual_light *vl, const shading_point *x, vec3 lx, vec3 lj, int lobes_j, vl_terms terms) {
     if (terms == VL_TERMS_ALL || vl->depth != 1)
-        return terms == VL_TERMS_HIGHLIGHTS ? v3(0, 0, 0)
-                                            : mul3(bsdf_eval(&x->b, x->wo, lx, BSDF_ALL), bsdf_eval(&vl->b, vl->wi, lj, lobes_j));
+        return terms == VL_TERMS_HIGHLIGHTS
+                   ? v3(0, 0, 0)
+                   : mul3(bsdf_eval(&x->b, x->wo, lx, BSDF_ALL), bsdf_eval(&vl->b, vl->wi, lj, lobes_j));
     vec3 gg = mul3(bsdf_eval(&x->b, x->wo, lx, bsdf_highlight_lobe(&x->b)),
                    bsdf_eval(&vl->b, vl->wi, lj, lobes_j & bsdf_highlight_lobe(&vl->b)));
     if (terms == VL_TERMS_HIGHLIGHTS) return gg;
@@ -24,7 +25,8 @@ static vec3 bsdf_pair(const virtual_light *vl, const shading_point *x, vec3 lx, 
 static vec3 saturate(vec3 power, vec3 f, double scale) {
     double c[3] = {(double)power.x * (double)f.x * scale, (double)power.y * (double)f.y * scale,
                    (double)power.z * (double)f.z * scale};
-    for (int k = 0; k < 3; k++) c[k] = c[k] < VL_MAX_CONTRIBUTION ? c[k] : VL_MAX_CONTRIBUTION; /* NaN-free: inputs are finite */
+    for (int k = 0; k < 3; k++)
+        c[k] = c[k] < VL_MAX_CONTRIBUTION ? c[k] : VL_MAX_CONTRIBUTION; /* NaN-free: inputs are finite */
     return v3((float)c[0], (float)c[1], (float)c[2]);
 }
 
@@ -44,10 +46,10 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
 /* Omega_j: the cone from x around the sphere (p_j, r_j), or x's hemisphere when x is inside. */
 typedef struct {
     int inside;
-    vec3 axis;        /* unit, x -> p_j (outside only) */
-    float omc;        /* 1 - cos(theta_max) */
-    float sin2_max;   /* sin^2(theta_max) = (r/d)^2: the membership test, exact for tiny cones */
-    frame3 cone;      /* around axis */
+    vec3 axis;      /* unit, x -> p_j (outside only) */
+    float omc;      /* 1 - cos(theta_max) */
+    float sin2_max; /* sin^2(theta_max) = (r/d)^2: the membership test, exact for tiny cones */
+    frame3 cone;    /* around axis */
 } solid_angle;
 
 static solid_angle omega_of(const virtual_light *vl, const shading_point *x) {
@@ -105,7 +107,8 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
         float u_lobe = rng_float(rng);
         vec3 l;
         if (strategy == 0) {
-            l = o.inside ? to_world(x->frame, sample_cosine_hemisphere(u)) : to_world(o.cone, sample_uniform_cone(u, o.omc));
+            l = o.inside ? to_world(x->frame, sample_cosine_hemisphere(u))
+                         : to_world(o.cone, sample_uniform_cone(u, o.omc));
         } else {
             const bsdf *b = strategy == 1 ? &x->b : &vl->b;
             vec3 wo = strategy == 1 ? x->wo : vl->wi;
@@ -120,16 +123,19 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
         vec3 g = integrand(vl, x, terms, l, &lx, &lj);
         if (is_black3(g)) continue;
         float p_cone = o.inside ? pdf_cosine_hemisphere(lx) : pdf_cone_uniform;
-        float p_sum = strategies == 1 ? p_cone
-                                      : p_cone + bsdf_pdf(&x->b, x->wo, lx, BSDF_ALL) + bsdf_pdf(&vl->b, vl->wi, lj, BSDF_ALL);
+        float p_sum = strategies == 1
+                          ? p_cone
+                          : p_cone + bsdf_pdf(&x->b, x->wo, lx, BSDF_ALL) + bsdf_pdf(&vl->b, vl->wi, lj, BSDF_ALL);
         if (!(p_sum > 0.0f)) continue;
         double w = (double)strategies / (double)p_sum;
         sum[0] += (double)g.x * w;
         sum[1] += (double)g.y * w;
         sum[2] += (double)g.z * w;
     }
-    return saturate(v3s(1.0f), v3((float)fmin(sum[0], VL_MAX_CONTRIBUTION), (float)fmin(sum[1], VL_MAX_CONTRIBUTION),
-                                  (float)fmin(sum[2], VL_MAX_CONTRIBUTION)), 1.0 / n);
+    return saturate(v3s(1.0f),
+                    v3((float)fmin(sum[0], VL_MAX_CONTRIBUTION), (float)fmin(sum[1], VL_MAX_CONTRIBUTION),
+                       (float)fmin(sum[2], VL_MAX_CONTRIBUTION)),
+                    1.0 / n);
 }
 
 /* The share of a disk of radius 1 on the near side of a chord at signed distance h beyond its
@@ -147,8 +153,8 @@ double vsl_front_share(const virtual_light *vl, const shading_point *x) {
     return fmin(a, b) * sqrt(fmax(a, b));
 }
 
-vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
-                      int *samples) {
+vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies,
+                      rng_state *rng, int *samples) {
     if (!(vl->radius > 0.0f)) return vpl_contribution(vl, x, 1, terms); /* the limit r -> 0 */
     vec3 i = vsl_integral(vl, x, terms, all_strategies, rng, samples);
     if (is_black3(i)) return i;

@@ -46,8 +46,8 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
  * geometry and the paper's estimator loses it (half of what a light on the floor by a wall sends
  * to the wall, 10-20% along a room's edges); the rest of the sphere carries it instead
  * (docs/design.md). *samples (optional) receives the count used. */
-vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
-                      int *samples);
+vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies,
+                      rng_state *rng, int *samples);
 
 /* The share of the sphere's cross-section in front of the receiver's tangent plane and of the
  * light's (1 when the sphere clears both): each plane cuts a disk seen edge-on to it at the

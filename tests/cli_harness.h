@@ -7,9 +7,9 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
-static const char *glint;                          /* the program under test */
-static char tmp[512];                              /* its working directory */
-static char out_text[65536], err_text[65536];      /* the last run's stdout and stderr */
+static const char *glint;                     /* the program under test */
+static char tmp[512];                         /* its working directory */
+static char out_text[65536], err_text[65536]; /* the last run's stdout and stderr */
 
 /* Reads file `name` (relative to tmp) into buf, NUL-terminated; returns its length (0: none). */
 static size_t read_file(const char *name, char *buf, size_t cap) {

@@ -53,8 +53,8 @@ extern "C" int write_test_exr(const char *path, exr_storage_t storage, exr_compr
             void *base = type == Imf::UINT   ? (void *)uints[(size_t)c].data()
                          : type == Imf::HALF ? (void *)halves[(size_t)c].data()
                                              : (void *)floats[(size_t)c].data();
-            fb.insert(chans[c].name, Imf::Slice::Make(type, base, data.min, (int64_t)w, (int64_t)h, (size_t)0,
-                                                      (size_t)0, s, s));
+            fb.insert(chans[c].name,
+                      Imf::Slice::Make(type, base, data.min, (int64_t)w, (int64_t)h, (size_t)0, (size_t)0, s, s));
         }
         if (storage == EXR_STORAGE_TILED) {
             header.setTileDescription(Imf::TileDescription(16, 8, Imf::ONE_LEVEL));

@@ -21,8 +21,8 @@ typedef struct {
 typedef float (*test_value_fn)(int c, int x, int y);
 
 /* Writes path; returns 0, or -1 after printing the library's message. */
-int write_test_exr(const char *path, exr_storage_t storage, exr_compression_t comp, const test_chan *chans,
-                   int nchan, exr_attr_box2i_t dw, exr_attr_box2i_t disp, test_value_fn value);
+int write_test_exr(const char *path, exr_storage_t storage, exr_compression_t comp, const test_chan *chans, int nchan,
+                   exr_attr_box2i_t dw, exr_attr_box2i_t disp, test_value_fn value);
 
 #ifdef __cplusplus
 }

@@ -18,7 +18,6 @@
 #include "cli_harness.h"
 #include "image_io.h"
 
-
 static const char *const header = "method,params,seed,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,"
                                   "direct_relmse,indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse";
 static const char *const summary_header = "method,params,component,budget,seeds,seconds,frames,rel_l2,relmse,noise,"
@@ -248,7 +247,8 @@ static void test_bench_run(void) {
     }
     if (n == 6) {
         CHECK(strcmp(rows[0].method, "pt") == 0 && strcmp(rows[3].method, "vsl") == 0, "methods in order");
-        CHECK(rows[0].seconds >= 0.01 && rows[2].seconds >= 1.0, "budgets met: %g, %g", rows[0].seconds, rows[2].seconds);
+        CHECK(rows[0].seconds >= 0.01 && rows[2].seconds >= 1.0, "budgets met: %g, %g", rows[0].seconds,
+              rows[2].seconds);
         /* By frames (seed 8): 1.39 at 2, 0.65 at 10, 0.29 at 44, 0.25 at 200, 0.19 at 700; one
          * firefly can raise the curve a little, so only a clear fall counts. */
         CHECK(rows[2].rel_l2 < 0.6 * rows[0].rel_l2, "pt's error does not fall: %g at %g s, %g at %g s", rows[0].rel_l2,
@@ -260,8 +260,9 @@ static void test_bench_run(void) {
     CHECK(ns == 6, "summary.csv: %d rows (-1: bad header), expected 6", ns);
     for (int i = 0; i < ns && i < n; i++)
         CHECK(sum[i].fields == 14 && sum[i].seeds == 1 && strcmp(sum[i].method, rows[i].method) == 0 &&
-                  strcmp(sum[i].component, "all") == 0 && fabs(sum[i].rel_l2 - rows[i].rel_l2) <= 1e-5 * rows[i].rel_l2 &&
-                  sum[i].lo == sum[i].hi && fabs(sum[i].lo - sum[i].rel_l2) <= 1e-5 * sum[i].lo && isnan(sum[i].noise) && isnan(sum[i].bias),
+                  strcmp(sum[i].component, "all") == 0 &&
+                  fabs(sum[i].rel_l2 - rows[i].rel_l2) <= 1e-5 * rows[i].rel_l2 && sum[i].lo == sum[i].hi &&
+                  fabs(sum[i].lo - sum[i].rel_l2) <= 1e-5 * sum[i].lo && isnan(sum[i].noise) && isnan(sum[i].bias),
               "summary row %d: %d fields, %d seeds, %s, rel_l2 %g (run %g), noise %g, bias %g", i, sum[i].fields,
               sum[i].seeds, sum[i].method, sum[i].rel_l2, rows[i].rel_l2, sum[i].noise, sum[i].bias);
     char svg[1 << 16];
@@ -278,14 +279,16 @@ static void test_bench_run(void) {
         long dark = 0;
         for (long i = 0; i < (long)w * h * 3; i++) dark += png[i] < 128;
         CHECK(dark > 1000, "the png is blank (%ld dark values)", dark);
-        if (w == 860 && h == 500) check_png_words(png, w, h);
-        else CHECK(0, "error-vs-time.png is %dx%d, not the 860x500 of the layout the words are looked for in", w, h);
+        if (w == 860 && h == 500)
+            check_png_words(png, w, h);
+        else
+            CHECK(0, "error-vs-time.png is %dx%d, not the 860x500 of the layout the words are looked for in", w, h);
     }
     stbi_image_free(png);
     char md[1 << 16];
     read_file("b1/report.md", md, sizeof md);
-    CHECK(strstr(md, "| pt |") && strstr(md, "| vsl |") && strstr(md, "## Convergence") && strstr(md, "## Equal error") &&
-              strstr(md, "| 1 s |") && strstr(md, "| 0.3–1 s |"),
+    CHECK(strstr(md, "| pt |") && strstr(md, "| vsl |") && strstr(md, "## Convergence") &&
+              strstr(md, "## Equal error") && strstr(md, "| 1 s |") && strstr(md, "| 0.3–1 s |"),
           "report.md: %s", md);
 
     /* Nothing is overwritten: the same --out is refused, the files stay as they were. */
@@ -309,7 +312,8 @@ static void test_sweeps_and_highlights(void) {
     int n = parse_csv("b2/results.csv", rows, 64);
     CHECK(n == 10, "sweep results: %d rows, expected 2 (pt) + 4 settings x 2 (vsl)", n);
     int found = 0;
-    for (int i = 0; i < n; i++) found += strcmp(rows[i].method, "vsl") == 0 && strcmp(rows[i].params, "radius-mult=4") == 0;
+    for (int i = 0; i < n; i++)
+        found += strcmp(rows[i].method, "vsl") == 0 && strcmp(rows[i].params, "radius-mult=4") == 0;
     CHECK(found == 2, "no vsl radius-mult=4 rows");
     CHECK(exists("b2/sweep-radius-mult.svg") && exists("b2/sweep-columns.png"), "sweep plots missing");
     char md[1 << 16];
@@ -410,7 +414,8 @@ static void test_seeds(void) {
      * 0.19 to 0.35 of the reference measured (8 benches of 3 seeds, 16 to 60 frames), never
      * clamped at 0; its noise is the direct light's. So the identity holds in its strict form here,
      * which a split that forgets the mean's noise or the reference's would break. */
-    rc = run("bench --reference ref.exr --methods pt --seeds 3 --max-depth 1 --times 0.06 --threads 1 --quiet --out s3");
+    rc =
+        run("bench --reference ref.exr --methods pt --seeds 3 --max-depth 1 --times 0.06 --threads 1 --quiet --out s3");
     CHECK(rc == 0, "depth 1, all: exit %d: %s", rc, err_text);
     ns = parse_summary("s3/summary.csv", sum, 16);
     CHECK(ns == 1 && sum[0].bias > 0.1 && sum[0].noise > 0.0, "depth 1, all: %d rows, noise %g, bias %g", ns,

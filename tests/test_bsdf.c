@@ -128,8 +128,7 @@ static void test_ggx_reference(void) {
             double want = ggx_reference(1.0, b.alpha_x, b.alpha_y, wo, wi);
             double got = avg3(bsdf_eval(&b, wo, wi, BSDF_GLOSSY));
             if (!(fabs(got - want) <= 1e-3 * want + 1e-7)) {
-                if (bad++ < 3)
-                    fprintf(stderr, "ggx case %d: f = %.7g, reference %.7g\n", c, got, want);
+                if (bad++ < 3) fprintf(stderr, "ggx case %d: f = %.7g, reference %.7g\n", c, got, want);
             }
         }
         CHECK(bad == 0, "GGX case %d: %d of 2000 evaluations differ from the reference", c, bad);
@@ -146,14 +145,13 @@ static void test_ggx_reference(void) {
             for (int k = 0; k < n; k++) {
                 bsdf_sample_result s;
                 double w = 0.0;
-                if (bsdf_sample(&b, wo, BSDF_ALL, rng_float(&rng), rng_vec2(&rng), &s))
-                    w = avg3(s.f) * s.wi.z / s.pdf;
+                if (bsdf_sample(&b, wo, BSDF_ALL, rng_float(&rng), rng_vec2(&rng), &s)) w = avg3(s.f) * s.wi.z / s.pdf;
                 sum += w;
                 sum2 += w * w;
             }
             double mean = sum / n, sigma = sqrt(fmax(0.0, sum2 / n - mean * mean) / n);
-            CHECK(fabs(mean - quad) <= 4.0 * sigma + 2e-3, "GGX case %d, wo %d: sampled albedo %.5f vs quadrature %.5f (sigma %.2g)",
-                  c, a, mean, quad, sigma);
+            CHECK(fabs(mean - quad) <= 4.0 * sigma + 2e-3,
+                  "GGX case %d, wo %d: sampled albedo %.5f vs quadrature %.5f (sigma %.2g)", c, a, mean, quad, sigma);
             CHECK(quad <= 1.0 + 1e-3 && quad > 0.3, "GGX case %d, wo %d: albedo %.5f", c, a, quad);
         }
     }
@@ -228,7 +226,8 @@ static void test_furnace(void) {
     bsdf lam = make_bsdf_lambert(v3s(1.0f));
     for (int a = 0; a < 4; a++) {
         eval_ctx ec = {&lam, dir_from_angles(a * 28.0, 0.0), BSDF_ALL};
-        CHECK_NEAR(hemisphere_integral(albedo_integrand, &ec, v3(0, 0, 1), 400, 64), 1.0, 1e-3, "Lambert furnace %d", a);
+        CHECK_NEAR(hemisphere_integral(albedo_integrand, &ec, v3(0, 0, 1), 400, 64), 1.0, 1e-3, "Lambert furnace %d",
+                   a);
     }
     /* Energy-normalised Phong, ks = 1, at normal incidence: (n + 2) / (2 pi) int cos^(n+1) = 1. */
     float exps[] = {1.0f, 10.0f, 100.0f, 1e4f};
@@ -370,7 +369,8 @@ static void test_glossy_albedo_table(void) {
                 double sum[3] = {0}, sum2 = 0.0;
                 for (int i = 0; i < N; i++) {
                     bsdf_sample_result bs;
-                    if (!bsdf_sample(&b, wo, BSDF_GLOSSY, 0.0f, rng_vec2(&rng), &bs) || !(bs.pdf > 0.0f) || bs.wi.z <= 0.0f)
+                    if (!bsdf_sample(&b, wo, BSDF_GLOSSY, 0.0f, rng_vec2(&rng), &bs) || !(bs.pdf > 0.0f) ||
+                        bs.wi.z <= 0.0f)
                         continue;
                     vec3 v = scale3(bs.f, bs.wi.z / bs.pdf);
                     sum[0] += (double)v.x;
@@ -387,8 +387,8 @@ static void test_glossy_albedo_table(void) {
                      * anisotropic lobes off grazing too, 10% at grazing incidence. */
                     double tol = aspect > 1.0f && ct < 0.5f ? 0.10 : 0.02;
                     CHECK(fabs((double)t[k] - mc) <= tol * mc + 4.0 * sigma * (mc / fmax(mean, 1e-9)) + 1e-3,
-                          "model %d alpha %g aspect %g cos %g channel %d: table %.4f, Monte Carlo %.4f", model, (double)a,
-                          (double)aspect, (double)ct, k, (double)t[k], mc);
+                          "model %d alpha %g aspect %g cos %g channel %d: table %.4f, Monte Carlo %.4f", model,
+                          (double)a, (double)aspect, (double)ct, k, (double)t[k], mc);
                 }
                 checked++;
             }

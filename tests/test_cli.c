@@ -15,7 +15,6 @@
 #include "image_io.h"
 #include "scene.h"
 
-
 static int count_lines(const char *s) {
     int n = 0;
     for (; *s; s++) n += *s == '\n';
@@ -51,8 +50,8 @@ static int stray_temp_files(void) {
 
 static void test_usage(void) {
     CHECK(run("--help") == 0, "--help exit code");
-    const char *options[] = {"render", "info", "--spp", "--time", "--size", "--max-depth", "--env", "--camera", "--seed",
-                             "--out", "--png", "--stats", "--method", "--quiet"};
+    const char *options[] = {"render",   "info",   "--spp", "--time", "--size",  "--max-depth", "--env",
+                             "--camera", "--seed", "--out", "--png",  "--stats", "--method",    "--quiet"};
     char all[sizeof out_text * 2];
     snprintf(all, sizeof all, "%s", out_text);
     CHECK(run("render --help") == 0, "render --help exit code");
@@ -94,7 +93,8 @@ static void test_errors(void) {
 }
 
 static void test_outputs(void) {
-    int rc = run("render --spp 4 --size 48x27 --max-depth 4 --seed 3 --out img.exr --png img.png --stats img.json --quiet");
+    int rc =
+        run("render --spp 4 --size 48x27 --max-depth 4 --seed 3 --out img.exr --png img.png --stats img.json --quiet");
     CHECK(rc == 0, "render: exit %d: %s", rc, err_text);
     CHECK(err_text[0] == 0, "--quiet render printed to stderr: %s", err_text);
     char p[1024], err[512];
@@ -205,8 +205,8 @@ static void test_builtin_scenes(void) {
                               "view builtin:nosuch", "builtin:nosuch"};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) expect_failure(commands[i], 1, want);
 
-    CHECK(run("info builtin:showcase") == 0 && strstr(out_text, "scene:      builtin:showcase\n"), "info builtin:showcase: %s%s",
-          out_text, err_text);
+    CHECK(run("info builtin:showcase") == 0 && strstr(out_text, "scene:      builtin:showcase\n"),
+          "info builtin:showcase: %s%s", out_text, err_text);
     char json[8192], hash_builtin[64] = "", hash_file[64] = "";
     CHECK(run("render --spp 1 --size 16x9 --out default.exr --quiet") == 0, "default render: %s", err_text);
     read_file("default.exr.json", json, sizeof json);
@@ -240,9 +240,9 @@ static void test_builtin_scenes(void) {
  * methods run with them, report their lights and clamping in the stats, and write finite images. */
 static void test_many_light_options(void) {
     CHECK(run("render --help") == 0, "render --help exit code");
-    const char *options[] = {"--vsl-count", "--clamp ", "--clamp-value", "--clamp-growth", "--vpl-glossy", "--radius-mult",
-                             "--radius-shrink", "--rows", "--columns", "--per-pixel", "--candidates",
-                             "--trace-glossy"};
+    const char *options[] = {"--vsl-count",  "--clamp ",      "--clamp-value",   "--clamp-growth",
+                             "--vpl-glossy", "--radius-mult", "--radius-shrink", "--rows",
+                             "--columns",    "--per-pixel",   "--candidates",    "--trace-glossy"};
     for (size_t i = 0; i < sizeof options / sizeof options[0]; i++)
         CHECK(strstr(out_text, options[i]) != NULL, "render help does not mention %s", options[i]);
 
@@ -266,7 +266,8 @@ static void test_many_light_options(void) {
     CHECK(strstr(json, "\"method\": \"vpl\"") && strstr(json, "\"virtual_lights_per_frame\": 64") && total &&
               atol(total + 24) >= 128 && !strstr(json, "\"clamped\": 0,"),
           "vpl stats json: %s", json);
-    rc = run("render --method vpl --spp 2 --size 32x18 --vsl-count 64 --clamp off --vpl-glossy --stats vpl2.json --quiet");
+    rc = run(
+        "render --method vpl --spp 2 --size 32x18 --vsl-count 64 --clamp off --vpl-glossy --stats vpl2.json --quiet");
     CHECK(rc == 0, "unclamped glossy vpl render: exit %d: %s", rc, err_text);
     read_file("vpl2.json", json, sizeof json);
     CHECK(strstr(json, "\"clamped\": 0,") != NULL, "clamping off still clamped: %s", json);
@@ -276,8 +277,8 @@ static void test_many_light_options(void) {
     CHECK(rc == 0, "vsl render: exit %d: %s", rc, err_text);
     read_file("vsl.json", json, sizeof json);
     /* The default scene's metals are sharper than the default --trace-glossy: paths go through. */
-    CHECK(strstr(json, "\"method\": \"vsl\"") && strstr(json, "\"columns\": 32") && !strstr(json, "\"vsl_samples\": 0,") &&
-              !strstr(json, "\"glossy_bounces\": 0,"),
+    CHECK(strstr(json, "\"method\": \"vsl\"") && strstr(json, "\"columns\": 32") &&
+              !strstr(json, "\"vsl_samples\": 0,") && !strstr(json, "\"glossy_bounces\": 0,"),
           "vsl stats json: %s", json);
     rc = run("render --method vsl --spp 1 --size 32x18 --vsl-count 64 --trace-glossy off --stats off.json --quiet");
     read_file("off.json", json, sizeof json);
@@ -320,8 +321,10 @@ static void test_highlights_layer(void) {
             bad += !(fabsf(all[i] - (d[i] + ind[i] + hl[i])) <= 1e-5f * fabsf(all[i]) + 1e-7f) || hl[i] < 0.0f;
             hl_sum += hl[i];
         }
-        CHECK(bad == 0 && hl_sum > 0.0, "highlights layer: %d pixels off the sum, total %g (the default scene has "
-              "glossy-glossy light)", bad, hl_sum);
+        CHECK(bad == 0 && hl_sum > 0.0,
+              "highlights layer: %d pixels off the sum, total %g (the default scene has "
+              "glossy-glossy light)",
+              bad, hl_sum);
     }
     exr_image_free(&exr);
 }

@@ -174,14 +174,17 @@ static void test_vsl_converges(int glossy) {
         double b[CHECKPOINTS], se[CHECKPOINTS], fb, fse;
         for (int c = 0; c < CHECKPOINTS; c++) bias_of(schedule[c][r], ref_mean[r], schedule_se[c][r], &b[c], &se[c]);
         bias_of(fixed[CHECKPOINTS - 1][r], ref_mean[r], fixed_se[CHECKPOINTS - 1][r], &fb, &fse);
-        printf("%s, %s: bias %+.4f (%.4f), %+.4f (%.4f), %+.4f (%.4f) after %d, %d, %d frames; fixed radius %+.4f (%.4f)\n",
+        printf("%s, %s: bias %+.4f (%.4f), %+.4f (%.4f), %+.4f (%.4f) after %d, %d, %d frames; fixed radius %+.4f "
+               "(%.4f)\n",
                s->path, regions[r], b[0], se[0], b[1], se[1], b[2], se[2], checkpoint_frames[0], checkpoint_frames[1],
                checkpoint_frames[2], fb, fse);
         /* The reference's own noise is below 0.3% over a region (measured); 1% stands for it. */
-        CHECK(fabs(b[2]) < 3.0 * se[2] + 0.01, "%s, %s: the mean is %+.4f off path tracing after %d frames (noise %.4f)",
-              s->path, regions[r], b[2], checkpoint_frames[2], se[2]);
+        CHECK(fabs(b[2]) < 3.0 * se[2] + 0.01,
+              "%s, %s: the mean is %+.4f off path tracing after %d frames (noise %.4f)", s->path, regions[r], b[2],
+              checkpoint_frames[2], se[2]);
         CHECK(fabs(b[2]) < fabs(fb) || fabs(fb) < 3.0 * fse + 0.01,
-              "%s, %s: the schedule leaves %+.4f, no less than the fixed radius's %+.4f", s->path, regions[r], b[2], fb);
+              "%s, %s: the schedule leaves %+.4f, no less than the fixed radius's %+.4f", s->path, regions[r], b[2],
+              fb);
     }
     free(ref);
     scene_destroy(s);

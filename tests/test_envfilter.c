@@ -102,8 +102,8 @@ static void test_convention(void) {
     }
 }
 
-static const double kappas_wide[] = {0.0, 1e-30, 1e-6, 1e-3, 0.1, 0.25, 0.3, 1.0, 7.0, 50.0, 700.0, 710.0,
-                                     800.0, 3000.0, 1e4, 3e4, 1e5, 3e5, 1e6};
+static const double kappas_wide[] = {0.0,   1e-30, 1e-6,  1e-3,   0.1, 0.25, 0.3, 1.0, 7.0, 50.0,
+                                     700.0, 710.0, 800.0, 3000.0, 1e4, 3e4,  1e5, 3e5, 1e6};
 enum { NKW = sizeof kappas_wide / sizeof kappas_wide[0] };
 
 static void constant_fn(const double d[3], const void *param, float out[3]) {
@@ -178,7 +178,8 @@ static const double lin_a[3] = {2.0, 1.0, 1.5};
 static const double lin_b[3][3] = {{0.5, -0.7, 0.3}, {0.1, 0.6, -0.5}, {-0.8, 0.2, 0.9}};
 
 static void linear_fn(const double d[3], const void *param, float out[3]) {
-    for (int c = 0; c < 3; c++) out[c] = (float)(lin_a[c] + lin_b[c][0] * d[0] + lin_b[c][1] * d[1] + lin_b[c][2] * d[2]);
+    for (int c = 0; c < 3; c++)
+        out[c] = (float)(lin_a[c] + lin_b[c][0] * d[0] + lin_b[c][1] * d[1] + lin_b[c][2] * d[2]);
 }
 
 static long double ref_rbar(long double k) {
@@ -213,8 +214,8 @@ static void test_linear(void) {
         if (!(level_worst <= worst[range])) worst[range] = level_worst;
     }
     printf("linear map 512x256, %d kappas x %d directions: worst relative error %.2g%% (kappa < 1), %.2g%% (1..100), "
-           "%.2g%% (100..1e4), %.2g%% (1e4..1e6)\n", NK, nd, 100.0 * worst[0], 100.0 * worst[1], 100.0 * worst[2],
-           100.0 * worst[3]);
+           "%.2g%% (100..1e4), %.2g%% (1e4..1e6)\n",
+           NK, nd, 100.0 * worst[0], 100.0 * worst[1], 100.0 * worst[2], 100.0 * worst[3]);
     env_vmf_filter_destroy(f);
     env_map_destroy(env);
 }
@@ -305,10 +306,12 @@ static void test_spots(void) {
         for (int s = 0; s < 3; s++) {
             double t1[3], t2[3], *c = m.spots[s].dir;
             double ref[3] = {fabs(c[1]) < 0.9 ? 0.0 : 1.0, fabs(c[1]) < 0.9 ? 1.0 : 0.0, 0.0};
-            t1[0] = ref[1] * c[2] - ref[2] * c[1], t1[1] = ref[2] * c[0] - ref[0] * c[2], t1[2] = ref[0] * c[1] - ref[1] * c[0];
+            t1[0] = ref[1] * c[2] - ref[2] * c[1], t1[1] = ref[2] * c[0] - ref[0] * c[2],
+            t1[2] = ref[0] * c[1] - ref[1] * c[0];
             double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
             for (int i = 0; i < 3; i++) t1[i] /= l;
-            t2[0] = c[1] * t1[2] - c[2] * t1[1], t2[1] = c[2] * t1[0] - c[0] * t1[2], t2[2] = c[0] * t1[1] - c[1] * t1[0];
+            t2[0] = c[1] * t1[2] - c[2] * t1[1], t2[1] = c[2] * t1[0] - c[0] * t1[2],
+            t2[2] = c[0] * t1[1] - c[1] * t1[0];
             const double offs[] = {0.0, 0.5, 1.0, 2.0};
             for (int o = 0; o < 4; o++)
                 for (int side = 0; side < (o == 0 ? 1 : 2); side++) {
@@ -318,7 +321,8 @@ static void test_spots(void) {
         }
         vec3 extra[8];
         int ne = test_directions(rot, extra, 8); /* the poles, the seam */
-        for (int i = 0; i < ne && np < 40; i++) probes[np][0] = extra[i].x, probes[np][1] = extra[i].y, probes[np++][2] = extra[i].z;
+        for (int i = 0; i < ne && np < 40; i++)
+            probes[np][0] = extra[i].x, probes[np][1] = extra[i].y, probes[np++][2] = extra[i].z;
         double worst = 0.0, mass_lo = 1.0, mass_hi = 1.0;
         for (int i = 0; i < np; i++) {
             double want[3], mass;
@@ -330,13 +334,16 @@ static void test_spots(void) {
             for (int c = 0; c < 3; c++) {
                 double rel = fabs(comp3(e, c) - want[c]) / want[c];
                 if (!(rel <= worst)) worst = rel;
-                if (getenv("ENVF_VERBOSE")) printf("  kappa %g probe %d ch %d: %g vs %g (%.2f%%)\n", kappa, i, c, comp3(e, c), want[c], 100.0 * (comp3(e, c) - want[c]) / want[c]);
+                if (getenv("ENVF_VERBOSE"))
+                    printf("  kappa %g probe %d ch %d: %g vs %g (%.2f%%)\n", kappa, i, c, comp3(e, c), want[c],
+                           100.0 * (comp3(e, c) - want[c]) / want[c]);
                 CHECK(rel <= 0.025, "spots, kappa %g, probe %d, channel %d: %g, brute force %g (%.2g%%)", kappa, i, c,
                       comp3(e, c), want[c], 100.0 * rel);
             }
         }
         printf("spot map: kappa %g, worst relative error %.3g%% over %d probes (spot centres, 0.5/1/2 lobe widths off, "
-               "poles, seam); quadrature mass %.4f..%.4f\n", kappa, 100.0 * worst, np, mass_lo, mass_hi);
+               "poles, seam); quadrature mass %.4f..%.4f\n",
+               kappa, 100.0 * worst, np, mass_lo, mass_hi);
     }
     free(dirs3);
     free(dom);
@@ -356,7 +363,7 @@ static void extreme_fn(const double d[3], const void *param, float out[3]) {
     unsigned bits = (unsigned)(fabs(d[0] * 7919.0 + d[1] * 104729.0 + d[2] * 1299709.0)) * 2654435761u;
     for (int c = 0; c < 3; c++) {
         unsigned kind = (bits >> (3 * c)) % 5;
-        out[c] = kind < 2 ? 0.0f : (kind == 2 ? 0.5f * FLT_MAX : (float)(kind) * 0.7f);
+        out[c] = kind < 2 ? 0.0f : (kind == 2 ? 0.5f * FLT_MAX : (float)(kind)*0.7f);
     }
 }
 
@@ -375,14 +382,17 @@ static void test_extremes(void) {
             for (int i = 0; i < nd; i++) {
                 float kappa = k < NKW ? (float)kappas_wide[k] : more[k - NKW];
                 vec3 e = env_vmf_filter_lookup(f, (vmf){dirs[i], kappa});
-                if (!is_finite3(e)) bad++;
-                else if (min_comp3(e) < 0.0f || max_comp3(e) > hi * 1.00001f) outside++;
+                if (!is_finite3(e))
+                    bad++;
+                else if (min_comp3(e) < 0.0f || max_comp3(e) > hi * 1.00001f)
+                    outside++;
             }
         /* a degenerate direction must not poison the lookup either */
         vec3 nan_dir = env_vmf_filter_lookup(f, (vmf){v3(NAN, 0, 0), 100.0f});
         CHECK(is_finite3(nan_dir), "NaN direction gives a non-finite result");
         CHECK(bad == 0, "%s map: %d non-finite lookups", all_max ? "FLT_MAX" : "zeros and huge", bad);
-        CHECK(outside == 0, "%s map: %d lookups outside the map's range", all_max ? "FLT_MAX" : "zeros and huge", outside);
+        CHECK(outside == 0, "%s map: %d lookups outside the map's range", all_max ? "FLT_MAX" : "zeros and huge",
+              outside);
         env_vmf_filter_destroy(f);
         env_map_destroy(env);
     }

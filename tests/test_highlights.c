@@ -114,7 +114,8 @@ static void test_trace_matches_path_tracer(void) {
     float *hl = ts_render_with(s, &cam, &p, 64, HL);
     for (int c = 0; c < 3; c++) {
         double a = channel_sum(hl, NPIX, c), b = channel_sum(ref, NPIX, c);
-        printf("trace vs path tracer, channel %d: %.4f vs %.4f (%+.2f%%)\n", c, a / NPIX, b / NPIX, 100.0 * (a / b - 1.0));
+        printf("trace vs path tracer, channel %d: %.4f vs %.4f (%+.2f%%)\n", c, a / NPIX, b / NPIX,
+               100.0 * (a / b - 1.0));
         CHECK(b > 0.0 && fabs(a / b - 1.0) < 0.03, "channel %d: highlights %.5f, the path tracer's %.5f", c, a, b);
     }
     double err = rel_l2(hl, ref, NPIX);
@@ -142,7 +143,8 @@ static void vmf_modes_close_to_exact(int env, const material *wall) {
         p = hl_params(merges[k], ks[k], 32);
         float *img = ts_render_with(s, &cam, &p, 48, HL);
         double bias = total(img, NPIX) / total(exact, NPIX) - 1.0, err = rel_l2(img, exact, NPIX);
-        printf("merge %s, K=%d: bias %+.3f, relative L2 %.3f\n", merges[k] == HL_MERGE_OFF ? "off" : "on", ks[k], bias, err);
+        printf("merge %s, K=%d: bias %+.3f, relative L2 %.3f\n", merges[k] == HL_MERGE_OFF ? "off" : "on", ks[k], bias,
+               err);
         /* Measured: biases within 1.1%, L2 0.022 unmerged and 0.03-0.04 merged (0.09 before merged
          * lobes saw the lights from their members' positions). The brushed wall's lobe is a streak:
          * its secondary hits spread along the floor, merged lobes follow that spread (+0.6%, 0.06;
@@ -170,15 +172,17 @@ static scene *fig6_corner(float far) {
     int red = ts_material(s, ts_phong(v3(0.1f, 0.0f, 0.0f), v3(0.9f, 0.1f, 0.1f), 300.0f));
     int green = ts_material(s, ts_phong(v3(0.0f, 0.1f, 0.0f), v3(0.1f, 0.9f, 0.1f), 300.0f));
     ts_quad(s, v3(0, 0, 0), v3(0, 0, 3), v3(3, 0, 3), v3(3, 0, 0), floor_m);
-    ts_quad(s, v3(0, 0, 0), v3(0, 1.2f, 0), v3(0, 1.2f, 3), v3(0, 0, 3), red);     /* x = 0, facing +x */
-    ts_quad(s, v3(0, 0, 0), v3(3, 0, 0), v3(3, 1.2f, 0), v3(0, 1.2f, 0), green);   /* z = 0, facing +z */
+    ts_quad(s, v3(0, 0, 0), v3(0, 1.2f, 0), v3(0, 1.2f, 3), v3(0, 0, 3), red);   /* x = 0, facing +x */
+    ts_quad(s, v3(0, 0, 0), v3(3, 0, 0), v3(3, 1.2f, 0), v3(0, 1.2f, 0), green); /* z = 0, facing +z */
     light pl = {.type = LIGHT_POINT, .color = v3s(2.0f * far * far), .position = scale3(v3(0.7f, 1.0f, 0.7f), far)};
     scene_add_light(s, &pl);
     ts_finalize(s);
     return s;
 }
 
-static camera fig6_camera(void) { return camera_look_at(v3(2.6f, 1.6f, 2.6f), v3(0.6f, 0.0f, 0.6f), v3(0, 1, 0), 1.1f); }
+static camera fig6_camera(void) {
+    return camera_look_at(v3(2.6f, 1.6f, 2.6f), v3(0.6f, 0.0f, 0.6f), v3(0, 1, 0), 1.1f);
+}
 
 /* Pixels that see, in the floor, the walls near their shared vertical edge (x = z = 0): the
  * camera ray's mirror image off the floor passes within `reach` of the edge below its top. */
@@ -222,12 +226,14 @@ static void test_fig6_edge(void) {
         edge_light[k - 1] = in_edge / total(ref, FN);
         err[k - 1] = rel_l2(img, ref, FN);
         printf("fig. 6 corner, K=%d: light in the edge's reflection %.4f of all highlights (path tracer: %.4f), "
-               "relative L2 over the image %.3f\n", k, edge_light[k - 1], edge_ref / total(ref, FN), err[k - 1]);
+               "relative L2 over the image %.3f\n",
+               k, edge_light[k - 1], edge_ref / total(ref, FN), err[k - 1]);
         CHECK(all_finite(img, FN), "K=%d: non-finite pixels", k);
         free(img);
     }
     /* Measured: no light in the edge's reflection with either, relative L2 0.048 (K=1) and 0.057 (K=2). */
-    CHECK(edge_pixels > 40.0, "only %.0f pixels see the edge's reflection: is the test still looking at it?", edge_pixels);
+    CHECK(edge_pixels > 40.0, "only %.0f pixels see the edge's reflection: is the test still looking at it?",
+          edge_pixels);
     CHECK(edge_ref <= 1e-6 * total(ref, FN), "the reference has light at the edge (%g): the region is wrong", edge_ref);
     for (int k = 0; k < 2; k++) {
         CHECK(edge_light[k] < 1e-6, "K=%d smears the edge: %.4f of the light", k + 1, edge_light[k]);
@@ -262,15 +268,18 @@ static void test_split_against_path_tracer(void) {
         p.method = METHOD_VSL;
         float *vsl_ind = ts_render_with(s, &cam, &p, 64, IND);
         double a_ind = total(ind, NPIX), a_hl = total(hl, NPIX), v_ind = total(vsl_ind, NPIX);
-        printf("split (%s): vsl+hl indirect %.4f + highlights %.4f = %.4f; vsl indirect %.4f; path tracer %.4f + %.4f\n",
-               traced ? "traced" : "gathered", a_ind / NPIX, a_hl / NPIX, (a_ind + a_hl) / NPIX, v_ind / NPIX,
-               r_ind / NPIX, r_hl / NPIX);
+        printf(
+            "split (%s): vsl+hl indirect %.4f + highlights %.4f = %.4f; vsl indirect %.4f; path tracer %.4f + %.4f\n",
+            traced ? "traced" : "gathered", a_ind / NPIX, a_hl / NPIX, (a_ind + a_hl) / NPIX, v_ind / NPIX,
+            r_ind / NPIX, r_hl / NPIX);
         CHECK(fabs(a_hl / r_hl - 1.0) < 0.03, "highlights %.4f vs the path tracer's %.4f", a_hl, r_hl);
         /* The rest is VSL's, with its radius bias (measured -6% traced, -11% gathered) */
         CHECK(fabs(a_ind / r_ind - 1.0) < 0.15, "vsl+hl indirect %.4f vs the path tracer's split indirect %.4f", a_ind,
               r_ind);
-        CHECK(fabs((a_ind + a_hl) / (r_ind + r_hl) - 1.0) < 0.05, "vsl+hl indirect + highlights %.4f vs the path "
-              "tracer's %.4f", a_ind + a_hl, r_ind + r_hl);
+        CHECK(fabs((a_ind + a_hl) / (r_ind + r_hl) - 1.0) < 0.05,
+              "vsl+hl indirect + highlights %.4f vs the path "
+              "tracer's %.4f",
+              a_ind + a_hl, r_ind + r_hl);
         /* Traced through, vsl computes the highlights' paths exactly too; gathering with a sharp lobe it
          * misses part of them (measured -17%), which the highlight estimator restores. */
         if (traced)
@@ -393,7 +402,9 @@ static void test_peak_and_shape(void) {
     const struct {
         int merge, clusters, frames;
         const char *name;
-    } runs[] = {{HL_MERGE_TRACE, 0, 24, "trace"}, {HL_MERGE_ON, 0, 24, "merged (defaults)"}, {HL_MERGE_ON, 1, 24, "merged, K=1"},
+    } runs[] = {{HL_MERGE_TRACE, 0, 24, "trace"},
+                {HL_MERGE_ON, 0, 24, "merged (defaults)"},
+                {HL_MERGE_ON, 1, 24, "merged, K=1"},
                 {HL_MERGE_OFF, 0, 24, "no merging"}};
     for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
         render_params p = hl_params(runs[k].merge, runs[k].clusters, 0);
@@ -402,15 +413,15 @@ static void test_peak_and_shape(void) {
         p.max_depth = 2;
         render_batches(s, &cam, p, runs[k].frames, img);
         peak_shape r = compare_peak_shape(img, ref);
-        printf("peak and shape, %s: peak %.3f +- %.3f, halo %.3f +- %.3f of path tracing's, shape error %.3f\n", runs[k].name,
-               r.peak, r.peak_se, r.halo, r.halo_se, r.shape);
+        printf("peak and shape, %s: peak %.3f +- %.3f, halo %.3f +- %.3f of path tracing's, shape error %.3f\n",
+               runs[k].name, r.peak, r.peak_se, r.halo, r.halo_se, r.shape);
         /* The vMF lobes' own approximation (measured 2-8% at the peak, 0.05-0.1 in shape) plus
          * four standard errors. */
         double tol = runs[k].merge == HL_MERGE_TRACE ? 0.0 : 0.1;
-        CHECK(fabs(r.peak - 1.0) < tol + 4.0 * r.peak_se, "%s: peak %.3f of path tracing's (+- %.3f)", runs[k].name, r.peak,
-              r.peak_se);
-        CHECK(fabs(r.halo - 1.0) < tol + 4.0 * r.halo_se, "%s: halo %.3f of path tracing's (+- %.3f)", runs[k].name, r.halo,
-              r.halo_se);
+        CHECK(fabs(r.peak - 1.0) < tol + 4.0 * r.peak_se, "%s: peak %.3f of path tracing's (+- %.3f)", runs[k].name,
+              r.peak, r.peak_se);
+        CHECK(fabs(r.halo - 1.0) < tol + 4.0 * r.halo_se, "%s: halo %.3f of path tracing's (+- %.3f)", runs[k].name,
+              r.halo, r.halo_se);
         CHECK(r.shape < (runs[k].merge == HL_MERGE_TRACE ? 0.05 : 0.15), "%s: shape error %.3f", runs[k].name, r.shape);
     }
     free(ref);
@@ -439,7 +450,8 @@ static void add_sphere(scene *s, vec3 c, float r, int mat) {
             memcpy(&idx[ni], tri, sizeof tri);
             ni += 6;
         }
-    mesh_desc md = {.num_vertices = nv, .positions = pos, .normals = nrm, .num_indices = ni, .indices = idx, .material = mat};
+    mesh_desc md = {
+        .num_vertices = nv, .positions = pos, .normals = nrm, .num_indices = ni, .indices = idx, .material = mat};
     mat4 id = mat4_identity();
     char err[256];
     if (scene_add_mesh(s, &md, &id, err, sizeof err) != 0) {
@@ -513,8 +525,8 @@ static void test_hard_cases(void) {
     for (int k = 1; k <= HL_MAX_CLUSTERS; k *= 8) {
         double t = hard_total(s, &cam, HL_MERGE_ON, k, 48, &se);
         double allowed = 0.2 * converged + 3.0 * sqrt(se * se + se_c * se_c);
-        CHECK(fabs(t - converged) < allowed, "razor floor, K=%d: merged highlights %.4f +- %.4f, converged %.4f +- %.4f",
-              k, t, se, converged, se_c);
+        CHECK(fabs(t - converged) < allowed,
+              "razor floor, K=%d: merged highlights %.4f +- %.4f, converged %.4f +- %.4f", k, t, se, converged, se_c);
     }
     scene_destroy(s);
 }

@@ -107,8 +107,8 @@ static void test_exr_roundtrip(void) {
     if (rc == 0) {
         int bad = 0;
         for (int i = 0; i < 3 * W * H; i++) bad += im.rgb[i] != (float)i;
-        CHECK(im.width == W && im.height == H && bad == 0, "layered file: %dx%d, %d wrong values", im.width,
-              im.height, bad);
+        CHECK(im.width == W && im.height == H && bad == 0, "layered file: %dx%d, %d wrong values", im.width, im.height,
+              bad);
         image_rgb_free(&im);
     }
 
@@ -141,10 +141,10 @@ static void test_exr_foreign(void) {
     char path[1200], err[512] = "";
     /* Tiled, PIZ, half R, G, B and a uint channel; the data window is offset from the display
      * window and overlaps it only partly, so loading must pad with zeros and crop. */
-    const test_chan chans[4] = {{"B", EXR_PIXEL_HALF, 0}, {"G", EXR_PIXEL_HALF, 0}, {"R", EXR_PIXEL_HALF, 0},
-                                {"id", EXR_PIXEL_UINT, 0}};
+    const test_chan chans[4] = {
+        {"B", EXR_PIXEL_HALF, 0}, {"G", EXR_PIXEL_HALF, 0}, {"R", EXR_PIXEL_HALF, 0}, {"id", EXR_PIXEL_UINT, 0}};
     exr_attr_box2i_t dw = box(5, -3, 5 + 40 - 1, -3 + 30 - 1); /* 40x30 at (5, -3) */
-    exr_attr_box2i_t disp = box(0, 0, 41, 19);                  /* 42x20 at the origin */
+    exr_attr_box2i_t disp = box(0, 0, 41, 19);                 /* 42x20 at the origin */
     path_in(path, sizeof path, "tiled.exr");
     CHECK(write_test_exr(path, EXR_STORAGE_TILED, EXR_COMPRESSION_PIZ, chans, 4, dw, disp, tiled_value) == 0,
           "writing the tiled test file");
@@ -201,12 +201,12 @@ static void test_exr_foreign(void) {
     }
 
     /* Half RGBA, the commonest HDR download: alpha is skipped, R, G, B come out exact. */
-    const test_chan rgba[4] = {{"A", EXR_PIXEL_HALF, 0}, {"B", EXR_PIXEL_HALF, 0}, {"G", EXR_PIXEL_HALF, 0},
-                               {"R", EXR_PIXEL_HALF, 0}};
+    const test_chan rgba[4] = {
+        {"A", EXR_PIXEL_HALF, 0}, {"B", EXR_PIXEL_HALF, 0}, {"G", EXR_PIXEL_HALF, 0}, {"R", EXR_PIXEL_HALF, 0}};
     exr_attr_box2i_t rgba_win = box(0, 0, 30, 20);
     path_in(path, sizeof path, "rgba.exr");
-    CHECK(write_test_exr(path, EXR_STORAGE_SCANLINE, EXR_COMPRESSION_ZIPS, rgba, 4, rgba_win, rgba_win,
-                         half_value) == 0,
+    CHECK(write_test_exr(path, EXR_STORAGE_SCANLINE, EXR_COMPRESSION_ZIPS, rgba, 4, rgba_win, rgba_win, half_value) ==
+              0,
           "writing the RGBA test file");
     rc = image_rgb_load(path, &im, err, sizeof err);
     CHECK(rc == 0 && im.width == 31 && im.height == 21, "image_rgb_load of a half RGBA file: %s", err);
@@ -375,8 +375,7 @@ static size_t put_attr(unsigned char *b, size_t n, const char *name, const char 
 /* An uncompressed EXR header no writer would produce: a w x h image of nchan half channels (R, G,
  * B, c3, c4, ...), in tw x th tiles if tw > 0, with a string attribute declaring str_size bytes
  * if that is not 0; then an offset table of `chunks` zeros (missing chunks) and no pixels. */
-static unsigned char *hostile_exr(size_t *size, int w, int h, int nchan, int tw, int th, int32_t str_size,
-                                  int chunks) {
+static unsigned char *hostile_exr(size_t *size, int w, int h, int nchan, int tw, int th, int32_t str_size, int chunks) {
     unsigned char *b = calloc(1, 4096 + 20 * (size_t)nchan + 8 * (size_t)chunks), ch[20 * 64 + 1];
     memcpy(b, "\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
     b[5] = tw > 0 ? 0x02 : 0x00; /* the tiled flag */
@@ -420,12 +419,12 @@ static void test_hostile_headers(void) {
         int chunks;
         const char *problem;
     } cases[] = {
-        {16, 16, 3, 0, 0, INT32_MAX, 16, "more than the file holds"},  /* a 2 GB string */
-        {200000, 4, 3, 0, 0, 0, 4, "unsupported image size"},          /* too wide */
-        {16384, 16384, 64, 0, 0, 0, 16384, "unsupported image size"},  /* 64 GB of planes */
-        {131072, 2, 64, 0, 0, 0, 2, "unsupported image size"},         /* 4 GB for 256 lines */
-        {16, 16, 3, 65536, 65536, 0, 1, "unsupported image size"},     /* a 24 GB tile */
-        {16384, 16384, 3, 1, 1, 0, 0, "not a readable OpenEXR file"},  /* 2 GB of tile offsets */
+        {16, 16, 3, 0, 0, INT32_MAX, 16, "more than the file holds"},   /* a 2 GB string */
+        {200000, 4, 3, 0, 0, 0, 4, "unsupported image size"},           /* too wide */
+        {16384, 16384, 64, 0, 0, 0, 16384, "unsupported image size"},   /* 64 GB of planes */
+        {131072, 2, 64, 0, 0, 0, 2, "unsupported image size"},          /* 4 GB for 256 lines */
+        {16, 16, 3, 65536, 65536, 0, 1, "unsupported image size"},      /* a 24 GB tile */
+        {16384, 16384, 3, 1, 1, 0, 0, "not a readable OpenEXR file"},   /* 2 GB of tile offsets */
         {16384, 16384, 3, 0, 0, 0, 16384, "corrupt or truncated file"}, /* just no pixels */
     };
     char path[1200], err[512];

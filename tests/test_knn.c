@@ -29,7 +29,8 @@ static void check_against_brute(const char *name, const vec3 *p, int n, int k) {
     for (int i = 0; i < n; i++) {
         float want = is_finite3(p[i]) ? brute(p, n, i, k) : INFINITY;
         if (!(out[i] == want)) {
-            if (bad++ < 3) fprintf(stderr, "%s k=%d: point %d got %.9g want %.9g\n", name, k, i, (double)out[i], (double)want);
+            if (bad++ < 3)
+                fprintf(stderr, "%s k=%d: point %d got %.9g want %.9g\n", name, k, i, (double)out[i], (double)want);
         }
     }
     CHECK(bad == 0, "%s, n=%d, k=%d: %d distances differ from brute force", name, n, k, bad);
@@ -42,11 +43,11 @@ static vec3 *make_points(int n, int kind, uint64_t seed) {
     for (int i = 0; i < n; i++) {
         float a = rng_float(&r), b = rng_float(&r), c = rng_float(&r);
         switch (kind) {
-        case 0: p[i] = v3(a, b, c); break;                                  /* uniform cube */
-        case 1: p[i] = v3((float)(i % 5), 0.01f * a, 0.01f * b); break;      /* tight blobs */
-        case 2: p[i] = v3(a * 100.0f, b * 100.0f, 3.0f); break;             /* a plane, large */
-        case 3: p[i] = v3((float)(i % 3), 1.0f, 2.0f); break;               /* exact duplicates */
-        default: p[i] = v3(a, b, i % 17 == 0 ? NAN : c); break;             /* some non-finite */
+        case 0: p[i] = v3(a, b, c); break;                              /* uniform cube */
+        case 1: p[i] = v3((float)(i % 5), 0.01f * a, 0.01f * b); break; /* tight blobs */
+        case 2: p[i] = v3(a * 100.0f, b * 100.0f, 3.0f); break;         /* a plane, large */
+        case 3: p[i] = v3((float)(i % 3), 1.0f, 2.0f); break;           /* exact duplicates */
+        default: p[i] = v3(a, b, i % 17 == 0 ? NAN : c); break;         /* some non-finite */
         }
     }
     return p;
@@ -64,7 +65,11 @@ int main(void) {
             }
 
     /* A struct stride, as the virtual lights pass theirs. */
-    struct item { int pad; vec3 p; float more[5]; } items[500];
+    struct item {
+        int pad;
+        vec3 p;
+        float more[5];
+    } items[500];
     vec3 flat[500];
     rng_state r = rng_make(3, 3);
     for (int i = 0; i < 500; i++) flat[i] = items[i].p = v3(rng_float(&r), rng_float(&r), rng_float(&r));

@@ -119,8 +119,10 @@ static void test_area_light(void) {
     scene_light_groups(s, g, 3);
     CHECK_NEAR(length3(sub3(g[1].center, v3(a / 2, h + 5.5f, a / 2))), 0.0, 1e-5, "the emitter's centre moved");
     /* Bad edits are refused and change nothing. */
-    CHECK(scene_move_light(s, 0, v3(1, 0, 0), err, sizeof err) != 0 && strstr(err, "directional"), "directional: %s", err);
-    CHECK(scene_move_light(s, 2, v3(1, 0, 0), err, sizeof err) != 0 && strstr(err, "no light 2"), "no such group: %s", err);
+    CHECK(scene_move_light(s, 0, v3(1, 0, 0), err, sizeof err) != 0 && strstr(err, "directional"), "directional: %s",
+          err);
+    CHECK(scene_move_light(s, 2, v3(1, 0, 0), err, sizeof err) != 0 && strstr(err, "no light 2"), "no such group: %s",
+          err);
     CHECK(scene_move_light(s, 1, v3(NAN, 0, 0), err, sizeof err) != 0, "a NaN move");
     CHECK(scene_move_light(s, 1, v3(1e9f, 0, 0), err, sizeof err) != 0, "a huge move");
     CHECK(scene_set_light_gain(s, 1, 0.0f, err, sizeof err) != 0, "gain 0");

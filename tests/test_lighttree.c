@@ -24,7 +24,8 @@ static vec3 random_unit(rng_state *rng) {
 static bsdf random_bsdf(rng_state *rng) {
     float kind = rng_float(rng);
     if (kind < 0.35f) return make_bsdf_lambert(v3s(0.2f + 0.6f * rng_float(rng)));
-    if (kind < 0.7f) return make_bsdf_phong(v3s(0.2f * rng_float(rng)), v3s(0.7f), powf(10.0f, 1.0f + 3.0f * rng_float(rng)));
+    if (kind < 0.7f)
+        return make_bsdf_phong(v3s(0.2f * rng_float(rng)), v3s(0.7f), powf(10.0f, 1.0f + 3.0f * rng_float(rng)));
     return make_bsdf_gltf(v3(0.9f, 0.8f, 0.6f), 1.0f, 0.05f + 0.6f * rng_float(rng), 0.0f);
 }
 
@@ -193,7 +194,7 @@ static void test_variance_against_power(void) {
         /* a point on a wall, the floor or the ceiling, facing in */
         int face = q % 3;
         vec3 n = face == 0 ? v3(0, 1, 0) : face == 1 ? v3(0, -1, 0) : v3(1, 0, 0);
-        vec3 p = face == 0 ? v3(2 * rng_float(&rng) - 1, 0, 2 * rng_float(&rng) - 1)
+        vec3 p = face == 0   ? v3(2 * rng_float(&rng) - 1, 0, 2 * rng_float(&rng) - 1)
                  : face == 1 ? v3(2 * rng_float(&rng) - 1, 1.2f, 2 * rng_float(&rng) - 1)
                              : v3(-1, 1.2f * rng_float(&rng), 2 * rng_float(&rng) - 1);
         shading_point x = {.p = p, .ng = n, .frame = frame_from_normal(n), .b = make_bsdf_lambert(v3s(0.7f))};

@@ -59,7 +59,8 @@ static const char *VIEWS_AND_ACCESSORS =
 /* Accessor numbers in VIEWS_AND_ACCESSORS. */
 enum { ACC_POS = 0, ACC_NRM, ACC_I16, ACC_I8, ACC_I32, ACC_BAD_INDEX, ACC_POS_OVERRUN, ACC_POS_TRI };
 
-static const char *DEFAULT_MESH = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}]";
+static const char *DEFAULT_MESH =
+    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}]";
 static const char *DEFAULT_NODES = "\"nodes\":[{\"mesh\":0}]";
 
 static void base64(const unsigned char *in, size_t n, char *out) {
@@ -195,7 +196,8 @@ static void test_index_types(void) {
     for (int k = 0; k < 3; k++) {
         char meshes[256];
         snprintf(meshes, sizeof meshes,
-                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":%d}]}]", acc[k]);
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":%d}]}]",
+                 acc[k]);
         scene *s = load(write_gltf("indices.gltf", gltf_json(NULL, meshes, NULL, NULL)), err, sizeof err);
         CHECK(s != NULL && s->num_triangles == 2, "index accessor %d: %s", acc[k], s ? "wrong triangle count" : err);
         if (s) {
@@ -228,13 +230,12 @@ static void test_lights_cameras(void) {
     /* Node 0 holds the mesh; nodes 1-3 the lights; node 4 the camera. The spot node turns -z
      * (a light's direction) into -y: rotation of -90 degrees... +90 about +x maps -z to +y, so
      * use -90 about x: q = (-sin 45, 0, 0, cos 45). */
-    const char *nodes =
-        "\"nodes\":[{\"mesh\":0,\"children\":[1,2,3,4]},"
-        "{\"translation\":[0,5,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
-        "{\"translation\":[1,2,3],\"rotation\":[-0.70710678,0,0,0.70710678],"
-        "\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}},"
-        "{\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}},"
-        "{\"translation\":[0,1,5],\"camera\":0}]";
+    const char *nodes = "\"nodes\":[{\"mesh\":0,\"children\":[1,2,3,4]},"
+                        "{\"translation\":[0,5,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+                        "{\"translation\":[1,2,3],\"rotation\":[-0.70710678,0,0,0.70710678],"
+                        "\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}},"
+                        "{\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}},"
+                        "{\"translation\":[0,1,5],\"camera\":0}]";
     const char *extra =
         "\"extensionsUsed\":[\"KHR_lights_punctual\"],"
         "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
@@ -324,7 +325,8 @@ static void test_materials(void) {
     int tri_lights = 0;
     for (int i = 0; i < s->num_lights; i++) tri_lights += s->lights[i].type == LIGHT_TRIANGLE;
     CHECK(tri_lights == 2, "emissive triangles as lights: %d", tri_lights);
-    CHECK(num_warnings >= 1 && strstr(last_warning, "materials.gltf"), "unsupported extension: no warning naming the file");
+    CHECK(num_warnings >= 1 && strstr(last_warning, "materials.gltf"),
+          "unsupported extension: no warning naming the file");
     scene_destroy(s);
 }
 
@@ -364,15 +366,17 @@ static void test_malformed(void) {
              "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":%d}]}]",
              ACC_BAD_INDEX);
     expect_error("index out of range", write_gltf("badindex.gltf", gltf_json(NULL, meshes, NULL, NULL)), "ind");
-    snprintf(meshes, sizeof meshes, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":%d}}]}]", ACC_POS_OVERRUN);
+    snprintf(meshes, sizeof meshes, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":%d}}]}]",
+             ACC_POS_OVERRUN);
     expect_error("accessor past its buffer", write_gltf("overrun.gltf", gltf_json(NULL, meshes, NULL, NULL)), NULL);
-    expect_error("mesh index out of range", write_gltf("badmesh.gltf", gltf_json("\"nodes\":[{\"mesh\":7}]", NULL, NULL, NULL)),
-                 NULL);
+    expect_error("mesh index out of range",
+                 write_gltf("badmesh.gltf", gltf_json("\"nodes\":[{\"mesh\":7}]", NULL, NULL, NULL)), NULL);
     expect_error("node cycle",
-                 write_gltf("cycle.gltf", gltf_json("\"nodes\":[{\"mesh\":0,\"children\":[1]},{\"children\":[0]}]", NULL,
-                                                    NULL, NULL)),
+                 write_gltf("cycle.gltf", gltf_json("\"nodes\":[{\"mesh\":0,\"children\":[1]},{\"children\":[0]}]",
+                                                    NULL, NULL, NULL)),
                  NULL);
-    expect_error("missing buffer file", write_gltf("nobin.gltf", gltf_json(NULL, NULL, NULL, "missing.bin")), "missing.bin");
+    expect_error("missing buffer file", write_gltf("nobin.gltf", gltf_json(NULL, NULL, NULL, "missing.bin")),
+                 "missing.bin");
 
     const char *tex_extra = "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
                             "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"no-such-texture.png\"}]";
@@ -393,8 +397,8 @@ static void test_env_errors(void) {
     if (!s) return;
     const char *garbage = tmp_path("garbage.exr");
     write_bytes(garbage, "v/1\x01 this is not an exr file at all", 36);
-    CHECK(scene_set_env(s, garbage, 0.0f, err, sizeof err) != 0 && strstr(err, "garbage.exr"),
-          "garbage env map: '%s'", err);
+    CHECK(scene_set_env(s, garbage, 0.0f, err, sizeof err) != 0 && strstr(err, "garbage.exr"), "garbage env map: '%s'",
+          err);
     CHECK(scene_set_env(s, tmp_path("none.hdr"), 0.0f, err, sizeof err) != 0 && strstr(err, "none.hdr"),
           "missing env map: '%s'", err);
     CHECK(s->env == NULL, "a failed env map must leave the scene without one");

@@ -172,7 +172,8 @@ static void test_curves(void) {
     CHECK(metric_last_doubling(t, 4) == 2, "1, 2, 4, 8: %d", metric_last_doubling(t, 4));
     CHECK(metric_last_doubling(budgets, 5) == 3, "up to 600 s: %d", metric_last_doubling(budgets, 5));
     CHECK(metric_last_doubling(budgets, 3) == 1, "2, 10, 60: %d", metric_last_doubling(budgets, 3));
-    CHECK(metric_last_doubling(wide, 2) == 0 && metric_last_doubling(narrow, 3) == 0, "two points, or less than a doubling");
+    CHECK(metric_last_doubling(wide, 2) == 0 && metric_last_doubling(narrow, 3) == 0,
+          "two points, or less than a doubling");
     CHECK(metric_last_doubling(t, 1) == 0 && metric_last_doubling(t, 0) == 0, "fewer than two points");
 
     /* Log-log interpolation: between (1, 1) and (4, 0.5), at 2 (halfway in log) sqrt(0.5). */

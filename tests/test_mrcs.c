@@ -14,7 +14,8 @@
 
 static double column_norm(const float *m, int rows, int n, int j) {
     double s = 0.0;
-    for (int i = 0; i < rows; i++) s += (double)m[(size_t)i * (size_t)n + (size_t)j] * (double)m[(size_t)i * (size_t)n + (size_t)j];
+    for (int i = 0; i < rows; i++)
+        s += (double)m[(size_t)i * (size_t)n + (size_t)j] * (double)m[(size_t)i * (size_t)n + (size_t)j];
     return sqrt(s);
 }
 
@@ -41,7 +42,8 @@ static float *random_matrix(int rows, int n, double zero_cols, rng_state *rng) {
 static void reconstruct(const float *mat, int rows, int n, const mrcs_cluster *cl, int k, double *est) {
     for (int p = 0; p < rows; p++) {
         double s = 0.0;
-        for (int c = 0; c < k; c++) s += (double)cl[c].scale * (double)mat[(size_t)p * (size_t)n + (size_t)cl[c].representative];
+        for (int c = 0; c < k; c++)
+            s += (double)cl[c].scale * (double)mat[(size_t)p * (size_t)n + (size_t)cl[c].representative];
         est[p] = s;
     }
 }
@@ -71,13 +73,20 @@ static const char *cluster_problem(const float *m, int rows, int n, int C, const
     double weights = 0.0;
     for (int c = 0; c < k && !problem; c++) {
         int j = cl[c].representative;
-        if (j < 0 || j >= n) problem = "representative out of range";
-        else if (used[j]) problem = "a representative twice";
-        else if (column_norm(m, rows, n, j) == 0.0) problem = "a zero column as representative";
-        else if (!isfinite(cl[c].scale) || !(cl[c].scale >= 1.0f)) problem = "scale not finite or below 1";
-        else if (!isfinite(cl[c].weight) || !(cl[c].weight > 0.0f)) problem = "weight not finite and positive";
-        else if (cl[c].size < 1) problem = "empty cluster";
-        else if (cl[c].size == 1 && cl[c].scale != 1.0f) problem = "a lone column scaled";
+        if (j < 0 || j >= n)
+            problem = "representative out of range";
+        else if (used[j])
+            problem = "a representative twice";
+        else if (column_norm(m, rows, n, j) == 0.0)
+            problem = "a zero column as representative";
+        else if (!isfinite(cl[c].scale) || !(cl[c].scale >= 1.0f))
+            problem = "scale not finite or below 1";
+        else if (!isfinite(cl[c].weight) || !(cl[c].weight > 0.0f))
+            problem = "weight not finite and positive";
+        else if (cl[c].size < 1)
+            problem = "empty cluster";
+        else if (cl[c].size == 1 && cl[c].scale != 1.0f)
+            problem = "a lone column scaled";
         if (j >= 0 && j < n) used[j] = 1;
         sizes += cl[c].size;
         weights += (double)cl[c].weight;
@@ -130,7 +139,8 @@ static double check_unbiased(const char *name, const float *red, int R, const fl
     CHECK(outliers == 0, "%s: %d of %d rows off by more than 5 standard errors", name, outliers, P);
     double tmean = tsum / runs, tse = sqrt(fmax((tsum2 - (double)runs * tmean * tmean) / (runs - 1), 0.0) / runs);
     CHECK_NEAR(tmean, total, fmax(5.0 * tse, 1e-6 * total), "%s: all rows together", name);
-    if (random) CHECK(random_rows > P / 2, "%s: only %d of %d rows vary: the test would not see a bias", name, random_rows, P);
+    if (random)
+        CHECK(random_rows > P / 2, "%s: only %d of %d rows vary: the test would not see a bias", name, random_rows, P);
     free(cl);
     free(est);
     free(sum);
@@ -139,11 +149,15 @@ static double check_unbiased(const char *name, const float *red, int R, const fl
 }
 
 static void test_unbiased(void) {
-    struct { int R, P, n, C; double zero_cols; int runs; } cases[] = {
-        {6, 40, 120, 12, 0.0, 3000},   /* a few rows, clusters of ~10 */
-        {20, 60, 300, 30, 0.3, 1500},  /* zero columns among them */
-        {1, 30, 60, 6, 0.0, 3000},     /* one sampled row: every column the same direction */
-        {8, 30, 100, 1, 0.0, 3000},    /* one cluster */
+    struct {
+        int R, P, n, C;
+        double zero_cols;
+        int runs;
+    } cases[] = {
+        {6, 40, 120, 12, 0.0, 3000},  /* a few rows, clusters of ~10 */
+        {20, 60, 300, 30, 0.3, 1500}, /* zero columns among them */
+        {1, 30, 60, 6, 0.0, 3000},    /* one sampled row: every column the same direction */
+        {8, 30, 100, 1, 0.0, 3000},   /* one cluster */
     };
     for (int t = 0; t < (int)(sizeof cases / sizeof cases[0]); t++) {
         int R = cases[t].R, P = cases[t].P, n = cases[t].n, C = cases[t].C;
@@ -157,7 +171,8 @@ static void test_unbiased(void) {
             int a = (int)(rng_next_u32(&rng) % (uint32_t)R), b = (int)(rng_next_u32(&rng) % (uint32_t)R);
             float f = rng_float(&rng);
             for (int j = 0; j < n; j++) {
-                float v = f * red[(size_t)a * (size_t)n + (size_t)j] + (1.0f - f) * red[(size_t)b * (size_t)n + (size_t)j];
+                float v =
+                    f * red[(size_t)a * (size_t)n + (size_t)j] + (1.0f - f) * red[(size_t)b * (size_t)n + (size_t)j];
                 int zero = column_norm(red, R, n, j) == 0.0;
                 pix[(size_t)p * (size_t)n + (size_t)j] = zero ? 0.0f : v + 0.3f * rng_float(&rng);
             }
@@ -192,7 +207,10 @@ static void test_exact_when_c_large(void) {
         int seen[100] = {0}, wrong = 0;
         for (int c = 0; c < k && k >= 0; c++) {
             int j = cl[c].representative;
-            if (j < 0 || j >= n) { wrong++; continue; }
+            if (j < 0 || j >= n) {
+                wrong++;
+                continue;
+            }
             seen[j]++;
             double nj = column_norm(m, R, n, j);
             wrong += cl[c].scale != 1.0f || cl[c].size != 1 || !(fabs((double)cl[c].weight - nj) <= 1e-6 * nj);
@@ -201,7 +219,8 @@ static void test_exact_when_c_large(void) {
         CHECK(wrong == 0, "C=%d: %d columns not exactly once with scale 1, size 1, weight = norm", Cs[t], wrong);
         double est[10];
         reconstruct(m, R, n, cl, k > 0 ? k : 0, est);
-        for (int p = 0; p < R; p++) CHECK_NEAR(est[p], row_sum(m, n, p), 1e-6 * row_sum(m, n, p), "C=%d row %d", Cs[t], p);
+        for (int p = 0; p < R; p++)
+            CHECK_NEAR(est[p], row_sum(m, n, p), 1e-6 * row_sum(m, n, p), "C=%d row %d", Cs[t], p);
     }
     free(m);
 }
@@ -221,7 +240,8 @@ static void check_groups(int R, int K, int n, uint64_t seed, int seeds) {
     float *m = calloc((size_t)R * (size_t)n, sizeof(float));
     int *group_size = calloc((size_t)K, sizeof(int));
     double *group_norm = calloc((size_t)K, sizeof(double));
-    for (int j = 0; j < n; j++) group[j] = j < K ? j : (rng_double(&g) < 0.1 ? -1 : (int)(rng_next_u32(&g) % (uint32_t)K));
+    for (int j = 0; j < n; j++)
+        group[j] = j < K ? j : (rng_double(&g) < 0.1 ? -1 : (int)(rng_next_u32(&g) % (uint32_t)K));
     for (int j = n - 1; j > 0; j--) { /* shuffle so groups interleave */
         int i = (int)(rng_next_u32(&g) % (uint32_t)(j + 1)), t = group[i];
         group[i] = group[j];
@@ -249,8 +269,12 @@ static void check_groups(int R, int K, int n, uint64_t seed, int seeds) {
         int wrong = 0;
         for (int c = 0; c < k; c++) {
             int gr = group[cl[c].representative];
-            if (gr < 0 || hit[gr]++) { wrong++; continue; }
-            wrong += cl[c].size != group_size[gr] || !(fabs((double)cl[c].weight - group_norm[gr]) <= 1e-5 * group_norm[gr]);
+            if (gr < 0 || hit[gr]++) {
+                wrong++;
+                continue;
+            }
+            wrong +=
+                cl[c].size != group_size[gr] || !(fabs((double)cl[c].weight - group_norm[gr]) <= 1e-5 * group_norm[gr]);
         }
         bad_groups += wrong > 0;
         reconstruct(m, R, n, cl, k, est);
@@ -302,8 +326,8 @@ static void check_same_direction(int R, int n, int C, int identical) {
     }
     CHECK(bad == 0, "%s R=%d N=%d C=%d: %d of 20 seeds gave the wrong count or broke an invariant",
           identical ? "identical" : "proportional", R, n, C, bad);
-    CHECK(off == 0, "%s R=%d N=%d C=%d: %d rows not reconstructed exactly", identical ? "identical" : "proportional", R, n,
-          C, off);
+    CHECK(off == 0, "%s R=%d N=%d C=%d: %d rows not reconstructed exactly", identical ? "identical" : "proportional", R,
+          n, C, off);
     free(m);
     free(col);
     free(cl);
@@ -358,7 +382,9 @@ static void test_zero_columns(void) {
 
 static void test_invariants(void) {
     /* Ordinary matrices, several shapes. */
-    struct { int R, n, C; } shapes[] = {{1, 80, 10}, {2, 200, 20}, {30, 400, 50}, {64, 300, 299}, {5, 1000, 3}};
+    struct {
+        int R, n, C;
+    } shapes[] = {{1, 80, 10}, {2, 200, 20}, {30, 400, 50}, {64, 300, 299}, {5, 1000, 3}};
     int bad = 0;
     for (int t = 0; t < 5; t++) {
         rng_state g = rng_for((uint64_t)t, 9, 9);
@@ -382,7 +408,8 @@ static void test_invariants(void) {
     float *m = random_matrix(R, n, 0.1, &g);
     for (int j = 0; j < n; j++) {
         double f = j % 3 == 0 ? 1e-30 : (j % 3 == 1 ? 1e30 : 1.0);
-        for (int i = 0; i < R; i++) m[(size_t)i * (size_t)n + (size_t)j] = (float)((double)m[(size_t)i * (size_t)n + (size_t)j] * f);
+        for (int i = 0; i < R; i++)
+            m[(size_t)i * (size_t)n + (size_t)j] = (float)((double)m[(size_t)i * (size_t)n + (size_t)j] * f);
     }
     mrcs_cluster cl[40];
     double est[20];

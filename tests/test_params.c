@@ -50,8 +50,10 @@ static void test_entry(const param_desc *d, const char *help) {
     int i = 0;
     CHECK(cli_vl_option(2, argv, &i, &c) == 1, "cli_vl_option %s", option);
     CHECK(i == (d->flag ? 0 : 1), "%s took %d arguments", option, i);
-    if (d->flag) CHECK(param_get(d, &c) == 1.0, "%s alone is not on", option);
-    else CHECK(memcmp(&a, &c, sizeof a) == 0, "cli_vl_option %s %s differs from set", option, text);
+    if (d->flag)
+        CHECK(param_get(d, &c) == 1.0, "%s alone is not on", option);
+    else
+        CHECK(memcmp(&a, &c, sizeof a) == 0, "cli_vl_option %s %s differs from set", option, text);
     CHECK(strstr(help, option) != NULL, "the help does not list %s", option);
 
     /* A bad value is refused with a message and changes nothing; the off word is -1. */
@@ -78,7 +80,8 @@ static void test_entry(const param_desc *d, const char *help) {
     /* The panel's widget. */
     CHECK(d->label && d->label[0] && d->help && d->help[0], "%s: no label or help", d->name);
     if (d->type == PARAM_CHOICE) {
-        for (int k = 0; k < d->num_choices; k++) CHECK(d->choices[k].label != NULL, "%s: a choice without a label", d->name);
+        for (int k = 0; k < d->num_choices; k++)
+            CHECK(d->choices[k].label != NULL, "%s: a choice without a label", d->name);
     } else {
         CHECK(d->panel_lo < d->panel_hi && d->panel_format, "%s: no slider range", d->name);
         CHECK(d->panel_hi <= d->hi, "%s: the slider goes past the accepted range", d->name);
@@ -113,7 +116,8 @@ static void test_resolve(void) {
     CHECK(memcmp(&r, &rr, sizeof r) == 0, "resolving twice changes the parameters");
     vl_params set = {.count = 77, .radius_shrink = -1.0f, .trace_glossy = -1.0f, .per_pixel = -1, .candidates = 100000};
     r = vl_params_resolve(&set);
-    CHECK(r.count == 77 && r.radius_shrink < 0.0f && r.trace_glossy < 0.0f && r.per_pixel == -1, "explicit values changed");
+    CHECK(r.count == 77 && r.radius_shrink < 0.0f && r.trace_glossy < 0.0f && r.per_pixel == -1,
+          "explicit values changed");
     CHECK(r.candidates == VL_MAX_CANDIDATES, "candidates not capped: %d", r.candidates);
     vl_params clustered = {.columns = 100};
     CHECK(vl_params_resolve(&clustered).per_pixel == -1, "with columns every representative is shaded");
@@ -121,8 +125,10 @@ static void test_resolve(void) {
           "a frame's lights per pixel");
     for (int m = 0; m < METHOD_COUNT; m++) {
         render_params p = render_params_resolve(&(render_params){.method = (render_method)m});
-        CHECK(p.vl.clamp == (m == METHOD_VPL ? VL_CLAMP_ON : VL_CLAMP_OFF), "%s: clamp %d", method_name(p.method), p.vl.clamp);
-        CHECK(p.max_depth == DEFAULT_MAX_DEPTH && p.width > 0 && p.height > 0, "%s: size or depth", method_name(p.method));
+        CHECK(p.vl.clamp == (m == METHOD_VPL ? VL_CLAMP_ON : VL_CLAMP_OFF), "%s: clamp %d", method_name(p.method),
+              p.vl.clamp);
+        CHECK(p.max_depth == DEFAULT_MAX_DEPTH && p.width > 0 && p.height > 0, "%s: size or depth",
+              method_name(p.method));
     }
 }
 
@@ -135,7 +141,8 @@ static void test_options_doc(void) {
     size_t n = fread(text, 1, sizeof text - 1, f);
     text[n] = 0;
     fclose(f);
-    CHECK(strstr(text, cli_vl_help()) != NULL, "%s: the option list differs from --help's:\n%s", GLINT_OPTIONS_DOC, cli_vl_help());
+    CHECK(strstr(text, cli_vl_help()) != NULL, "%s: the option list differs from --help's:\n%s", GLINT_OPTIONS_DOC,
+          cli_vl_help());
 }
 
 /* Each entry given to glint render as a user would: a tiny vsl image. */

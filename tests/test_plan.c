@@ -99,8 +99,8 @@ static run_result run(const scene *s, const camera *cam, render_params p, int fr
 static void agree(const char *what, const run_result *a, const run_result *b) {
     for (int k = 0; k < 4; k++) {
         double tol = 4.5 * sqrt(a->sem[k] * a->sem[k] + b->sem[k] * b->sem[k]) + 1e-6;
-        CHECK(fabs(a->mean[k] - b->mean[k]) <= tol, "%s, quadrant %d: plan %.5f vs every pass %.5f (tolerance %.5f)", what,
-              k, a->mean[k], b->mean[k], tol);
+        CHECK(fabs(a->mean[k] - b->mean[k]) <= tol, "%s, quadrant %d: plan %.5f vs every pass %.5f (tolerance %.5f)",
+              what, k, a->mean[k], b->mean[k], tol);
     }
     printf("%s: plan %.4f %.4f %.4f %.4f, every pass %.4f %.4f %.4f %.4f\n", what, a->mean[0], a->mean[1], a->mean[2],
            a->mean[3], b->mean[0], b->mean[1], b->mean[2], b->mean[3]);
@@ -121,8 +121,8 @@ static void test_diffuse_then_glossy(void) {
     scene *s = room(ROOM_DIFFUSE);
     camera cam = room_camera();
     scene_analysis a = analyse(s);
-    CHECK(a.glossy == 0 && a.diffuse >= 1 && !a.glossy_to_glossy, "diffuse room: %d glossy, %d diffuse materials, g2g %d",
-          a.glossy, a.diffuse, a.glossy_to_glossy);
+    CHECK(a.glossy == 0 && a.diffuse >= 1 && !a.glossy_to_glossy,
+          "diffuse room: %d glossy, %d diffuse materials, g2g %d", a.glossy, a.diffuse, a.glossy_to_glossy);
     CHECK(a.indirect && a.reflective && a.area == 2 && a.punctual == 0 && !a.env,
           "diffuse room: indirect %d, reflective %d, %d emissive triangles", a.indirect, a.reflective, a.area);
     effect_plan p = plan_make(&a, METHOD_VSL_HL, 5, PLAN_AUTO);
@@ -168,8 +168,8 @@ static void test_glossy_without_glossy_transport(void) {
     scene *s = room(ROOM_GLOSSY_BLOCK);
     camera cam = room_camera();
     scene_analysis a = analyse(s);
-    CHECK(a.glossy == 1 && !a.glossy_to_glossy, "glossy block: %d glossy, g2g %d (the inside of the block must not count)",
-          a.glossy, a.glossy_to_glossy);
+    CHECK(a.glossy == 1 && !a.glossy_to_glossy,
+          "glossy block: %d glossy, g2g %d (the inside of the block must not count)", a.glossy, a.glossy_to_glossy);
     run_result plan = run(s, &cam, params(METHOD_VSL_HL, PLAN_AUTO), 48, ALL);
     run_result full = run(s, &cam, params(METHOD_VSL_HL, PLAN_FULL), 48, ALL);
     CHECK(!plan.plan.highlights && plan.stats.hl_secondary_rays == 0, "glossy block: no highlight pass expected");
@@ -209,7 +209,8 @@ static void test_environment_only(void) {
     run_result plan = run(s, &cam, params(METHOD_VSL, PLAN_AUTO), 24, ALL);
     CHECK(plan.plan.max_depth == 1 && !plan.plan.virtual_lights && plan.stats.light_paths == 0 &&
               plan.stats.pass_ns[PASS_VIRTUAL_LIGHTS] == 0,
-          "block under the sky: depth %d, %llu light paths", plan.plan.max_depth, (unsigned long long)plan.stats.light_paths);
+          "block under the sky: depth %d, %llu light paths", plan.plan.max_depth,
+          (unsigned long long)plan.stats.light_paths);
     run_result pt = run(s, &cam, params(METHOD_PT, PLAN_FULL), 24, ALL);
     agree("block under the sky, vsl (plan) vs pt", &plan, &pt);
     scene_analysis_free(&a);

@@ -340,7 +340,9 @@ static void test_glossy_area(const char *name, material mat) {
         free(sorted);
     }
     for (int i = 0; i < n; i++)
-        if (e[3 * i] >= thresh) sum_i += avg3(v3(img[3 * i], img[3 * i + 1], img[3 * i + 2])), sum_e += avg3(v3(e[3 * i], e[3 * i + 1], e[3 * i + 2]));
+        if (e[3 * i] >= thresh)
+            sum_i += avg3(v3(img[3 * i], img[3 * i + 1], img[3 * i + 2])),
+                sum_e += avg3(v3(e[3 * i], e[3 * i + 1], e[3 * i + 2]));
     CHECK_NEAR(sum_i / sum_e, 1.0, 0.03, "%s: highlight pixels' energy against quadrature", name);
     free(img);
     free(e);
@@ -406,15 +408,18 @@ static void test_highlights_layer(void) {
             ind_total += ind[i];
             rest_total += ind_split[i];
         }
-        printf("highlights layer, %s box: highlights %.4f of indirect %.4f\n", names[k], hl_total / ind_total, ind_total);
+        printf("highlights layer, %s box: highlights %.4f of indirect %.4f\n", names[k], hl_total / ind_total,
+               ind_total);
         CHECK(bad_sum == 0 && negative == 0, "%s: indirect != split indirect + highlights at %d channels, %d negative",
               names[k], bad_sum, negative);
         CHECK(direct_changed == 0, "%s: the split changed the direct light at %d channels", names[k], direct_changed);
         CHECK(ind_total > 0.0, "%s: no indirect light", names[k]);
-        if (k == 0) CHECK(hl_total > 0.05 * ind_total && rest_total > 0.05 * ind_total, "mixed: highlights share %.3f",
-                          hl_total / ind_total);
-        if (k == 1) CHECK(rest_total <= 1e-6 * ind_total, "glossy, depth 2: %.3g of the indirect is not highlights",
-                          rest_total / ind_total);
+        if (k == 0)
+            CHECK(hl_total > 0.05 * ind_total && rest_total > 0.05 * ind_total, "mixed: highlights share %.3f",
+                  hl_total / ind_total);
+        if (k == 1)
+            CHECK(rest_total <= 1e-6 * ind_total, "glossy, depth 2: %.3g of the indirect is not highlights",
+                  rest_total / ind_total);
         if (k == 2) CHECK(hl_total == 0.0, "diffuse: highlights %g", hl_total);
         free(ind);
         free(ind_split);

@@ -352,13 +352,14 @@ static void test_russian_roulette(void) {
             survived++;
             sum[0] += w.x, sum[1] += w.y, sum[2] += w.z;
         }
-        CHECK(fabs(sum[0] / n - ws[k].x) < 1e-3 * ws[k].x + 1e-7 && fabs(sum[1] / n - ws[k].y) < 1e-3 * ws[k].y + 1e-7 &&
+        CHECK(fabs(sum[0] / n - ws[k].x) < 1e-3 * ws[k].x + 1e-7 &&
+                  fabs(sum[1] / n - ws[k].y) < 1e-3 * ws[k].y + 1e-7 &&
                   fabs(sum[2] / n - ws[k].z) < 1e-3 * ws[k].z + 1e-7,
               "roulette: weight %d's mean (%g %g %g) against (%g %g %g)", k, sum[0] / n, sum[1] / n, sum[2] / n,
               (double)ws[k].x, (double)ws[k].y, (double)ws[k].z);
         double q = fmin(0.95, max_comp3(ws[k]));
-        CHECK(fabs((double)survived / n - q) < 2.0 / n, "roulette: weight %d survives %d of %d, expected %g", k, survived,
-              n, q);
+        CHECK(fabs((double)survived / n - q) < 2.0 / n, "roulette: weight %d survives %d of %d, expected %g", k,
+              survived, n, q);
     }
 }
 

@@ -49,7 +49,12 @@ static inline void ts_quad(scene *s, vec3 p0, vec3 p1, vec3 p2, vec3 p3, int mat
     vec3 n = normalize3(cross3(sub3(p1, p0), sub3(p2, p0)));
     float nrm[12];
     for (int i = 0; i < 4; i++) nrm[3 * i] = n.x, nrm[3 * i + 1] = n.y, nrm[3 * i + 2] = n.z;
-    mesh_desc md = {.num_vertices = 4, .positions = pos, .normals = nrm, .uv0 = uv, .num_indices = 6, .indices = idx,
+    mesh_desc md = {.num_vertices = 4,
+                    .positions = pos,
+                    .normals = nrm,
+                    .uv0 = uv,
+                    .num_indices = 6,
+                    .indices = idx,
                     .material = mat};
     mat4 id = mat4_identity();
     char err[256];
@@ -66,8 +71,10 @@ static inline void ts_box(scene *s, vec3 lo, vec3 hi, int inward, int mat) {
     /* outward-facing faces, counter-clockwise seen from outside */
     int f[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     for (int k = 0; k < 6; k++) {
-        if (inward) ts_quad(s, c[f[k][3]], c[f[k][2]], c[f[k][1]], c[f[k][0]], mat);
-        else ts_quad(s, c[f[k][0]], c[f[k][1]], c[f[k][2]], c[f[k][3]], mat);
+        if (inward)
+            ts_quad(s, c[f[k][3]], c[f[k][2]], c[f[k][1]], c[f[k][0]], mat);
+        else
+            ts_quad(s, c[f[k][0]], c[f[k][1]], c[f[k][2]], c[f[k][3]], mat);
     }
 }
 
@@ -96,7 +103,8 @@ static inline float *ts_render_with(const scene *s, const camera *cam, const ren
     float *img = malloc(sizeof(float) * 3 * (size_t)p->width * (size_t)p->height);
     film_resolve(session_film(rs), mask, img);
     render_stats st = session_stats(rs);
-    if (st.rejected_samples) fprintf(stderr, "ts_render: %llu rejected samples\n", (unsigned long long)st.rejected_samples);
+    if (st.rejected_samples)
+        fprintf(stderr, "ts_render: %llu rejected samples\n", (unsigned long long)st.rejected_samples);
     session_destroy(rs);
     return img;
 }

@@ -19,7 +19,8 @@
 static void check_edge_coverage(void) {
     enum { EW = 64, EH = 40, N = 64, G = 32 };
     scene *s = ts_new("edge");
-    ts_quad(s, v3(-5, -5, -1), v3(-1.4f, -5, -1), v3(1.6f, 5, -1), v3(-5, 5, -1), ts_lambert(s, v3s(0.0f), v3s(1.0f), 0));
+    ts_quad(s, v3(-5, -5, -1), v3(-1.4f, -5, -1), v3(1.6f, 5, -1), v3(-5, 5, -1),
+            ts_lambert(s, v3s(0.0f), v3s(1.0f), 0));
     ts_finalize(s);
     camera cam = camera_look_at(v3(0, 0, 0), v3(0, 0, -1), v3(0, 1, 0), 0.6f);
     render_params p = {.width = EW, .height = EH, .max_depth = 1, .seed = 11};
@@ -46,8 +47,10 @@ static void check_edge_coverage(void) {
     }
     CHECK(edge >= 20, "the edge must cross pixels (%d)", edge);
     double rms = sqrt(err2 / edge), indep = sqrt(indep2 / edge);
-    CHECK(rms < 0.5 * indep, "pixels along an edge after %d frames: RMS error %.4f, independent positions would "
-          "leave %.4f", N, rms, indep);
+    CHECK(rms < 0.5 * indep,
+          "pixels along an edge after %d frames: RMS error %.4f, independent positions would "
+          "leave %.4f",
+          N, rms, indep);
     free(img);
     scene_destroy(s);
 }

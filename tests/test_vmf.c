@@ -54,8 +54,8 @@ static void test_density_and_rbar(void) {
         long double omc = 1.0L - cosl((long double)theta);
         CHECK(close_rel(vmf_eval(v, s), ref_density((float)k, omc), 1e-5), "vmf_eval near the peak, kappa %g", k);
         long double r = ref_rbar(k);
-        CHECK(close_rel(vmf_rbar_from_kappa(k), r, 1e-12), "rbar(%g) = %.17g, expected %.17Lg", k, vmf_rbar_from_kappa(k),
-              r);
+        CHECK(close_rel(vmf_rbar_from_kappa(k), r, 1e-12), "rbar(%g) = %.17g, expected %.17Lg", k,
+              vmf_rbar_from_kappa(k), r);
         CHECK(isfinite(vmf_log_norm(k)), "log c(%g) not finite", k);
     }
     /* The density integrates to one: quadrature in 1 - cos, refined toward the peak. */
@@ -118,8 +118,8 @@ static void test_sampling(void) {
         }
         CHECK(bad == 0, "kappa %g: %d samples not unit or not finite", k, bad);
         double mean = sum / n, var = sum2 / n - mean * mean, sem = sqrt(var > 0 ? var / n : 0) + 1e-7;
-        CHECK(fabs(mean - vmf_rbar_from_kappa(k)) < 5.0 * sem, "kappa %g: mean cosine %.6f, rbar %.6f (sem %.2g)", k, mean,
-              vmf_rbar_from_kappa(k), sem);
+        CHECK(fabs(mean - vmf_rbar_from_kappa(k)) < 5.0 * sem, "kappa %g: mean cosine %.6f, rbar %.6f (sem %.2g)", k,
+              mean, vmf_rbar_from_kappa(k), sem);
         if (k <= 1e4) /* float directions resolve angles down to ~1e-4 rad: enough below kappa 1e4 */
             for (int j = 0; j < 3; j++) {
                 double p = 0.25 * (j + 1), frac = (double)below[j] / n, sd = sqrt(p * (1 - p) / n);
@@ -141,13 +141,15 @@ static void test_product_and_convolution(void) {
         for (int t = 0; t < 20; t++) {
             vec3 s = vmf_sample(p, rng_vec2(&rng));
             double lhs = vmf_eval(a, s) * vmf_eval(b, s), rhs = scale * vmf_eval(p, s);
-            CHECK(fabs(lhs - rhs) <= 1e-3 * fabs(lhs) + 1e-300, "product %zu: a b = %.9g, scale * p = %.9g", c, lhs, rhs);
+            CHECK(fabs(lhs - rhs) <= 1e-3 * fabs(lhs) + 1e-300, "product %zu: a b = %.9g, scale * p = %.9g", c, lhs,
+                  rhs);
         }
     }
     vmf a = {v3(0, 0, 1), 10.0f}, b = {v3(0, 0, -1), 10.0f};
     double scale;
     vmf p = vmf_product(a, b, &scale);
-    CHECK(p.kappa == 0.0f && fabs(scale - vmf_eval(a, v3(1, 0, 0)) * vmf_eval(b, v3(1, 0, 0)) * 4.0 * M_PI) < 1e-9 * scale,
+    CHECK(p.kappa == 0.0f &&
+              fabs(scale - vmf_eval(a, v3(1, 0, 0)) * vmf_eval(b, v3(1, 0, 0)) * 4.0 * M_PI) < 1e-9 * scale,
           "antipodal product: kappa %g, scale %g", (double)p.kappa, scale);
 
     /* Convolution: sampling a, then b about each sample, has mean cosine rbar_a rbar_b. */
@@ -164,8 +166,8 @@ static void test_product_and_convolution(void) {
             sum2 += z * z;
         }
         double mean = sum / n, sem = sqrt((sum2 / n - mean * mean) / n) + 1e-7;
-        CHECK(fabs(mean - vmf_rbar_from_kappa(k)) < 5.0 * sem, "convolution %zu: kappa %g has rbar %.6f, sampled %.6f", c,
-              k, vmf_rbar_from_kappa(k), mean);
+        CHECK(fabs(mean - vmf_rbar_from_kappa(k)) < 5.0 * sem, "convolution %zu: kappa %g has rbar %.6f, sampled %.6f",
+              c, k, vmf_rbar_from_kappa(k), mean);
     }
     double big = vmf_convolve_kappa(1e5, 1e5);
     CHECK(fabs(big - 5e4) < 5.0, "convolving two kappa 1e5 lobes: %g, expected ~5e4", big);
@@ -207,14 +209,15 @@ static void test_fit_glossy(void) {
                 bsdf_sample_result s;
                 float ul = rng_float(&rng);
                 if (!bsdf_sample(&cases[c].b, wo, BSDF_GLOSSY, ul, rng_vec2(&rng), &s)) continue;
-                double dx = (double)s.wi.x - lobe.mu.x, dy = (double)s.wi.y - lobe.mu.y, dz = (double)s.wi.z - lobe.mu.z;
+                double dx = (double)s.wi.x - lobe.mu.x, dy = (double)s.wi.y - lobe.mu.y,
+                       dz = (double)s.wi.z - lobe.mu.z;
                 omc[got++] = 0.5 * (dx * dx + dy * dy + dz * dz);
                 alb += avg3(s.f) * s.wi.z / s.pdf;
             }
             qsort(omc, (size_t)got, sizeof(double), cmp_double);
             double k = lobe.kappa, median = omc[got / 2], want = -log1p(0.5 * expm1(-2.0 * k)) / k;
-            CHECK(fabs(median / want - 1.0) < 0.15, "%s at %g deg: median 1 - cos %.3g, fitted vMF's %.3g", cases[c].name,
-                  angles[a], median, want);
+            CHECK(fabs(median / want - 1.0) < 0.15, "%s at %g deg: median 1 - cos %.3g, fitted vMF's %.3g",
+                  cases[c].name, angles[a], median, want);
             alb /= N;
             CHECK(fabs(avg3(albedo) / alb - 1.0) < 0.03, "%s at %g deg: albedo %.4f, Monte Carlo %.4f", cases[c].name,
                   angles[a], (double)avg3(albedo), alb);
@@ -268,7 +271,8 @@ static void test_fit_bands(void) {
     vec3 mirror = v3(-wo.x, -wo.y, wo.z), tail = normalize3(v3(-0.3f, 0.5f, 0.8f));
     CHECK(vmf_glossy_band_shares(&ggx, wo, mirror, share) == VMF_LOBE_BANDS, "GGX: shares per band");
     CHECK_NEAR(share[0] + share[1], 1.0, 1e-6, "shares at the mirror direction");
-    CHECK(share[1] > share[0], "at the mirror direction the sharp band's share %.3f is below the broad one's", share[1]);
+    CHECK(share[1] > share[0], "at the mirror direction the sharp band's share %.3f is below the broad one's",
+          share[1]);
     vmf_glossy_band_shares(&ggx, wo, tail, share);
     CHECK(share[0] > 0.99f, "far in the tail the broad band's share is only %.3f", share[0]);
 }
@@ -309,7 +313,8 @@ static void test_merge(void) {
     m = vmf_merge(two, NULL, NULL, 2);
     CHECK(fabsf(m.mu.x) < 1e-6f && m.mu.z > 0.99999f, "merged mean (%g %g %g)", (double)m.mu.x, (double)m.mu.y,
           (double)m.mu.z);
-    CHECK(m.kappa < 200.0f && m.kappa > 20.0f, "merged kappa %g: the spread of the centres must dominate", (double)m.kappa);
+    CHECK(m.kappa < 200.0f && m.kappa > 20.0f, "merged kappa %g: the spread of the centres must dominate",
+          (double)m.kappa);
     /* Weights pull the mean; members select; zero weights are ignored. */
     float w2[2] = {3.0f, 1.0f};
     m = vmf_merge(two, w2, NULL, 2);
@@ -344,8 +349,8 @@ static void test_em(void) {
     for (int i = 0; i < N; i++)
         if (cluster_of[truth[i]] < 0) cluster_of[truth[i]] = assign[i];
     for (int i = 0; i < N; i++) agree += assign[i] == cluster_of[truth[i]];
-    CHECK(cluster_of[0] != cluster_of[1] && agree > N - 5, "two lobes: %d of %d directions in their lobe's cluster", agree,
-          N);
+    CHECK(cluster_of[0] != cluster_of[1] && agree > N - 5, "two lobes: %d of %d directions in their lobe's cluster",
+          agree, N);
     for (int t = 0; t < 2; t++) {
         int members[N], nm = 0;
         for (int i = 0; i < N; i++)

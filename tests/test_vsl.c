@@ -259,11 +259,14 @@ static void test_terms_split(void) {
             hl += avg(vsl_contribution(&vl, &x, VL_TERMS_HIGHLIGHTS, 1, &r3, NULL));
         }
         CHECK_NEAR(split + hl, all, 1e-4 * all, "depth %d: without + only highlights = all", depth);
-        if (depth == 1) CHECK(hl > 0.05 * all, "depth 1: the glossy-glossy part is missing (%.3g of %.3g)", hl, all);
-        else CHECK(hl == 0.0, "depth %d: lights past the first bounce have no highlight part", depth);
+        if (depth == 1)
+            CHECK(hl > 0.05 * all, "depth 1: the glossy-glossy part is missing (%.3g of %.3g)", hl, all);
+        else
+            CHECK(hl == 0.0, "depth %d: lights past the first bounce have no highlight part", depth);
         /* The VPL kernels split the same way. */
         double v_all = avg(vpl_contribution(&vl, &x, 1, VL_TERMS_ALL));
-        double v_split = avg(vpl_contribution(&vl, &x, 1, VL_TERMS_NO_HIGHLIGHTS)) + avg(vpl_contribution(&vl, &x, 1, VL_TERMS_HIGHLIGHTS));
+        double v_split = avg(vpl_contribution(&vl, &x, 1, VL_TERMS_NO_HIGHLIGHTS)) +
+                         avg(vpl_contribution(&vl, &x, 1, VL_TERMS_HIGHLIGHTS));
         CHECK_NEAR(v_split, v_all, 1e-5 * v_all, "VPL depth %d split", depth);
     }
 }
@@ -376,9 +379,7 @@ static int all_finite(const float *img, int n) {
 enum { W = 24, H = 18, NPIX = W * H };
 static const unsigned INDIRECT = 1u << COMP_INDIRECT;
 
-static camera box_camera(void) {
-    return camera_look_at(v3(0.2f, 0.1f, 0.9f), v3(-1, -1, -1), v3(0, 1, 0), 1.2f);
-}
+static camera box_camera(void) { return camera_look_at(v3(0.2f, 0.1f, 0.9f), v3(-1, -1, -1), v3(0, 1, 0), 1.2f); }
 
 static render_params vl_params_for(render_method m, int count) {
     render_params p = {.width = W, .height = H, .method = m, .max_depth = 8, .seed = 11};
@@ -426,9 +427,10 @@ static void test_diffuse_box_against_pt(void) {
     double err_fixed = rel_l2(fixed, ref, NPIX);
     printf("radius shrink: error %.4f, %.4f, %.4f after 16, 64, 256 frames; fixed radius %.4f\n", errs[0], errs[1],
            errs[2], err_fixed);
-    CHECK(errs[1] < errs[0] && errs[2] < errs[1], "radius shrink: the error does not decrease (%.4f %.4f %.4f)", errs[0],
-          errs[1], errs[2]);
-    CHECK(errs[2] < 0.7 * err_fixed, "radius shrink: %.4f is not clearly below the fixed radius's %.4f", errs[2], err_fixed);
+    CHECK(errs[1] < errs[0] && errs[2] < errs[1], "radius shrink: the error does not decrease (%.4f %.4f %.4f)",
+          errs[0], errs[1], errs[2]);
+    CHECK(errs[2] < 0.7 * err_fixed, "radius shrink: %.4f is not clearly below the fixed radius's %.4f", errs[2],
+          err_fixed);
     free(fixed);
     free(vsl);
     free(ref);
@@ -445,7 +447,7 @@ static void test_glossy_box_energy(void) {
     camera cam = box_camera();
     float *ref = ts_render(s, &cam, W, H, 2048, 8, 2, INDIRECT);
     render_params p = vl_params_for(METHOD_VPL, 1024);
-    p.vl.clamp_value = 0.1f; /* a typical bound: below the brightest indirect radiance (~0.4) */
+    p.vl.clamp_value = 0.1f;   /* a typical bound: below the brightest indirect radiance (~0.4) */
     p.vl.clamp_growth = -1.0f; /* the paper's baseline: a fixed bound */
     p.vl.trace_glossy = -1.0f; /* the paper's baseline: every lobe gathered */
     float *vpl = ts_render_with(s, &cam, &p, 16, INDIRECT);
@@ -481,8 +483,10 @@ static void test_light_selection_unbiased(void) {
     static const struct {
         const char *name;
         int select, candidates;
-    } ways[] = {{"by power", VL_SELECT_POWER, 1}, {"resampled from power draws", VL_SELECT_POWER, 16},
-                {"through the tree", VL_SELECT_TREE, 1}, {"resampled from tree draws", VL_SELECT_TREE, 8}};
+    } ways[] = {{"by power", VL_SELECT_POWER, 1},
+                {"resampled from power draws", VL_SELECT_POWER, 16},
+                {"through the tree", VL_SELECT_TREE, 1},
+                {"resampled from tree draws", VL_SELECT_TREE, 8}};
     for (int method = METHOD_VPL; method <= METHOD_VSL; method++) {
         const int frames = 200;
         render_params p = vl_params_for((render_method)method, 256);
@@ -555,8 +559,8 @@ static void test_trace_glossy_matches_pt(void) {
                k, depths[k], ratio, e_traced, image_mean(pt, NPIX) / image_mean(ref, NPIX), e_pt,
                (unsigned long long)st.glossy_bounces);
         CHECK(fabs(ratio - 1.0) < 0.03, "depth %d: traced glossy indirect mean off by %+.4f", depths[k], ratio - 1.0);
-        CHECK(e_traced < 1.5 * e_pt + 0.01, "depth %d: traced glossy indirect L2 %.4f vs path tracing's %.4f", depths[k],
-              e_traced, e_pt);
+        CHECK(e_traced < 1.5 * e_pt + 0.01, "depth %d: traced glossy indirect L2 %.4f vs path tracing's %.4f",
+              depths[k], e_traced, e_pt);
         CHECK(st.glossy_bounces >= (uint64_t)(0.95 * 2048 * NPIX), "depth %d: only %llu glossy bounces", depths[k],
               (unsigned long long)st.glossy_bounces);
         CHECK(st.vl_connections == 0, "depth %d: %llu virtual lights shaded where nothing is gathered", depths[k],
@@ -630,8 +634,8 @@ static void test_lights_touching_surfaces(void) {
         scene *s = closed_box(m, spots[k]);
         camera cam = box_camera();
         for (int run = 0; run < 4; run++) { /* vpl, vsl; sharp lobes traced through, then gathered */
-            render_params p = {.width = 8, .height = 6, .method = (render_method)(METHOD_VPL + run / 2), .max_depth = 6,
-                               .seed = 3};
+            render_params p = {
+                .width = 8, .height = 6, .method = (render_method)(METHOD_VPL + run / 2), .max_depth = 6, .seed = 3};
             p.vl.trace_glossy = run % 2 ? -1.0f : 0.0f;
             p.vl.count = 32;
             p.vl.per_pixel = 4;
@@ -642,8 +646,8 @@ static void test_lights_touching_surfaces(void) {
             float img[8 * 6 * 3];
             film_resolve(session_film(rs), COMP_MASK_ALL, img);
             render_stats st = session_stats(rs);
-            CHECK(st.rejected_samples == 0, "light %d, %s, run %d: %llu samples were NaN or Inf", k, method_name(p.method), run,
-                  (unsigned long long)st.rejected_samples);
+            CHECK(st.rejected_samples == 0, "light %d, %s, run %d: %llu samples were NaN or Inf", k,
+                  method_name(p.method), run, (unsigned long long)st.rejected_samples);
             CHECK(all_finite(img, 48), "light %d, %s, run %d: non-finite pixels", k, method_name(p.method), run);
             CHECK(st.virtual_lights >= 2000u * 32u, "light %d: virtual_lights_total %llu", k,
                   (unsigned long long)st.virtual_lights);

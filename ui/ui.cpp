@@ -51,7 +51,7 @@ extern "C" void ui_draw_lights(const float *xy, int n, int selected) {
     }
 }
 
-static const ImU32 curve_colours[6] = {IM_COL32(255, 200, 60, 255), IM_COL32(90, 200, 255, 255),
+static const ImU32 curve_colours[6] = {IM_COL32(255, 200, 60, 255),  IM_COL32(90, 200, 255, 255),
                                        IM_COL32(140, 255, 120, 255), IM_COL32(255, 110, 110, 255),
                                        IM_COL32(210, 140, 255, 255), IM_COL32(230, 230, 230, 255)};
 
@@ -92,8 +92,10 @@ static void error_plot(const ui_stats *s) {
             float y = p0.y + h * (1.0f - (std::log10(e) - lo) / (hi - lo));
             pts.push_back(ImVec2(x, y));
         }
-        if (pts.Size == 1) dl->AddCircleFilled(pts[0], 2.0f, curve_colours[c % 6]);
-        else if (pts.Size > 1) dl->AddPolyline(pts.Data, pts.Size, curve_colours[c % 6], 0, 1.5f);
+        if (pts.Size == 1)
+            dl->AddCircleFilled(pts[0], 2.0f, curve_colours[c % 6]);
+        else if (pts.Size > 1)
+            dl->AddPolyline(pts.Data, pts.Size, curve_colours[c % 6], 0, 1.5f);
     }
     char label[32];
     std::snprintf(label, sizeof label, "1e%+.0f", (double)hi);
@@ -101,9 +103,9 @@ static void error_plot(const ui_stats *s) {
     std::snprintf(label, sizeof label, "1e%+.0f", (double)lo);
     dl->AddText(ImVec2(p0.x + 2, p0.y + h - 15), IM_COL32(200, 200, 200, 255), label);
     std::snprintf(label, sizeof label, "%.1f s", (double)tmax);
-    dl->AddText(ImVec2(p0.x + w - 8.0f * (float)std::strlen(label), p0.y + h - 15), IM_COL32(200, 200, 200, 255), label);
-    for (int c = 0; c < s->num_curves; c++)
-        ImGui::TextColored(ImColor(curve_colours[c % 6]), "%s", s->curves[c].label);
+    dl->AddText(ImVec2(p0.x + w - 8.0f * (float)std::strlen(label), p0.y + h - 15), IM_COL32(200, 200, 200, 255),
+                label);
+    for (int c = 0; c < s->num_curves; c++) ImGui::TextColored(ImColor(curve_colours[c % 6]), "%s", s->curves[c].label);
 }
 
 // One widget per many-light parameter of the group, from the table (params.h): choices as combo
@@ -140,8 +142,10 @@ static void param_widgets(param_group group, vl_params *vl) {
             edited = x;
         }
         // The lowest position is "off" where there is one; anything else stays in the accepted range.
-        if (has_off && edited <= d->panel_lo) edited = -1.0;
-        else edited = std::fmin(std::fmax(edited, d->lo), d->below_hi ? std::nextafter(d->hi, 0.0) : d->hi);
+        if (has_off && edited <= d->panel_lo)
+            edited = -1.0;
+        else
+            edited = std::fmin(std::fmax(edited, d->lo), d->below_hi ? std::nextafter(d->hi, 0.0) : d->hi);
         param_put(d, vl, edited);
     }
 }
@@ -194,8 +198,10 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
 
     if (s->reference && ImGui::CollapsingHeader("Reference", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::TextWrapped("%s", s->reference);
-        if (s->rel_error >= 0.0) ImGui::Text("relative L2 error %.4f", s->rel_error);
-        else ImGui::TextUnformatted("relative L2 error -");
+        if (s->rel_error >= 0.0)
+            ImGui::Text("relative L2 error %.4f", s->rel_error);
+        else
+            ImGui::TextUnformatted("relative L2 error -");
         error_plot(s);
     }
 

@@ -22,18 +22,18 @@ typedef struct {
     /* estimator settings: a change resets the accumulation. The panel edits method, max_depth and
      * vl (its defaults resolved, vl_params_resolve), the many-light fields through params_table. */
     render_params params;
-    int camera;        /* scene camera index, -1 for the free camera */
+    int camera; /* scene camera index, -1 for the free camera */
     /* the selected light and its intensity: a change of intensity resets */
-    int light;         /* light group, -1 for none */
-    float light_gain;  /* its intensity multiplier */
+    int light;        /* light group, -1 for none */
+    float light_gain; /* its intensity multiplier */
     /* display settings: a change never resets */
-    float exposure;    /* stops */
-    int tonemap;       /* index into the tone mapper names given to ui_panel */
-    int show;          /* UI_SHOW_* */
+    float exposure; /* stops */
+    int tonemap;    /* index into the tone mapper names given to ui_panel */
+    int show;       /* UI_SHOW_* */
     int show_panel;
     /* one-shot actions, set by the panel, cleared by the viewer */
     int screenshot, export_exr, reset_view, load_scene, load_env, load_reference;
-    char path[1024];   /* the panel's path field for loading */
+    char path[1024]; /* the panel's path field for loading */
 } ui_controls;
 
 /* One curve of the error plot: relative L2 error against seconds since a reset. */
@@ -45,35 +45,35 @@ typedef struct {
 
 typedef struct {
     const char *scene_name;
-    long long frames;          /* at full resolution since the last reset */
+    long long frames; /* at full resolution since the last reset */
     double spp;
-    double seconds;            /* since the last reset */
-    double frame_ms;           /* the last frame's render time */
+    double seconds;  /* since the last reset */
+    double frame_ms; /* the last frame's render time */
     double rays_per_second;
     unsigned long long rejected_samples;
-    int width, height;         /* of the image shown */
-    int previewing;            /* a reduced-resolution frame is shown while things move */
+    int width, height; /* of the image shown */
+    int previewing;    /* a reduced-resolution frame is shown while things move */
     int num_cameras;
     const char *const *method_names;
     int num_methods;
-    int many_light;            /* the current method uses virtual lights: show their settings */
+    int many_light;                    /* the current method uses virtual lights: show their settings */
     unsigned long long virtual_lights; /* deposited since the last reset */
-    int highlights;            /* the current method is vsl+hl: show the highlight settings */
+    int highlights;                    /* the current method is vsl+hl: show the highlight settings */
     /* the last full-resolution frame's highlight work (vsl+hl) */
     unsigned long long hl_points, hl_lobes; /* camera hits worked at, lobes lit */
-    double hl_merge_share;     /* of the frame's thread time spent clustering and merging */
-    const char *plan;          /* the effect plan, "pass: why" a line; empty before the first frame */
+    double hl_merge_share;                  /* of the frame's thread time spent clustering and merging */
+    const char *plan;                       /* the effect plan, "pass: why" a line; empty before the first frame */
     const char *const *tonemap_names;
     int num_tonemaps;
     const char *const *light_names; /* the scene's light groups, "name (type)" */
     int num_lights;
-    int light_movable;         /* the selected light has a position */
-    const char *reference;     /* the reference image's path, NULL without one */
-    double rel_error;          /* of the full-resolution image against it; < 0: none yet */
-    const ui_curve *curves;    /* the error plot, one curve per method and setting */
+    int light_movable;      /* the selected light has a position */
+    const char *reference;  /* the reference image's path, NULL without one */
+    double rel_error;       /* of the full-resolution image against it; < 0: none yet */
+    const ui_curve *curves; /* the error plot, one curve per method and setting */
     int num_curves;
-    const char *bookmarks;     /* which of bookmarks 1-9 are set, e.g. "1 3", and where they live */
-    const char *message;       /* last export path or error, shown until replaced */
+    const char *bookmarks; /* which of bookmarks 1-9 are set, e.g. "1 3", and where they live */
+    const char *message;   /* last export path or error, shown until replaced */
 } ui_stats;
 
 /* Sets up Dear ImGui for a window with a current OpenGL 3.3 context. Returns 0 or -1. */

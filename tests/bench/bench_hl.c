@@ -42,8 +42,8 @@ typedef struct {
     int w, h;
     hl_setup hl;
     long long frame;
-    double *sum;          /* running sum per pixel channel */
-    render_stats *stats;  /* per worker */
+    double *sum;         /* running sum per pixel channel */
+    render_stats *stats; /* per worker */
     uint64_t seed;
 } run;
 
@@ -93,7 +93,7 @@ static long long render_for(const run *proto, threadpool *pool, double seconds, 
 /* The whole renderer (session) with params for `seconds`: its highlights layer into img. Returns
  * the frames rendered. */
 static long long session_render_for(const scene *s, const camera *cam, const render_params *params, double seconds,
-                                     float *img) {
+                                    float *img) {
     char err[256];
     render_session *rs = session_create(s, cam, params, err, sizeof err);
     if (!rs) die(err);
@@ -189,7 +189,8 @@ int main(int argc, char **argv) {
     /* Two independent runs A, B: E|A - B|^2 = 2 var, E|A - ref|^2 = var + bias^2 (bias here
      * includes the reference's own noise). */
     printf("\nNoise and bias, N = 8, two independent runs of %g s each:\n\n"
-           "| estimator | frames | noise | bias |\n|---|---|---|---|\n", 0.5 * seconds);
+           "| estimator | frames | noise | bias |\n|---|---|---|---|\n",
+           0.5 * seconds);
     float *img2 = malloc(sizeof(float) * n);
     if (!img2) die("out of memory");
     const int split_rows[] = {0, 1, 4};
@@ -205,7 +206,8 @@ int main(int argc, char **argv) {
         double ea = metric_rel_l2(img, ref, n), eb = metric_rel_l2(img2, ref, n);
         double noise2 = 0.5 * rel_sq(img, img2, ref, n);
         double bias2 = 0.5 * (ea * ea + eb * eb) - noise2;
-        printf("| %s | %lld, %lld | %.4f | %.4f |\n", rows[r].label, fa, fb, sqrt(noise2), bias2 > 0.0 ? sqrt(bias2) : 0.0);
+        printf("| %s | %lld, %lld | %.4f | %.4f |\n", rows[r].label, fa, fb, sqrt(noise2),
+               bias2 > 0.0 ? sqrt(bias2) : 0.0);
         fflush(stdout);
     }
     free(img2);
@@ -214,7 +216,8 @@ int main(int argc, char **argv) {
      * path tracer reaches those paths through its one sample per pixel, vsl+hl through its
      * dedicated pass of N secondary rays. */
     printf("\nThe whole renderer at equal time (%g s each, every component rendered, the highlights layer "
-           "compared): relative L2 error (frames)\n\n| method | N = 8 | N = 32 |\n|---|---|---|\n", seconds);
+           "compared): relative L2 error (frames)\n\n| method | N = 8 | N = 32 |\n|---|---|---|\n",
+           seconds);
     render_params pp = {.width = proto.w, .height = proto.h, .method = METHOD_PT, .pt_highlights = 1, .seed = 5};
     long long pf = session_render_for(s, &proto.cam, &pp, seconds, img);
     printf("| path tracer (`--method pt --highlights-layer`) | %.4f (%lld) | |\n", metric_rel_l2(img, ref, n), pf);

@@ -80,11 +80,14 @@ int main(int argc, char **argv) {
         err_of[mode] = metric_rel_l2(img, ref, n);
         render_stats st = session_stats(rs);
         printf("| %s | %s | %lld | %.1f | %.1f | %.1f | %.1f | %.4f |", argv[1], mode == PLAN_AUTO ? "auto" : "full",
-               session_frames(rs), 1e-9 * (double)st.pass_ns[PASS_DIRECT], 1e-9 * (double)st.pass_ns[PASS_VIRTUAL_LIGHTS],
-               1e-9 * (double)st.pass_ns[PASS_GATHER], 1e-9 * (double)st.pass_ns[PASS_HIGHLIGHTS], err_of[mode]);
-        if (mode == PLAN_AUTO) printf(" %.0f s |\n", seconds);
-        else printf(" %.0f s (the plan saves %.0f%%) |\n", seconds * (err_of[1] / err_of[0]) * (err_of[1] / err_of[0]),
-                    100.0 * (1.0 - (err_of[0] / err_of[1]) * (err_of[0] / err_of[1])));
+               session_frames(rs), 1e-9 * (double)st.pass_ns[PASS_DIRECT],
+               1e-9 * (double)st.pass_ns[PASS_VIRTUAL_LIGHTS], 1e-9 * (double)st.pass_ns[PASS_GATHER],
+               1e-9 * (double)st.pass_ns[PASS_HIGHLIGHTS], err_of[mode]);
+        if (mode == PLAN_AUTO)
+            printf(" %.0f s |\n", seconds);
+        else
+            printf(" %.0f s (the plan saves %.0f%%) |\n", seconds * (err_of[1] / err_of[0]) * (err_of[1] / err_of[0]),
+                   100.0 * (1.0 - (err_of[0] / err_of[1]) * (err_of[0] / err_of[1])));
         fflush(stdout);
         session_destroy(rs);
     }

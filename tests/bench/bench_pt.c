@@ -37,7 +37,8 @@ static int write_obj(const scene *s, const char *dir) {
     if (!f) return -1;
     fprintf(f, "mtllib scene.mtl\n");
     for (int i = 0; i < s->num_vertices; i++)
-        fprintf(f, "v %.9g %.9g %.9g\n", (double)s->positions[i].x, (double)s->positions[i].y, (double)s->positions[i].z);
+        fprintf(f, "v %.9g %.9g %.9g\n", (double)s->positions[i].x, (double)s->positions[i].y,
+                (double)s->positions[i].z);
     for (int i = 0; i < s->num_vertices; i++)
         fprintf(f, "vn %.6g %.6g %.6g\n", (double)s->normals[i].x, (double)s->normals[i].y, (double)s->normals[i].z);
     int current = -2;

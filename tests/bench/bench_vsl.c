@@ -93,7 +93,8 @@ static void run_seeds(const bench *b, const char *label, render_params p, const 
         }
     }
     printf("| %s |", label);
-    for (int k = 0; k < nt; k++) printf(" %.3f (%.3f-%.3f; %.0f) |", sqrt(sum2[k] / seeds), lo[k], hi[k], mean_frames[k]);
+    for (int k = 0; k < nt; k++)
+        printf(" %.3f (%.3f-%.3f; %.0f) |", sqrt(sum2[k] / seeds), lo[k], hi[k], mean_frames[k]);
     printf("\n");
     fflush(stdout);
 }
@@ -109,7 +110,8 @@ static double run_for(const bench *b, render_params p, double seconds) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 7 && argc != 8) die("usage: bench_vsl SCENE|default REF.exr WxH REF_SECONDS T1,T2,... SWEEP_SECONDS [SEEDS]");
+    if (argc != 7 && argc != 8)
+        die("usage: bench_vsl SCENE|default REF.exr WxH REF_SECONDS T1,T2,... SWEEP_SECONDS [SEEDS]");
     int seeds = argc == 8 ? atoi(argv[7]) : 4;
     if (seeds < 1 || seeds > 1000) die("SEEDS: expected 1 to 1000");
     char err[1024];
@@ -171,8 +173,7 @@ int main(int argc, char **argv) {
     vsl.vl.radius_shrink = 0.7f;
     run_times(&b, "vsl, radius shrink 0.7", vsl, times, nt);
 
-    printf("\n### The aim, over %d independent runs: root mean square error (range; mean frames)\n\n| method |",
-           seeds);
+    printf("\n### The aim, over %d independent runs: root mean square error (range; mean frames)\n\n| method |", seeds);
     for (int k = 0; k < nt; k++) printf(" %g s |", times[k]);
     printf("\n|---|");
     for (int k = 0; k < nt; k++) printf("---|");
