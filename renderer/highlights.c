@@ -313,7 +313,7 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
             float pdf;
             vec3 f = lobe_eval(l, ls.wi, ls.p_light, !isfinite(ls.dist), &pdf);
             if (!is_black3(f) && light_sample_visible(s, l->origin, l->n, &ls, &st->rays[RAY_SHADOW]))
-                sum = add3(sum, scale3(mul3(f, ls.radiance), mis_power(ls.pdf, pdf) / ls.pdf));
+                sum = add3(sum, scale3(mul3(f, ls.radiance), nee_light_weight(&ls, pdf) / ls.pdf));
         }
         vec3 wi;
         if (lobe_sample(l, rng, &wi)) {
@@ -325,13 +325,13 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
                 float pdf;
                 vec3 f = is_black3(le) ? le : lobe_eval(l, wi, e.p, 0, &pdf);
                 if (!is_black3(f) && pdf > 0.0f)
-                    sum =
-                        add3(sum, scale3(mul3(f, le), mis_power(pdf, light_pdf_triangle(s, li, l->origin, &e)) / pdf));
+                    sum = add3(sum, scale3(mul3(f, le), nee_emission_weight(s, l->origin, &e, wi, pdf) / pdf));
             } else if (env_by_sampling) {
                 float pdf;
                 vec3 f = lobe_eval(l, wi, wi, 1, &pdf);
                 if (!is_black3(f) && pdf > 0.0f)
-                    sum = add3(sum, scale3(mul3(f, env_eval(s, wi)), mis_power(pdf, light_pdf_env(s, wi)) / pdf));
+                    sum = add3(
+                        sum, scale3(mul3(f, env_eval(s, wi)), nee_emission_weight(s, l->origin, NULL, wi, pdf) / pdf));
             }
         }
     }

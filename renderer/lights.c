@@ -267,6 +267,12 @@ float light_pdf_triangle(const scene *s, int li, vec3 p, const surface_hit *h) {
     return dist1d_pmf(&s->light_dist, li) * d2 / (cos_l * area);
 }
 
+float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, float lobe_pdf) {
+    if (!h) return mis_power(lobe_pdf, light_pdf_env(s, d));
+    int li = s->tri_light[h->tri];
+    return mis_power(lobe_pdf, li >= 0 ? light_pdf_triangle(s, li, p, h) : 0.0f);
+}
+
 float light_pdf_env(const scene *s, vec3 d) {
     if (s->env_light < 0) return 0.0f;
     vec2 uv = env_uv(s->env, d);

@@ -52,6 +52,16 @@ float light_pdf_triangle(const scene *s, int light, vec3 p, const surface_hit *h
 /* The pdf light_sample_direct would have given for the environment along direction d. */
 float light_pdf_env(const scene *s, vec3 d);
 
+/* Next-event estimation's two multiple-importance weights (the power heuristic, one sample each),
+ * the one rule the path tracer and the highlight estimator share. For a light sample: against the
+ * lobe that could have found the same direction (lobe_pdf, solid angle); a delta light cannot be
+ * found, so 1. For emission found by sampling the lobe from p: against light_sample_direct's pdf
+ * for the same point (h: an emissive triangle's hit; NULL: the environment along d). */
+static inline float nee_light_weight(const light_sample *ls, float lobe_pdf) {
+    return ls->delta ? 1.0f : mis_power(ls->pdf, lobe_pdf);
+}
+float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, float lobe_pdf);
+
 /* Rebuilds the light list after geometry, materials or the environment changed: keeps the
  * punctual lights, re-derives emissive triangles and the environment light, powers and the
  * selection distribution. Returns 0 or -1 with err set. */

@@ -51,18 +51,14 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
         if (!hit) {
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (depth > 0 || !continuation)) {
-                float w = depth == 0 ? 1.0f : mis_power(prev_pdf, light_pdf_env(s, d));
+                float w = depth == 0 ? 1.0f : nee_emission_weight(s, prev_p, NULL, d, prev_pdf);
                 add_emission(out, depth, split_highlights, beta, beta_hl, le, w);
             }
             break;
         }
         vec3 le = material_emission(s, &h);
         if (!is_black3(le) && (depth > 0 || !continuation)) {
-            float w = 1.0f;
-            if (depth > 0) {
-                int li = s->tri_light[h.tri];
-                w = mis_power(prev_pdf, li >= 0 ? light_pdf_triangle(s, li, prev_p, &h) : 0.0f);
-            }
+            float w = depth > 0 ? nee_emission_weight(s, prev_p, &h, d, prev_pdf) : 1.0f;
             add_emission(out, depth, split_highlights, beta, beta_hl, le, w);
         }
         if (depth >= max_depth) break;
@@ -83,7 +79,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
             vec3 f = wi.z > 0.0f ? bsdf_eval(&b, wo, wi, lobes) : v3(0, 0, 0);
             if (!is_black3(f)) {
                 if (light_sample_visible(s, h.p, h.ng, &ls, &rays[RAY_SHADOW])) {
-                    float w = ls.delta ? 1.0f : mis_power(ls.pdf, bsdf_pdf(&b, wo, wi, lobes));
+                    float w = nee_light_weight(&ls, bsdf_pdf(&b, wo, wi, lobes));
                     vec3 c = scale3(mul3(mul3(beta, f), ls.radiance), wi.z * w / ls.pdf);
                     if (split_highlights && depth == 1) {
                         vec3 fg = bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b));
