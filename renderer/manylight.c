@@ -202,7 +202,7 @@ static int reserve_entries(manylight *m, int n) {
 
 static int cluster_lights(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
                           threadpool *pool, render_stats *st) {
-    int n = m->set.count, rows = vl_params_resolve(&p->vl).rows;
+    int n = m->set.count, rows = p->vl.rows; /* p is resolved (manylight_begin_frame) */
     float *matrix = malloc(sizeof(float) * (size_t)rows * (size_t)n);
     render_stats *row_stats = calloc((size_t)rows, sizeof(render_stats));
     mrcs_cluster *clusters = malloc(sizeof(mrcs_cluster) * (size_t)p->vl.columns);
@@ -326,7 +326,7 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
         lighttree_build(&m->tree, &m->set) != 0)
         return snprintf(err, errlen, "out of memory for the light tree"), -1;
     if (clustering) {
-        if (cluster_lights(m, s, cam, p, frame, pool, st) != 0)
+        if (cluster_lights(m, s, cam, &r, frame, pool, st) != 0)
             return snprintf(err, errlen, "out of memory for the light clusters"), -1;
         m->clustered = 1;
         return 0;

@@ -79,7 +79,9 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
             vec3 f = wi.z > 0.0f ? bsdf_eval(&b, wo, wi, lobes) : v3(0, 0, 0);
             if (!is_black3(f)) {
                 if (light_sample_visible(s, h.p, h.ng, &ls, &rays[RAY_SHADOW])) {
-                    float w = nee_light_weight(&ls, bsdf_pdf(&b, wo, wi, lobes));
+                    /* A delta light's weight needs no lobe pdf: skip evaluating it (point and spot
+                     * lights are common, and this runs at every vertex). */
+                    float w = nee_light_weight(&ls, ls.delta ? 0.0f : bsdf_pdf(&b, wo, wi, lobes));
                     vec3 c = scale3(mul3(mul3(beta, f), ls.radiance), wi.z * w / ls.pdf);
                     if (split_highlights && depth == 1) {
                         vec3 fg = bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b));
