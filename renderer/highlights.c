@@ -271,6 +271,20 @@ static vec3 lobe_eval(const lit_lobe *l, vec3 wi, vec3 y, int far, float *pdf) {
     return dot3(wi, l->n) > 0.0f ? cluster_toward(l->c, wi, y, far) : v3(0, 0, 0);
 }
 
+/* The lobe toward a light sample for next-event estimation: punctual lights are not sampled here
+ * (each has its own shadow ray), nor the environment unless traced. */
+typedef struct {
+    const lit_lobe *l;
+    const scene *s;
+    int env_by_sampling;
+} lobe_nee;
+
+static vec3 lobe_toward(const void *ctx, const light_sample *ls, float *pdf) {
+    const lobe_nee *n = ctx;
+    if (ls->delta || (n->s->lights[ls->light].type != LIGHT_TRIANGLE && !n->env_by_sampling)) return v3(0, 0, 0);
+    return lobe_eval(n->l, ls->wi, ls->p_light, !isfinite(ls->dist), pdf);
+}
+
 /* A direction from the lobe (BSDF sampling, or the far vMF bands); 0 when none. */
 static int lobe_sample(const lit_lobe *l, rng_state *rng, vec3 *wi) {
     float u_band = rng_float(rng);
@@ -305,16 +319,12 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
     }
     int env_by_sampling = traced && s->env_light >= 0;
     if (h->area_lights || env_by_sampling) {
-        light_sample ls;
         float u_sel = rng_float(rng);
         vec2 u = rng_vec2(rng);
-        if (light_sample_direct(s, l->origin, u_sel, u, &ls) && !ls.delta &&
-            (s->lights[ls.light].type == LIGHT_TRIANGLE || env_by_sampling)) {
-            float pdf;
-            vec3 f = lobe_eval(l, ls.wi, ls.p_light, !isfinite(ls.dist), &pdf);
-            if (!is_black3(f) && light_sample_visible(s, l->origin, l->n, &ls, &st->rays[RAY_SHADOW]))
-                sum = add3(sum, scale3(mul3(f, ls.radiance), nee_light_weight(&ls, pdf) / ls.pdf));
-        }
+        lobe_nee ctx = {l, s, env_by_sampling};
+        vec3 f_light, arrival = nee_direct(s, l->origin, l->n, u_sel, u, lobe_toward, &ctx, &st->rays[RAY_SHADOW],
+                                           &f_light, NULL);
+        sum = add3(sum, mul3(f_light, arrival));
         vec3 wi;
         if (lobe_sample(l, rng, &wi)) {
             surface_hit e;

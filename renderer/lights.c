@@ -273,6 +273,18 @@ float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, 
     return mis_power(lobe_pdf, li >= 0 ? light_pdf_triangle(s, li, p, h) : 0.0f);
 }
 
+vec3 nee_direct(const scene *s, vec3 p, vec3 ng, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
+                uint64_t *shadow_rays, vec3 *f, light_sample *out) {
+    light_sample ls;
+    *f = v3(0, 0, 0);
+    if (!light_sample_direct(s, p, u_select, u, &ls) || !(dot3(ls.wi, ng) > 0.0f)) return v3(0, 0, 0);
+    if (out) *out = ls;
+    float lobe_pdf = 0.0f;
+    *f = lobe(ctx, &ls, &lobe_pdf);
+    if (is_black3(*f) || !light_sample_visible(s, p, ng, &ls, shadow_rays)) return v3(0, 0, 0);
+    return scale3(ls.radiance, nee_light_weight(&ls, lobe_pdf) / ls.pdf);
+}
+
 float light_pdf_env(const scene *s, vec3 d) {
     if (s->env_light < 0) return 0.0f;
     vec2 uv = env_uv(s->env, d);

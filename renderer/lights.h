@@ -62,6 +62,18 @@ static inline float nee_light_weight(const light_sample *ls, float lobe_pdf) {
 }
 float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, float lobe_pdf);
 
+/* A lobe as next-event estimation sees it: its value toward the light sample (f times the cosine,
+ * or a merged lobe's value) and, unless the light is delta, the pdf with which the lobe's own
+ * sampling finds that direction. Black means no shadow ray. */
+typedef vec3 (*nee_lobe_fn)(const void *lobe, const light_sample *ls, float *lobe_pdf);
+
+/* Next-event estimation, the one routine: picks a light from p (u_select, u), keeps it only above
+ * the geometric surface (ng), asks the lobe for its value *f and traces one shadow ray when that is
+ * not black. Returns the light's weighted arrival Le w / pdf (black when nothing arrives); the
+ * contribution is *f times it. *ls (optional) receives the sample. */
+vec3 nee_direct(const scene *s, vec3 p, vec3 ng, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
+                uint64_t *shadow_rays, vec3 *f, light_sample *ls);
+
 /* Rebuilds the light list after geometry, materials or the environment changed: keeps the
  * punctual lights, re-derives emissive triangles and the environment light, powers and the
  * selection distribution. Returns 0 or -1 with err set. */

@@ -27,6 +27,25 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int split_highlights, 
         out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
 }
 
+/* A BSDF's lobes as next-event estimation sees them. */
+typedef struct {
+    const bsdf *b;
+    frame3 fr;
+    vec3 wo;
+    int lobes;
+} bsdf_lobe;
+
+static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lobe_pdf) {
+    const bsdf_lobe *l = ctx;
+    vec3 wi = to_local(l->fr, ls->wi);
+    if (!(wi.z > 0.0f)) return v3(0, 0, 0);
+    vec3 f = bsdf_eval(l->b, l->wo, wi, l->lobes);
+    /* A delta light's weight needs no lobe pdf: skip evaluating it (point and spot lights are
+     * common, and this runs at every vertex). */
+    if (!ls->delta && !is_black3(f)) *lobe_pdf = bsdf_pdf(l->b, l->wo, wi, l->lobes);
+    return scale3(f, wi.z);
+}
+
 /* The path tracer, for a ray (o, d) whose closest hit the caller has traced: *first, or NULL when
  * the ray escaped. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
  * first belongs to that path's direct light and is not counted. With split_highlights the paths
@@ -71,25 +90,20 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
                                                         : first_lobes;
 
         /* Next-event estimation. */
-        light_sample ls;
         float u_sel = rng_float(rng);
         vec2 u_light = rng_vec2(rng);
-        if (light_sample_direct(s, h.p, u_sel, u_light, &ls) && dot3(ls.wi, h.ng) > 0.0f) {
-            vec3 wi = to_local(fr, ls.wi);
-            vec3 f = wi.z > 0.0f ? bsdf_eval(&b, wo, wi, lobes) : v3(0, 0, 0);
-            if (!is_black3(f)) {
-                if (light_sample_visible(s, h.p, h.ng, &ls, &rays[RAY_SHADOW])) {
-                    /* A delta light's weight needs no lobe pdf: skip evaluating it (point and spot
-                     * lights are common, and this runs at every vertex). */
-                    float w = nee_light_weight(&ls, ls.delta ? 0.0f : bsdf_pdf(&b, wo, wi, lobes));
-                    vec3 c = scale3(mul3(mul3(beta, f), ls.radiance), wi.z * w / ls.pdf);
-                    if (split_highlights && depth == 1) {
-                        vec3 fg = bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b));
-                        add_split(out, c, scale3(mul3(mul3(beta_hl, fg), ls.radiance), wi.z * w / ls.pdf));
-                    } else {
-                        out[component_of(depth + 1)] = add3(out[component_of(depth + 1)], c);
-                    }
-                }
+        bsdf_lobe lobe = {&b, fr, wo, lobes};
+        light_sample ls;
+        vec3 f;
+        vec3 arrival = nee_direct(s, h.p, h.ng, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
+        if (!is_black3(arrival)) {
+            vec3 c = mul3(mul3(beta, f), arrival);
+            if (split_highlights && depth == 1) {
+                vec3 wi = to_local(fr, ls.wi);
+                vec3 fg = scale3(bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b)), wi.z);
+                add_split(out, c, mul3(mul3(beta_hl, fg), arrival));
+            } else {
+                out[component_of(depth + 1)] = add3(out[component_of(depth + 1)], c);
             }
         }
 
