@@ -42,7 +42,7 @@ static void print_render_help(void) {
            "                       vMF-merged indirect highlights, in a highlights.* layer) [pt]\n"
            "  --spp N              samples per pixel (frames) [%d]\n"
            "  --time SECONDS       render until this much time has passed instead of --spp\n"
-           "  --size WxH           image size [960x540]\n"
+           "  --size WxH           image size [%dx%d]\n"
            "  --max-depth D        scattering events per path; 1 = direct light only [%d]\n"
            "  --plan auto|full     auto: only the passes the scene calls for (glint info shows\n"
            "                       them); full: every pass, for comparison [auto]\n"
@@ -66,7 +66,7 @@ static void print_render_help(void) {
            "\n"
            "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
            "new file render.png (render-1.png, ... if taken).\n",
-           DEFAULT_SPP, DEFAULT_MAX_DEPTH, cli_vl_help());
+           DEFAULT_SPP, DEFAULT_WIDTH, DEFAULT_HEIGHT, DEFAULT_MAX_DEPTH, cli_vl_help());
 }
 
 /* Returns 0 to render, 1 when --help was shown, -1 on a usage error (already reported). */
@@ -298,8 +298,7 @@ int cmd_render(int argc, char **argv) {
         scene_destroy(s);
         return EXIT_USAGE;
     }
-    render_params p = o.params;
-    if (p.width <= 0) p.width = 960, p.height = 540;
+    render_params p = render_params_resolve_frame(&o.params);
     camera cam = scene_camera(s, (int)o.camera_index, (float)p.width / (float)p.height);
     char err[1024];
     render_session *rs = session_create(s, &cam, &p, err, sizeof err);

@@ -28,7 +28,7 @@ static void print_view_help(void) {
            "default: the default built-in scene).\n"
            "\n"
            "options:\n"
-           "  --size WxH           window and render size [960x540]\n"
+           "  --size WxH           window and render size [%dx%d]\n"
            "  --method NAME        estimator: pt, vpl, vsl, vsl+hl [pt]\n"
            "  --max-depth D        scattering events per path [%d]\n"
            "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
@@ -47,13 +47,13 @@ static void print_view_help(void) {
            "PageUp/PageDown move the selected light, ctrl+click picks a light, ctrl+drag moves it,\n"
            "F12 screenshot (PNG), F11 export (EXR), Tab panel, Esc quit.\n"
            "Drop a .gltf/.glb on the window to open it, an .exr/.hdr to light the scene with it.\n",
-           DEFAULT_MAX_DEPTH, cli_vl_help());
+           DEFAULT_WIDTH, DEFAULT_HEIGHT, DEFAULT_MAX_DEPTH, cli_vl_help());
 }
 
 static int parse_view_options(int argc, char **argv, view_options *o) {
     memset(o, 0, sizeof *o);
-    o->width = 960;
-    o->height = 540;
+    o->width = DEFAULT_WIDTH;
+    o->height = DEFAULT_HEIGHT;
     o->camera = -1;
     o->params.max_depth = DEFAULT_MAX_DEPTH;
     const cli_opt opts[] = {

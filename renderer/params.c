@@ -43,12 +43,17 @@ vl_params vl_params_resolve(const vl_params *vp) {
     return r;
 }
 
-render_params render_params_resolve(const render_params *p) {
+render_params render_params_resolve_frame(const render_params *p) {
     render_params r = *p;
-    if (r.width <= 0) r.width = 960;
-    if (r.height <= 0) r.height = 540;
+    if (r.width <= 0) r.width = DEFAULT_WIDTH;
+    if (r.height <= 0) r.height = DEFAULT_HEIGHT;
     if (r.max_depth <= 0) r.max_depth = DEFAULT_MAX_DEPTH;
     if ((unsigned)r.method >= METHOD_COUNT) r.method = METHOD_PT;
+    return r;
+}
+
+render_params render_params_resolve(const render_params *p) {
+    render_params r = render_params_resolve_frame(p);
     r.vl = vl_params_resolve(&p->vl);
     if (r.vl.clamp == VL_CLAMP_DEFAULT) r.vl.clamp = r.method == METHOD_VPL ? VL_CLAMP_ON : VL_CLAMP_OFF;
     return r;

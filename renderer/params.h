@@ -26,6 +26,8 @@ const char *method_name(render_method m);
 int method_from_name(const char *name);
 
 #define DEFAULT_MAX_DEPTH 16
+#define DEFAULT_WIDTH 960
+#define DEFAULT_HEIGHT 540
 
 /* The many-light methods (vpl, vsl, vsl+hl). Zero means default for every field but the switches. */
 typedef struct {
@@ -92,7 +94,7 @@ enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };
 
 /* Zero means default for every field. */
 typedef struct {
-    int width, height; /* 0: 960 x 540 */
+    int width, height; /* 0: DEFAULT_WIDTH x DEFAULT_HEIGHT */
     render_method method;
     int max_depth; /* scattering events per path; 0: DEFAULT_MAX_DEPTH; 1 is direct light only */
     uint64_t seed;
@@ -138,6 +140,9 @@ typedef struct {
  * a frame with fewer lights than columns does not cluster and then takes the default
  * (vl_frame_per_pixel). */
 vl_params vl_params_resolve(const vl_params *vp);
+/* p with its size, depth and method resolved, vl as given: what a session keeps (its estimators
+ * resolve vl themselves, with the frame's light count at hand). */
+render_params render_params_resolve_frame(const render_params *p);
 /* p with its size, depth, method and vl resolved, clamp included (on for vpl, off otherwise). */
 render_params render_params_resolve(const render_params *p);
 /* Lights a pixel shades in a frame from vp as given (unresolved); 0: every one. clustering: the

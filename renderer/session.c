@@ -58,12 +58,8 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
     if (!rs) return snprintf(err, errlen, "out of memory"), NULL;
     rs->scene = s;
     rs->cam = *cam;
-    rs->params = *params;
+    rs->params = render_params_resolve_frame(params);
     render_params *p = &rs->params;
-    if (p->width <= 0) p->width = 960;
-    if (p->height <= 0) p->height = 540;
-    if (p->max_depth <= 0) p->max_depth = DEFAULT_MAX_DEPTH;
-    if ((unsigned)p->method >= METHOD_COUNT) p->method = METHOD_PT;
     if (film_init(&rs->film, p->width, p->height) != 0) {
         snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height);
         free(rs);
@@ -269,8 +265,7 @@ void session_set_params(render_session *rs, const render_params *params) {
     p.width = rs->params.width;
     p.height = rs->params.height;
     p.threads = rs->params.threads;
-    if (p.max_depth <= 0) p.max_depth = DEFAULT_MAX_DEPTH;
-    if ((unsigned)p.method >= METHOD_COUNT) p.method = METHOD_PT;
+    p = render_params_resolve_frame(&p);
     rs->params = p;
     rs->plan = plan_make(&rs->analysis, p.method, p.max_depth, p.plan);
     session_reset(rs);
