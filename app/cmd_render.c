@@ -145,6 +145,12 @@ static void progress_update(progress *pg, const render_options *o, long long fra
     pg->last = now;
 }
 
+/* Highlights are a layer of their own when they are split off (vsl+hl, --highlights-layer). */
+static unsigned exr_layers(const render_options *o) {
+    int split = o->params.pt_highlights || o->params.method == METHOD_VSL_HL;
+    return (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (split ? 1u << COMP_HIGHLIGHTS : 0u);
+}
+
 static int write_stats(const char *path, const render_options *o, const render_session *rs, const scene *s,
                        double seconds) {
     char *buf = NULL;
@@ -167,7 +173,8 @@ static int write_stats(const char *path, const render_options *o, const render_s
         fprintf(f, "\"%s\": %llu, ", ray_kind_names[k], (unsigned long long)st.rays[k]);
     fprintf(f, "\"total\": %llu},\n", (unsigned long long)total);
     fprintf(f, "  \"rays_per_second\": %.1f,\n", seconds > 0 ? (double)total / seconds : 0.0);
-    fprintf(f, "  \"rejected_samples\": %llu", (unsigned long long)st.rejected_samples);
+    fprintf(f, "  \"rejected_samples\": %llu,\n", (unsigned long long)st.rejected_samples);
+    fprintf(f, "  \"values_clamped_to_float\": %zu", film_count_clamped(session_film(rs), exr_layers(o)));
     if (p->method != METHOD_PT) {
         const vl_params vp = vl_params_resolve(&p->vl); /* the values the frames used */
         fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"virtual_lights_total\": %llu,\n", vp.count,
@@ -209,7 +216,6 @@ static int write_stats(const char *path, const render_options *o, const render_s
     int status = write_file_atomic(path, buf, size, WRITE_REPLACE, err, sizeof err);
     free(buf);
     if (status) cli_error("%s", err);
-    (void)o;
     return status;
 }
 
@@ -235,9 +241,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
                          reference_noise *rn) {
     const film *fm = session_film(rs);
     char err[1024];
-    /* Highlights are a layer of their own when they are split off (vsl+hl, --highlights-layer). */
-    int split = o->params.pt_highlights || o->params.method == METHOD_VSL_HL;
-    const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (split ? 1u << COMP_HIGHLIGHTS : 0u);
+    const unsigned layers = exr_layers(o);
     if (o->out_exr && film_save_exr(fm, layers, o->out_exr, WRITE_REPLACE, err, sizeof err) != 0) {
         cli_error("%s", err);
         return -1;
@@ -332,6 +336,8 @@ int cmd_render(int argc, char **argv) {
     progress_update(&pg, &o, session_frames(rs), cli_now(), 1);
     render_stats st = session_stats(rs);
     if (st.rejected_samples) cli_warning("%llu NaN/Inf samples were rejected", (unsigned long long)st.rejected_samples);
+    size_t clamped = film_count_clamped(session_film(rs), exr_layers(&o));
+    if (clamped) cli_warning("%zu pixel values beyond float's range were written as the largest float", clamped);
 
     int status = write_outputs(&o, rs, s, elapsed, &rn);
     reference_noise_deinit(&rn);

@@ -1,5 +1,6 @@
 #include "film.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,8 +36,8 @@ void film_clear(film *f) {
     f->passes = 0;
 }
 
-void film_resolve(const film *f, unsigned mask, float *rgb) {
-    size_t n = (size_t)f->width * (size_t)f->height;
+size_t film_resolve(const film *f, unsigned mask, float *rgb) {
+    size_t n = (size_t)f->width * (size_t)f->height, clamped = 0;
     for (size_t i = 0; i < n; i++) {
         double acc[3] = {0, 0, 0};
         for (int c = 0; c < COMP_COUNT; c++) {
@@ -48,8 +49,24 @@ void film_resolve(const film *f, unsigned mask, float *rgb) {
         }
         long long count = f->passes - (long long)f->rejected[i];
         double inv = count > 0 ? 1.0 / (double)count : 0.0;
-        for (int k = 0; k < 3; k++) rgb[3 * i + (size_t)k] = (float)(acc[k] * inv);
+        for (int k = 0; k < 3; k++) {
+            /* Finite samples can still add up past float's range; the conversion would give Inf. */
+            double v = acc[k] * inv;
+            if (fabs(v) > (double)FLT_MAX) v = copysign((double)FLT_MAX, v), clamped++;
+            rgb[3 * i + (size_t)k] = (float)v;
+        }
     }
+    return clamped;
+}
+
+size_t film_count_clamped(const film *f, unsigned layers_mask) {
+    float *rgb = malloc(sizeof(float) * 3 * (size_t)f->width * (size_t)f->height);
+    if (!rgb) return 0;
+    size_t n = film_resolve(f, COMP_MASK_ALL, rgb);
+    for (int c = 0; c < COMP_COUNT; c++)
+        if (layers_mask & (1u << c)) n += film_resolve(f, 1u << c, rgb);
+    free(rgb);
+    return n;
 }
 
 float srgb_encode(float x) {

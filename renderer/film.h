@@ -52,8 +52,12 @@ static inline void film_add(film *f, int i, const float rgb[COMP_COUNT][3]) {
 static inline void film_reject(film *f, int i) { f->rejected[i]++; }
 static inline void film_end_pass(film *f) { f->passes++; }
 
-/* Mean radiance of the components in mask (bit c = component c) into rgb (3 floats per pixel). */
-void film_resolve(const film *f, unsigned mask, float *rgb);
+/* Mean radiance of the components in mask (bit c = component c) into rgb (3 floats per pixel),
+ * finite by construction: a mean beyond float's range is written as +-FLT_MAX. Returns how many
+ * values were clamped so. */
+size_t film_resolve(const film *f, unsigned mask, float *rgb);
+/* Values film_save_exr would clamp: in the whole image and in the layers of layers_mask. */
+size_t film_count_clamped(const film *f, unsigned layers_mask);
 
 /* Global tone operators, all followed by the sRGB transfer function to 8 bits. */
 typedef enum {

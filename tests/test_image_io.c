@@ -9,6 +9,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -760,6 +761,29 @@ static void test_film_means(void) {
     film_deinit(&f);
 }
 
+/* Finite samples whose sum is not: two components each at 3/4 of FLT_MAX (an environment map's
+ * texels near the top of float's range do this). Each component's mean is finite; the image,
+ * their sum, would be Inf as a float: the film writes the largest float and counts it. */
+static void test_film_finite(void) {
+    film f;
+    CHECK(film_init(&f, 2, 1) == 0, "film_init");
+    const float big = 0.75f * FLT_MAX;
+    float a[COMP_COUNT][3] = {{big, -big, 1}, {big, -big, 1}, {0, 0, 0}};
+    film_add(&f, 0, (const float(*)[3])a);
+    film_add(&f, 1, (const float(*)[3])a);
+    film_end_pass(&f);
+    float rgb[6];
+    size_t clamped = film_resolve(&f, COMP_MASK_ALL, rgb);
+    CHECK(clamped == 4 && rgb[0] == FLT_MAX && rgb[1] == -FLT_MAX && rgb[2] == 2.0f,
+          "the sum past float's range: %zu clamped, (%g %g %g)", clamped, (double)rgb[0], (double)rgb[1],
+          (double)rgb[2]);
+    clamped = film_resolve(&f, 1u << COMP_DIRECT, rgb);
+    CHECK(clamped == 0 && rgb[0] == big && rgb[1] == -big, "one component alone is in range: %zu clamped", clamped);
+    size_t counted = film_count_clamped(&f, (1u << COMP_DIRECT) | (1u << COMP_INDIRECT));
+    CHECK(counted == 4, "film_count_clamped: %zu, expected the image's 4 (the layers are in range)", counted);
+    film_deinit(&f);
+}
+
 /* Files made by OpenEXR's own tools (the openexr package): a scanline file turned into tiled PIZ
  * and tiled DWAA by exrmaketiled, and the two combined into one multi-part file by exrmultipart
  * (its first part read). Each loads as an image and as an environment map with the values the
@@ -819,6 +843,7 @@ int main(void) {
     test_shared_env_maps();
     test_errors();
     test_film_means();
+    test_film_finite();
     CHECK(stray_temp_files(scratch_dir) == 0, "temporary files left behind");
     return scratch_close(check_exit("test_image_io"));
 }
