@@ -612,9 +612,10 @@ static void test_description_shapes(void) {
     CHECK(!exists("seedbig"), "a refused bench created seedbig");
 }
 
-/* References must read back exactly. OpenEXR 3.1's ZIP encoder kept zlib output exactly as long
- * as the raw chunk, which readers take for raw pixels (OpenEXR issue #2306); partly compressible
- * chunks of every length between all-zero and all-random meet that length now and then. */
+/* References must read back exactly. OpenEXR 3.1's C core, which glint once wrote with, kept ZIP
+ * output exactly as long as the raw chunk, which readers take for raw pixels (OpenEXR issue
+ * #2306); partly compressible chunks of every length between all-zero and all-random meet that
+ * length now and then, so any writer is held to it. */
 static void test_exr_round_trip(void) {
     enum { W = 16, H = 2, N = 3 * W * H };
     float rgb[N];
