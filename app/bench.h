@@ -92,8 +92,8 @@ typedef struct {
     int has_info;
 } bench_ref;
 
-/* The reference's own relative noise in a component, as its sidecar records it: known for the
- * whole image only (0 otherwise, and without a sidecar). */
+/* The reference's own relative noise in a component, as its description records it: known for
+ * the whole image only (0 otherwise, and without a description). */
 static inline double bench_ref_noise(const bench_ref *r, int component) {
     return component == ERR_ALL && r->has_info && r->info.has_noise ? r->info.rel_l2_noise : 0.0;
 }

@@ -224,7 +224,7 @@ static void report_header(FILE *f, const bench_options *o, const bench_ref *ref,
                     ref->info.rel_l2_noise);
         fputs("\n", f);
     } else {
-        fprintf(f, "- reference: `%s` without a sidecar (--force): scene, camera and size were not checked\n",
+        fprintf(f, "- reference: `%s` without a description (--force): scene, camera and size were not checked\n",
                 o->ref_path);
     }
     fprintf(f, "- error: relative L2, ‖I − R‖₂ / ‖R‖₂ over all pixels and channels, of the %s%s", comp,
@@ -276,14 +276,14 @@ static void report_noise_bias(FILE *f, const bench_options *o, const bench_ref *
             "from 0, and more seeds narrow it. ",
             o->seeds, o->seeds);
     if (o->component == ERR_ALL && ref->has_info && ref->info.has_noise)
-        fprintf(f, "Here r = %.4f, from the reference's sidecar.\n", rn);
+        fprintf(f, "Here r = %.4f, from the reference's description.\n", rn);
     else if (ref->has_info && ref->info.has_noise)
         fprintf(f,
-                "The sidecar records the reference's noise for the whole image only: for the %s component r is "
+                "The reference records its noise for the whole image only: for the %s component r is "
                 "taken as 0, so the bias includes it.\n",
                 bench_err_names[o->component]);
     else
-        fputs("The reference's own noise is not known (no estimate in its sidecar): r is taken as 0, so the bias "
+        fputs("The reference's own noise is not known (no estimate in its description): r is taken as 0, so the bias "
               "includes it.\n",
               f);
     for (int r = 0; r < num_runs; r++) {

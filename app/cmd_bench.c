@@ -49,7 +49,7 @@ static float *ref_layer(const exr_image *ex, const char *prefix) {
 
 static int ref_load(const bench_options *o, bench_ref *r) {
     memset(r, 0, sizeof *r);
-    char err[1200], side[4200];
+    char err[1200];
     exr_image ex;
     if (exr_image_load(o->ref_path, &ex, err, sizeof err) != 0) return cli_error("%s", err), -1;
     r->width = ex.width;
@@ -67,26 +67,22 @@ static int ref_load(const bench_options *o, bench_ref *r) {
     if (r->layer[ERR_INDIRECT] && r->layer[ERR_HIGHLIGHTS])
         for (size_t i = 0; i < 3 * (size_t)r->width * (size_t)r->height; i++)
             r->layer[ERR_INDIRECT][i] += r->layer[ERR_HIGHLIGHTS][i];
-    if (reference_sidecar_path(o->ref_path, side, sizeof side) != 0) {
-        ref_free(r);
-        return cli_error("%s: file name too long", o->ref_path), -1;
-    }
-    int st = reference_load(side, &r->info, err, sizeof err);
+    int st = reference_load(o->ref_path, &r->info, err, sizeof err);
     if (st < 0) {
         ref_free(r);
         return cli_error("%s", err), -1;
     }
     if (st > 0 && !o->force) {
         ref_free(r);
-        return cli_error("%s: no sidecar %s, so its scene, camera and size are unknown (render references with "
-                         "glint render --out; --force uses it anyway)",
-                         o->ref_path, side),
+        return cli_error("%s: no %s header attribute nor sidecar %s.json, so its scene, camera and size are unknown "
+                         "(render references with glint render --out; --force uses it anyway)",
+                         o->ref_path, REFERENCE_ATTR, o->ref_path),
                -1;
     }
     r->has_info = st == 0;
     if (r->has_info && (r->info.width != r->width || r->info.height != r->height)) {
         ref_free(r);
-        return cli_error("%s: the image is %dx%d but its sidecar says %dx%d", o->ref_path, r->width, r->height,
+        return cli_error("%s: the image is %dx%d but its description says %dx%d", o->ref_path, r->width, r->height,
                          r->info.width, r->info.height),
                -1;
     }

@@ -219,22 +219,22 @@ static int write_stats(const char *path, const render_options *o, const render_s
     return status;
 }
 
-/* The reference sidecar beside the EXR (reference.h): what glint bench checks a reference by. */
-static int write_sidecar(const render_options *o, const render_session *rs, const scene *s, double seconds,
-                         reference_noise *rn) {
-    char err[1024], path[4200];
+/* What makes the EXR a reference (reference.h), as JSON for its header; glint bench checks a
+ * reference by it. NULL after printing the error. */
+static char *describe_reference(const render_options *o, const render_session *rs, const scene *s, double seconds,
+                                reference_noise *rn) {
+    char err[1024];
     reference_info info;
     const render_params *p = session_params(rs);
-    if (reference_sidecar_path(o->out_exr, path, sizeof path) != 0)
-        return cli_error("%s: file name too long for its sidecar", o->out_exr), -1;
     if (reference_describe(&info, o->scene_path, o->env_path, o->env_rotation_deg, s, (int)o->camera_index, p, err,
                            sizeof err) != 0)
-        return cli_error("%s", err), -1;
+        return cli_error("%s", err), NULL;
     info.spp = session_frames(rs);
     info.seconds = seconds;
     reference_noise_finish(rn, rs, &info);
-    if (reference_save(path, &info, err, sizeof err) != 0) return cli_error("%s", err), -1;
-    return 0;
+    char *json = reference_json(&info);
+    if (!json) cli_error("%s: out of memory", o->out_exr);
+    return json;
 }
 
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, double seconds,
@@ -242,11 +242,17 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
     const film *fm = session_film(rs);
     char err[1024];
     const unsigned layers = exr_layers(o);
-    if (o->out_exr && film_save_exr(fm, layers, o->out_exr, WRITE_REPLACE, err, sizeof err) != 0) {
-        cli_error("%s", err);
-        return -1;
+    if (o->out_exr) {
+        char *json = describe_reference(o, rs, s, seconds, rn);
+        if (!json) return -1;
+        exr_text_attr attr = {REFERENCE_ATTR, json};
+        int st = film_save_exr_attrs(fm, layers, o->out_exr, &attr, 1, WRITE_REPLACE, err, sizeof err);
+        free(json);
+        if (st != 0) {
+            cli_error("%s", err);
+            return -1;
+        }
     }
-    if (o->out_exr && write_sidecar(o, rs, s, seconds, rn) != 0) return -1;
     const char *png = o->out_png;
     char fallback[4096];
     if (!o->out_exr && !o->out_png && !o->out_stats) {
@@ -315,7 +321,7 @@ int cmd_render(int argc, char **argv) {
     /* Only a reference (an EXR) pays for the noise estimate's snapshots. */
     reference_noise rn = {0};
     if (o.out_exr && reference_noise_init(&rn, p.width, p.height) != 0)
-        cli_warning("%s: out of memory for the noise estimate; the sidecar will lack it", o.out_exr);
+        cli_warning("%s: out of memory for the noise estimate; the reference will lack it", o.out_exr);
     progress pg = {!o.quiet, isatty(STDERR_FILENO), cli_now(), 0.0};
     pg.last = pg.start;
     double elapsed = 0.0;

@@ -1,5 +1,6 @@
-/* glint — reference sidecars: content hashes, the JSON beside a reference EXR, the noise of a
- * progressive mean from two halves, and the match check glint bench runs. */
+/* glint — reference descriptions: content hashes, the JSON in a reference EXR's header (or, from
+ * older glint, beside it), the noise of a progressive mean from two halves, and the match check
+ * glint bench runs. */
 #define _POSIX_C_SOURCE 200809L
 #include "reference.h"
 
@@ -13,6 +14,7 @@
 #include <string.h>
 
 #include "camera.h"
+#include "image_io.h"
 #include "metrics.h"
 
 static int fail(char *err, size_t errlen, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -78,7 +80,8 @@ int reference_describe(reference_info *r, const char *scene_path, const char *en
     return 0;
 }
 
-int reference_sidecar_path(const char *exr_path, char *out, size_t outlen) {
+/* The sidecar path of an EXR as older glint wrote it: "OUT.exr.json". */
+static int reference_sidecar_path(const char *exr_path, char *out, size_t outlen) {
     int n = snprintf(out, outlen, "%s.json", exr_path);
     return n < 0 || (size_t)n >= outlen ? -1 : 0;
 }
@@ -103,11 +106,14 @@ static void json_vec3(FILE *f, const char *key, vec3 v) {
     fprintf(f, "\"%s\": [%.9g, %.9g, %.9g]", key, (double)v.x, (double)v.y, (double)v.z);
 }
 
-int reference_save(const char *path, const reference_info *r, char *err, size_t errlen) {
+/* One string attribute holding the same JSON as the old sidecar, rather than typed attributes:
+ * one schema and one parser (cJSON) for both, and EXR has no 64-bit integer attribute for the
+ * seed nor nesting for the camera. */
+char *reference_json(const reference_info *r) {
     char *buf = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&buf, &size);
-    if (!f) return fail(err, errlen, "%s: out of memory", path);
+    if (!f) return NULL;
     fprintf(f, "{\n  \"glint_reference\": 1,\n  \"scene\": ");
     reference_json_string(f, r->scene);
     fprintf(f, ",\n  \"scene_hash\": \"%s\",\n  \"env\": ", r->scene_hash);
@@ -134,10 +140,12 @@ int reference_save(const char *path, const reference_info *r, char *err, size_t 
                 r->mean_variance, r->rel_l2_noise);
     else
         fprintf(f, "  \"variance\": null\n}\n");
-    fclose(f);
-    int status = write_file_atomic(path, buf, size, WRITE_REPLACE, err, errlen);
-    free(buf);
-    return status;
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad) {
+        free(buf);
+        return NULL;
+    }
+    return buf;
 }
 
 /* ---- reading: cJSON parses, then every field is checked for its type and range ---------------- */
@@ -211,44 +219,26 @@ static int json_seed(const cJSON *obj, const char *text, uint64_t *out) {
     return -1;
 }
 
-int reference_load(const char *path, reference_info *r, char *err, size_t errlen) {
+/* A description is small; this bounds what a damaged or hostile file can make the parser do. */
+enum { MAX_DESCRIPTION = 1 << 20 };
+
+/* Parses the description text (n bytes, NUL-terminated) into r; label starts every message
+ * ("PATH: not a glint reference sidecar"). */
+static int reference_parse(const char *text, size_t n, const char *label, reference_info *r, char *err, size_t errlen) {
     memset(r, 0, sizeof *r);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        if (errno == ENOENT) return 1;
-        return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-    }
-    enum { CAP = 1 << 20 };
-    char *text = malloc(CAP + 1);
-    if (!text) {
-        fclose(f);
-        return fail(err, errlen, "%s: out of memory", path);
-    }
-    size_t n = fread(text, 1, CAP + 1, f);
-    int bad_read = ferror(f);
-    fclose(f);
-    if (bad_read || n > CAP) {
-        free(text);
-        return fail(err, errlen, "%s: %s", path, bad_read ? "read error" : "too large for a reference sidecar");
-    }
-    text[n] = '\0';
-    if (memchr(text, '\0', n)) {
-        free(text);
-        return fail(err, errlen, "%s: not a glint reference sidecar (binary data)", path);
-    }
+    if (n > MAX_DESCRIPTION) return fail(err, errlen, "%s (too large: more than 1 MiB)", label);
+    if (memchr(text, '\0', n)) return fail(err, errlen, "%s (binary data)", label);
     /* cJSON refuses nesting deeper than CJSON_NESTING_LIMIT (1000), so no input exhausts the stack. */
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
     if (!root) {
         int line = 1;
         for (const char *p = text; end && p < end; p++) line += *p == '\n';
-        free(text);
-        return fail(err, errlen, "%s: not a glint reference sidecar (not JSON, line %d)", path, line);
+        return fail(err, errlen, "%s (not JSON, line %d)", label, line);
     }
     if (!cJSON_IsObject(root)) {
         cJSON_Delete(root);
-        free(text);
-        return fail(err, errlen, "%s: not a glint reference sidecar (not a JSON object)", path);
+        return fail(err, errlen, "%s (not a JSON object)", label);
     }
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
     const char *missing = NULL;
@@ -294,9 +284,46 @@ int reference_load(const char *path, reference_info *r, char *err, size_t errlen
                    json_number(var, "rel_l2_noise", &r->rel_l2_noise) == 0;
 #undef NEED
     cJSON_Delete(root);
-    free(text);
-    if (missing) return fail(err, errlen, "%s: not a glint reference sidecar (missing or bad \"%s\")", path, missing);
+    if (missing) return fail(err, errlen, "%s (missing or bad \"%s\")", label, missing);
     return 0;
+}
+
+/* An older reference's sidecar: 1 when there is none. */
+static int load_sidecar(const char *exr_path, reference_info *r, char *err, size_t errlen) {
+    char path[4200], label[4300];
+    if (reference_sidecar_path(exr_path, path, sizeof path) != 0)
+        return fail(err, errlen, "%s: name too long", exr_path);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        if (errno == ENOENT) return 1;
+        return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+    }
+    char *text = malloc(MAX_DESCRIPTION + 2);
+    if (!text) {
+        fclose(f);
+        return fail(err, errlen, "%s: out of memory", path);
+    }
+    size_t n = fread(text, 1, MAX_DESCRIPTION + 1, f);
+    int bad_read = ferror(f);
+    fclose(f);
+    text[n] = '\0';
+    snprintf(label, sizeof label, "%s: not a glint reference sidecar", path);
+    int status = bad_read ? fail(err, errlen, "%s: read error", path) : reference_parse(text, n, label, r, err, errlen);
+    free(text);
+    return status;
+}
+
+int reference_load(const char *exr_path, reference_info *r, char *err, size_t errlen) {
+    memset(r, 0, sizeof *r);
+    char *text = NULL, label[4300];
+    size_t n = 0;
+    int st = exr_header_string(exr_path, REFERENCE_ATTR, &text, &n, err, errlen);
+    if (st < 0) return -1;
+    if (st > 0) return load_sidecar(exr_path, r, err, errlen);
+    snprintf(label, sizeof label, "%s: bad %s header attribute", exr_path, REFERENCE_ATTR);
+    int status = reference_parse(text, n, label, r, err, errlen);
+    free(text);
+    return status;
 }
 
 /* ---- noise of the reference ------------------------------------------------------------------ */

@@ -1,6 +1,7 @@
-/* glint — what makes a reference image trustworthy and reusable: the JSON sidecar that glint
- * render writes beside its EXR (OUT.exr.json) and glint bench reads to refuse a reference of
- * another scene, camera or size. */
+/* glint — what makes a reference image trustworthy and reusable: the description glint render
+ * stores in the header of its EXR (the string attribute glint.reference, JSON), which glint bench
+ * reads to refuse a reference of another scene, camera or size. Older references carried it in a
+ * JSON sidecar beside the EXR (OUT.exr.json), which is still read. */
 #ifndef GLINT_REFERENCE_H
 #define GLINT_REFERENCE_H
 
@@ -48,14 +49,16 @@ int reference_describe(reference_info *info, const char *scene_path, const char 
 /* Writes s as a JSON string (quotes, escapes); shared with glint render's --stats. */
 void reference_json_string(FILE *f, const char *s);
 
-/* The sidecar path of an EXR: "OUT.exr.json". Returns 0, or -1 when out is too small. */
-int reference_sidecar_path(const char *exr_path, char *out, size_t outlen);
+/* The EXR header attribute that holds a reference's description: a string, the JSON text that
+ * reference_json makes. */
+#define REFERENCE_ATTR "glint.reference"
 
-/* Writes info as JSON to path, atomically (replacing: it belongs to an EXR the user named). */
-int reference_save(const char *path, const reference_info *info, char *err, size_t errlen);
-/* Reads a sidecar. Returns 0, 1 when the file does not exist, -1 when it is unreadable or
- * malformed (err = "PATH: problem"). */
-int reference_load(const char *path, reference_info *info, char *err, size_t errlen);
+/* info as JSON text (malloc'ed; free it), or NULL when out of memory. */
+char *reference_json(const reference_info *info);
+/* Reads the description of the reference EXR at exr_path: its header attribute REFERENCE_ATTR,
+ * or, when the header has none, its sidecar (an older reference). Returns 0, 1 when there is
+ * neither, -1 when the file is unreadable or the description malformed (err = "PATH: problem"). */
+int reference_load(const char *exr_path, reference_info *info, char *err, size_t errlen);
 
 /* Tracks two halves of a progressive render for the noise estimate: call reference_noise_frame
  * after every frame, reference_noise_finish at the end. Snapshots of the mean are taken at
@@ -73,7 +76,7 @@ void reference_noise_frame(reference_noise *rn, const render_session *rs);
 void reference_noise_finish(reference_noise *rn, const render_session *rs, reference_info *info);
 void reference_noise_deinit(reference_noise *rn);
 
-/* Compares what a bench renders (want) with a reference's sidecar (have), field by field: scene
+/* Compares what a bench renders (want) with a reference's description (have), field by field: scene
  * and environment hashes, camera index and parameters, size. Returns 0 when they match, else -1
  * with err naming the first difference ("REF.exr: ..."). */
 int reference_check(const char *ref_path, const reference_info *have, const reference_info *want, char *err,

@@ -132,6 +132,11 @@ void tonemap_apply(const float *rgb, int num_pixels, const tonemap_params *p, ui
 }
 
 int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen) {
+    return film_save_exr_attrs(f, layers_mask, path, NULL, 0, mode, err, errlen);
+}
+
+int film_save_exr_attrs(const film *f, unsigned layers_mask, const char *path, const exr_text_attr *attrs,
+                        int num_attrs, write_mode mode, char *err, size_t errlen) {
     size_t n = 3 * (size_t)f->width * (size_t)f->height;
     float *planes[1 + COMP_COUNT] = {0};
     exr_layer layers[1 + COMP_COUNT];
@@ -146,7 +151,7 @@ int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_m
         layers[nl] = (exr_layer){c < 0 ? "" : film_component_names[c], planes[nl]};
         nl++;
     }
-    status = exr_save_layers(path, f->width, f->height, layers, nl, mode, err, errlen);
+    status = exr_save_layers_attrs(path, f->width, f->height, layers, nl, attrs, num_attrs, mode, err, errlen);
 done:
     for (int i = 0; i < nl; i++) free(planes[i]);
     return status;

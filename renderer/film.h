@@ -86,9 +86,12 @@ void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p,
 float srgb_encode(float linear);
 
 /* Exports (atomic; see image_io.h for write_mode). The EXR holds R,G,B (the sum of the
- * components) plus one layer per component in layers_mask ("direct.R", ...). The PNG is the sum,
- * tone-mapped with tp->op. Return 0, or -1 with err = "PATH: problem". */
+ * components) plus one layer per component in layers_mask ("direct.R", ...), and in its header
+ * the string attributes attrs (film_save_exr_attrs; NULL when num_attrs is 0). The PNG is the
+ * sum, tone-mapped with tp->op. Return 0, or -1 with err = "PATH: problem". */
 int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen);
+int film_save_exr_attrs(const film *f, unsigned layers_mask, const char *path, const exr_text_attr *attrs,
+                        int num_attrs, write_mode mode, char *err, size_t errlen);
 int film_save_png(const film *f, unsigned mask, const tonemap_params *tp, const char *path, write_mode mode, char *err,
                   size_t errlen);
 

@@ -1,10 +1,10 @@
-/* glint — image files: OpenEXR read through its C++ library (exr_read.cpp) and written through its
- * C API, Radiance HDR through stb_image, PNG through stb_image_write, and the atomic writer every
- * export goes through. See image_io.h. */
+/* glint — image files: OpenEXR read and written through its C++ library (exr_io.cpp), Radiance
+ * HDR through stb_image, PNG through stb_image_write, and the atomic writer every export goes
+ * through. See image_io.h. */
 #define _POSIX_C_SOURCE 200809L /* pread, fsync, link, strdup, lstat, clock_gettime */
 
 #include "image_io.h"
-#include "exr_read.h"
+#include "exr_io.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -19,7 +19,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <openexr.h>
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
@@ -57,8 +56,7 @@ typedef struct {
     int failed; /* an allocation failed; the content is incomplete */
 } membuf;
 
-/* Writes n bytes at offset (the OpenEXR writer seeks back to fill in its chunk table), zero
- * filling any gap. */
+/* Writes n bytes at offset, zero filling any gap. */
 static int membuf_write_at(membuf *b, size_t offset, const void *src, size_t n) {
     if (b->failed || offset > SIZE_MAX - n) return b->failed = 1, -1;
     size_t end = offset + n;
@@ -120,39 +118,7 @@ static int size_ok(int64_t w, int64_t h) {
 
 static const unsigned char exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
 
-/* ---- OpenEXR: the C API's plumbing, for writing ---------------------------------------------- */
-
-/* The library reports errors through a callback, on the thread that hit them. A thread-local
- * sink lets each call collect its own first (most specific) message without calling back into
- * the library from the handler, and without the default handler printing to stderr. */
-typedef struct {
-    char msg[256];
-} exr_errbox;
-static _Thread_local exr_errbox *exr_sink;
-
-static void exr_on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg) {
-    (void)ctxt;
-    if (exr_sink && !exr_sink->msg[0])
-        snprintf(exr_sink->msg, sizeof exr_sink->msg, "%s", msg && msg[0] ? msg : exr_get_default_error_message(code));
-}
-
-/* "PATH: what: <library message>" for a failed library call. */
-static int exr_fail(char *err, size_t errlen, const char *path, const char *what, exr_result_t rv,
-                    const exr_errbox *box) {
-    const char *why = box->msg[0] ? box->msg : exr_get_default_error_message(rv);
-    return fail(err, errlen, path, "%s: %s", what, why);
-}
-
-static int64_t exr_membuf_write(exr_const_context_t ctxt, void *userdata, const void *buffer, uint64_t sz,
-                                uint64_t offset, exr_stream_error_func_ptr_t error_cb) {
-    (void)ctxt;
-    (void)error_cb; /* out of memory is reported by the caller, which sees membuf.failed */
-    membuf *b = userdata;
-    if (sz > SIZE_MAX || offset > SIZE_MAX || membuf_write_at(b, (size_t)offset, buffer, (size_t)sz) != 0) return -1;
-    return (int64_t)sz;
-}
-
-/* ---- OpenEXR: reading (exr_read.cpp, through the C++ library) -------------------------------- */
+/* ---- OpenEXR: reading (exr_io.cpp, through the C++ library) ---------------------------------- */
 
 int exr_image_load(const char *path, exr_image *out, char *err, size_t errlen) {
     memset(out, 0, sizeof *out);
@@ -179,6 +145,18 @@ const float *exr_image_channel(const exr_image *img, const char *name) {
     for (int i = 0; img && name && i < img->num_channels; i++)
         if (strcmp(img->names[i], name) == 0) return img->planes[i];
     return NULL;
+}
+
+int exr_header_string(const char *path, const char *name, char **value, size_t *len, char *err, size_t errlen) {
+    *value = NULL;
+    *len = 0;
+    if (!name || !name[0]) return fail(err, errlen, path, "empty attribute name");
+    int64_t size = 0;
+    int fd = open_input(path, &size, err, errlen);
+    if (fd < 0) return -1;
+    int status = exr_read_string_fd(path, fd, size, name, value, len, err, errlen);
+    close(fd);
+    return status;
 }
 
 /* ---- RGB loading ----------------------------------------------------------------------------- */
@@ -343,133 +321,40 @@ void image_rgb_free(image_rgb *img) {
     memset(img, 0, sizeof *img);
 }
 
-/* ---- OpenEXR: writing ------------------------------------------------------------------------ */
+/* ---- OpenEXR: writing (exr_io.cpp, through the C++ library) ---------------------------------- */
 
-/* OpenEXR 3.1's ZIP encoder keeps its zlib output when that is exactly as long as the raw chunk,
- * and every reader then takes it for raw pixels (OpenEXR issue #2306): noisy renders hit this.
- * In that case the raw bytes are stored instead, as the format prescribes when compression does
- * not pay. The library's own compressor is called first; it is the same for every chunk. */
-static _Thread_local exr_result_t (*exr_zip_compress)(exr_encode_pipeline_t *);
-
-static exr_result_t exr_zip_compress_or_store(exr_encode_pipeline_t *enc) {
-    exr_result_t rv = exr_zip_compress(enc);
-    if (rv == EXR_ERR_SUCCESS && enc->compressed_bytes == enc->packed_bytes && enc->compressed_buffer &&
-        enc->packed_buffer && enc->compressed_buffer != enc->packed_buffer)
-        memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
-    return rv;
-}
-
-/* Encodes the layers as a ZIP-compressed scanline EXR into buf. */
-static int exr_encode(const char *path, int width, int height, const exr_layer *layers, int num_layers, char **names,
-                      membuf *buf, char *err, size_t errlen) {
-    exr_errbox box = {""};
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = exr_on_error;
-    init.user_data = buf;
-    init.write_fn = exr_membuf_write; /* the file name is then only used in messages */
-    exr_context_t ctx = NULL;
-    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
-    int have_enc = 0, part = 0, status = 0, nchan = 3 * num_layers;
-    const char *what = "cannot write OpenEXR";
-    exr_sink = &box;
-
-    exr_result_t rv = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
-    if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
-    if (rv == EXR_ERR_SUCCESS) rv = exr_initialize_required_attr_simple(ctx, part, width, height, EXR_COMPRESSION_ZIP);
-    int longest = 0;
-    for (int k = 0; k < nchan; k++)
-        if ((int)strlen(names[k]) > longest) longest = (int)strlen(names[k]);
-    if (rv == EXR_ERR_SUCCESS && longest > 31) rv = exr_set_longname_support(ctx, 1);
-    /* The library keeps the channel list sorted by name, as the format requires; the encoder's
-     * channels follow that order, so they are bound by name below, not by position. */
-    for (int k = 0; k < nchan && rv == EXR_ERR_SUCCESS; k++)
-        rv = exr_add_channel(ctx, part, names[k], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
-    if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
-    int32_t lines = 0;
-    if (rv == EXR_ERR_SUCCESS) rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
-    if (rv == EXR_ERR_SUCCESS && lines <= 0) rv = EXR_ERR_UNKNOWN;
-
-    for (int y = 0; y < height && rv == EXR_ERR_SUCCESS; y += lines) {
-        exr_chunk_info_t ci;
-        what = "cannot encode OpenEXR";
-        rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
-        if (rv != EXR_ERR_SUCCESS) break;
-        rv = have_enc ? exr_encoding_update(ctx, part, &ci, &enc) : exr_encoding_initialize(ctx, part, &ci, &enc);
-        have_enc = 1;
-        if (rv != EXR_ERR_SUCCESS) break;
-        for (int c = 0; c < enc.channel_count; c++) {
-            exr_coding_channel_info_t *ch = &enc.channels[c];
-            int k = 0;
-            while (k < nchan && strcmp(names[k], ch->channel_name) != 0) k++;
-            if (k == nchan) {
-                rv = EXR_ERR_UNKNOWN;
-                break;
-            }
-            ch->encode_from_ptr =
-                (const uint8_t *)(layers[k / 3].rgb + 3 * ((size_t)ci.start_y * (size_t)width) + (size_t)(k % 3));
-            ch->user_data_type = EXR_PIXEL_FLOAT;
-            ch->user_bytes_per_element = 4;
-            ch->user_pixel_stride = 3 * 4;
-            ch->user_line_stride = 3 * 4 * width;
-        }
-        if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_choose_default_routines(ctx, part, &enc);
-        if (rv == EXR_ERR_SUCCESS && enc.compress_fn && enc.compress_fn != exr_zip_compress_or_store) {
-            exr_zip_compress = enc.compress_fn;
-            enc.compress_fn = exr_zip_compress_or_store;
-        }
-        if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctx, part, &enc);
-    }
-    if (have_enc) exr_encoding_destroy(ctx, &enc);
-    if (rv != EXR_ERR_SUCCESS) {
-        status = buf->failed ? fail(err, errlen, path, "out of memory") : exr_fail(err, errlen, path, what, rv, &box);
-    }
-    if (ctx) {
-        /* finish writes the chunk offset table, so its result matters. */
-        exr_result_t frv = exr_finish(&ctx);
-        if (status == 0 && frv != EXR_ERR_SUCCESS)
-            status =
-                buf->failed ? fail(err, errlen, path, "out of memory") : exr_fail(err, errlen, path, what, frv, &box);
-    }
-    if (status == 0 && buf->failed) status = fail(err, errlen, path, "out of memory");
-    exr_sink = NULL;
-    return status;
-}
-
-int exr_save_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers, write_mode mode,
-                    char *err, size_t errlen) {
+int exr_save_layers_attrs(const char *path, int width, int height, const exr_layer *layers, int num_layers,
+                          const exr_text_attr *attrs, int num_attrs, write_mode mode, char *err, size_t errlen) {
     if (!path || !path[0]) return fail(err, errlen, path ? path : "", "empty file name");
     if (width <= 0 || height <= 0 || width > MAX_IMAGE_DIM || height > MAX_IMAGE_DIM)
         return fail(err, errlen, path, "invalid image size %dx%d", width, height);
     if (!layers || num_layers <= 0 || num_layers > 1000) return fail(err, errlen, path, "no layers to write");
     for (int l = 0; l < num_layers; l++) {
         if (!layers[l].prefix || !layers[l].rgb) return fail(err, errlen, path, "layer %d has no name or pixels", l);
+        /* The format's names end with NUL and take at most 255 bytes. */
+        if (strlen(layers[l].prefix) > 250) return fail(err, errlen, path, "layer name too long");
         for (int m = 0; m < l; m++)
             if (strcmp(layers[l].prefix, layers[m].prefix) == 0)
                 return fail(err, errlen, path, "layer name '%s' used twice", layers[l].prefix);
     }
-    int nchan = 3 * num_layers;
-    char **names = calloc((size_t)nchan, sizeof(char *));
-    int status = names ? 0 : fail(err, errlen, path, "out of memory");
-    for (int k = 0; k < nchan && status == 0; k++) {
-        const char *prefix = layers[k / 3].prefix;
-        size_t len = strlen(prefix) + 3;
-        names[k] = malloc(len);
-        if (!names[k]) {
-            status = fail(err, errlen, path, "out of memory");
-            break;
-        }
-        if (prefix[0])
-            snprintf(names[k], len, "%s.%c", prefix, "RGB"[k % 3]);
-        else
-            snprintf(names[k], len, "%c", "RGB"[k % 3]);
+    if (num_attrs < 0 || num_attrs > 1000 || (num_attrs > 0 && !attrs))
+        return fail(err, errlen, path, "invalid header attributes");
+    for (int i = 0; i < num_attrs; i++) {
+        if (!attrs[i].name || !attrs[i].name[0] || strlen(attrs[i].name) > 255 || !attrs[i].value)
+            return fail(err, errlen, path, "header attribute %d has no name, a name too long or no value", i);
+        /* The format stores sizes in 32 bits. */
+        if (strlen(attrs[i].value) > ((size_t)1 << 30))
+            return fail(err, errlen, path, "header attribute %s is too long", attrs[i].name);
+        for (int j = 0; j < i; j++)
+            if (strcmp(attrs[i].name, attrs[j].name) == 0)
+                return fail(err, errlen, path, "header attribute %s given twice", attrs[i].name);
     }
-    membuf buf = {0};
-    if (status == 0) status = exr_encode(path, width, height, layers, num_layers, names, &buf, err, errlen);
-    if (status == 0) status = write_file_atomic(path, buf.data, buf.size, mode, err, errlen);
-    free(buf.data);
-    for (int k = 0; names && k < nchan; k++) free(names[k]);
-    free(names);
-    return status;
+    return exr_write_layers(path, width, height, layers, num_layers, attrs, num_attrs, mode, err, errlen);
+}
+
+int exr_save_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers, write_mode mode,
+                    char *err, size_t errlen) {
+    return exr_save_layers_attrs(path, width, height, layers, num_layers, NULL, 0, mode, err, errlen);
 }
 
 /* ---- PNG ------------------------------------------------------------------------------------- */

@@ -54,9 +54,28 @@ typedef enum {
     WRITE_NO_REPLACE, /* fail with "PATH: file exists" rather than replace */
 } write_mode;
 
-/* Writes a scanline EXR of 32-bit float channels (ZIP compression) atomically. */
+/* A string attribute for an EXR header. The name must not be one of the format's own (channels,
+ * compression, dataWindow, ...); the value is text (it cannot hold a NUL). */
+typedef struct {
+    const char *name;
+    const char *value;
+} exr_text_attr;
+
+/* Writes a scanline EXR of 32-bit float channels (ZIP compression) atomically, through
+ * OpenEXR's C++ library, with the string attributes attrs (NULL when num_attrs is 0) in its
+ * header. */
+int exr_save_layers_attrs(const char *path, int width, int height, const exr_layer *layers, int num_layers,
+                          const exr_text_attr *attrs, int num_attrs, write_mode mode, char *err, size_t errlen);
+/* The same without attributes. */
 int exr_save_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers, write_mode mode,
                     char *err, size_t errlen);
+
+/* Reads the string attribute name from the header of the EXR file's first flat part (the part
+ * exr_image_load reads). Returns 0 with *value a malloc'ed copy (free it; NUL-terminated, *len
+ * bytes before the terminator, which may include NULs the file holds), 1 when the header has no
+ * attribute of that name, or -1 with err ("PATH: problem") when the file is unreadable or the
+ * attribute is not a string. */
+int exr_header_string(const char *path, const char *name, char **value, size_t *len, char *err, size_t errlen);
 
 /* Writes 8-bit sRGB (already encoded) RGB pixels as PNG atomically. */
 int png_save_rgb8(const char *path, int width, int height, const unsigned char *rgb, write_mode mode, char *err,

@@ -1,9 +1,10 @@
-/* glint bench and reference sidecars, run as a user would: the sidecar beside a reference EXR,
- * a bench whose CSV parses (header, monotone time, pt's error falling), whose SVG and PNG plots
- * and report appear, sweeps, the highlights component; several seeds per run, their summary and
- * its split into noise and bias; mismatched references (size, camera, scene, no or broken
- * sidecar, a sidecar of unexpected shape) and impossible seed counts refused with one error line;
- * nothing ever overwritten; the PNG plot's words.
+/* glint bench and references, run as a user would: the description in a reference EXR's header
+ * (no sidecar), which a copy keeps, and an older reference's sidecar still read; a bench whose
+ * CSV parses (header, monotone time, pt's error falling), whose SVG and PNG plots and report
+ * appear, sweeps, the highlights component; several seeds per run, their summary and its split
+ * into noise and bias; mismatched references (size, camera, scene, no or broken description,
+ * one of unexpected shape, in the header or a sidecar) and impossible seed counts refused with
+ * one error line; nothing ever overwritten; the PNG plot's words.
  * Usage: test_bench PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -200,30 +201,31 @@ static void check_png_words(const unsigned char *png, int w, int h) {
     }
 }
 
-static void test_sidecar(void) {
+static void test_reference_header(void) {
     /* 1024 spp: the reference's own noise must stay below pt's error at the bench's budgets. */
     int rc = run("render --spp 1024 --size 24x16 --max-depth 3 --seed 7 --out ref.exr --quiet");
     CHECK(rc == 0, "reference render: exit %d: %s", rc, err_text);
+    CHECK(!exists("ref.exr.json"), "a sidecar beside the reference");
     char json[8192];
-    read_file("ref.exr.json", json, sizeof json);
+    read_reference("ref.exr", json, sizeof json);
     CHECK(strstr(json, "\"scene_hash\": \"builtin:atelier:fnv1a64:") && strstr(json, "\"spp\": 1024") &&
               strstr(json, "\"width\": 24") && strstr(json, "\"height\": 16") && strstr(json, "\"max_depth\": 3") &&
               strstr(json, "\"seed\": 7") && strstr(json, "\"index\": 0") && strstr(json, "\"method\": \"pt\"") &&
               strstr(json, "\"mean_pixel_variance\": "),
-          "sidecar: %s", json);
+          "the reference's description: %s", json);
     const char *noise = strstr(json, "\"rel_l2_noise\": ");
     double rel = noise ? atof(noise + 16) : -1.0;
     CHECK(rel > 0.0 && rel < 1.0, "the reference's relative noise %g", rel);
     /* A reference with the highlights split off, for the highlights component. */
     rc = run("render --spp 64 --size 24x16 --max-depth 3 --seed 7 --highlights-layer --out refhl.exr --quiet");
     CHECK(rc == 0, "highlights reference render: exit %d: %s", rc, err_text);
-    read_file("refhl.exr.json", json, sizeof json);
-    CHECK(strstr(json, "\"highlights_layer\": true") != NULL, "highlights sidecar: %s", json);
+    read_reference("refhl.exr", json, sizeof json);
+    CHECK(strstr(json, "\"highlights_layer\": true") != NULL, "highlights reference: %s", json);
     /* A reference of another scene. */
     write_text("other.gltf", other_scene);
     rc = run("render other.gltf --spp 16 --size 24x16 --max-depth 3 --out other.exr --quiet");
     CHECK(rc == 0, "other scene render: exit %d: %s", rc, err_text);
-    read_file("other.exr.json", json, sizeof json);
+    read_reference("other.exr", json, sizeof json);
     CHECK(strstr(json, "\"scene_hash\": \"fnv1a64:") && strstr(json, "\"scene\": \"other.gltf\""), "other: %s", json);
 }
 
@@ -459,30 +461,85 @@ static void test_refusals(void) {
     expect_refusal("bench --reference ref.exr --sweep radius-mult=1,x --out r11", "--radius-mult");
     expect_refusal("bench --reference ref.exr --methods pt,nope --out r12", "nope");
     CHECK(!exists("r1") && !exists("r2") && !exists("r3"), "a refused bench created its directory");
-    /* Without a sidecar: refused unless --force; a broken sidecar is refused always. */
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "cp '%s/ref.exr' '%s/bare.exr' && cp '%s/ref.exr' '%s/broken.exr'", tmp, tmp, tmp, tmp);
-    CHECK(system(cmd) == 0, "copying the reference");
-    expect_refusal("bench --reference bare.exr --times 0.05 --out r13", "sidecar");
+    /* Without a description: refused unless --force; a broken one, in the header or in an older
+     * reference's sidecar, is refused always. */
+    CHECK(write_reference("ref.exr", "bare.exr", NULL, 0) == 0, "writing a bare EXR");
+    expect_refusal("bench --reference bare.exr --times 0.05 --out r13",
+                   "bare.exr: no glint.reference header attribute nor sidecar bare.exr.json");
     CHECK(run("bench --reference bare.exr --force --methods pt --times 0.05 --quiet --out r14") == 0 &&
               exists("r14/results.csv"),
           "--force: %s", err_text);
-    write_text("broken.exr.json", "{\"glint_reference\": 1, \"scene\": \"x\"");
-    expect_refusal("bench --reference broken.exr --times 0.05 --out r15", "broken.exr.json");
+    static const char broken[] = "{\"glint_reference\": 1, \"scene\": \"x\"";
+    CHECK(write_reference("ref.exr", "broken.exr", broken, 1) == 0 &&
+              write_reference("ref.exr", "broken2.exr", broken, 0) == 0,
+          "writing broken references");
+    expect_refusal("bench --reference broken.exr --times 0.05 --out r15",
+                   "broken.exr.json: not a glint reference sidecar (not JSON");
+    expect_refusal("bench --reference broken2.exr --times 0.05 --out r16",
+                   "broken2.exr: bad glint.reference header attribute (not JSON");
+    CHECK(!exists("r13") && !exists("r15") && !exists("r16"), "a refused bench created its directory");
 }
 
-/* Sidecars of unexpected shape, as a hand edit, another program or a broken disk might leave them:
- * wrong types, missing keys, nesting deeper than any parser's stack, numbers past every range,
- * not JSON at all. Each is one error line naming the file and what is wrong, never a crash. A
- * seed above 2^53, beyond a double's integers, reads back exactly. */
-static void test_sidecar_shapes(void) {
+/* A reference is one file: a copy under another name is the same reference, no sidecar needed;
+ * an older reference, its description in a sidecar FILE.exr.json, is still one and still checked;
+ * where both are there the header wins. */
+static void test_reference_files(void) {
+    static char report[1 << 16];
+    char cmd[4096], json[8192];
+    snprintf(cmd, sizeof cmd, "cp '%s/ref.exr' '%s/copy.exr'", tmp, tmp);
+    CHECK(system(cmd) == 0, "copying the reference");
+    CHECK(run("bench --reference copy.exr --methods pt --times 0.05 --quiet --out f1") == 0, "a copied reference: %s",
+          err_text);
+    read_file("f1/report.md", report, sizeof report);
+    CHECK(strstr(report, "- reference: `copy.exr`, pt, 1024 spp") != NULL, "f1/report.md: %s", report);
+
+    read_reference("ref.exr", json, sizeof json);
+    CHECK(write_reference("ref.exr", "old.exr", json, 1) == 0, "writing an old-style reference");
+    char none[16];
+    CHECK(read_reference("old.exr", none, sizeof none) == 0 && exists("old.exr.json"), "old.exr is not old-style");
+    CHECK(run("bench --reference old.exr --methods pt --times 0.05 --quiet --out f2") == 0, "an old reference: %s",
+          err_text);
+    read_file("f2/report.md", report, sizeof report);
+    CHECK(strstr(report, "- reference: `old.exr`, pt, 1024 spp") != NULL, "f2/report.md: %s", report);
+    expect_refusal("bench --reference old.exr --size 32x16 --times 0.05 --out f3", "24x16");
+    expect_refusal("bench other.gltf --reference old.exr --times 0.05 --out f4", "another scene");
+
+    write_text("copy.exr.json", "{\"glint_reference\": 1, \"scene\": \"x\"");
+    CHECK(run("bench --reference copy.exr --methods pt --times 0.05 --quiet --out f5") == 0,
+          "a stale sidecar beside a reference: %s", err_text);
+    CHECK(!exists("f3") && !exists("f4"), "a refused bench created its directory");
+}
+
+/* The reference ref.exr with the description text as shape<k>.exr (in its header) or, when
+ * sidecar is set, as shape<k>s.exr with text in shape<k>s.exr.json beside it: a bench of it must
+ * be refused with one error line naming the file and problem, and create nothing. */
+static void expect_bad_description(int k, int sidecar, const char *text, const char *problem) {
+    char exr[64], args[256], needle[256];
+    snprintf(exr, sizeof exr, "shape%d%s.exr", k, sidecar ? "s" : "");
+    CHECK(write_reference("ref.exr", exr, text, sidecar) == 0, "writing %s", exr);
+    snprintf(args, sizeof args, "bench --reference %s --times 0.05 --out out-%s", exr, exr);
+    if (sidecar)
+        snprintf(needle, sizeof needle, "%s.json: not a glint reference sidecar (%s", exr, problem);
+    else
+        snprintf(needle, sizeof needle, "%s: bad glint.reference header attribute (%s", exr, problem);
+    expect_refusal(args, needle);
+    snprintf(args, sizeof args, "out-%s", exr);
+    CHECK(!exists(args), "a refused bench created %s", args);
+}
+
+/* Descriptions of unexpected shape, in the header or a sidecar, as a hand edit, another program
+ * or a broken disk might leave them: wrong types, missing keys, nesting deeper than any parser's
+ * stack, numbers past every range, not JSON at all. Each is one error line naming the file and
+ * what is wrong, never a crash. A seed above 2^53, beyond a double's integers, reads back
+ * exactly. */
+static void test_description_shapes(void) {
     static char good[8192];
-    read_file("ref.exr.json", good, sizeof good);
-    CHECK(strstr(good, "\"seed\": 7,") && strstr(good, "\"width\": 24,"), "ref.exr.json: %s", good);
+    read_reference("ref.exr", good, sizeof good);
+    CHECK(strstr(good, "\"seed\": 7,") && strstr(good, "\"width\": 24,"), "ref.exr: %s", good);
     static char huge[420] = "\"spp\": 1"; /* 400 digits: past a double's range */
     memset(huge + strlen(huge), '0', 400);
     struct {
-        const char *from, *to, *problem; /* to replaces the first from in the good sidecar */
+        const char *from, *to, *problem; /* to replaces the first from in the good description */
     } edits[] = {
         {"\"width\": 24", "\"width\": \"24\"", "missing or bad \"width\""},
         {"\"width\": 24", "\"width\": 1e999", "missing or bad \"width\""},
@@ -505,74 +562,60 @@ static void test_sidecar_shapes(void) {
         {"{", "[", "not JSON, line 2)"},
     };
     enum { N = sizeof edits / sizeof edits[0], EXTRA = 5 };
-    char cmd[4096] = "", name[64], args[256], needle[256];
-    for (int k = 0; k < N + EXTRA + 1; k++)
-        snprintf(cmd + strlen(cmd), sizeof cmd - strlen(cmd), "%scp '%s/ref.exr' '%s/shape%d.exr'", k ? " && " : "",
-                 tmp, tmp, k);
-    CHECK(system(cmd) == 0, "copying the reference");
     static char text[1 << 21];
-    for (int k = 0; k < N; k++) {
-        const char *at = strstr(good, edits[k].from);
-        CHECK(at != NULL, "the good sidecar lacks '%s'", edits[k].from);
-        if (!at) continue;
-        snprintf(text, sizeof text, "%.*s%s%s", (int)(at - good), good, edits[k].to, at + strlen(edits[k].from));
-        snprintf(name, sizeof name, "shape%d.exr.json", k);
-        write_text(name, text);
-        snprintf(args, sizeof args, "bench --reference shape%d.exr --times 0.05 --out shape%d", k, k);
-        snprintf(needle, sizeof needle, "%s: not a glint reference sidecar (%s", name, edits[k].problem);
-        expect_refusal(args, needle);
-    }
-    /* Nesting a million deep, a top-level value that is no object, trailing text, an empty file,
-     * more than the 1 MiB a sidecar may take. */
+    for (int sidecar = 0; sidecar < 2; sidecar++)
+        for (int k = 0; k < N; k++) {
+            const char *at = strstr(good, edits[k].from);
+            CHECK(at != NULL, "the good description lacks '%s'", edits[k].from);
+            if (!at) continue;
+            snprintf(text, sizeof text, "%.*s%s%s", (int)(at - good), good, edits[k].to, at + strlen(edits[k].from));
+            expect_bad_description(k, sidecar, text, edits[k].problem);
+        }
+    /* Nesting a million deep, a top-level value that is no object, trailing text, an empty
+     * description, more than the 1 MiB a description may take. */
     const char *problems[EXTRA] = {"not JSON, line 1", "not a JSON object", "not JSON, line", "not JSON, line 1",
                                    "too large"};
-    for (int k = 0; k < EXTRA; k++) {
-        size_t n = 0;
-        if (k == 0) {
-            n = (size_t)snprintf(text, sizeof text, "{\"glint_reference\": 1, \"x\": ");
-            memset(text + n, '[', 1000000);
-            n += 1000000;
-        } else if (k == 1) {
-            n = (size_t)snprintf(text, sizeof text, "[%s]", good);
-        } else if (k == 2) {
-            n = (size_t)snprintf(text, sizeof text, "%s}", good);
-        } else if (k == 4) {
-            n = (size_t)snprintf(text, sizeof text, "%s", good);
-            memset(text + n, ' ', (1 << 20) + 1);
-            n += (1 << 20) + 1;
+    for (int sidecar = 0; sidecar < 2; sidecar++)
+        for (int k = 0; k < EXTRA; k++) {
+            size_t n = 0;
+            if (k == 0) {
+                n = (size_t)snprintf(text, sizeof text, "{\"glint_reference\": 1, \"x\": ");
+                memset(text + n, '[', 1000000);
+                n += 1000000;
+            } else if (k == 1) {
+                n = (size_t)snprintf(text, sizeof text, "[%s]", good);
+            } else if (k == 2) {
+                n = (size_t)snprintf(text, sizeof text, "%s}", good);
+            } else if (k == 4) {
+                n = (size_t)snprintf(text, sizeof text, "%s", good);
+                memset(text + n, ' ', (1 << 20) + 1);
+                n += (1 << 20) + 1;
+            }
+            text[n] = 0;
+            expect_bad_description(N + k, sidecar, text, problems[k]);
         }
-        text[n] = 0;
-        snprintf(name, sizeof name, "shape%d.exr.json", N + k);
-        write_text(name, text);
-        snprintf(args, sizeof args, "bench --reference shape%d.exr --times 0.05 --out shape%d", N + k, N + k);
-        snprintf(needle, sizeof needle, "%s: ", name);
-        expect_refusal(args, needle);
-        CHECK(strstr(err_text, problems[k]) != NULL, "%s: '%s' lacks '%s'", name, err_text, problems[k]);
-    }
     /* 2^53 + 1 and 2^64 - 1: a double would read 2^53 and 2^64, and the bench's seeds just below
      * would not seem to hold the reference's. */
     const char *at = strstr(good, "\"seed\": 7");
     static const char *const seeds[2][2] = {{"9007199254740992", "9007199254740993"},
                                             {"18446744073709551614", "18446744073709551615"}};
-    for (int k = 0; at && k < 2; k++) {
-        snprintf(text, sizeof text, "%.*s\"seed\": %s%s", (int)(at - good), good, seeds[k][1], at + 9);
-        snprintf(name, sizeof name, "shape%d.exr.json", N + EXTRA);
-        write_text(name, text);
-        snprintf(args, sizeof args, "bench --reference shape%d.exr --seed %s --seeds 2 --times 0.05 --out seedbig",
-                 N + EXTRA, seeds[k][0]);
-        snprintf(needle, sizeof needle, "the reference's seed %s;", seeds[k][1]);
-        expect_usage(args, needle);
-    }
-    for (int k = 0; k <= N + EXTRA; k++) {
-        snprintf(name, sizeof name, "shape%d", k);
-        CHECK(!exists(name), "a refused bench created %s", name);
-    }
+    char args[256], needle[256];
+    for (int sidecar = 0; sidecar < 2; sidecar++)
+        for (int k = 0; at && k < 2; k++) {
+            snprintf(text, sizeof text, "%.*s\"seed\": %s%s", (int)(at - good), good, seeds[k][1], at + 9);
+            CHECK(write_reference("ref.exr", "seedbig.exr", text, sidecar) == 0, "writing seedbig.exr");
+            snprintf(args, sizeof args, "bench --reference seedbig.exr --seed %s --seeds 2 --times 0.05 --out seedbig",
+                     seeds[k][0]);
+            snprintf(needle, sizeof needle, "the reference's seed %s;", seeds[k][1]);
+            expect_usage(args, needle);
+        }
     CHECK(!exists("seedbig"), "a refused bench created seedbig");
 }
 
-/* References must read back exactly. OpenEXR 3.1's ZIP encoder kept zlib output exactly as long
- * as the raw chunk, which readers take for raw pixels (OpenEXR issue #2306); partly compressible
- * chunks of every length between all-zero and all-random meet that length now and then. */
+/* References must read back exactly. OpenEXR 3.1's C core, which glint once wrote with, kept ZIP
+ * output exactly as long as the raw chunk, which readers take for raw pixels (OpenEXR issue
+ * #2306); partly compressible chunks of every length between all-zero and all-random meet that
+ * length now and then, so any writer is held to it. */
 static void test_exr_round_trip(void) {
     enum { W = 16, H = 2, N = 3 * W * H };
     float rgb[N];
@@ -608,11 +651,12 @@ int main(int argc, char **argv) {
     int start = harness_start(argc, argv, "bench");
     if (start != 0) return start;
     test_exr_round_trip();
-    test_sidecar();
+    test_reference_header();
     test_bench_run();
     test_sweeps_and_highlights();
     test_seeds();
     test_refusals();
-    test_sidecar_shapes();
+    test_reference_files();
+    test_description_shapes();
     return check_exit("test_bench");
 }

@@ -169,22 +169,8 @@ static void test_outputs(void) {
     CHECK(rc == 0 && strstr(out_text, "triangles"), "glint info: %s%s", out_text, err_text);
 }
 
-/* Replaces the first `from` in file `name` (in tmp) with `to`; returns 0, or -1 when absent. */
-static int edit_file(const char *name, const char *from, const char *to) {
-    char text[8192], p[1024];
-    read_file(name, text, sizeof text);
-    char *at = strstr(text, from);
-    if (!at) return -1;
-    snprintf(p, sizeof p, "%s/%s", tmp, name);
-    FILE *f = fopen(p, "wb");
-    if (!f) return -1;
-    fprintf(f, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
-    fclose(f);
-    return 0;
-}
-
 /* builtin:NAME: listed in the help, loaded by every command, an unknown name one error; a
- * built-in's sidecar names it and hashes the very bytes of its glTF under assets/scenes/. */
+ * reference of a built-in names it and hashes the very bytes of its glTF under assets/scenes/. */
 static void test_builtin_scenes(void) {
     int n;
     const builtin_scene *all = scene_builtins(&n);
@@ -209,18 +195,19 @@ static void test_builtin_scenes(void) {
           "info builtin:showcase: %s%s", out_text, err_text);
     char json[8192], hash_builtin[64] = "", hash_file[64] = "";
     CHECK(run("render --spp 1 --size 16x9 --out default.exr --quiet") == 0, "default render: %s", err_text);
-    read_file("default.exr.json", json, sizeof json);
+    read_reference("default.exr", json, sizeof json);
     snprintf(want, sizeof want, "\"scene\": \"builtin:%s\"", all[0].name);
-    CHECK(strstr(json, want) != NULL, "the default scene's sidecar: %s", json);
+    CHECK(strstr(json, want) != NULL, "the default scene's reference: %s", json);
+    CHECK(!file_exists("default.exr.json"), "a sidecar beside the reference");
     CHECK(run("render builtin:showcase --spp 1 --size 16x9 --out showcase.exr --quiet") == 0, "showcase: %s", err_text);
-    read_file("showcase.exr.json", json, sizeof json);
+    read_reference("showcase.exr", json, sizeof json);
     const char *h = strstr(json, "\"scene_hash\": \"builtin:showcase:fnv1a64:");
-    CHECK(strstr(json, "\"scene\": \"builtin:showcase\"") && h, "showcase sidecar: %s", json);
+    CHECK(strstr(json, "\"scene\": \"builtin:showcase\"") && h, "showcase reference: %s", json);
     if (h) sscanf(h + strlen("\"scene_hash\": \"builtin:showcase:"), "%63[^\"]", hash_builtin);
     snprintf(cmd, sizeof cmd, "render '%s/scenes/showcase.gltf' --spp 1 --size 16x9 --out file.exr --quiet",
              GLINT_ASSETS_DIR);
     CHECK(run(cmd) == 0, "showcase.gltf: %s", err_text);
-    read_file("file.exr.json", json, sizeof json);
+    read_reference("file.exr", json, sizeof json);
     h = strstr(json, "\"scene_hash\": \"");
     if (h) sscanf(h + strlen("\"scene_hash\": \""), "%63[^\"]", hash_file);
     CHECK(hash_builtin[0] && strcmp(hash_builtin, hash_file) == 0,
@@ -228,11 +215,15 @@ static void test_builtin_scenes(void) {
     snprintf(want, sizeof want, "builtin:nosuch: no such built-in scene (have: %s)", names);
     expect_failure("bench builtin:nosuch --reference showcase.exr --times 0.01 --out nosuch", 1, want);
     /* A sidecar from before there were several built-ins calls the showcase builtin:default. */
-    CHECK(edit_file("showcase.exr.json", "builtin:showcase:fnv1a64:", "builtin:default:fnv1a64:") == 0,
-          "editing the sidecar");
-    CHECK(run("bench builtin:showcase --reference showcase.exr --methods pt --times 0.01 --quiet --out legacy") == 0,
+    read_reference("showcase.exr", json, sizeof json);
+    char *at = strstr(json, "builtin:showcase:fnv1a64:"), old[8192];
+    CHECK(at != NULL, "showcase reference: %s", json);
+    if (at)
+        snprintf(old, sizeof old, "%.*sbuiltin:default:%s", (int)(at - json), json, at + strlen("builtin:showcase:"));
+    CHECK(at && write_reference("showcase.exr", "legacy.exr", old, 1) == 0, "writing an old reference");
+    CHECK(run("bench builtin:showcase --reference legacy.exr --methods pt --times 0.01 --quiet --out legacy") == 0,
           "an old builtin:default sidecar refused: %s", err_text);
-    expect_failure("bench builtin:doorway --reference showcase.exr --methods pt --times 0.01 --quiet --out other", 1,
+    expect_failure("bench builtin:doorway --reference legacy.exr --methods pt --times 0.01 --quiet --out other", 1,
                    "another scene");
 }
 

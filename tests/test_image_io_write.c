@@ -1,6 +1,7 @@
 /* The writing side of image I/O: the atomic writer's guarantees (no replace, no partial file, no
  * temporary left behind, only regular files replaced, the umask honoured), errors that name the
- * path, free names for exports, and PNGs as stb_image decodes them. */
+ * path, free names for exports, string attributes in EXR headers as written and read back, and
+ * PNGs as stb_image decodes them. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdint.h>
@@ -152,6 +153,90 @@ static void test_unique_path(void) {
     CHECK(unique_path("x.png", tiny, 5) == -1, "no room for the terminator");
 }
 
+/* ---- EXR header attributes ------------------------------------------------------------------- */
+
+static void test_exr_attributes(void) {
+    enum { W = 5, H = 3 };
+    float px[3 * W * H];
+    for (int i = 0; i < 3 * W * H; i++) px[i] = (float)i * 0.5f;
+    /* A layer name past the format's 31 short characters needs its long-name flag. */
+    const char *long_name = "a-layer-name-longer-than-thirty-one-characters";
+    exr_layer layers[2] = {{"", px}, {long_name, px}};
+    /* Text as a reference's: several lines, quotes, UTF-8; and a value long enough that the
+     * header is larger than any buffer the writer might start with. */
+    const char *json = "{\n  \"glint_reference\": 1,\n  \"scene\": \"caf\xc3\xa9 \\\"x\\\".gltf\"\n}\n";
+    size_t big_len = (size_t)3 << 20;
+    char *big = malloc(big_len + 1);
+    for (size_t i = 0; i < big_len; i++) big[i] = (char)('a' + i % 26);
+    big[big_len] = '\0';
+    exr_text_attr attrs[3] = {{"glint.reference", json}, {"empty", ""}, {"big", big}};
+    char path[1200], err[512] = "";
+    path_in(path, sizeof path, "attrs.exr");
+    CHECK(exr_save_layers_attrs(path, W, H, layers, 2, attrs, 3, WRITE_NO_REPLACE, err, sizeof err) == 0,
+          "exr_save_layers_attrs: %s", err);
+    for (int k = 0; k < 3; k++) {
+        char *value = NULL;
+        size_t len = 0;
+        int rc = exr_header_string(path, attrs[k].name, &value, &len, err, sizeof err);
+        CHECK(rc == 0 && value && len == strlen(attrs[k].value) && strcmp(value, attrs[k].value) == 0,
+              "attribute %s: rc %d, %zu bytes, '%s'", attrs[k].name, rc, len, rc == 0 ? "" : err);
+        free(value);
+    }
+    free(big);
+    exr_image img;
+    CHECK(exr_image_load(path, &img, err, sizeof err) == 0, "pixels beside attributes: %s", err);
+    char name[64];
+    snprintf(name, sizeof name, "%s.G", long_name);
+    const float *g = exr_image_channel(&img, name);
+    CHECK(img.num_channels == 6 && g && g[W * H - 1] == px[3 * (W * H - 1) + 1], "the long-named layer: %d channels",
+          img.num_channels);
+    exr_image_free(&img);
+
+    /* No such attribute: 1; one of another type: an error naming the file and the type. */
+    char *value = (char *)"untouched";
+    size_t len = 7;
+    CHECK(exr_header_string(path, "nosuch", &value, &len, err, sizeof err) == 1 && value == NULL && len == 0,
+          "a missing attribute");
+    err[0] = '\0';
+    CHECK(exr_header_string(path, "compression", &value, &len, err, sizeof err) == -1 && strstr(err, path) &&
+              strstr(err, "not string") && one_line(err),
+          "a compression attribute read as a string: '%s'", err);
+    /* Not an EXR, or no file: errors naming it. */
+    char other[1200];
+    path_in(other, sizeof other, "not-an.exr");
+    put_file(other, "hello", 5);
+    CHECK(exr_header_string(other, "glint.reference", &value, &len, err, sizeof err) == -1 && strstr(err, other) &&
+              strstr(err, "not an OpenEXR file"),
+          "a text file: '%s'", err);
+    path_in(other, sizeof other, "missing.exr");
+    CHECK(exr_header_string(other, "glint.reference", &value, &len, err, sizeof err) == -1 && strstr(err, other),
+          "a missing file: '%s'", err);
+    /* Written without attributes: none. */
+    path_in(other, sizeof other, "plain.exr");
+    CHECK(exr_save_layers(other, W, H, layers, 1, WRITE_NO_REPLACE, err, sizeof err) == 0, "plain: %s", err);
+    CHECK(exr_header_string(other, "glint.reference", &value, &len, err, sizeof err) == 1, "plain file: '%s'", err);
+
+    /* The format's own names, a name given twice, no name: refused before any file appears. */
+    path_in(other, sizeof other, "refused.exr");
+    const char *reserved[] = {"channels", "compression", "dataWindow", "type", "tiles"};
+    for (size_t k = 0; k < sizeof reserved / sizeof reserved[0]; k++) {
+        exr_text_attr a = {reserved[k], "x"};
+        err[0] = '\0';
+        CHECK(exr_save_layers_attrs(other, W, H, layers, 1, &a, 1, WRITE_REPLACE, err, sizeof err) == -1 &&
+                  strstr(err, other) && strstr(err, reserved[k]) && one_line(err),
+              "attribute %s accepted: '%s'", reserved[k], err);
+    }
+    exr_text_attr twice[2] = {{"note", "a"}, {"note", "b"}};
+    CHECK(exr_save_layers_attrs(other, W, H, layers, 1, twice, 2, WRITE_REPLACE, err, sizeof err) == -1 &&
+              strstr(err, "twice"),
+          "an attribute given twice: '%s'", err);
+    exr_text_attr unnamed = {"", "x"};
+    CHECK(exr_save_layers_attrs(other, W, H, layers, 1, &unnamed, 1, WRITE_REPLACE, err, sizeof err) == -1,
+          "an attribute without a name accepted");
+    CHECK(!file_exists(other), "a refused save created a file");
+    CHECK(stray_temp_files(scratch_dir) == 0, "temporary files left behind");
+}
+
 /* ---- PNG ------------------------------------------------------------------------------------- */
 
 static void test_png(void) {
@@ -181,6 +266,7 @@ int main(void) {
     if (scratch_open("test_image_io_write") != 0) return 1;
     test_write_modes();
     test_unique_path();
+    test_exr_attributes();
     test_png();
     CHECK(stray_temp_files(scratch_dir) == 0, "temporary files left behind");
     return scratch_close(check_exit("test_image_io_write"));

@@ -1,6 +1,7 @@
-// glint — OpenEXR reading through OpenEXR's C++ library (Imf), which reads every compression the
-// format has and is fuzzed upstream. See exr_read.h. Every exception stops at exr_read_fd.
-#include "exr_read.h"
+// glint — OpenEXR through OpenEXR's C++ library (Imf), which reads every compression the format
+// has and is fuzzed upstream: reading, writing and header attributes. See exr_io.h. Every
+// exception stops at the extern "C" functions at the end.
+#include "exr_io.h"
 
 #include <Iex.h>
 #include <ImfChannelList.h>
@@ -9,7 +10,9 @@
 #include <ImfIO.h>
 #include <ImfInputPart.h>
 #include <ImfMultiPartInputFile.h>
+#include <ImfOutputFile.h>
 #include <ImfPartType.h>
+#include <ImfStringAttribute.h>
 #include <ImfTiledInputPart.h>
 
 #include <cerrno>
@@ -205,6 +208,13 @@ void check_layout(const Imf::Header &h) {
     }
 }
 
+// The first flat part of file: the one glint reads, pixels and attributes alike.
+int first_flat_part(Imf::MultiPartInputFile &file) {
+    for (int p = 0; p < file.parts(); p++)
+        if (!Imf::isDeepData(file.header(p).type())) return p;
+    throw Refused("no flat image part (deep data is not supported)");
+}
+
 void read_file(const char *path, int fd, int64_t size, exr_read_select select, exr_image *out, int *lossy_dct,
                const char **stage) {
     FdStream in(path, fd, size);
@@ -212,10 +222,7 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
     // No worker threads: the renderer has its own. No rebuilt offset table: a damaged file is
     // refused with its error rather than loaded with holes.
     Imf::MultiPartInputFile file(in, 0, false);
-    int part = -1;
-    for (int p = 0; p < file.parts() && part < 0; p++)
-        if (!Imf::isDeepData(file.header(p).type())) part = p;
-    if (part < 0) throw Refused("no flat image part (deep data is not supported)");
+    int part = first_flat_part(file);
     const Imf::Header &h = file.header(part);
     check_layout(h);
     std::vector<std::string> pick = pick_channels(h.channels(), select);
@@ -253,35 +260,172 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
     if (dw != disp) to_display_window(out, dw, disp);
 }
 
+// The string attribute name of the first flat part's header, copied with malloc into *value;
+// returns false when there is none.
+bool read_string(const char *path, int fd, int64_t size, const char *name, char **value, size_t *len) {
+    FdStream in(path, fd, size);
+    check_attribute_sizes(in);
+    Imf::MultiPartInputFile file(in, 0, false);
+    const Imf::Header &h = file.header(first_flat_part(file));
+    Imf::Header::ConstIterator it = h.find(name);
+    if (it == h.end()) return false;
+    const Imf::StringAttribute *attr = h.findTypedAttribute<Imf::StringAttribute>(name);
+    if (!attr)
+        throw Refused(std::string("header attribute ") + name + " is of type " + it.attribute().typeName() +
+                      ", not string");
+    const std::string &v = attr->value();
+    char *copy = static_cast<char *>(std::malloc(v.size() + 1));
+    if (!copy) throw std::bad_alloc();
+    std::memcpy(copy, v.data(), v.size());
+    copy[v.size()] = '\0';
+    *value = copy;
+    *len = v.size();
+    return true;
+}
+
+// The file as the library writes it, in memory, so that the file on disk appears only complete
+// (through write_file_atomic). The library seeks back to fill in the line offset table, and does
+// so in OutputFile's destructor, which swallows exceptions: a failed allocation is remembered.
+class MemStream : public Imf::OStream {
+  public:
+    explicit MemStream(const char *path) : Imf::OStream(path) {}
+
+    void write(const char c[], int n) override {
+        if (n <= 0) return;
+        try {
+            if (pos_ + (size_t)n > data.size()) data.resize(pos_ + (size_t)n); // zero fills a gap
+        } catch (...) {
+            failed = true;
+            throw;
+        }
+        std::memcpy(data.data() + pos_, c, (size_t)n);
+        pos_ += (size_t)n;
+    }
+    uint64_t tellp() override { return pos_; }
+    void seekp(uint64_t pos) override { pos_ = (size_t)pos; }
+
+    std::vector<char> data;
+    bool failed = false;
+
+  private:
+    size_t pos_ = 0;
+};
+
+// Attributes the format defines or that OpenEXR sets itself: a string under one of these names
+// would make the file unreadable or mean something else.
+bool reserved_attribute(const Imf::Header &h, const char *name) {
+    static const char *const optional[] = {"tiles", "type", "name", "version", "chunkCount", "maxSamplesPerPixel"};
+    for (const char *o : optional)
+        if (std::strcmp(name, o) == 0) return true;
+    return h.find(name) != h.end();
+}
+
+// One channel a layer and colour: "R" for the unnamed layer, "direct.R" for layer direct.
+void encode(MemStream &out, int width, int height, const exr_layer *layers, int num_layers, const exr_text_attr *attrs,
+            int num_attrs) {
+    // The defaults are what glint writes: display window = data window = width x height, ZIP (the
+    // format's lossless standard, smaller than RLE on renders), increasing y.
+    Imf::Header header(width, height);
+    for (int i = 0; i < num_attrs; i++) {
+        if (reserved_attribute(header, attrs[i].name))
+            throw Refused(std::string("header attribute name '") + attrs[i].name + "' is taken by the format");
+        header.insert(attrs[i].name, Imf::StringAttribute(attrs[i].value));
+    }
+    Imf::FrameBuffer fb;
+    const size_t xstride = 3 * sizeof(float), ystride = xstride * (size_t)width;
+    for (int l = 0; l < num_layers; l++)
+        for (int c = 0; c < 3; c++) {
+            std::string name = layers[l].prefix[0] ? std::string(layers[l].prefix) + "." : std::string();
+            name += "RGB"[c];
+            // The library keeps channels sorted by name, as the format requires, and binds the frame
+            // buffer by name: the order here does not matter. Slices are only read from.
+            header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+            char *base = reinterpret_cast<char *>(const_cast<float *>(layers[l].rgb + c));
+            fb.insert(name, Imf::Slice(Imf::FLOAT, base, xstride, ystride));
+        }
+    Imf::OutputFile file(out, header, 0); // no worker threads: the caller may be a render thread
+    file.setFrameBuffer(fb);
+    file.writePixels(height);
+}
+
+// Runs body, turning every exception into "PATH: problem" in err (stage: what the library was
+// doing, for its own messages; oom: the message for a failed allocation). Returns 0 or -1.
+template <class Body, class Oom>
+int guarded(const char *path, char *err, size_t errlen, const char *const &stage, Body body, Oom oom) {
+    try {
+        body();
+        return 0;
+    } catch (const Refused &e) {
+        return fail(err, errlen, path, "%s", e.what());
+    } catch (const std::bad_alloc &) {
+        return fail(err, errlen, path, "%s", oom().c_str());
+    } catch (const std::exception &e) {
+        // The library names the file in its messages, which follow ours: once is enough.
+        std::string why = e.what();
+        for (const std::string &named : {"image file \"" + std::string(path) + "\"", "\"" + std::string(path) + "\""})
+            for (size_t at; (at = why.find(named)) != std::string::npos;) why.replace(at, named.size(), "the file");
+        return fail(err, errlen, path, "%s: %s", stage, why.c_str());
+    } catch (...) {
+        return fail(err, errlen, path, "%s", stage);
+    }
+}
+
+// The magic number every OpenEXR file starts with, checked before the library sees the file.
+int check_magic(const char *path, int fd, int64_t size, char *err, size_t errlen) {
+    static const unsigned char magic[4] = {0x76, 0x2f, 0x31, 0x01};
+    unsigned char head[4] = {0, 0, 0, 0};
+    if (size == 0) return fail(err, errlen, path, "empty file");
+    if (pread(fd, head, 4, 0) != 4 || std::memcmp(head, magic, 4) != 0)
+        return fail(err, errlen, path, "not an OpenEXR file");
+    return 0;
+}
+
 } // namespace
 
 extern "C" int exr_read_fd(const char *path, int fd, int64_t size, exr_read_select select, exr_image *out,
                            int *lossy_dct, char *err, size_t errlen) {
     std::memset(out, 0, sizeof *out);
     if (lossy_dct) *lossy_dct = 0;
-    static const unsigned char magic[4] = {0x76, 0x2f, 0x31, 0x01};
-    unsigned char head[4] = {0, 0, 0, 0};
-    if (size == 0) return fail(err, errlen, path, "empty file");
-    if (pread(fd, head, 4, 0) != 4 || std::memcmp(head, magic, 4) != 0)
-        return fail(err, errlen, path, "not an OpenEXR file");
+    if (check_magic(path, fd, size, err, errlen) != 0) return -1;
     const char *stage = "not a readable OpenEXR file";
-    int status = 0;
-    try {
-        read_file(path, fd, size, select, out, lossy_dct, &stage);
-    } catch (const Refused &e) {
-        status = fail(err, errlen, path, "%s", e.what());
-    } catch (const std::bad_alloc &) {
-        status = out->width > 0 ? fail(err, errlen, path, "out of memory for a %dx%d image", out->width, out->height)
-                                : fail(err, errlen, path, "out of memory");
-    } catch (const std::exception &e) {
-        // The library names the file in its messages, which follow ours: once is enough.
-        std::string why = e.what();
-        for (const std::string &named : {"image file \"" + std::string(path) + "\"", "\"" + std::string(path) + "\""})
-            for (size_t at; (at = why.find(named)) != std::string::npos;) why.replace(at, named.size(), "the file");
-        status = fail(err, errlen, path, "%s: %s", stage, why.c_str());
-    } catch (...) {
-        status = fail(err, errlen, path, "%s", stage);
-    }
+    int status = guarded(
+        path, err, errlen, stage, [&] { read_file(path, fd, size, select, out, lossy_dct, &stage); },
+        [&] {
+            return out->width > 0 ? "out of memory for a " + std::to_string(out->width) + "x" +
+                                        std::to_string(out->height) + " image"
+                                  : std::string("out of memory");
+        });
     if (status != 0) exr_image_free(out);
     return status;
+}
+
+extern "C" int exr_read_string_fd(const char *path, int fd, int64_t size, const char *name, char **value, size_t *len,
+                                  char *err, size_t errlen) {
+    *value = nullptr;
+    *len = 0;
+    if (check_magic(path, fd, size, err, errlen) != 0) return -1;
+    const char *stage = "not a readable OpenEXR file";
+    bool found = false;
+    int status = guarded(
+        path, err, errlen, stage, [&] { found = read_string(path, fd, size, name, value, len); },
+        [] { return std::string("out of memory"); });
+    if (status != 0) return -1;
+    return found ? 0 : 1;
+}
+
+extern "C" int exr_write_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers,
+                                const exr_text_attr *attrs, int num_attrs, write_mode mode, char *err, size_t errlen) {
+    const char *stage = "cannot encode OpenEXR";
+    std::vector<char> data;
+    int status = guarded(
+        path, err, errlen, stage,
+        [&] {
+            MemStream out(path);
+            encode(out, width, height, layers, num_layers, attrs, num_attrs); // complete once it returns
+            if (out.failed) throw std::bad_alloc();
+            data.swap(out.data);
+        },
+        [] { return std::string("out of memory"); });
+    if (status != 0) return -1;
+    return write_file_atomic(path, data.data(), data.size(), mode, err, errlen);
 }
