@@ -203,6 +203,8 @@ static int reserve_entries(manylight *m, int n) {
 static int cluster_lights(manylight *m, const scene *s, const camera *cam, const render_params *p, long long frame,
                           threadpool *pool, render_stats *st) {
     int n = m->set.count, rows = p->vl.rows; /* p is resolved (manylight_begin_frame) */
+    /* A row is a pixel: more rows than pixels would only repeat them (and the matrix is rows x n). */
+    if ((long long)rows > (long long)p->width * p->height) rows = p->width * p->height;
     float *matrix = malloc(sizeof(float) * (size_t)rows * (size_t)n);
     render_stats *row_stats = calloc((size_t)rows, sizeof(render_stats));
     mrcs_cluster *clusters = malloc(sizeof(mrcs_cluster) * (size_t)p->vl.columns);
@@ -318,6 +320,9 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
 
     int clustering = vp->columns > 0 && vp->columns < m->set.count;
     m->per_pixel = vl_frame_per_pixel(&p->vl, clustering);
+    /* As many picks as there are lights (or clusters) or more: shading every one is exact and no
+     * dearer, however large the number asked. */
+    if (m->per_pixel >= (clustering ? vp->columns : m->set.count)) m->per_pixel = 0;
     m->candidates = vp->candidates;
     m->glossy_split = vp->glossy_rays;
     m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : 0.0f;

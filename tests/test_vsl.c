@@ -657,6 +657,38 @@ static void test_lights_touching_surfaces(void) {
     }
 }
 
+/* Numbers far above what a frame has: --per-pixel above its light or cluster count shades every
+ * light (the same image as "all", not a million picks), --rows above its pixel count samples every
+ * pixel once (the same clusters as rows = pixels). */
+static void test_counts_beyond_the_frame(void) {
+    material m = material_default();
+    scene *s = closed_box(m, v3(0.3f, 0.5f, -0.2f));
+    camera cam = box_camera();
+    const struct {
+        const char *what;
+        int per_pixel, rows, columns, ref_per_pixel, ref_rows;
+    } cases[] = {
+        {"--per-pixel 1000000 of 64 lights", 1000000, 0, 0, -1, 0},
+        {"--per-pixel 1000000 of 16 clusters", 1000000, 0, 16, -1, 0},
+        {"--rows 100000 of 432 pixels", 0, 100000, 16, 0, NPIX},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        render_params p = vl_params_for(METHOD_VSL, 64), q;
+        p.vl.columns = cases[c].columns;
+        q = p;
+        p.vl.per_pixel = cases[c].per_pixel;
+        p.vl.rows = cases[c].rows;
+        q.vl.per_pixel = cases[c].ref_per_pixel;
+        q.vl.rows = cases[c].ref_rows;
+        float *a = ts_render_with(s, &cam, &p, 2, ~0u), *b = ts_render_with(s, &cam, &q, 2, ~0u);
+        CHECK(memcmp(a, b, sizeof(float) * 3 * NPIX) == 0 && all_finite(a, NPIX),
+              "%s: not the image of every light / every pixel (rel. L2 %g)", cases[c].what, rel_l2(a, b, NPIX));
+        free(a);
+        free(b);
+    }
+    scene_destroy(s);
+}
+
 int main(void) {
     test_integral_against_brute_force();
     test_diffuse_kernel();
@@ -670,5 +702,6 @@ int main(void) {
     test_trace_glossy_matches_pt();
     test_no_leak_through_thin_walls();
     test_lights_touching_surfaces();
+    test_counts_beyond_the_frame();
     return check_exit("test_vsl");
 }
