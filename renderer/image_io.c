@@ -1,7 +1,7 @@
 /* glint — image files: OpenEXR read and written through its C++ library (exr_io.cpp), Radiance
  * HDR through stb_image, PNG through stb_image_write, and the atomic writer every export goes
  * through. See image_io.h. */
-#define _POSIX_C_SOURCE 200809L /* pread, fsync, link, strdup, lstat, clock_gettime */
+#define _XOPEN_SOURCE 700 /* pread, fsync, link, strdup, lstat, clock_gettime, realpath */
 
 #include "image_io.h"
 #include "exr_io.h"
@@ -409,33 +409,27 @@ static void parent_dir(const char *path, char *out, size_t outlen) {
         snprintf(out, outlen, "%.*s", (int)(slash - path), path);
 }
 
-int write_file_atomic(const char *path, const void *data, size_t size, write_mode mode, char *err, size_t errlen) {
-    if (!path || !path[0]) return fail(err, errlen, path ? path : "", "empty file name");
-    if (!data && size > 0) return fail(err, errlen, path, "no data to write");
-    /* Only a regular file is ever replaced: renaming over a device (--stats /dev/null), a
-     * directory or a FIFO would destroy it (a session once turned /dev/null into a file). */
-    struct stat existing;
-    if (mode == WRITE_REPLACE && lstat(path, &existing) == 0 && !S_ISREG(existing.st_mode) &&
-        !S_ISLNK(existing.st_mode))
-        return fail(err, errlen, path, "not a regular file; not replacing it");
+/* write_file_atomic's work on target (path: the name the user gave, for messages). */
+static int write_to(const char *target, const char *path, const void *data, size_t size, write_mode mode, char *err,
+                    size_t errlen) {
     /* The temporary file is created next to the target (so rename and link stay within one file
      * system), named after it with ".tmp-" so a leftover is recognisable. mkstemp is not used
      * because it creates files with mode 0600; this honours the umask like any other output. */
-    size_t tmplen = strlen(path) + 16;
+    size_t tmplen = strlen(target) + 16;
     char *tmp = malloc(tmplen);
     if (!tmp) return fail(err, errlen, path, "out of memory");
     int fd = -1;
     for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
         char suffix[7];
         temp_suffix(suffix);
-        snprintf(tmp, tmplen, "%s.tmp-%s", path, suffix);
+        snprintf(tmp, tmplen, "%s.tmp-%s", target, suffix);
         fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (fd < 0 && errno != EEXIST) break;
     }
     if (fd < 0) {
         int e = errno;
         char dir[1024];
-        parent_dir(path, dir, sizeof dir);
+        parent_dir(target, dir, sizeof dir);
         free(tmp);
         if (e == ENOENT) return fail(err, errlen, path, "directory '%s' does not exist", dir);
         if (e == ENOTDIR) return fail(err, errlen, path, "'%s' is not a directory", dir);
@@ -463,10 +457,10 @@ int write_file_atomic(const char *path, const void *data, size_t size, write_mod
         if (mode == WRITE_NO_REPLACE) {
             /* link() fails with EEXIST instead of replacing, atomically, even against a racing
              * writer; rename() would silently replace. */
-            if (link(tmp, path) != 0)
+            if (link(tmp, target) != 0)
                 status = errno == EEXIST ? fail(err, errlen, path, "file exists")
                                          : fail(err, errlen, path, "cannot create: %s", strerror(errno));
-        } else if (rename(tmp, path) != 0) {
+        } else if (rename(tmp, target) != 0) {
             status = fail(err, errlen, path, "cannot replace: %s", strerror(errno));
         }
     }
@@ -479,13 +473,35 @@ int write_file_atomic(const char *path, const void *data, size_t size, write_mod
         /* Make the new directory entry durable too; best effort, as not every file system
          * supports fsync on a directory. */
         char dir[1024];
-        parent_dir(path, dir, sizeof dir);
+        parent_dir(target, dir, sizeof dir);
         int dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (dfd >= 0) {
             fsync(dfd);
             close(dfd);
         }
     }
+    return status;
+}
+
+int write_file_atomic(const char *path, const void *data, size_t size, write_mode mode, char *err, size_t errlen) {
+    if (!path || !path[0]) return fail(err, errlen, path ? path : "", "empty file name");
+    if (!data && size > 0) return fail(err, errlen, path, "no data to write");
+    /* Only a regular file is ever replaced: renaming over a device (--stats /dev/null), a
+     * directory or a FIFO would destroy it (a session once turned /dev/null into a file). */
+    struct stat existing;
+    char *through = NULL; /* a symbolic link's target, written through: the link stays a link */
+    if (mode == WRITE_REPLACE && lstat(path, &existing) == 0 && S_ISLNK(existing.st_mode)) {
+        if (!(through = realpath(path, NULL)))
+            return fail(err, errlen, path, "a symbolic link to nothing (%s); not following it", strerror(errno));
+        if (stat(through, &existing) != 0 || !S_ISREG(existing.st_mode)) {
+            free(through);
+            return fail(err, errlen, path, "a symbolic link to something not a regular file; not replacing it");
+        }
+    }
+    if (mode == WRITE_REPLACE && !through && lstat(path, &existing) == 0 && !S_ISREG(existing.st_mode))
+        return fail(err, errlen, path, "not a regular file; not replacing it");
+    int status = write_to(through ? through : path, path, data, size, mode, err, errlen);
+    free(through);
     return status;
 }
 

@@ -83,7 +83,9 @@ int png_save_rgb8(const char *path, int width, int height, const unsigned char *
 
 /* Writes size bytes to path atomically: a temporary file in the same directory, fsync, then
  * rename (WRITE_REPLACE) or link (WRITE_NO_REPLACE, so an existing file is never replaced even
- * in a race). Never leaves a partial file at path, and removes its temporary file on failure. */
+ * in a race). Never leaves a partial file at path, and removes its temporary file on failure.
+ * Replaces only a regular file; a symbolic link is written through (its target replaced, the
+ * link kept), and refused when it leads nowhere or to anything but a regular file. */
 int write_file_atomic(const char *path, const void *data, size_t size, write_mode mode, char *err, size_t errlen);
 
 /* Finds a free name for an export that must never overwrite: "dir/stem.ext" if it does not
