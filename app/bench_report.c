@@ -96,6 +96,9 @@ int bench_write_summary(const bench_options *o, const char *dir, const bench_ref
 /* Error of run r at budget k in the reported component: the RMS over its seeds. */
 static double err_at(const bench_run *r, int k) { return k < r->num_points ? r->rms[k] : (double)NAN; }
 
+/* The relative L2 error is a multiple of the reference's own norm. */
+static const char *const error_unit = "fraction of ‖R‖₂";
+
 static int write_plot(const char *dir, const char *stem, const plot_desc *pd) {
     char path[4200], err[4400];
     snprintf(path, sizeof path, "%s/%s.svg", dir, stem);
@@ -124,18 +127,32 @@ static int write_time_plot(const bench_options *o, const char *dir, const bench_
             u->label, u->num_points, u->seconds, u->rms, o->seeds > 1 ? u->lo : NULL, o->seeds > 1 ? u->hi : NULL};
     }
     int last = o->num_times - 1, best = best_run(runs, num_runs, last);
-    char title[160], ylabel[128], xmark[64], ymark[192];
+    char title[160], ylabel[128], band[64], xmark[64], ymark[192];
     snprintf(title, sizeof title, "Relative L2 error (%s) against render time", bench_err_names[o->component]);
     if (o->seeds > 1)
-        snprintf(ylabel, sizeof ylabel, "relative L2 error, %s (RMS of %d seeds, band: min-max)",
-                 bench_err_names[o->component], o->seeds);
+        snprintf(ylabel, sizeof ylabel, "relative L2 error, %s, RMS of %d seeds", bench_err_names[o->component],
+                 o->seeds);
     else
         snprintf(ylabel, sizeof ylabel, "relative L2 error, %s", bench_err_names[o->component]);
+    snprintf(band, sizeof band, "min–max of %d seeds", o->seeds);
     snprintf(xmark, sizeof xmark, "equal time: %g s", o->times[last]);
     double ey = best >= 0 ? err_at(&runs[best], last) : (double)NAN;
     snprintf(ymark, sizeof ymark, "equal error: %.3g (%s at %g s)", ey, best >= 0 ? runs[best].label : "",
              o->times[last]);
-    plot_desc pd = {title, "render time (s)", ylabel, 1, 1, series, num_runs, o->times[last], ey, xmark, ymark};
+    plot_desc pd = {.title = title,
+                    .x_label = "render time",
+                    .x_unit = "s",
+                    .y_label = ylabel,
+                    .y_unit = error_unit,
+                    .log_x = 1,
+                    .log_y = 1,
+                    .series = series,
+                    .num_series = num_runs,
+                    .band_label = o->seeds > 1 ? band : NULL,
+                    .mark_x = o->times[last],
+                    .mark_y = ey,
+                    .mark_x_label = xmark,
+                    .mark_y_label = ymark};
     return write_plot(dir, "error-vs-time", &pd);
 }
 
@@ -174,7 +191,18 @@ static int write_sweep_plot(const bench_options *o, const char *dir, const bench
              sw->name, o->times[last]);
     snprintf(ylabel, sizeof ylabel, "relative L2 error, %s", bench_err_names[o->component]);
     snprintf(stem, sizeof stem, "sweep-%s", sw->name);
-    plot_desc pd = {title, sw->name, ylabel, pos, 1, series, ns, (double)NAN, (double)NAN, "", ""};
+    const param_desc *d = param_find(sw->name);
+    plot_desc pd = {.title = title,
+                    .x_label = sw->name,
+                    .x_unit = d ? d->unit : NULL,
+                    .y_label = ylabel,
+                    .y_unit = error_unit,
+                    .log_x = pos,
+                    .log_y = 1,
+                    .series = series,
+                    .num_series = ns,
+                    .mark_x = (double)NAN,
+                    .mark_y = (double)NAN};
     return write_plot(dir, stem, &pd);
 }
 

@@ -1,7 +1,9 @@
-/* glint — line plots as SVG text and as PNG drawn by cairo, from one layout. */
+/* glint — line plots: one cairo drawing routine, onto cairo's SVG surface and onto an image
+ * surface for the PNG. */
 #define _POSIX_C_SOURCE 200809L
 #include "plot.h"
 
+#include <cairo-svg.h>
 #include <cairo.h>
 #include <math.h>
 #include <stdint.h>
@@ -11,8 +13,15 @@
 
 #include "metrics.h"
 
-/* Geometry shared by both outputs: the figure, the plot area inside it, the legend to its right. */
-enum { FIG_W = 860, FIG_H = 500, AREA_X0 = 80, AREA_X1 = 580, AREA_Y0 = 40, AREA_Y1 = 430, LEGEND_X = 600 };
+enum {
+    FIG_W = PLOT_WIDTH,
+    FIG_H = PLOT_HEIGHT,
+    AREA_X0 = PLOT_AREA_X0,
+    AREA_X1 = PLOT_AREA_X1,
+    AREA_Y0 = PLOT_AREA_Y0,
+    AREA_Y1 = PLOT_AREA_Y1,
+    LEGEND_X = PLOT_LEGEND_X
+};
 
 /* Tableau 10: distinct on white, and for the common kinds of colour blindness. */
 static const uint8_t palette[10][3] = {{31, 119, 180},  {255, 127, 14}, {44, 160, 44},   {214, 39, 40},
@@ -131,174 +140,17 @@ static int in_area(const layout *l, double x, double y) {
     return X >= AREA_X0 - 0.5 && X <= AREA_X1 + 0.5 && Y >= AREA_Y0 - 0.5 && Y <= AREA_Y1 + 0.5;
 }
 
-/* The vertical reading's label goes right of its line, or left of it where it would run out of the
- * plot into the legend (the last budget often sits at the axis' end). 6 px a character: a little
- * more than sans-serif's average at 11 px, as the SVG cannot measure its text. */
-static int mark_label_left(double X, const char *label) {
-    return label && X + 4.0 + 6.0 * (double)strlen(label) > AREA_X1;
+/* Point i of a series is drawn: its curve point, and with band it the band's ends too. */
+static int drawn(const layout *l, const plot_series *s, int i, int band) {
+    if (band) return in_area(l, s->x[i], s->lo[i]) && in_area(l, s->x[i], s->hi[i]);
+    return in_area(l, s->x[i], s->y[i]);
 }
 
-/* ---- SVG ------------------------------------------------------------------------------------- */
-
-static void xml_text(FILE *f, const char *s) {
-    for (; s && *s; s++) {
-        if (*s == '<')
-            fputs("&lt;", f);
-        else if (*s == '>')
-            fputs("&gt;", f);
-        else if (*s == '&')
-            fputs("&amp;", f);
-        else if (*s == '"')
-            fputs("&quot;", f);
-        else
-            fputc(*s, f);
-    }
-}
-
-int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *err, size_t errlen) {
-    layout l;
-    layout_make(p, &l);
-    char *buf = NULL;
-    size_t size = 0;
-    FILE *f = open_memstream(&buf, &size);
-    if (!f) {
-        snprintf(err, errlen, "%s: out of memory", path);
-        return -1;
-    }
-    fprintf(f,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" "
-            "font-family=\"sans-serif\" font-size=\"12\">\n",
-            FIG_W, FIG_H, FIG_W, FIG_H);
-    fprintf(f, "<rect width=\"%d\" height=\"%d\" fill=\"white\"/>\n", FIG_W, FIG_H);
-    /* grid and ticks */
-    for (int k = 0; k < l.x.num_minor; k++) {
-        double X = px(&l, pow(10.0, l.x.minor[k]));
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#f0f0f0\"/>\n", X, AREA_Y0, X, AREA_Y1);
-    }
-    for (int k = 0; k < l.y.num_minor; k++) {
-        double Y = py(&l, pow(10.0, l.y.minor[k]));
-        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#f0f0f0\"/>\n", AREA_X0, Y, AREA_X1, Y);
-    }
-    char t[64];
-    for (int k = 0; k < l.x.num_ticks; k++) {
-        double X = px(&l, tick_value(&l.x, l.x.ticks[k]));
-        tick_text(&l.x, l.x.ticks[k], t, sizeof t);
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#d8d8d8\"/>\n", X, AREA_Y0, X, AREA_Y1);
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"black\"/>\n", X, AREA_Y1, X,
-                AREA_Y1 + 5);
-        fprintf(f, "<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", X, AREA_Y1 + 19, t);
-    }
-    for (int k = 0; k < l.y.num_ticks; k++) {
-        double Y = py(&l, tick_value(&l.y, l.y.ticks[k]));
-        tick_text(&l.y, l.y.ticks[k], t, sizeof t);
-        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#d8d8d8\"/>\n", AREA_X0, Y, AREA_X1, Y);
-        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"black\"/>\n", AREA_X0 - 5, Y, AREA_X0,
-                Y);
-        fprintf(f, "<text x=\"%d\" y=\"%.1f\" text-anchor=\"end\">%s</text>\n", AREA_X0 - 8, Y + 4, t);
-    }
-    fprintf(f, "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n", AREA_X0,
-            AREA_Y0, AREA_X1 - AREA_X0, AREA_Y1 - AREA_Y0);
-    fprintf(f, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">", (AREA_X0 + AREA_X1) / 2, AREA_Y1 + 42);
-    xml_text(f, p->x_label);
-    fprintf(f, "</text>\n<text transform=\"translate(22 %d) rotate(-90)\" text-anchor=\"middle\">",
-            (AREA_Y0 + AREA_Y1) / 2);
-    xml_text(f, p->y_label);
-    fprintf(f, "</text>\n<text x=\"%d\" y=\"24\" text-anchor=\"middle\" font-size=\"14\">", (AREA_X0 + AREA_X1) / 2);
-    xml_text(f, p->title);
-    fputs("</text>\n", f);
-
-    /* the readings: dashed lines, labelled */
-    if (in_area(&l, p->mark_x, tick_value(&l.y, l.y.lo))) {
-        double X = px(&l, p->mark_x);
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#555\" stroke-dasharray=\"6 4\"/>\n", X,
-                AREA_Y0, X, AREA_Y1);
-        int left = mark_label_left(X, p->mark_x_label);
-        fprintf(f, "<text x=\"%.1f\" y=\"%d\" font-size=\"11\" fill=\"#555\"%s>", left ? X - 4 : X + 4, AREA_Y0 + 12,
-                left ? " text-anchor=\"end\"" : "");
-        xml_text(f, p->mark_x_label);
-        fputs("</text>\n", f);
-    }
-    if (in_area(&l, tick_value(&l.x, l.x.lo), p->mark_y)) {
-        double Y = py(&l, p->mark_y);
-        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#555\" stroke-dasharray=\"2 3\"/>\n",
-                AREA_X0, Y, AREA_X1, Y);
-        fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"11\" fill=\"#555\">", AREA_X0 + 4, Y - 4);
-        xml_text(f, p->mark_y_label);
-        fputs("</text>\n", f);
-    }
-
-    /* the bands first, under every curve */
-    for (int s = 0; s < p->num_series; s++) {
-        const plot_series *se = &p->series[s];
-        if (!se->lo || !se->hi) continue;
-        const uint8_t *c = palette[s % 10];
-        fprintf(f, "<polygon fill=\"#%02x%02x%02x\" fill-opacity=\"0.15\" stroke=\"none\" points=\"", c[0], c[1], c[2]);
-        for (int i = 0; i < se->n; i++)
-            if (in_area(&l, se->x[i], se->lo[i]) && in_area(&l, se->x[i], se->hi[i]))
-                fprintf(f, "%.1f,%.1f ", px(&l, se->x[i]), py(&l, se->lo[i]));
-        for (int i = se->n - 1; i >= 0; i--)
-            if (in_area(&l, se->x[i], se->lo[i]) && in_area(&l, se->x[i], se->hi[i]))
-                fprintf(f, "%.1f,%.1f ", px(&l, se->x[i]), py(&l, se->hi[i]));
-        fputs("\"/>\n", f);
-    }
-    for (int s = 0; s < p->num_series; s++) {
-        const plot_series *se = &p->series[s];
-        const uint8_t *c = palette[s % 10];
-        char col[16];
-        snprintf(col, sizeof col, "#%02x%02x%02x", c[0], c[1], c[2]);
-        fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\" points=\"", col);
-        for (int i = 0; i < se->n; i++)
-            if (in_area(&l, se->x[i], se->y[i])) fprintf(f, "%.1f,%.1f ", px(&l, se->x[i]), py(&l, se->y[i]));
-        fputs("\"/>\n", f);
-        for (int i = 0; i < se->n; i++)
-            if (in_area(&l, se->x[i], se->y[i]))
-                fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", px(&l, se->x[i]),
-                        py(&l, se->y[i]), col);
-        double yx = cross_x(se, p->mark_x), xy = cross_y(se, p->mark_y);
-        if (in_area(&l, p->mark_x, yx))
-            fprintf(f,
-                    "<rect x=\"%.1f\" y=\"%.1f\" width=\"9\" height=\"9\" fill=\"white\" stroke=\"%s\" "
-                    "stroke-width=\"2\"/>\n",
-                    px(&l, p->mark_x) - 4.5, py(&l, yx) - 4.5, col);
-        if (in_area(&l, xy, p->mark_y)) {
-            double X = px(&l, xy), Y = py(&l, p->mark_y);
-            fprintf(f,
-                    "<polygon points=\"%.1f,%.1f %.1f,%.1f %.1f,%.1f %.1f,%.1f\" fill=\"white\" stroke=\"%s\" "
-                    "stroke-width=\"2\"/>\n",
-                    X, Y - 6, X + 6, Y, X, Y + 6, X - 6, Y, col);
-        }
-        /* legend entry */
-        int ly = AREA_Y0 + 10 + 20 * s;
-        fprintf(f, "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"%s\" stroke-width=\"2\"/>", LEGEND_X, ly,
-                LEGEND_X + 24, ly, col);
-        fprintf(f, "<circle cx=\"%d\" cy=\"%d\" r=\"3\" fill=\"%s\"/>", LEGEND_X + 12, ly, col);
-        fprintf(f, "<text x=\"%d\" y=\"%d\">", LEGEND_X + 30, ly + 4);
-        xml_text(f, se->label);
-        fputs("</text>\n", f);
-    }
-    int ly = AREA_Y0 + 10 + 20 * p->num_series + 10;
-    if (isfinite(p->mark_x))
-        fprintf(f,
-                "<rect x=\"%d\" y=\"%d\" width=\"9\" height=\"9\" fill=\"white\" stroke=\"#555\" stroke-width=\"2\"/>"
-                "<text x=\"%d\" y=\"%d\" fill=\"#555\">equal time</text>\n",
-                LEGEND_X + 8, ly - 4, LEGEND_X + 30, ly + 4),
-            ly += 20;
-    if (isfinite(p->mark_y))
-        fprintf(f,
-                "<polygon points=\"%d,%d %d,%d %d,%d %d,%d\" fill=\"white\" stroke=\"#555\" stroke-width=\"2\"/>"
-                "<text x=\"%d\" y=\"%d\" fill=\"#555\">equal error</text>\n",
-                LEGEND_X + 12, ly - 6, LEGEND_X + 18, ly, LEGEND_X + 12, ly + 6, LEGEND_X + 6, ly, LEGEND_X + 30,
-                ly + 4);
-    fputs("</svg>\n", f);
-    fclose(f);
-    int status = write_file_atomic(path, buf, size, mode, err, errlen);
-    free(buf);
-    return status;
-}
-
-/* ---- PNG: the same figure drawn by cairo ------------------------------------------------------ */
+/* ---- drawing: one routine for both surfaces --------------------------------------------------- */
 
 #define TAU 6.28318530717958647692 /* a full turn, for cairo_arc */
+
+static const uint8_t white[3] = {255, 255, 255}, black[3] = {0, 0, 0}, grey[3] = {85, 85, 85};
 
 static void colour(cairo_t *cr, const uint8_t c[3], double alpha) {
     cairo_set_source_rgba(cr, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, alpha);
@@ -313,17 +165,38 @@ static void line(cairo_t *cr, double x0, double y0, double x1, double y1) {
     cairo_stroke(cr);
 }
 
-/* Text with its baseline at y, starting at x (align 0), centred on it (0.5) or ending there (1). */
-static void words(cairo_t *cr, double x, double y, const char *s, double align) {
-    if (!s || !*s) return;
+static double text_width(cairo_t *cr, const char *s) {
     cairo_text_extents_t e;
     cairo_text_extents(cr, s, &e);
-    cairo_move_to(cr, x - align * e.x_advance, y);
+    return e.x_advance;
+}
+
+/* Text with its baseline at y, starting at x (align 0), centred on it (0.5) or ending there (1);
+ * in a smaller size when wider than max (down to 7 px). */
+static void words(cairo_t *cr, double x, double y, const char *s, double align, double max) {
+    if (!s || !*s) return;
+    cairo_matrix_t m;
+    cairo_get_font_matrix(cr, &m); /* a plain scale: rotations go into the transformation */
+    double w = text_width(cr, s), size = m.xx;
+    if (w > max && w > 0.0) {
+        cairo_set_font_size(cr, fmax(7.0, size * max / w));
+        w = text_width(cr, s);
+    }
+    cairo_move_to(cr, x - align * w, y);
     cairo_show_text(cr, s);
+    cairo_new_path(cr); /* show_text leaves a current point a later path would start from */
+    cairo_set_font_size(cr, size);
+}
+
+/* "label (unit)", or the label alone. */
+static void axis_title(const char *label, const char *unit, char *out, size_t n) {
+    if (unit && *unit)
+        snprintf(out, n, "%s (%s)", label ? label : "", unit);
+    else
+        snprintf(out, n, "%s", label ? label : "");
 }
 
 static void square_marker(cairo_t *cr, double cx, double cy, const uint8_t col[3]) {
-    static const uint8_t white[3] = {255, 255, 255};
     cairo_rectangle(cr, cx - 4.5, cy - 4.5, 9, 9);
     colour(cr, white, 1.0);
     cairo_fill_preserve(cr);
@@ -332,7 +205,6 @@ static void square_marker(cairo_t *cr, double cx, double cy, const uint8_t col[3
 }
 
 static void diamond_marker(cairo_t *cr, double cx, double cy, const uint8_t col[3]) {
-    static const uint8_t white[3] = {255, 255, 255};
     cairo_move_to(cr, cx, cy - 6);
     cairo_line_to(cr, cx + 6, cy);
     cairo_line_to(cr, cx, cy + 6);
@@ -344,14 +216,13 @@ static void diamond_marker(cairo_t *cr, double cx, double cy, const uint8_t col[
     cairo_stroke(cr);
 }
 
-/* The SVG's figure, element for element at its coordinates and sizes. */
-static void draw(cairo_t *cr, const plot_desc *p, const layout *l) {
-    static const uint8_t white[3] = {255, 255, 255}, minor[3] = {240, 240, 240}, grid[3] = {216, 216, 216},
-                         black[3] = {0, 0, 0}, grey[3] = {85, 85, 85};
-    colour(cr, white, 1.0);
-    cairo_paint(cr);
-    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr, 12);
+static void dot(cairo_t *cr, double x, double y) {
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, x, y, 3.0, 0.0, TAU);
+}
+
+static void draw_axes(cairo_t *cr, const plot_desc *p, const layout *l) {
+    static const uint8_t minor[3] = {240, 240, 240}, grid[3] = {216, 216, 216};
     cairo_set_line_width(cr, 1.0);
     colour(cr, minor, 1.0);
     for (int k = 0; k < l->x.num_minor; k++) {
@@ -362,7 +233,7 @@ static void draw(cairo_t *cr, const plot_desc *p, const layout *l) {
         double Y = crisp(py(l, pow(10.0, l->y.minor[k])));
         line(cr, AREA_X0, Y, AREA_X1, Y);
     }
-    char t[64];
+    char t[320];
     for (int k = 0; k < l->x.num_ticks; k++) {
         double X = crisp(px(l, tick_value(&l->x, l->x.ticks[k])));
         colour(cr, grid, 1.0);
@@ -370,7 +241,7 @@ static void draw(cairo_t *cr, const plot_desc *p, const layout *l) {
         colour(cr, black, 1.0);
         line(cr, X, AREA_Y1, X, AREA_Y1 + 5);
         tick_text(&l->x, l->x.ticks[k], t, sizeof t);
-        words(cr, X, AREA_Y1 + 19, t, 0.5);
+        words(cr, X, AREA_Y1 + 19, t, 0.5, 80);
     }
     for (int k = 0; k < l->y.num_ticks; k++) {
         double Y = crisp(py(l, tick_value(&l->y, l->y.ticks[k])));
@@ -379,51 +250,71 @@ static void draw(cairo_t *cr, const plot_desc *p, const layout *l) {
         colour(cr, black, 1.0);
         line(cr, AREA_X0 - 5, Y, AREA_X0, Y);
         tick_text(&l->y, l->y.ticks[k], t, sizeof t);
-        words(cr, AREA_X0 - 8, Y + 4, t, 1.0);
+        words(cr, AREA_X0 - 8, Y + 4, t, 1.0, AREA_X0 - 36);
     }
     cairo_rectangle(cr, AREA_X0 + 0.5, AREA_Y0 + 0.5, AREA_X1 - AREA_X0, AREA_Y1 - AREA_Y0);
     cairo_stroke(cr);
-    words(cr, (AREA_X0 + AREA_X1) / 2, AREA_Y1 + 42, p->x_label, 0.5);
+    axis_title(p->x_label, p->x_unit, t, sizeof t);
+    words(cr, (AREA_X0 + AREA_X1) / 2.0, AREA_Y1 + 42, t, 0.5, AREA_X1 - AREA_X0 + 100);
+    axis_title(p->y_label, p->y_unit, t, sizeof t);
     cairo_save(cr);
-    cairo_translate(cr, 22, (AREA_Y0 + AREA_Y1) / 2);
+    cairo_translate(cr, 22, (AREA_Y0 + AREA_Y1) / 2.0);
     cairo_rotate(cr, -0.25 * TAU);
-    words(cr, 0, 0, p->y_label, 0.5);
+    words(cr, 0, 0, t, 0.5, AREA_Y1 - AREA_Y0 + 60);
     cairo_restore(cr);
     cairo_set_font_size(cr, 14);
-    words(cr, (AREA_X0 + AREA_X1) / 2, 24, p->title, 0.5);
+    words(cr, (AREA_X0 + AREA_X1) / 2.0, 24, p->title, 0.5, AREA_X1 - AREA_X0 + 100);
+    cairo_set_font_size(cr, 12);
+}
 
-    /* the readings: dashed lines, labelled */
+/* The readings drawn: both lie on the axes' ranges. */
+static int shows_x(const plot_desc *p, const layout *l) { return in_area(l, p->mark_x, tick_value(&l->y, l->y.lo)); }
+static int shows_y(const plot_desc *p, const layout *l) { return in_area(l, tick_value(&l->x, l->x.lo), p->mark_y); }
+
+/* The readings: dashed lines, labelled. The vertical one's label goes right of its line, or left
+ * of it where it would run out of the plot into the legend (the last budget often sits at the
+ * axis' end). */
+static void draw_readings(cairo_t *cr, const plot_desc *p, const layout *l) {
     cairo_set_font_size(cr, 11);
     colour(cr, grey, 1.0);
-    if (in_area(l, p->mark_x, tick_value(&l->y, l->y.lo))) {
+    if (shows_x(p, l)) {
         double X = crisp(px(l, p->mark_x)), dash[2] = {6, 4};
         cairo_set_dash(cr, dash, 2, 0);
         line(cr, X, AREA_Y0, X, AREA_Y1);
-        int left = mark_label_left(X, p->mark_x_label);
-        words(cr, left ? X - 4 : X + 4, AREA_Y0 + 12, p->mark_x_label, left ? 1.0 : 0.0);
+        const char *s = p->mark_x_label ? p->mark_x_label : "";
+        int left = X + 4.0 + text_width(cr, s) > AREA_X1;
+        words(cr, left ? X - 4 : X + 4, AREA_Y0 + 12, s, left ? 1.0 : 0.0, AREA_X1 - AREA_X0 - 8);
     }
-    if (in_area(l, tick_value(&l->x, l->x.lo), p->mark_y)) {
+    if (shows_y(p, l)) {
         double Y = crisp(py(l, p->mark_y)), dash[2] = {2, 3};
         cairo_set_dash(cr, dash, 2, 0);
         line(cr, AREA_X0, Y, AREA_X1, Y);
-        words(cr, AREA_X0 + 4, Y - 4, p->mark_y_label, 0.0);
+        words(cr, AREA_X0 + 4, Y - 4, p->mark_y_label, 0.0, AREA_X1 - AREA_X0 - 8);
     }
     cairo_set_dash(cr, NULL, 0, 0);
     cairo_set_font_size(cr, 12);
+}
 
-    /* the bands first, under every curve */
+/* The curves over their bands, with their points and their readings' markers. A point not drawn
+ * (see drawn) breaks the curve and the band there. */
+static void draw_series(cairo_t *cr, const plot_desc *p, const layout *l) {
     for (int s = 0; s < p->num_series; s++) {
         const plot_series *se = &p->series[s];
         if (!se->lo || !se->hi) continue;
-        cairo_new_path(cr); /* cairo_show_text leaves a current point, which the path would start at */
-        for (int i = 0; i < se->n; i++)
-            if (in_area(l, se->x[i], se->lo[i]) && in_area(l, se->x[i], se->hi[i]))
-                cairo_line_to(cr, px(l, se->x[i]), py(l, se->lo[i]));
-        for (int i = se->n - 1; i >= 0; i--)
-            if (in_area(l, se->x[i], se->lo[i]) && in_area(l, se->x[i], se->hi[i]))
-                cairo_line_to(cr, px(l, se->x[i]), py(l, se->hi[i]));
-        colour(cr, palette[s % 10], 0.15);
-        cairo_fill(cr);
+        for (int a = 0; a < se->n;) {
+            if (!drawn(l, se, a, 1)) {
+                a++;
+                continue;
+            }
+            int b = a;
+            while (b + 1 < se->n && drawn(l, se, b + 1, 1)) b++;
+            cairo_new_path(cr);
+            for (int i = a; i <= b; i++) cairo_line_to(cr, px(l, se->x[i]), py(l, se->lo[i]));
+            for (int i = b; i >= a; i--) cairo_line_to(cr, px(l, se->x[i]), py(l, se->hi[i]));
+            colour(cr, palette[s % 10], 0.15);
+            cairo_fill(cr);
+            a = b + 1;
+        }
     }
     cairo_set_line_width(cr, 2.0);
     cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
@@ -432,56 +323,157 @@ static void draw(cairo_t *cr, const plot_desc *p, const layout *l) {
         const uint8_t *col = palette[s % 10];
         colour(cr, col, 1.0);
         cairo_new_path(cr);
-        for (int i = 0; i < se->n; i++)
-            if (in_area(l, se->x[i], se->y[i])) cairo_line_to(cr, px(l, se->x[i]), py(l, se->y[i]));
+        for (int i = 0, pen = 0; i < se->n; i++) {
+            int in = drawn(l, se, i, 0);
+            if (in && pen) cairo_line_to(cr, px(l, se->x[i]), py(l, se->y[i]));
+            if (in && !pen) cairo_move_to(cr, px(l, se->x[i]), py(l, se->y[i]));
+            pen = in;
+        }
         cairo_stroke(cr);
         for (int i = 0; i < se->n; i++)
-            if (in_area(l, se->x[i], se->y[i])) {
-                cairo_new_sub_path(cr);
-                cairo_arc(cr, px(l, se->x[i]), py(l, se->y[i]), 3.0, 0.0, TAU);
-            }
+            if (drawn(l, se, i, 0)) dot(cr, px(l, se->x[i]), py(l, se->y[i]));
         cairo_fill(cr);
         double yx = cross_x(se, p->mark_x), xy = cross_y(se, p->mark_y);
         if (in_area(l, p->mark_x, yx)) square_marker(cr, px(l, p->mark_x), py(l, yx), col);
         if (in_area(l, xy, p->mark_y)) diamond_marker(cr, px(l, xy), py(l, p->mark_y), col);
-        /* legend entry */
-        int ly = AREA_Y0 + 10 + 20 * s;
-        colour(cr, col, 1.0);
-        line(cr, LEGEND_X, ly, LEGEND_X + 24, ly);
-        cairo_arc(cr, LEGEND_X + 12, ly, 3.0, 0.0, TAU);
-        cairo_fill(cr);
-        colour(cr, black, 1.0);
-        words(cr, LEGEND_X + 30, ly + 4, se->label, 0.0);
-    }
-    int ly = AREA_Y0 + 10 + 20 * p->num_series + 10;
-    if (isfinite(p->mark_x)) {
-        square_marker(cr, LEGEND_X + 12.5, ly + 0.5, grey);
-        words(cr, LEGEND_X + 30, ly + 4, "equal time", 0.0);
-        ly += 20;
-    }
-    if (isfinite(p->mark_y)) {
-        diamond_marker(cr, LEGEND_X + 12, ly, grey);
-        words(cr, LEGEND_X + 30, ly + 4, "equal error", 0.0);
     }
 }
 
-int plot_save_png(const plot_desc *p, const char *path, write_mode mode, char *err, size_t errlen) {
+/* The legend, right of the plot: a row per series (its line, point and band), then the band's
+ * meaning and the readings' markers. Rows close up when many; those that still do not fit are
+ * counted in a last row. */
+static void draw_legend(cairo_t *cr, const plot_desc *p, const layout *l) {
+    int bands = 0;
+    for (int s = 0; s < p->num_series; s++) bands |= p->series[s].lo && p->series[s].hi;
+    int extra = (bands && p->band_label && *p->band_label) + shows_x(p, l) + shows_y(p, l);
+    double top = AREA_Y0 + 10, room = FIG_H - 8 - top, gap = extra ? 10.0 : 0.0, pitch = 20.0;
+    int shown = p->num_series;
+    if ((shown + extra) * pitch + gap > room) pitch = fmax(11.0, (room - gap) / (shown + extra));
+    if ((shown + extra) * pitch + gap > room) shown = (int)((room - gap) / pitch) - extra - 1;
+    double font = fmin(12.0, pitch - 1.0), text_x = LEGEND_X + 30, max = FIG_W - 4 - text_x;
+    cairo_set_font_size(cr, font);
+    cairo_set_line_width(cr, 2.0);
+    double y = top;
+    for (int s = 0; s < shown; s++, y += pitch) {
+        const uint8_t *col = palette[s % 10];
+        if (p->series[s].lo && p->series[s].hi) {
+            double h = fmin(10.0, pitch - 2.0);
+            cairo_rectangle(cr, LEGEND_X, y - 0.5 * h, 24, h);
+            colour(cr, col, 0.15);
+            cairo_fill(cr);
+        }
+        colour(cr, col, 1.0);
+        line(cr, LEGEND_X, y, LEGEND_X + 24, y);
+        dot(cr, LEGEND_X + 12, y);
+        cairo_fill(cr);
+        colour(cr, black, 1.0);
+        words(cr, text_x, y + font / 3.0, p->series[s].label, 0.0, max);
+    }
+    if (shown < p->num_series) {
+        char more[64];
+        snprintf(more, sizeof more, "and %d more", p->num_series - shown);
+        colour(cr, grey, 1.0);
+        words(cr, text_x, y + font / 3.0, more, 0.0, max);
+        y += pitch;
+    }
+    y += gap;
+    if (bands && p->band_label && *p->band_label) {
+        cairo_rectangle(cr, LEGEND_X, y - 5, 24, 10);
+        colour(cr, grey, 0.15);
+        cairo_fill(cr);
+        colour(cr, grey, 1.0);
+        words(cr, text_x, y + font / 3.0, p->band_label, 0.0, max);
+        y += pitch;
+    }
+    if (shows_x(p, l)) {
+        square_marker(cr, LEGEND_X + 12.5, y + 0.5, grey);
+        words(cr, text_x, y + font / 3.0, "equal time", 0.0, max);
+        y += pitch;
+    }
+    if (shows_y(p, l)) {
+        diamond_marker(cr, LEGEND_X + 12, y, grey);
+        words(cr, text_x, y + font / 3.0, "equal error", 0.0, max);
+    }
+    cairo_set_font_size(cr, 12);
+}
+
+/* The figure, on any surface FIG_W x FIG_H. */
+static cairo_status_t draw(cairo_surface_t *surface, const plot_desc *p) {
     layout l;
     layout_make(p, &l);
+    cairo_t *cr = cairo_create(surface);
+    colour(cr, white, 1.0);
+    cairo_paint(cr);
+    /* Unhinted text on both surfaces: the same glyph positions and widths in the SVG and the PNG,
+     * whichever is drawn first (cairo shares fonts between surfaces). */
+    cairo_font_options_t *fo = cairo_font_options_create();
+    cairo_font_options_set_hint_style(fo, CAIRO_HINT_STYLE_NONE);
+    cairo_font_options_set_hint_metrics(fo, CAIRO_HINT_METRICS_OFF);
+    cairo_font_options_set_antialias(fo, CAIRO_ANTIALIAS_GRAY);
+    cairo_set_font_options(cr, fo);
+    cairo_font_options_destroy(fo);
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, 12);
+    draw_axes(cr, p, &l);
+    draw_readings(cr, p, &l);
+    draw_series(cr, p, &l);
+    draw_legend(cr, p, &l);
+    cairo_status_t st = cairo_status(cr);
+    cairo_destroy(cr);
+    return st;
+}
+
+static int draw_failed(const char *path, cairo_status_t st, char *err, size_t errlen) {
+    snprintf(err, errlen, "%s: cannot draw the plot: %s", path, cairo_status_to_string(st));
+    return -1;
+}
+
+/* ---- the two outputs ---------------------------------------------------------------------------- */
+
+typedef struct {
+    unsigned char *data;
+    size_t size, cap;
+} membuf;
+
+static cairo_status_t membuf_write(void *closure, const unsigned char *data, unsigned int n) {
+    membuf *b = closure;
+    if (n > b->cap - b->size) {
+        size_t cap = b->cap ? b->cap : 1 << 16;
+        while (cap - b->size < n) cap *= 2;
+        unsigned char *q = realloc(b->data, cap);
+        if (!q) return CAIRO_STATUS_WRITE_ERROR;
+        b->data = q, b->cap = cap;
+    }
+    memcpy(b->data + b->size, data, n);
+    b->size += n;
+    return CAIRO_STATUS_SUCCESS;
+}
+
+int plot_save_svg(const plot_desc *p, const char *path, write_mode mode, char *err, size_t errlen) {
+    /* cairo writes the document into memory; it goes out through the atomic writer. */
+    membuf b = {0};
+    cairo_surface_t *surface = cairo_svg_surface_create_for_stream(membuf_write, &b, FIG_W, FIG_H);
+    cairo_svg_surface_set_document_unit(surface, CAIRO_SVG_UNIT_USER); /* width="860", as the PNG's pixels */
+    cairo_status_t st = draw(surface, p);
+    cairo_surface_finish(surface);
+    if (st == CAIRO_STATUS_SUCCESS) st = cairo_surface_status(surface);
+    cairo_surface_destroy(surface);
+    int status = st == CAIRO_STATUS_SUCCESS ? write_file_atomic(path, b.data, b.size, mode, err, errlen)
+                                            : draw_failed(path, st, err, errlen);
+    free(b.data);
+    return status;
+}
+
+int plot_save_png(const plot_desc *p, const char *path, write_mode mode, char *err, size_t errlen) {
     /* cairo draws into its own image surface (xRGB, 32 bits a pixel); its pixels go out through
      * png_save_rgb8, the atomic writer every glint export uses. */
     cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, FIG_W, FIG_H);
-    cairo_t *cr = cairo_create(surface);
-    draw(cr, p, &l);
-    cairo_status_t st = cairo_status(cr);
-    cairo_destroy(cr);
+    cairo_status_t st = draw(surface, p);
     cairo_surface_flush(surface);
     unsigned char *rgb = st == CAIRO_STATUS_SUCCESS ? malloc((size_t)FIG_W * FIG_H * 3) : NULL;
     if (!rgb) {
         cairo_surface_destroy(surface);
-        snprintf(err, errlen, "%s: cannot draw the plot: %s", path,
-                 cairo_status_to_string(st != CAIRO_STATUS_SUCCESS ? st : CAIRO_STATUS_NO_MEMORY));
-        return -1;
+        return draw_failed(path, st != CAIRO_STATUS_SUCCESS ? st : CAIRO_STATUS_NO_MEMORY, err, errlen);
     }
     const unsigned char *data = cairo_image_surface_get_data(surface);
     int stride = cairo_image_surface_get_stride(surface);

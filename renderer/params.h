@@ -179,6 +179,7 @@ typedef struct {
     const char *value_name; /* the help's name for the value */
     const char *help;       /* lines for --help, '\n' between them */
     const char *label;      /* the panel's */
+    const char *unit;       /* numbers: what the value counts or measures, for plots' axes */
     double panel_lo, panel_hi;
     int panel_log; /* a logarithmic slider */
     const char *panel_format;

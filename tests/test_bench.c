@@ -4,7 +4,8 @@
  * appear, sweeps, the highlights component; several seeds per run, their summary and its split
  * into noise and bias; mismatched references (size, camera, scene, no or broken description,
  * one of unexpected shape, in the header or a sidecar) and impossible seed counts refused with
- * one error line; nothing ever overwritten; the PNG plot's words.
+ * one error line; nothing ever overwritten; the plots' words, and the SVG drawn as the PNG is (the
+ * curves and legend in the PNG legend's colours, the legend's names as glyphs).
  * Usage: test_bench PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -18,6 +19,7 @@
 #include "check.h"
 #include "cli_harness.h"
 #include "image_io.h"
+#include "svg_read.h"
 
 static const char *const header = "method,params,seed,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,"
                                   "direct_relmse,indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse";
@@ -178,8 +180,9 @@ static void ink(const unsigned char *rgb, int w, int h, int x0, int y0, int x1, 
 
 /* The PNG plot has words where the SVG has them: title, axis labels, the curves' names and the
  * readings' in the legend. The regions hold nothing else (app/plot.c's layout: the plot area
- * 80..580 x 40..430, the legend from x 600, a row every 20 px from y 50). Digits alone, as the
- * PNG once had beside its legend swatches, are narrower than the names asked for. */
+ * 80..580 x 40..430, the legend from x 600, a row every 20 px from y 50). A digit alone, as the
+ * PNG once had beside its legend swatches, is narrower than the names asked for (unhinted 12 px
+ * text: "vsl" 14 px of ink). */
 static void check_png_words(const unsigned char *png, int w, int h) {
     enum { AREA_X0 = 80, AREA_X1 = 580, AREA_Y0 = 40, AREA_Y1 = 430, LEGEND_X = 600 };
     int iw, ih;
@@ -194,11 +197,44 @@ static void check_png_words(const unsigned char *png, int w, int h) {
     ink(png, w, h, AREA_X0 - 20, AREA_Y1 + 8, AREA_X1 + 20, AREA_Y1 + 24, &iw, &ih);
     CHECK(iw >= 400 && ih >= 6, "the PNG has no x tick labels (ink %dx%d)", iw, ih);
     static const char *const names[] = {"pt", "vsl", "equal time", "equal error"};
-    static const int rows[] = {50, 70, 100, 120}, widths[] = {10, 15, 45, 45};
+    static const int rows[] = {50, 70, 100, 120}, widths[] = {10, 12, 45, 45};
     for (int k = 0; k < 4; k++) {
         ink(png, w, h, LEGEND_X + 28, rows[k] - 9, w, rows[k] + 7, &iw, &ih);
         CHECK(iw >= widths[k] && ih >= 6, "the PNG's legend lacks '%s' (ink %dx%d)", names[k], iw, ih);
     }
+}
+
+/* The SVG plot NAME beside its PNG (decoded, 860x500): well-formed, of the PNG's size, with a
+ * curve in the plot area and a line at its legend row in the colour of each of the first
+ * num_series legend swatches of the PNG (one description drawn twice), each legend name as glyphs
+ * at its row, and with bands, a band of the first curve's colour. */
+static void check_svg_plot(const char *name, const unsigned char *png, const char *const *names, const int *rows,
+                           int num_names, int num_series, int band) {
+    enum { AREA_X0 = 80, AREA_X1 = 580, AREA_Y0 = 40, AREA_Y1 = 430, LEGEND_X = 600 };
+    static char svg[1 << 20];
+    read_file(name, svg, sizeof svg);
+    const char *problem = xml_problem(svg);
+    CHECK(problem == NULL, "%s is not well-formed XML: %s", name, problem);
+    drawing *dr = calloc(1, sizeof *dr);
+    if (!dr) return;
+    read_drawing(svg, dr);
+    CHECK(strcmp(dr->width, "860") == 0 && strcmp(dr->height, "500") == 0 && strcmp(dr->view_box, "0 0 860 500") == 0,
+          "%s: %s x %s, viewBox '%s', not the PNG's 860x500", name, dr->width, dr->height, dr->view_box);
+    for (int s = 0; s < num_series; s++) {
+        const unsigned char *q = png + 3 * (rows[s] * 860 + LEGEND_X + 12);
+        const double c[3] = {q[0], q[1], q[2]};
+        CHECK(paths_within(dr, c, 2.0, -1.0, AREA_X0 - 0.5, AREA_Y0 - 0.5, AREA_X1 + 0.5, AREA_Y1 + 0.5) >= 1,
+              "%s: no curve in the colour of '%s' in the PNG (%g %g %g)", name, names[s], c[0], c[1], c[2]);
+        CHECK(paths_within(dr, c, 2.0, -1.0, LEGEND_X, rows[s] - 0.5, LEGEND_X + 24, rows[s] + 0.5) == 1,
+              "%s: no legend line for '%s'", name, names[s]);
+        if (band && s == 0)
+            CHECK(paths_within(dr, c, 0.0, 0.15, AREA_X0 - 0.5, AREA_Y0 - 0.5, AREA_X1 + 0.5, AREA_Y1 + 0.5) >= 1,
+                  "%s: no band in the colour of '%s'", name, names[s]);
+    }
+    for (int k = 0; k < num_names; k++)
+        CHECK(glyphs_in(dr, LEGEND_X + 28, rows[k] - 2, 860, rows[k] + 8) >= visible_chars(names[k]),
+              "%s: the legend lacks '%s'", name, names[k]);
+    free(dr);
 }
 
 static void test_reference_header(void) {
@@ -267,11 +303,6 @@ static void test_bench_run(void) {
                   fabs(sum[i].lo - sum[i].rel_l2) <= 1e-5 * sum[i].lo && isnan(sum[i].noise) && isnan(sum[i].bias),
               "summary row %d: %d fields, %d seeds, %s, rel_l2 %g (run %g), noise %g, bias %g", i, sum[i].fields,
               sum[i].seeds, sum[i].method, sum[i].rel_l2, rows[i].rel_l2, sum[i].noise, sum[i].bias);
-    char svg[1 << 16];
-    read_file("b1/error-vs-time.svg", svg, sizeof svg);
-    CHECK(strncmp(svg, "<svg", 4) == 0 && strstr(svg, "</svg>") && strstr(svg, "<polyline") && strstr(svg, ">pt<") &&
-              strstr(svg, ">vsl<") && strstr(svg, "equal time"),
-          "error-vs-time.svg is not the plot");
     char p[1024];
     snprintf(p, sizeof p, "%s/b1/error-vs-time.png", tmp);
     int w = 0, h = 0, c = 0;
@@ -281,9 +312,12 @@ static void test_bench_run(void) {
         long dark = 0;
         for (long i = 0; i < (long)w * h * 3; i++) dark += png[i] < 128;
         CHECK(dark > 1000, "the png is blank (%ld dark values)", dark);
-        if (w == 860 && h == 500)
+        if (w == 860 && h == 500) {
+            static const char *const names[] = {"pt", "vsl", "equal time", "equal error"};
+            static const int legend_rows[] = {50, 70, 100, 120};
             check_png_words(png, w, h);
-        else
+            check_svg_plot("b1/error-vs-time.svg", png, names, legend_rows, 4, 2, 0);
+        } else
             CHECK(0, "error-vs-time.png is %dx%d, not the 860x500 of the layout the words are looked for in", w, h);
     }
     stbi_image_free(png);
@@ -396,9 +430,18 @@ static void test_seeds(void) {
     CHECK(strstr(md, "RMS over 6 seeds") && strstr(md, "## Noise and bias") && strstr(md, "### pt") &&
               strstr(md, "| noise | bias |"),
           "report.md with seeds: %s", md);
-    char svg[1 << 16];
-    read_file("s1/error-vs-time.svg", svg, sizeof svg);
-    CHECK(strstr(svg, "fill-opacity") != NULL, "the SVG lacks the band over the seeds");
+    /* The band over the seeds, named in the legend below the curve. */
+    char p[1024];
+    snprintf(p, sizeof p, "%s/s1/error-vs-time.png", tmp);
+    int w = 0, h = 0, c = 0;
+    unsigned char *png = stbi_load(p, &w, &h, &c, 3);
+    CHECK(png && w == 860 && h == 500, "s1/error-vs-time.png: %dx%d", w, h);
+    if (png && w == 860 && h == 500) {
+        static const char *const names[] = {"pt", "min–max of 6 seeds", "equal time", "equal error"};
+        static const int legend_rows[] = {50, 80, 100, 120};
+        check_svg_plot("s1/error-vs-time.svg", png, names, legend_rows, 4, 1, 1);
+    }
+    stbi_image_free(png);
 
     /* All bias, no noise: at depth 1 the path tracer has no indirect light at all, so every seed's
      * indirect image is zero: noise 0 and bias 1 exactly (the reference's noise is not known for a

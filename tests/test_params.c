@@ -85,6 +85,7 @@ static void test_entry(const param_desc *d, const char *help) {
     } else {
         CHECK(d->panel_lo < d->panel_hi && d->panel_format, "%s: no slider range", d->name);
         CHECK(d->panel_hi <= d->hi, "%s: the slider goes past the accepted range", d->name);
+        CHECK(d->unit && d->unit[0], "%s: no unit for a sweep plot's axis", d->name);
     }
 }
 
