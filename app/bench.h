@@ -1,7 +1,7 @@
 /* glint bench: what the command's parts share — its options, the runs it plans and measures,
- * the reference it measures against — and the parts' entry points: parsing the options
- * (bench_options.c), running (cmd_bench.c), writing the results, plots and report
- * (bench_report.c). */
+ * the reference it measures against — and the parts' entry points: parsing the options and
+ * expanding presets (bench_options.c), running (cmd_bench.c), writing the results, plots and
+ * report (bench_report.c). */
 #ifndef GLINT_BENCH_H
 #define GLINT_BENCH_H
 
@@ -15,7 +15,8 @@
  * the sum images the noise and bias split keeps, one per budget (320x240 at 64 budgets takes
  * 113 MiB). */
 enum {
-    MAX_METHODS = 8,
+    MAX_VARIANTS = 16,
+    MAX_SETTINGS = 8,
     MAX_TIMES = 64,
     MAX_SWEEPS = 8,
     MAX_VALUES = 32,
@@ -37,11 +38,20 @@ typedef struct {
     char values[MAX_VALUES][32];
 } sweep;
 
+/* A method with settings of its own: --run METHOD:NAME=VALUE,... (--methods gives none). */
+typedef struct {
+    render_method method;
+    int num_settings;
+    char names[MAX_SETTINGS][32], values[MAX_SETTINGS][32];
+    char label[96]; /* "vsl trace-glossy=off" */
+} bench_variant;
+
 typedef struct {
     const char *scene_path, *ref_path, *out_dir, *env_path;
+    const char *preset; /* the --preset expanded, or NULL */
     double env_rotation_deg;
-    render_method methods[MAX_METHODS];
-    int num_methods;
+    bench_variant variants[MAX_VARIANTS];
+    int num_variants;
     double times[MAX_TIMES];
     int num_times;
     sweep sweeps[MAX_SWEEPS];
@@ -54,7 +64,9 @@ typedef struct {
     int seed_given;
     int seeds; /* renders per run, with seeds seed, seed + 1, ... */
     int threads;
-    vl_params vl; /* the many-light options given: every run's base */
+    int plan;      /* PLAN_AUTO, PLAN_FULL: every run's */
+    unsigned only; /* render_params.only: every run's; 0: all */
+    vl_params vl;  /* the many-light options given: every run's base */
     char base_text[512];
     int force, quiet;
 } bench_options;
@@ -64,13 +76,17 @@ typedef struct {
     double seconds, rays;
     long long frames;
     double rel_l2[ERR_COUNT], relmse[ERR_COUNT]; /* NAN: not measured */
+    int threads;
+    double pass_s[PASS_COUNT]; /* render_stats.pass_ns in seconds: thread time (virtual lights: wall) */
+    double merge_s;            /* thread time spent clustering and merging highlight lobes */
 } bench_point;
 
-/* A run: one method with one setting, rendered once per seed. */
+/* A run: one variant with one sweep setting, rendered once per seed. */
 typedef struct {
     render_params params; /* params.seed is the first seed's */
-    char setting[64];     /* "radius-mult=4", or "" for the base parameters */
-    char label[96];       /* "vsl radius-mult=4" */
+    char setting[192];    /* the variant's settings and the sweep's, "trace-glossy=off radius-mult=4" */
+    char label[208];      /* "vsl trace-glossy=off radius-mult=4" */
+    int variant;          /* index into the options' variants */
     int sweep;            /* index into the options' sweeps, -1 for a base run */
     int value;
     bench_point (*points)[MAX_TIMES]; /* [seed][budget] */
@@ -102,8 +118,15 @@ static inline double bench_ref_noise(const bench_ref *r, int component) {
  * (already reported). */
 int bench_parse_options(int argc, char **argv, bench_options *o);
 
-/* The methods a sweepable many-light parameter is live for (bit per render_method). */
+/* The methods a setting (a many-light parameter, or plan) is live for (bit per render_method). */
 unsigned bench_sweep_methods(const char *name);
+
+/* Applies a setting by name: plan (auto|full) or a many-light parameter. Returns 1 when applied,
+ * 0 when name is none of them, -1 on a bad value (reported). */
+int bench_apply_setting(const char *name, const char *value, render_params *p);
+
+/* The film components (1 << COMP_*) an error column compares. */
+unsigned bench_err_mask(int component);
 
 /* results.csv: every checkpoint of every render done of the first num_runs runs; summary.csv:
  * the aggregates of the runs done (num_points > 0). mode: WRITE_NO_REPLACE the first time, then

@@ -48,7 +48,8 @@ int bench_write_csv(const char *dir, const bench_run *runs, int num_runs, int nu
     size_t size;
     FILE *f = open_csv(dir, &buf, &size,
                        "method,params,seed,seconds,frames,spp,rays,rel_l2,relmse,direct_rel_l2,direct_relmse,"
-                       "indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse\n");
+                       "indirect_rel_l2,indirect_relmse,highlights_rel_l2,highlights_relmse,threads,paths_s,direct_s,"
+                       "virtual_lights_s,gather_s,highlights_s,merge_s\n");
     if (!f) return -1;
     for (int r = 0; r < num_runs; r++)
         for (int i = 0; i < runs[r].seeds_done; i++)
@@ -64,7 +65,9 @@ int bench_write_csv(const char *dir, const bench_run *runs, int num_runs, int nu
                     fputc(',', f);
                     csv_number(f, pt->relmse[c]);
                 }
-                fputc('\n', f);
+                fprintf(f, ",%d", pt->threads);
+                for (int q = 0; q < PASS_COUNT; q++) fprintf(f, ",%.6f", pt->pass_s[q]);
+                fprintf(f, ",%.6f\n", pt->merge_s);
             }
     return write_text(f, &buf, &size, dir, "results.csv", mode);
 }
@@ -127,7 +130,7 @@ static int write_time_plot(const bench_options *o, const char *dir, const bench_
             u->label, u->num_points, u->seconds, u->rms, o->seeds > 1 ? u->lo : NULL, o->seeds > 1 ? u->hi : NULL};
     }
     int last = o->num_times - 1, best = best_run(runs, num_runs, last);
-    char title[160], ylabel[128], band[64], xmark[64], ymark[192];
+    char title[160], ylabel[128], band[64], xmark[64], ymark[288];
     snprintf(title, sizeof title, "Relative L2 error (%s) against render time", bench_err_names[o->component]);
     if (o->seeds > 1)
         snprintf(ylabel, sizeof ylabel, "relative L2 error, %s, RMS of %d seeds", bench_err_names[o->component],
@@ -168,22 +171,21 @@ static int sweep_numbers(const sweep *sw, double *x) {
 
 static int write_sweep_plot(const bench_options *o, const char *dir, const bench_run *runs, int num_runs, int w) {
     const sweep *sw = &o->sweeps[w];
-    double x[MAX_VALUES], y[MAX_METHODS][MAX_VALUES];
+    double x[MAX_VALUES], y[MAX_VARIANTS][MAX_VALUES];
     if (!sweep_numbers(sw, x)) return 0;
-    plot_series series[MAX_METHODS];
+    plot_series series[MAX_VARIANTS];
     int ns = 0, last = o->num_times - 1, pos = 1;
     for (int v = 0; v < sw->num_values; v++) pos &= x[v] > 0.0;
-    for (int m = 0; m < o->num_methods; m++) {
+    for (int k = 0; k < o->num_variants; k++) {
         int any = 0;
         for (int v = 0; v < sw->num_values; v++) {
             y[ns][v] = (double)NAN;
             for (int r = 0; r < num_runs; r++)
-                if (runs[r].sweep == w && runs[r].value == v && runs[r].params.method == o->methods[m])
+                if (runs[r].sweep == w && runs[r].value == v && runs[r].variant == k)
                     y[ns][v] = err_at(&runs[r], last), any = 1;
         }
         if (any)
-            series[ns] = (plot_series){.label = method_name(o->methods[m]), .n = sw->num_values, .x = x, .y = y[ns]},
-            ns++;
+            series[ns] = (plot_series){.label = o->variants[k].label, .n = sw->num_values, .x = x, .y = y[ns]}, ns++;
     }
     if (ns == 0) return 0;
     char title[160], ylabel[96], stem[64];
@@ -233,6 +235,7 @@ static void report_header(FILE *f, const bench_options *o, const bench_ref *ref,
     const char *comp = bench_err_names[o->component];
 
     fprintf(f, "# glint bench\n\n");
+    if (o->preset) fprintf(f, "- preset: `%s` (`glint bench --help` lists its options)\n", o->preset);
     fprintf(f, "- scene: `%s` (%s)%s%s%s\n", want->scene, want->scene_hash, want->env[0] ? ", environment `" : "",
             want->env, want->env[0] ? "`" : "");
     fprintf(f, "- %dx%d, camera %d, max depth %d, ", want->width, want->height, want->camera_index, want->max_depth);
@@ -425,6 +428,11 @@ static void report_convergence(FILE *f, const bench_options *o, const bench_run 
     }
 }
 
+/* Whether variant k has runs in sweep w. */
+static int variant_swept(const bench_options *o, int k, int w) {
+    return (bench_sweep_methods(o->sweeps[w].name) & (1u << o->variants[k].method)) != 0;
+}
+
 static void report_sweeps(FILE *f, const bench_options *o, const bench_run *runs, int num_runs) {
     const int last = o->num_times - 1;
     for (int w = 0; w < o->num_sweeps; w++) {
@@ -432,18 +440,18 @@ static void report_sweeps(FILE *f, const bench_options *o, const bench_run *runs
         fprintf(f, "\n## Sweep: %s\n\n%s (%s) at %g s against the value of `--%s`.\n\n| %s |", sw->name,
                 o->seeds > 1 ? "RMS over seeds of the relative L2 error" : "Relative L2 error",
                 bench_err_names[o->component], o->times[last], sw->name, sw->name);
-        for (int m = 0; m < o->num_methods; m++)
-            if (bench_sweep_methods(sw->name) & (1u << o->methods[m])) fprintf(f, " %s |", method_name(o->methods[m]));
+        for (int k = 0; k < o->num_variants; k++)
+            if (variant_swept(o, k, w)) fprintf(f, " %s |", o->variants[k].label);
         fputs("\n|---|", f);
-        for (int m = 0; m < o->num_methods; m++)
-            if (bench_sweep_methods(sw->name) & (1u << o->methods[m])) fputs("---|", f);
+        for (int k = 0; k < o->num_variants; k++)
+            if (variant_swept(o, k, w)) fputs("---|", f);
         fputs("\n", f);
         for (int v = 0; v < sw->num_values; v++) {
             fprintf(f, "| %s |", sw->values[v]);
-            for (int m = 0; m < o->num_methods; m++) {
-                if (!(bench_sweep_methods(sw->name) & (1u << o->methods[m]))) continue;
+            for (int k = 0; k < o->num_variants; k++) {
+                if (!variant_swept(o, k, w)) continue;
                 for (int r = 0; r < num_runs; r++)
-                    if (runs[r].sweep == w && runs[r].value == v && runs[r].params.method == o->methods[m]) {
+                    if (runs[r].sweep == w && runs[r].value == v && runs[r].variant == k) {
                         fputc(' ', f);
                         md_error(f, err_at(&runs[r], last));
                         fputs(" |", f);
@@ -453,6 +461,39 @@ static void report_sweeps(FILE *f, const bench_options *o, const bench_run *runs
         }
         double x[MAX_VALUES];
         if (sweep_numbers(sw, x)) fprintf(f, "\n![error against %s](sweep-%s.svg)\n", sw->name, sw->name);
+    }
+}
+
+/* Per run at the last budget, over its seeds: frames, time a frame, each pass's share of the
+ * render threads' time and the share spent merging highlight lobes. */
+static void report_time(FILE *f, const bench_options *o, const bench_run *runs, int num_runs) {
+    const int last = o->num_times - 1;
+    fprintf(f,
+            "\n## Where the time goes\n\nAt %g s, mean over the seeds: each pass's share of the render threads' "
+            "time (threads x render time; the virtual lights' preparation counts its wall time on every "
+            "thread, camera rays count to the direct pass) and, of that, the share spent clustering and "
+            "merging highlight lobes (the highlight paper's Table 1, column C).\n\n| run | frames | ms a frame |",
+            o->times[last]);
+    for (int q = 0; q < PASS_COUNT; q++) fprintf(f, " %s |", pass_names[q]);
+    fputs(" merging |\n|---|---|---|", f);
+    for (int q = 0; q <= PASS_COUNT; q++) fputs("---|", f);
+    fputs("\n", f);
+    for (int r = 0; r < num_runs; r++) {
+        const bench_run *u = &runs[r];
+        if (u->seeds_done == 0) continue;
+        double share[PASS_COUNT + 1] = {0}, frames = 0.0, secs = 0.0;
+        for (int i = 0; i < u->seeds_done; i++) {
+            const bench_point *pt = &u->points[i][last];
+            double thread_s = pt->seconds * (pt->threads > 0 ? pt->threads : 1);
+            for (int q = 0; q < PASS_COUNT; q++)
+                share[q] += (q == PASS_VIRTUAL_LIGHTS ? pt->pass_s[q] * pt->threads : pt->pass_s[q]) / thread_s;
+            share[PASS_COUNT] += pt->merge_s / thread_s;
+            frames += (double)pt->frames;
+            secs += pt->seconds;
+        }
+        fprintf(f, "| %s | %.0f | %.3g |", u->label, frames / u->seeds_done, frames > 0 ? 1e3 * secs / frames : 0.0);
+        for (int q = 0; q <= PASS_COUNT; q++) fprintf(f, " %.1f%% |", 100.0 * share[q] / u->seeds_done);
+        fputs("\n", f);
     }
 }
 
@@ -468,7 +509,9 @@ static int write_report(const bench_options *o, const char *dir, const bench_ref
     report_winners(f, o, runs, num_runs);
     report_convergence(f, o, runs, num_runs);
     report_sweeps(f, o, runs, num_runs);
-    fputs("\n## Files\n\n- `results.csv`: every checkpoint of every render (one per seed), all components\n"
+    report_time(f, o, runs, num_runs);
+    fputs("\n## Files\n\n- `results.csv`: every checkpoint of every render (one per seed), all components, each "
+          "pass's time\n"
           "- `summary.csv`: per method, setting and budget, over the seeds: the RMS of rel_l2, the mean relMSE, "
           "noise and bias, the reference's own noise, the least and largest rel_l2\n"
           "- `error-vs-time.svg`, `error-vs-time.png`: the curves (log–log); squares mark the equal-time "

@@ -1,9 +1,10 @@
-/* glint bench: what accuracy costs in time. Renders each method (and each setting of a parameter
- * sweep) progressively against a reference, once per seed, reads the error at each time budget of
- * every render, splits it into noise and bias over the seeds, and writes results.csv, summary.csv,
- * error-versus-time plots (SVG, PNG) and report.md into a directory. This file loads the
- * reference, plans, runs and measures the renders; bench_options.c parses the command line,
- * bench_report.c writes the outputs. */
+/* glint bench: what accuracy costs in time. Renders each run (a method with its settings, once
+ * per setting of a sweep) progressively against a reference, once per seed, reads the error and
+ * each pass's time at each time budget of every render, splits the error into noise and bias
+ * over the seeds, and writes results.csv, summary.csv, error-versus-time plots (SVG, PNG) and
+ * report.md into a directory. This file loads the reference, plans, runs and measures the
+ * renders; bench_options.c parses the command line and expands presets, bench_report.c writes
+ * the outputs. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -97,6 +98,7 @@ static int ref_load(const bench_options *o, bench_ref *r) {
 typedef struct {
     const bench_ref *ref;
     int component;
+    unsigned only; /* the components rendered; 0: all */
     float *img;
     size_t n;
     double *sum;            /* [budget][value]; NULL with one seed */
@@ -107,12 +109,11 @@ static void measure(meter *m, const render_session *rs, bench_point *pt, int k) 
     const film *f = session_film(rs);
     const render_params *p = session_params(rs);
     int splits = p->pt_highlights || p->method == METHOD_VSL_HL;
-    const unsigned masks[ERR_COUNT] = {COMP_MASK_ALL, 1u << COMP_DIRECT,
-                                       (1u << COMP_INDIRECT) | (1u << COMP_HIGHLIGHTS), 1u << COMP_HIGHLIGHTS};
     for (int c = 0; c < ERR_COUNT; c++) {
+        unsigned mask = bench_err_mask(c);
         pt->rel_l2[c] = pt->relmse[c] = (double)NAN;
-        if (!m->ref->layer[c] || (c == ERR_HIGHLIGHTS && !splits)) continue;
-        film_resolve(f, masks[c], m->img);
+        if (!m->ref->layer[c] || (c == ERR_HIGHLIGHTS && !splits) || (m->only && (mask & m->only) != mask)) continue;
+        film_resolve(f, mask, m->img);
         pt->rel_l2[c] = metric_rel_l2(m->img, m->ref->layer[c], m->n);
         pt->relmse[c] = metric_relmse(m->img, m->ref->layer[c], m->n);
         if (c == m->component && m->sum)
@@ -128,6 +129,15 @@ static int render_seed(const bench_options *o, const scene *s, const camera *cam
     params.seed = run->params.seed + (uint64_t)seed;
     render_session *rs = session_create(s, cam, &params, err, sizeof err);
     if (!rs) return cli_error("%s", err), -1;
+    const effect_plan *plan = session_plan(rs);
+    if ((params.only & (1u << COMP_HIGHLIGHTS)) && params.method == METHOD_VSL_HL &&
+        !(plan->highlights && plan->max_depth > 1)) {
+        session_destroy(rs);
+        return cli_error("%s: --only highlights: the effect plan runs no highlight pass here (glint info --method "
+                         "vsl+hl shows why)",
+                         s->path),
+               -1;
+    }
     double rendered = 0.0;
     for (int k = 0; k < o->num_times; k++) {
         /* Only frame time counts: measuring the error in between is not the method's cost. */
@@ -146,6 +156,9 @@ static int render_seed(const bench_options *o, const scene *s, const camera *cam
         for (int r = 0; r < RAY_KIND_COUNT; r++) pt->rays += (double)st.rays[r];
         pt->seconds = rendered;
         pt->frames = session_frames(rs);
+        pt->threads = session_params(rs)->threads;
+        for (int q = 0; q < PASS_COUNT; q++) pt->pass_s[q] = 1e-9 * (double)st.pass_ns[q];
+        pt->merge_s = 1e-9 * (double)st.hl_merge_ns;
         measure(m, rs, pt, k);
         if (o->quiet) continue;
         char which[64] = "";
@@ -245,39 +258,47 @@ static int prepare_dir(const bench_options *o, char *dir, size_t dirlen) {
 
 /* ---- the command ----------------------------------------------------------------------------- */
 
-/* One run per method and sweep setting; a method no sweep applies to runs once, with the base. */
+/* Appends " name=value" (without the space when empty) to text. */
+static void append_setting(char *text, size_t len, const char *name, const char *value) {
+    size_t at = strlen(text);
+    snprintf(text + at, len - at, "%s%s=%s", at ? " " : "", name, value);
+}
+
+/* One run per variant and sweep setting; a variant no sweep applies to runs once, with its own
+ * settings. */
 static int plan_runs(const bench_options *o, const render_params *base, int split_highlights, bench_run *runs) {
     int n = 0;
-    for (int m = 0; m < o->num_methods; m++) {
+    for (int k = 0; k < o->num_variants; k++) {
+        const bench_variant *var = &o->variants[k];
         render_params p = *base;
-        p.method = o->methods[m];
+        p.method = var->method;
         p.pt_highlights = p.method == METHOD_PT && split_highlights;
+        char own[192] = "";
+        for (int j = 0; j < var->num_settings; j++) {
+            bench_apply_setting(var->names[j], var->values[j], &p); /* validated */
+            append_setting(own, sizeof own, var->names[j], var->values[j]);
+        }
         int swept = 0;
-        for (int w = 0; w < o->num_sweeps; w++) {
-            if (!(bench_sweep_methods(o->sweeps[w].name) & (1u << p.method))) continue;
-            for (int v = 0; v < o->sweeps[w].num_values; v++, swept++) {
-                if (n >= MAX_RUNS) { /* counted, so the caller can refuse */
-                    n++;
-                    continue;
-                }
-                bench_run *r = &runs[n++];
+        for (int w = 0; w <= o->num_sweeps; w++) {
+            const sweep *sw = w < o->num_sweeps ? &o->sweeps[w] : NULL;
+            if (sw && !(bench_sweep_methods(sw->name) & (1u << p.method))) continue;
+            if (!sw && swept) break; /* the base run only when no sweep applies */
+            for (int v = 0; v < (sw ? sw->num_values : 1); v++, swept++) {
+                if (n++ >= MAX_RUNS) continue; /* counted, so the caller can refuse */
+                bench_run *r = &runs[n - 1];
                 memset(r, 0, sizeof *r);
                 r->params = p;
-                cli_set_vl_param(o->sweeps[w].name, o->sweeps[w].values[v], &r->params.vl); /* validated */
-                r->sweep = w;
+                r->variant = k;
+                r->sweep = sw ? w : -1;
                 r->value = v;
-                snprintf(r->setting, sizeof r->setting, "%s=%s", o->sweeps[w].name, o->sweeps[w].values[v]);
-                snprintf(r->label, sizeof r->label, "%s %s", method_name(p.method), r->setting);
+                snprintf(r->setting, sizeof r->setting, "%s", own);
+                if (sw) {
+                    bench_apply_setting(sw->name, sw->values[v], &r->params); /* validated */
+                    append_setting(r->setting, sizeof r->setting, sw->name, sw->values[v]);
+                }
+                snprintf(r->label, sizeof r->label, "%s%s%s", method_name(p.method), r->setting[0] ? " " : "",
+                         r->setting);
             }
-        }
-        if (!swept && n >= MAX_RUNS) {
-            n++;
-        } else if (!swept) {
-            bench_run *r = &runs[n++];
-            memset(r, 0, sizeof *r);
-            r->params = p;
-            r->sweep = -1;
-            snprintf(r->label, sizeof r->label, "%s", method_name(p.method));
         }
     }
     return n;
@@ -292,7 +313,8 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
         return cli_error("%s: rendered at %dx%d, not %dx%d", o->ref_path, ref->width, ref->height, width, height),
                EXIT_FAILURE_;
     int cam_index = o->camera_index >= 0 ? (int)o->camera_index : have ? have->camera_index : -1;
-    render_params base = {.width = width, .height = height, .threads = o->threads, .vl = o->vl};
+    render_params base = {
+        .width = width, .height = height, .threads = o->threads, .plan = o->plan, .only = o->only, .vl = o->vl};
     base.max_depth = o->max_depth ? o->max_depth : have ? have->max_depth : 0;
     if (have && o->max_depth && o->max_depth != have->max_depth)
         cli_warning("%s: rendered with --max-depth %d, the bench uses %d: the errors include that difference",
@@ -328,7 +350,7 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
 
     int num_runs = plan_runs(o, &base, ref->layer[ERR_HIGHLIGHTS] != NULL, runs);
     if (num_runs > MAX_RUNS)
-        return cli_error("more than %d runs (methods x sweep values); split the bench", MAX_RUNS), EXIT_USAGE;
+        return cli_error("more than %d runs (runs x sweep values); split the bench", MAX_RUNS), EXIT_USAGE;
     if (num_runs * o->seeds > MAX_RENDERS)
         return cli_error("--seeds %d: %d runs x %d seeds = %d renders, more than %d; split the bench", o->seeds,
                          num_runs, o->seeds, num_runs * o->seeds, MAX_RENDERS),
@@ -353,7 +375,7 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
         return EXIT_FAILURE_;
     }
     if (have && strcmp(have->method, "pt") != 0)
-        cli_warning("%s: rendered with %s, not pt: its bias is in every error", o->ref_path, have->method);
+        cli_warning("%s: rendered with %s, not pt: its bias, if any, is in every error", o->ref_path, have->method);
     camera cam = scene_camera(s, cam_index, (float)width / (float)height);
 
     char dir[4096];
@@ -366,7 +388,7 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     if (!o->quiet)
         fprintf(stderr, "glint: bench: %d run%s x %d seed%s of %g s, about %.0f s; writing into %s\n", num_runs,
                 num_runs == 1 ? "" : "s", o->seeds, o->seeds == 1 ? "" : "s", last, renders * last, dir);
-    meter m = {.ref = ref, .component = o->component, .n = values};
+    meter m = {.ref = ref, .component = o->component, .only = o->only, .n = values};
     m.img = malloc(sizeof(float) * m.n);
     if (o->seeds > 1) m.sum = malloc((size_t)split_bytes);
     bench_point(*points)[MAX_TIMES] = calloc((size_t)renders, sizeof *points);

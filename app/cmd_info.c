@@ -1,24 +1,78 @@
-/* glint info: what a scene holds. */
+/* glint info: what a scene holds; its triangles as Wavefront OBJ for other renderers. */
+#define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
 
 #include "cli.h"
 #include "commands.h"
+#include "image_io.h"
 
 static void print_info_help(void) {
     printf("usage: glint info [SCENE] [--env FILE] [--method NAME] [--max-depth D] [--plan auto|full]\n"
+           "                  [--obj FILE.obj]\n"
            "\n"
            "Prints a summary of SCENE: geometry, materials, lights, cameras, size; then what the\n"
            "scene calls for (material classes, emitters, whether indirect and glossy-to-glossy\n"
            "transport exist) and the passes method NAME would run (default vsl+hl, which has them\n"
            "all), each with its reason.\n"
+           "\n"
+           "--obj FILE.obj writes the triangles as loaded (world space, with normals) as Wavefront\n"
+           "OBJ, and beside it FILE.mtl with each material's diffuse colour (its base colour or\n"
+           "Phong/Ward kd; nothing else of the material): the same geometry for another renderer.\n"
            "\n");
     cli_print_scenes();
 }
 
+/* FILE.obj and FILE.mtl (FILE.obj.mtl for another extension), each written atomically. */
+static int write_obj(const scene *s, const char *obj_path) {
+    char mtl_path[4200], err[4400];
+    size_t len = strlen(obj_path);
+    if (len > 4 && strcmp(obj_path + len - 4, ".obj") == 0)
+        snprintf(mtl_path, sizeof mtl_path, "%.*s.mtl", (int)(len - 4), obj_path);
+    else
+        snprintf(mtl_path, sizeof mtl_path, "%s.mtl", obj_path);
+    const char *slash = strrchr(mtl_path, '/');
+    char *buf[2] = {NULL, NULL};
+    size_t size[2] = {0, 0};
+    FILE *mtl = open_memstream(&buf[0], &size[0]), *obj = open_memstream(&buf[1], &size[1]);
+    if (!mtl || !obj) {
+        if (mtl) fclose(mtl);
+        if (obj) fclose(obj);
+        free(buf[0]);
+        free(buf[1]);
+        return cli_error("%s: out of memory", obj_path), -1;
+    }
+    for (int m = 0; m < s->num_materials; m++) {
+        const material *mat = &s->materials[m];
+        vec3 kd = mat->model == MATERIAL_GLTF ? mat->base_color : mat->kd;
+        fprintf(mtl, "newmtl m%d\nKd %.6g %.6g %.6g\nKs 0 0 0\n\n", m, (double)kd.x, (double)kd.y, (double)kd.z);
+    }
+    fprintf(obj, "mtllib %s\n", slash ? slash + 1 : mtl_path);
+    for (int i = 0; i < s->num_vertices; i++)
+        fprintf(obj, "v %.9g %.9g %.9g\n", (double)s->positions[i].x, (double)s->positions[i].y,
+                (double)s->positions[i].z);
+    for (int i = 0; i < s->num_vertices; i++)
+        fprintf(obj, "vn %.6g %.6g %.6g\n", (double)s->normals[i].x, (double)s->normals[i].y, (double)s->normals[i].z);
+    int current = -1;
+    for (int t = 0; t < s->num_triangles; t++) {
+        if (s->tri_material[t] != current) fprintf(obj, "usemtl m%d\n", current = s->tri_material[t]);
+        const uint32_t *v = &s->indices[3 * t];
+        fprintf(obj, "f %u//%u %u//%u %u//%u\n", v[0] + 1, v[0] + 1, v[1] + 1, v[1] + 1, v[2] + 1, v[2] + 1);
+    }
+    fclose(mtl);
+    fclose(obj);
+    int status = write_file_atomic(mtl_path, buf[0], size[0], WRITE_REPLACE, err, sizeof err);
+    if (status == 0) status = write_file_atomic(obj_path, buf[1], size[1], WRITE_REPLACE, err, sizeof err);
+    free(buf[0]);
+    free(buf[1]);
+    if (status) cli_error("%s", err);
+    return status;
+}
+
 int cmd_info(int argc, char **argv) {
-    const char *path = NULL, *env = NULL;
+    const char *path = NULL, *env = NULL, *obj = NULL;
     int method = METHOD_VSL_HL, max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
@@ -38,6 +92,8 @@ int cmd_info(int argc, char **argv) {
             long long n;
             if (!v || cli_parse_int("--max-depth", v, 1, 10000, &n)) return EXIT_USAGE;
             max_depth = (int)n;
+        } else if (strcmp(argv[i], "--obj") == 0) {
+            if (!(obj = cli_value(argc, argv, &i))) return EXIT_USAGE;
         } else if (strcmp(argv[i], "--plan") == 0) {
             const char *v = cli_value(argc, argv, &i);
             if (!v || cli_parse_plan("--plan", v, &plan_mode)) return EXIT_USAGE;
@@ -45,6 +101,7 @@ int cmd_info(int argc, char **argv) {
             return EXIT_USAGE;
         }
     }
+    if (obj && cli_check_output_dir("--obj", obj)) return EXIT_FAILURE_;
     double t0 = cli_now();
     scene *s = load_scene_or_default(path, env, 0.0f);
     if (!s) return EXIT_FAILURE_;
@@ -75,6 +132,10 @@ int cmd_info(int argc, char **argv) {
     /* Load includes parsing, flattening, the light list and the BVH build; ru_maxrss is in KiB. */
     printf("load:       %.3f s, peak memory %.1f MiB\n", load_seconds, (double)ru.ru_maxrss / 1024.0);
     if (s->num_warnings) printf("warnings:   %d (printed above)\n", s->num_warnings);
+    if (obj && write_obj(s, obj) != 0) {
+        scene_destroy(s);
+        return EXIT_FAILURE_;
+    }
     scene_analysis a;
     char err[256];
     if (scene_analyse(s, &a, err, sizeof err) != 0) {

@@ -152,7 +152,7 @@ static unsigned exr_layers(const render_options *o) {
 }
 
 static int write_stats(const char *path, const render_options *o, const render_session *rs, const scene *s,
-                       double seconds) {
+                       const camera *cam, double seconds) {
     char *buf = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&buf, &size);
@@ -168,6 +168,13 @@ static int write_stats(const char *path, const render_options *o, const render_s
             frames, frames);
     fprintf(f, "  \"seconds\": %.6f,\n  \"max_depth\": %d,\n  \"seed\": %llu,\n  \"threads\": %d,\n", seconds,
             p->max_depth, (unsigned long long)p->seed, p->threads);
+    const vec3 *axis[3] = {&cam->position, &cam->forward, &cam->up};
+    const char *axis_name[3] = {"position", "forward", "up"};
+    fprintf(f, "  \"camera\": {");
+    for (int k = 0; k < 3; k++)
+        fprintf(f, "\"%s\": [%.9g, %.9g, %.9g], ", axis_name[k], (double)axis[k]->x, (double)axis[k]->y,
+                (double)axis[k]->z);
+    fprintf(f, "\"yfov_degrees\": %.9g},\n", (double)cam->yfov * 180.0 / 3.14159265358979323846);
     fprintf(f, "  \"rays\": {");
     for (int k = 0; k < RAY_KIND_COUNT; k++)
         fprintf(f, "\"%s\": %llu, ", ray_kind_names[k], (unsigned long long)st.rays[k]);
@@ -237,8 +244,8 @@ static char *describe_reference(const render_options *o, const render_session *r
     return json;
 }
 
-static int write_outputs(const render_options *o, const render_session *rs, const scene *s, double seconds,
-                         reference_noise *rn) {
+static int write_outputs(const render_options *o, const render_session *rs, const scene *s, const camera *cam,
+                         double seconds, reference_noise *rn) {
     const film *fm = session_film(rs);
     char err[1024];
     const unsigned layers = exr_layers(o);
@@ -271,7 +278,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
         }
         if (png == fallback) printf("wrote %s\n", png);
     }
-    if (o->out_stats) return write_stats(o->out_stats, o, rs, s, seconds);
+    if (o->out_stats) return write_stats(o->out_stats, o, rs, s, cam, seconds);
     return 0;
 }
 
@@ -345,7 +352,7 @@ int cmd_render(int argc, char **argv) {
     size_t clamped = film_count_clamped(session_film(rs), exr_layers(&o));
     if (clamped) cli_warning("%zu pixel values beyond float's range were written as the largest float", clamped);
 
-    int status = write_outputs(&o, rs, s, elapsed, &rn);
+    int status = write_outputs(&o, rs, s, &cam, elapsed, &rn);
     reference_noise_deinit(&rn);
     session_destroy(rs);
     scene_destroy(s);

@@ -101,6 +101,9 @@ typedef struct {
     int threads;       /* 0: one per core */
     int pt_highlights; /* pt: camera - glossy - glossy - light paths in their own component */
     int plan;          /* PLAN_AUTO: only the passes the scene calls for; PLAN_FULL: all */
+    unsigned only;     /* many-light methods: render only these film components (a mask of
+                        * 1 << COMP_*), skipping the others' passes, to time one estimator alone;
+                        * the path tracer renders whole paths regardless; 0: all */
     vl_params vl;
 } render_params;
 

@@ -52,6 +52,17 @@ struct render_session {
     char error[256];
 };
 
+/* The plan for the session's parameters, less the passes of the components it does not render. */
+static effect_plan session_make_plan(const render_session *rs) {
+    const render_params *p = &rs->params;
+    effect_plan plan = plan_make(&rs->analysis, p->method, p->max_depth, p->plan);
+    if (p->only && p->method != METHOD_PT) {
+        if (!(p->only & (1u << COMP_INDIRECT))) plan.virtual_lights = 0;
+        if (!(p->only & (1u << COMP_HIGHLIGHTS))) plan.highlights = plan.env_prefilter = 0;
+    }
+    return plan;
+}
+
 render_session *session_create(const scene *s, const camera *cam, const render_params *params, char *err,
                                size_t errlen) {
     render_session *rs = calloc(1, sizeof(render_session));
@@ -76,7 +87,7 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         session_destroy(rs);
         return NULL;
     }
-    rs->plan = plan_make(&rs->analysis, p->method, p->max_depth, p->plan);
+    rs->plan = session_make_plan(rs);
     rs->tiles_x = (p->width + TILE - 1) / TILE;
     rs->tiles_y = (p->height + TILE - 1) / TILE;
     return rs;
@@ -111,7 +122,10 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
          * highlights, each pass timed. */
         for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
         uint64_t t0 = clock_ns();
-        L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first, MANYLIGHT_DIRECT_SAMPLES, rng, st->rays);
+        if (!p->only || p->only & (1u << COMP_DIRECT))
+            L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first, MANYLIGHT_DIRECT_SAMPLES, rng, st->rays);
+        else
+            st->rays[RAY_CAMERA]++;
         uint64_t t1 = clock_ns();
         st->pass_ns[PASS_DIRECT] += t1 - t0;
         if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
@@ -250,7 +264,7 @@ int session_scene_changed(render_session *rs) {
         env_vmf_filter_destroy(rs->envf);
         rs->envf = NULL;
     }
-    rs->plan = plan_make(&rs->analysis, rs->params.method, rs->params.max_depth, rs->params.plan);
+    rs->plan = session_make_plan(rs);
     session_reset(rs);
     return 0;
 }
@@ -267,7 +281,7 @@ void session_set_params(render_session *rs, const render_params *params) {
     p.threads = rs->params.threads;
     p = render_params_resolve_frame(&p);
     rs->params = p;
-    rs->plan = plan_make(&rs->analysis, p.method, p.max_depth, p.plan);
+    rs->plan = session_make_plan(rs);
     session_reset(rs);
 }
 

@@ -1,6 +1,7 @@
 /* The glint command line, run as a user would: exit codes (0, 1, 2), one-line errors naming the
  * file, the outputs (EXR layers that sum to the image, a PNG of the right size, stats JSON),
- * atomic and non-overwriting exports, progress lines when stderr is not a terminal.
+ * atomic and non-overwriting exports, progress lines when stderr is not a terminal; glint info's
+ * OBJ export against its own summary, the camera in the stats.
  * Usage: test_cli PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
@@ -320,6 +321,68 @@ static void test_highlights_layer(void) {
     exr_image_free(&exr);
 }
 
+/* glint info --obj: as many vertices and triangles as the summary says, bounds of its size,
+ * every face's indices in range, every material it uses defined in the MTL it names. glint
+ * render --stats: the camera as an orthonormal frame with a field of view. */
+static void test_obj_and_camera(void) {
+    int rc = run("info builtin:showcase --obj scene.obj");
+    CHECK(rc == 0, "info --obj: exit %d: %s", rc, err_text);
+    long triangles = -1, vertices = -1;
+    double ext[3] = {0, 0, 0};
+    const char *g = strstr(out_text, "geometry:   "), *z = strstr(out_text, "size:       ");
+    CHECK(g && sscanf(g, "geometry: %ld triangles, %ld vertices", &triangles, &vertices) == 2 && z &&
+              sscanf(z, "size: %lf x %lf x %lf", &ext[0], &ext[1], &ext[2]) == 3,
+          "info: %s", out_text);
+    static char obj[1 << 20], mtl[1 << 16];
+    read_file("scene.obj", obj, sizeof obj);
+    read_file("scene.mtl", mtl, sizeof mtl);
+    long v = 0, vn = 0, f = 0, bad = 0;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    CHECK(strncmp(obj, "mtllib scene.mtl\n", 17) == 0, "scene.obj does not name scene.mtl: %.40s", obj);
+    for (char *line = obj; *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : line + strlen(line)) {
+        double p[3];
+        long a[6];
+        char name[64], want[80];
+        if (sscanf(line, "v %lf %lf %lf", &p[0], &p[1], &p[2]) == 3) {
+            v++;
+            for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], p[k]), hi[k] = fmax(hi[k], p[k]);
+        } else if (strncmp(line, "vn ", 3) == 0) {
+            vn++;
+        } else if (sscanf(line, "f %ld//%ld %ld//%ld %ld//%ld", &a[0], &a[1], &a[2], &a[3], &a[4], &a[5]) == 6) {
+            f++;
+            for (int k = 0; k < 6; k++) bad += a[k] < 1 || a[k] > vertices || a[k] != a[k & ~1];
+        } else if (sscanf(line, "usemtl %63s", name) == 1) {
+            snprintf(want, sizeof want, "newmtl %s\nKd ", name);
+            bad += strstr(mtl, want) == NULL;
+        }
+    }
+    CHECK(v == vertices && vn == vertices && f == triangles && bad == 0,
+          "scene.obj: %ld v, %ld vn, %ld f, %ld bad (the summary: %ld vertices, %ld triangles)", v, vn, f, bad,
+          vertices, triangles);
+    for (int k = 0; k < 3; k++)
+        CHECK(fabs((hi[k] - lo[k]) - ext[k]) <= 1e-3 * ext[k], "scene.obj spans %g on axis %d, the summary %g",
+              hi[k] - lo[k], k, ext[k]);
+    expect_failure("info --obj nowhere/scene.obj", 1, "nowhere");
+
+    rc = run("render --spp 1 --size 16x9 --stats cam.json --quiet");
+    CHECK(rc == 0, "render --stats: exit %d: %s", rc, err_text);
+    char json[8192];
+    read_file("cam.json", json, sizeof json);
+    double c[3][3], fov = 0.0;
+    const char *cam = strstr(json, "\"camera\": {\"position\": [");
+    CHECK(cam && sscanf(cam,
+                        "\"camera\": {\"position\": [%lf, %lf, %lf], \"forward\": [%lf, %lf, %lf], \"up\": [%lf, %lf, "
+                        "%lf], \"yfov_degrees\": %lf}",
+                        &c[0][0], &c[0][1], &c[0][2], &c[1][0], &c[1][1], &c[1][2], &c[2][0], &c[2][1], &c[2][2],
+                        &fov) == 10,
+          "stats lack the camera: %s", json);
+    double ff = c[1][0] * c[1][0] + c[1][1] * c[1][1] + c[1][2] * c[1][2];
+    double uu = c[2][0] * c[2][0] + c[2][1] * c[2][1] + c[2][2] * c[2][2];
+    double fu = c[1][0] * c[2][0] + c[1][1] * c[2][1] + c[1][2] * c[2][2];
+    CHECK(fabs(ff - 1.0) < 1e-5 && fabs(uu - 1.0) < 1e-5 && fabs(fu) < 1e-5 && fov > 1.0 && fov < 179.0,
+          "camera: |forward|^2 %g, |up|^2 %g, forward.up %g, yfov %g", ff, uu, fu, fov);
+}
+
 int main(int argc, char **argv) {
     /* An empty directory, so the default-output numbering is known. */
     int start = harness_start(argc, argv, "cli");
@@ -330,5 +393,6 @@ int main(int argc, char **argv) {
     test_outputs();
     test_many_light_options();
     test_highlights_layer();
+    test_obj_and_camera();
     return check_exit("test_cli");
 }

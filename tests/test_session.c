@@ -3,7 +3,8 @@
  * leaves a film equal to one never stopped (same seed: the same image, bit for bit); statistics
  * count the frames since the last reset (the viewer's rays per second and virtual lights); a scene
  * edit re-analyses the scene and restarts. And the frames' positions inside a pixel cover it evenly:
- * an emitter's straight edge seen directly converges faster than independent positions would. */
+ * an emitter's straight edge seen directly converges faster than independent positions would.
+ * render_params.only: the components left out stay exactly zero and their passes never run. */
 #include <math.h>
 
 #include "check.h"
@@ -55,8 +56,68 @@ static void check_edge_coverage(void) {
     scene_destroy(s);
 }
 
+/* Sums of each component's film after two frames of p, and the statistics. */
+static render_stats render_only(const scene *s, const camera *cam, render_params p, double sum[COMP_COUNT]) {
+    char err[256];
+    render_session *rs = session_create(s, cam, &p, err, sizeof err);
+    CHECK(rs != NULL, "session: %s", err);
+    if (!rs) return (render_stats){0};
+    for (int f = 0; f < 2; f++) CHECK(session_render_frame(rs) == 0, "frame %d: %s", f, session_error(rs));
+    float img[3 * W * H];
+    for (int c = 0; c < COMP_COUNT; c++) {
+        film_resolve(session_film(rs), 1u << c, img);
+        sum[c] = 0.0;
+        for (int i = 0; i < 3 * W * H; i++) sum[c] += img[i];
+    }
+    render_stats st = session_stats(rs);
+    session_destroy(rs);
+    return st;
+}
+
+/* A glossy room (every wall a sharp Phong lobe), every pass forced on, some components left out. */
+static void check_only(void) {
+    scene *s = ts_new("glossy room");
+    ts_box(s, v3(-1, 0, -1), v3(1, 2, 1), 1, ts_material(s, ts_phong(v3s(0.3f), v3s(0.6f), 2000.0f)));
+    ts_quad(s, v3(-0.3f, 1.98f, -0.3f), v3(0.3f, 1.98f, -0.3f), v3(0.3f, 1.98f, 0.3f), v3(-0.3f, 1.98f, 0.3f),
+            ts_lambert(s, v3s(0.0f), v3s(5.0f), 0));
+    ts_finalize(s);
+    camera cam = camera_look_at(v3(0, 1, 0.9f), v3(0, 1, -1), v3(0, 1, 0), 1.2f);
+    const unsigned D = 1u << COMP_DIRECT, I = 1u << COMP_INDIRECT, HL = 1u << COMP_HIGHLIGHTS;
+    const unsigned masks[] = {0, HL, D, D | I};
+    for (int k = 0; k < 4; k++) {
+        render_params p = {.width = W,
+                           .height = H,
+                           .method = METHOD_VSL_HL,
+                           .max_depth = 4,
+                           .seed = 5,
+                           .plan = PLAN_FULL,
+                           .only = masks[k],
+                           .vl = {.count = 64}};
+        double sum[COMP_COUNT];
+        render_stats st = render_only(s, &cam, p, sum);
+        unsigned rendered = masks[k] ? masks[k] : COMP_MASK_ALL;
+        for (int c = 0; c < COMP_COUNT; c++)
+            CHECK((rendered >> c & 1u) ? sum[c] > 0.0 && isfinite(sum[c]) : sum[c] == 0.0,
+                  "only %#x: component %d sums to %g", masks[k], c, sum[c]);
+        CHECK(st.rays[RAY_CAMERA] == (uint64_t)(2 * W * H), "only %#x: %llu camera rays for %d", masks[k],
+              (unsigned long long)st.rays[RAY_CAMERA], 2 * W * H);
+        CHECK((rendered & I) ? st.virtual_lights > 0 : st.virtual_lights == 0 && st.pass_ns[PASS_GATHER] == 0,
+              "only %#x: %llu virtual lights", masks[k], (unsigned long long)st.virtual_lights);
+        CHECK((rendered & HL) ? st.hl_points > 0 : st.hl_points == 0 && st.pass_ns[PASS_HIGHLIGHTS] == 0,
+              "only %#x: the highlight estimator ran at %llu points", masks[k], (unsigned long long)st.hl_points);
+    }
+    /* The path tracer renders whole paths whatever is asked. */
+    render_params p = {.width = W, .height = H, .max_depth = 4, .seed = 5, .only = HL};
+    double sum[COMP_COUNT];
+    render_only(s, &cam, p, sum);
+    CHECK(sum[COMP_DIRECT] > 0.0 && sum[COMP_INDIRECT] > 0.0, "pt with only set: direct %g, indirect %g",
+          sum[COMP_DIRECT], sum[COMP_INDIRECT]);
+    scene_destroy(s);
+}
+
 int main(void) {
     check_edge_coverage();
+    check_only();
     scene *s = ts_new("box");
     ts_box(s, v3(-1, 0, -1), v3(1, 2, 1), 1, ts_lambert(s, v3s(0.6f), v3s(0.0f), 0));
     ts_quad(s, v3(-0.3f, 1.98f, -0.3f), v3(0.3f, 1.98f, -0.3f), v3(0.3f, 1.98f, 0.3f), v3(-0.3f, 1.98f, 0.3f),
