@@ -1,12 +1,14 @@
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "cli.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -177,6 +179,47 @@ int cli_check_output_dir(const char *option, const char *path) {
     if (access(dir, W_OK | X_OK) != 0) {
         cli_error("%s: %s: cannot write into directory '%s' (%s)", option, path, dir, strerror(errno));
         return -1;
+    }
+    return 0;
+}
+
+/* The file path names, as "DIR-resolved/NAME" when the directory exists (out: PATH_MAX). */
+static void file_identity(const char *path, char *out, size_t outlen) {
+    char dir[4096], resolved[PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    const char *name = slash ? slash + 1 : path;
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else
+        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    if (realpath(dir, resolved))
+        snprintf(out, outlen, "%s/%s", resolved, name);
+    else
+        snprintf(out, outlen, "%s", path);
+}
+
+static int same_file(const char *a, const char *b) {
+    struct stat sa, sb;
+    if (stat(a, &sa) == 0 && stat(b, &sb) == 0) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    char ia[PATH_MAX + 256], ib[PATH_MAX + 256];
+    file_identity(a, ia, sizeof ia);
+    file_identity(b, ib, sizeof ib);
+    return strcmp(ia, ib) == 0;
+}
+
+int cli_check_roles(const cli_file *outputs, int num_outputs, const cli_file *inputs, int num_inputs) {
+    for (int i = 0; i < num_outputs; i++) {
+        if (!outputs[i].path) continue;
+        for (int j = i + 1; j < num_outputs; j++)
+            if (outputs[j].path && same_file(outputs[i].path, outputs[j].path))
+                return cli_error("%s and %s name the same file '%s'", outputs[i].role, outputs[j].role,
+                                 outputs[i].path),
+                       -1;
+        for (int j = 0; j < num_inputs; j++)
+            if (inputs[j].path && same_file(outputs[i].path, inputs[j].path))
+                return cli_error("%s '%s' is %s: it would be replaced", outputs[i].role, outputs[i].path,
+                                 inputs[j].role),
+                       -1;
     }
     return 0;
 }

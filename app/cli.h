@@ -79,4 +79,15 @@ double cli_now(void);
  * writable: checked before a long render rather than after it. */
 int cli_check_output_dir(const char *option, const char *path);
 
+/* A file named on the command line and the option (or word) that named it. */
+typedef struct {
+    const char *role; /* "--out", "the scene", ... */
+    const char *path; /* NULL: not given */
+} cli_file;
+
+/* Fails (with a usage error naming both roles) when two outputs name the same file or an output
+ * names an input: one would silently replace the other. The same file is the same inode when it
+ * exists, else the same directory (symbolic links resolved) and name. */
+int cli_check_roles(const cli_file *outputs, int num_outputs, const cli_file *inputs, int num_inputs);
+
 #endif

@@ -101,6 +101,8 @@ int cmd_info(int argc, char **argv) {
             return EXIT_USAGE;
         }
     }
+    const cli_file outputs[] = {{"--obj", obj}}, inputs[] = {{"the scene", path}, {"the environment map (--env)", env}};
+    if (cli_check_roles(outputs, 1, inputs, 2) != 0) return EXIT_USAGE;
     if (obj && cli_check_output_dir("--obj", obj)) return EXIT_FAILURE_;
     double t0 = cli_now();
     scene *s = load_scene_or_default(path, env, 0.0f);

@@ -302,6 +302,9 @@ int cmd_render(int argc, char **argv) {
     render_options o;
     int parsed = parse_render_options(argc, argv, &o);
     if (parsed != 0) return parsed > 0 ? EXIT_OK : EXIT_USAGE;
+    const cli_file outputs[] = {{"--out", o.out_exr}, {"--png", o.out_png}, {"--stats", o.out_stats}};
+    const cli_file inputs[] = {{"the scene", o.scene_path}, {"the environment map (--env)", o.env_path}};
+    if (cli_check_roles(outputs, 3, inputs, 2) != 0) return EXIT_USAGE;
     if ((o.out_exr && cli_check_output_dir("--out", o.out_exr)) ||
         (o.out_png && cli_check_output_dir("--png", o.out_png)) ||
         (o.out_stats && cli_check_output_dir("--stats", o.out_stats)))

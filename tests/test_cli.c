@@ -5,6 +5,7 @@
  * Usage: test_cli PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -383,6 +384,39 @@ static void test_obj_and_camera(void) {
           "camera: |forward|^2 %g, |up|^2 %g, forward.up %g, yfov %g", ff, uu, fu, fov);
 }
 
+/* Two roles never share a file: two outputs, or an output and an input (the scene, the
+ * environment map), the same file by another spelling or through a link, is a usage error before
+ * anything renders, and every file stays as it was. */
+static void test_output_roles(void) {
+    char scene_path[1024], env[1024], err[256];
+    snprintf(scene_path, sizeof scene_path, "%s/roles.gltf", tmp);
+    FILE *f = fopen(scene_path, "w");
+    fputs("{\"asset\": {\"version\": \"2.0\"}}", f);
+    fclose(f);
+    snprintf(env, sizeof env, "%s/roles-sky.exr", tmp);
+    float px[3 * 8] = {1, 1, 1};
+    exr_layer layer = {"", px};
+    CHECK(exr_save_layers(env, 4, 2, &layer, 1, WRITE_REPLACE, err, sizeof err) == 0, "sky: %s", err);
+    char link_path[1100];
+    snprintf(link_path, sizeof link_path, "%s/roles-link.gltf", tmp);
+    CHECK(symlink("roles.gltf", link_path) == 0, "symlink: %s", strerror(errno));
+    expect_failure("render --spp 1 --size 8x8 --out same.exr --png same.exr", 2, "--out and --png name the same file");
+    expect_failure("render --spp 1 --size 8x8 --out same.exr --stats ./same.exr", 2, "--out and --stats");
+    expect_failure("render --spp 1 --size 8x8 --png same.png --stats ../cli/same.png", 2, "--png and --stats");
+    expect_failure("render roles.gltf --spp 1 --size 8x8 --png roles.gltf", 2, "is the scene");
+    expect_failure("render roles-link.gltf --spp 1 --size 8x8 --out roles.gltf", 2, "is the scene");
+    expect_failure("render roles.gltf --env roles-sky.exr --spp 1 --size 8x8 --out roles-sky.exr", 2,
+                   "is the environment map");
+    expect_failure("info roles.gltf --obj roles.gltf", 2, "is the scene");
+    CHECK(!file_exists("same.exr") && !file_exists("same.png"), "a refused render wrote an output");
+    char text[256];
+    CHECK(read_file("roles.gltf", text, sizeof text) > 0 && strstr(text, "\"2.0\""), "the scene was changed");
+    exr_image img;
+    int loaded = exr_image_load(env, &img, err, sizeof err) == 0;
+    CHECK(loaded && img.width == 4, "the map was changed: %s", err);
+    if (loaded) exr_image_free(&img);
+}
+
 int main(int argc, char **argv) {
     /* An empty directory, so the default-output numbering is known. */
     int start = harness_start(argc, argv, "cli");
@@ -394,5 +428,6 @@ int main(int argc, char **argv) {
     test_many_light_options();
     test_highlights_layer();
     test_obj_and_camera();
+    test_output_roles();
     return check_exit("test_cli");
 }
