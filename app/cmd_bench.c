@@ -64,6 +64,18 @@ static int ref_load(const bench_options *o, bench_ref *r) {
         ref_free(r);
         return cli_error("%s: no R, G, B channels (or out of memory)", o->ref_path), -1;
     }
+    /* A NaN in the reference would make every error NaN (or, summed away, 0): no answer at all. */
+    static const char *const layer_names[ERR_COUNT] = {"R,G,B", "direct.*", "indirect.*", "highlights.*"};
+    for (int k = 0; k < ERR_COUNT; k++) {
+        size_t bad = 0, n = 3 * (size_t)r->width * (size_t)r->height;
+        for (size_t i = 0; r->layer[k] && i < n; i++) bad += !isfinite(r->layer[k][i]);
+        if (bad) {
+            ref_free(r);
+            return cli_error("%s: %zu values of %s are not finite (NaN or Inf): not a usable reference", o->ref_path,
+                             bad, layer_names[k]),
+                   -1;
+        }
+    }
     /* Indirect means everything after the first bounce, whether or not highlights were split off. */
     if (r->layer[ERR_INDIRECT] && r->layer[ERR_HIGHLIGHTS])
         for (size_t i = 0; i < 3 * (size_t)r->width * (size_t)r->height; i++)

@@ -375,6 +375,17 @@ static void test_refusals(void) {
     CHECK(run("bench --reference bare.exr --force --methods pt --times 0.05 --quiet --out r14") == 0 &&
               exists("r14/results.csv"),
           "--force: %s", err_text);
+    /* A reference holding a NaN (or Inf) answers nothing: refused even with --force. */
+    static float nan_rgb[3 * 24 * 16];
+    nan_rgb[3 * 100 + 1] = NAN;
+    nan_rgb[3 * 200] = INFINITY;
+    char nan_path[1024], nan_err[512];
+    snprintf(nan_path, sizeof nan_path, "%s/nan.exr", tmp);
+    exr_layer nan_layer = {"", nan_rgb};
+    CHECK(exr_save_layers(nan_path, 24, 16, &nan_layer, 1, WRITE_REPLACE, nan_err, sizeof nan_err) == 0, "nan.exr: %s",
+          nan_err);
+    expect_refusal("bench --reference nan.exr --force --methods pt --times 0.05 --out r16",
+                   "nan.exr: 2 values of R,G,B are not finite");
     static const char broken[] = "{\"glint_reference\": 1, \"scene\": \"x\"";
     CHECK(write_reference("ref.exr", "broken.exr", broken, 1) == 0 &&
               write_reference("ref.exr", "broken2.exr", broken, 0) == 0,
