@@ -272,7 +272,7 @@ struct importer {
             int &img = image_map[(size_t)src];
             if (img < 0) {
                 const tinygltf::Image &im = m.images[(size_t)src];
-                std::string label = im.uri.empty() ? "image " + std::to_string(src) : "'" + im.uri + "'";
+                std::string label = im.uri.empty() ? std::to_string(src) : "'" + im.uri + "'";
                 if (im.image.empty() || im.width <= 0 || im.height <= 0)
                     fail("texture image " + label + ": " + image_problem(src));
                 size_t need = (size_t)im.width * (size_t)im.height * (size_t)im.component * (size_t)(im.bits / 8);

@@ -292,7 +292,9 @@ int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err
             for (int c = 0; c < 3; c++) s->normals[v[c]] = n;
         }
     }
-    if (skipped) scene_warn(s, "skipped %d degenerate or non-finite triangle%s", skipped, skipped > 1 ? "s" : "");
+    if (skipped)
+        scene_warn(s, "skipped %d triangle%s with no area, or too large for float's squares (edges beyond ~1e9)",
+                   skipped, skipped > 1 ? "s" : "");
 
     /* Tangents from uv0 where the mesh has none (Lengyel): area-weighted per vertex, then
      * orthogonalised against the normal; a fallback frame where the uvs are degenerate. */
