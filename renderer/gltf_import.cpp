@@ -44,6 +44,13 @@ std::string first_line(const std::string &s) {
 // undefined conversion.
 float to_f(double v) { return std::fabs(v) <= (double)FLT_MAX ? (float)v : (float)std::copysign(INFINITY, v); }
 
+// Text from the file (a URI, a name) made fit for a one-line message: control characters become '?'.
+std::string printable(std::string t) {
+    for (char &c : t)
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = '?';
+    return t;
+}
+
 std::string num(double v) {
     char b[32];
     std::snprintf(b, sizeof b, "%g", v);
@@ -704,12 +711,12 @@ int import(scene *s, const unsigned char *data, size_t size, const std::string &
             if (imp.image_map[i] < 0 && model.images[i].image.empty()) {
                 const std::string &uri = model.images[i].uri;
                 scene_warn(s, "%s: unused image %s not read: %s", name.c_str(),
-                           uri.empty() ? std::to_string(i).c_str() : ("'" + uri + "'").c_str(),
-                           imp.image_problem((int)i).c_str());
+                           uri.empty() ? std::to_string(i).c_str() : printable("'" + uri + "'").c_str(),
+                           printable(imp.image_problem((int)i)).c_str());
             }
         return 0;
     } catch (const import_error &ie) {
-        std::snprintf(err, errlen, "%s: %s", name.c_str(), ie.what.c_str());
+        std::snprintf(err, errlen, "%s: %s", name.c_str(), printable(ie.what).c_str());
     } catch (const std::bad_alloc &) {
         std::snprintf(err, errlen, "%s: out of memory", name.c_str());
     } catch (const std::exception &ex) {
