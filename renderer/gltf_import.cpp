@@ -3,7 +3,10 @@
 // and hands plain arrays to the C scene builder (scene_add_*).
 #include "gltf_import.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <cfloat>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -11,8 +14,9 @@
 #include <string>
 #include <vector>
 
-#include <stb_image.h>
 #include <tiny_gltf.h>
+
+#include "gltf_input.h"
 
 namespace {
 
@@ -27,12 +31,37 @@ struct import_error {
 
 [[noreturn]] void fail(const std::string &what) { throw import_error{what}; }
 
+// The first line of a parser's message, cut short (it may quote a whole data URI).
 std::string first_line(const std::string &s) {
     size_t a = s.find_first_not_of(" \n\r\t");
     if (a == std::string::npos) return "";
     size_t b = s.find_first_of("\n\r", a);
-    return s.substr(a, b == std::string::npos ? std::string::npos : b - a);
+    std::string line = s.substr(a, b == std::string::npos ? std::string::npos : b - a);
+    return line.size() > 160 ? line.substr(0, 150) + "..." : line;
 }
+
+// A double as float, beyond float's range as infinity (later checks refuse it) rather than by an
+// undefined conversion.
+float to_f(double v) { return std::fabs(v) <= (double)FLT_MAX ? (float)v : (float)std::copysign(INFINITY, v); }
+
+// Text from the file (a URI, a name) made fit for a one-line message: control characters become '?'.
+std::string printable(std::string t) {
+    for (char &c : t)
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = '?';
+    return t;
+}
+
+std::string num(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return b;
+}
+
+// Limits on what a scene may hold (README states them).
+constexpr int MAX_NODE_DEPTH = 4096;                       // nesting of the node hierarchy
+constexpr long MAX_NODE_INSTANCES = 1000000;               // node visits, counting each instance of a shared node
+constexpr double MAX_INTENSITY = 1e20;                     // light intensities, emission, material factors
+constexpr size_t MAX_INSTANCED_ELEMENTS = (size_t)1 << 27; // vertices + indices over all mesh instances
 
 // ---- accessors ----------------------------------------------------------------------------
 
@@ -115,11 +144,15 @@ std::vector<double> read_accessor(const Model &m, int index, int want, const std
         fail(what + ": accessor " + std::to_string(index) + " has the wrong type (" + std::to_string(nc) +
              " components, expected " + std::to_string(want) + ")");
     if (a.count > (1u << 28)) fail(what + ": accessor " + std::to_string(index) + " is too large");
+    // Without a bufferView the elements are zeros (then sparse values): nothing in the file bounds them.
+    if (a.bufferView < 0 && a.count > (1u << 20))
+        fail(what + ": accessor " + std::to_string(index) + " has no bufferView and more than 1048576 elements");
+    size_t stride = 0;
+    const unsigned char *p =
+        a.bufferView >= 0 ? view_elements(m, a.bufferView, a.byteOffset, a.count, (size_t)(nc * cs), &stride, what)
+                          : nullptr;
     std::vector<double> out(a.count * (size_t)want, 0.0);
-    if (a.bufferView >= 0) {
-        size_t stride;
-        const unsigned char *p =
-            view_elements(m, a.bufferView, a.byteOffset, a.count, (size_t)(nc * cs), &stride, what);
+    if (p) {
         for (size_t i = 0; i < a.count; i++)
             for (int c = 0; c < nc; c++)
                 out[i * (size_t)want + (size_t)c] =
@@ -148,7 +181,11 @@ std::vector<double> read_accessor(const Model &m, int index, int want, const std
     return out;
 }
 
-std::vector<float> to_float(const std::vector<double> &d) { return std::vector<float>(d.begin(), d.end()); }
+std::vector<float> to_float(const std::vector<double> &d) {
+    std::vector<float> f(d.size());
+    for (size_t i = 0; i < d.size(); i++) f[i] = to_f(d[i]);
+    return f;
+}
 
 // ---- materials and textures ---------------------------------------------------------------
 
@@ -158,21 +195,47 @@ double number_or(const Value &obj, const char *key, double fallback) {
     return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
-vec3 color_or(const Value &obj, const char *key, vec3 fallback) {
+// An index in an extension's JSON: a whole number from 0 to INT_MAX, else an error naming it.
+int index_or(const Value &obj, const char *key, int fallback, const std::string &what) {
+    if (!obj.IsObject() || !obj.Has(key)) return fallback;
+    const Value &v = obj.Get(key);
+    double d = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+    if (!(d >= 0.0 && d <= (double)INT_MAX) || d != std::floor(d))
+        fail(what + ": " + key + " " + (v.IsNumber() ? num(d) : "(not a number)") + " is not a valid index");
+    return (int)d;
+}
+
+// A factor or intensity as float: finite, non-negative, at most MAX_INTENSITY; else an error.
+float factor(double v, const std::string &what, const char *name) {
+    if (!(std::fabs(v) <= MAX_INTENSITY))
+        fail(what + ": " + name + " " + num(v) + " is not a finite number up to " + num(MAX_INTENSITY));
+    if (v < 0.0) fail(what + ": " + name + " " + num(v) + " is negative");
+    return (float)v;
+}
+
+vec3 factor3(const double c[3], const std::string &what, const char *name) {
+    return v3(factor(c[0], what, name), factor(c[1], what, name), factor(c[2], what, name));
+}
+
+vec3 color_or(const Value &obj, const char *key, vec3 fallback, const std::string &what) {
     if (!obj.IsObject() || !obj.Has(key)) return fallback;
     const Value &v = obj.Get(key);
     if (!v.IsArray() || v.ArrayLen() < 3) return fallback;
-    float c[3];
+    double c[3];
     for (int i = 0; i < 3; i++) {
         const Value &e = v.Get(i);
         if (!e.IsNumber()) return fallback;
-        c[i] = (float)e.GetNumberAsDouble();
+        c[i] = e.GetNumberAsDouble();
     }
-    return v3(c[0], c[1], c[2]);
+    return factor3(c, what, key);
 }
 
 vec3 vec3_from(const std::vector<double> &v, vec3 fallback) {
-    return v.size() >= 3 ? v3((float)v[0], (float)v[1], (float)v[2]) : fallback;
+    return v.size() >= 3 ? v3(to_f(v[0]), to_f(v[1]), to_f(v[2])) : fallback;
+}
+
+vec3 factor3_or(const std::vector<double> &v, vec3 fallback, const std::string &what, const char *name) {
+    return v.size() >= 3 ? factor3(v.data(), what, name) : fallback;
 }
 
 struct importer {
@@ -182,9 +245,21 @@ struct importer {
     std::vector<int> texture_map; // glTF texture -> scene texture (-1 until used)
     std::vector<int> image_map;   // glTF image -> scene image
     std::vector<int> material_map;
-    std::vector<char> on_stack; // node recursion guard: cycles are an error
+    std::vector<char> on_stack; // nodes on the current path: a node met again there is a cycle
+    long instances = 0;         // node visits so far
+    size_t elements = 0;        // vertices and indices read, over all instances
+    const gltf_input::context &in;
 
-    importer(scene *sc, const Model &model, const std::string &n) : s(sc), m(model), name(n) {}
+    importer(scene *sc, const Model &model, const std::string &n, const gltf_input::context &input)
+        : s(sc), m(model), name(n), in(input) {}
+
+    // Why image i has no pixels, as its loader or file access found.
+    std::string image_problem(int i) const {
+        auto p = in.image_problems.find(i);
+        if (p != in.image_problems.end()) return p->second;
+        auto u = in.uri_problems.find(m.images[(size_t)i].uri);
+        return u != in.uri_problems.end() ? u->second : "missing or unreadable";
+    }
 
     texture_slot texture(int index, int texcoord, const std::string &what) {
         if (index < 0) return texture_slot{-1, 0};
@@ -204,9 +279,9 @@ struct importer {
             int &img = image_map[(size_t)src];
             if (img < 0) {
                 const tinygltf::Image &im = m.images[(size_t)src];
-                std::string label = im.uri.empty() ? "image " + std::to_string(src) : "'" + im.uri + "'";
+                std::string label = im.uri.empty() ? std::to_string(src) : "'" + im.uri + "'";
                 if (im.image.empty() || im.width <= 0 || im.height <= 0)
-                    fail("texture image " + label + " is missing or unreadable");
+                    fail("texture image " + label + ": " + image_problem(src));
                 size_t need = (size_t)im.width * (size_t)im.height * (size_t)im.component * (size_t)(im.bits / 8);
                 if (im.image.size() < need) fail("texture image " + label + " is truncated");
                 img = scene_add_image(s, im.width, im.height, im.component, im.bits, im.image.data());
@@ -228,6 +303,18 @@ struct importer {
         return texture_slot{mapped, texcoord};
     }
 
+    // glTF's [0, 1] factors: a value above 1 is clamped, with one warning per material.
+    void clamp_unit(material &mat, const std::string &label) {
+        float *f[] = {&mat.base_color.x, &mat.base_color.y, &mat.base_color.z,
+                      &mat.metallic,     &mat.roughness,    &mat.anisotropy_strength};
+        bool clamped = false;
+        for (float *v : f)
+            if (*v > 1.0f) *v = 1.0f, clamped = true;
+        if (clamped)
+            scene_warn(s, "%s: %s: a colour or factor above 1 (glTF's range is 0 to 1), clamped to 1", name.c_str(),
+                       label.c_str());
+    }
+
     void materials() {
         material_map.assign(m.materials.size(), -1);
         for (size_t i = 0; i < m.materials.size(); i++) {
@@ -236,26 +323,33 @@ struct importer {
             material mat = material_default();
             std::snprintf(mat.name, sizeof mat.name, "%s", gm.name.empty() ? what.c_str() : gm.name.c_str());
             const auto &pbr = gm.pbrMetallicRoughness;
-            mat.base_color = vec3_from(pbr.baseColorFactor, v3s(1.0f));
-            mat.metallic = (float)pbr.metallicFactor;
-            mat.roughness = (float)pbr.roughnessFactor;
+            std::string label = "material '" + std::string(mat.name) + "'";
+            mat.base_color = factor3_or(pbr.baseColorFactor, v3s(1.0f), label, "baseColorFactor");
+            mat.metallic = factor(pbr.metallicFactor, label, "metallicFactor");
+            mat.roughness = factor(pbr.roughnessFactor, label, "roughnessFactor");
             mat.base_color_tex = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what);
             mat.metal_rough_tex =
                 texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what);
-            mat.emission = vec3_from(gm.emissiveFactor, v3s(0.0f));
+            mat.emission = factor3_or(gm.emissiveFactor, v3s(0.0f), label, "emissiveFactor");
             mat.emissive_tex = texture(gm.emissiveTexture.index, gm.emissiveTexture.texCoord, what);
             mat.double_sided = gm.doubleSided;
             for (const auto &ext : gm.extensions) {
                 const Value &e = ext.second;
                 if (ext.first == "KHR_materials_emissive_strength") {
-                    mat.emission = scale3(mat.emission, (float)number_or(e, "emissiveStrength", 1.0));
+                    float k = factor(number_or(e, "emissiveStrength", 1.0), label, "emissiveStrength");
+                    mat.emission = scale3(mat.emission, k);
+                    double c[3] = {mat.emission.x, mat.emission.y, mat.emission.z};
+                    factor3(c, label, "emissiveFactor x emissiveStrength");
                 } else if (ext.first == "KHR_materials_anisotropy") {
-                    mat.anisotropy_strength = (float)number_or(e, "anisotropyStrength", 0.0);
-                    mat.anisotropy_rotation = (float)number_or(e, "anisotropyRotation", 0.0);
+                    mat.anisotropy_strength =
+                        factor(number_or(e, "anisotropyStrength", 0.0), label, "anisotropyStrength");
+                    double rot = number_or(e, "anisotropyRotation", 0.0);
+                    if (!(std::fabs(rot) <= 1e6)) fail(label + ": anisotropyRotation " + num(rot) + " is not an angle");
+                    mat.anisotropy_rotation = (float)rot;
                     if (e.Has("anisotropyTexture")) {
                         const Value &t = e.Get("anisotropyTexture");
-                        mat.anisotropy_tex =
-                            texture((int)number_or(t, "index", -1), (int)number_or(t, "texCoord", 0), what);
+                        mat.anisotropy_tex = texture(index_or(t, "index", -1, label + ": anisotropyTexture"),
+                                                     std::min(index_or(t, "texCoord", 0, label), 2), what);
                     }
                 }
             }
@@ -266,18 +360,21 @@ struct importer {
                     g.Has("model") && g.Get("model").IsString() ? g.Get("model").Get<std::string>() : "";
                 if (model == "phong" || model == "ward") {
                     mat.model = model == "phong" ? MATERIAL_PHONG : MATERIAL_WARD;
-                    mat.kd = color_or(g, "kd", v3s(0.0f));
-                    mat.ks = color_or(g, "ks", v3s(0.5f));
-                    mat.exponent = (float)number_or(g, "exponent", 64.0);
-                    mat.alpha_x = (float)number_or(g, "alpha_x", 0.1);
-                    mat.alpha_y = (float)number_or(g, "alpha_y", number_or(g, "alpha_x", 0.1));
-                    mat.anisotropy_rotation = (float)number_or(g, "rotation", 0.0);
+                    mat.kd = color_or(g, "kd", v3s(0.0f), label);
+                    mat.ks = color_or(g, "ks", v3s(0.5f), label);
+                    mat.exponent = factor(number_or(g, "exponent", 64.0), label, "exponent");
+                    mat.alpha_x = factor(number_or(g, "alpha_x", 0.1), label, "alpha_x");
+                    mat.alpha_y = factor(number_or(g, "alpha_y", number_or(g, "alpha_x", 0.1)), label, "alpha_y");
+                    double rot = number_or(g, "rotation", 0.0);
+                    if (!(std::fabs(rot) <= 1e6)) fail(label + ": rotation " + num(rot) + " is not an angle");
+                    mat.anisotropy_rotation = (float)rot;
                     // Textures other than emission do not apply to these lobes, except base colour tinting kd.
                 } else if (!model.empty() && model != "gltf") {
                     scene_warn(s, "%s: %s: unknown extras.glint.model '%s', using metallic-roughness", name.c_str(),
                                mat.name, model.c_str());
                 }
             }
+            clamp_unit(mat, label);
             if (gm.alphaMode == "BLEND" || gm.alphaMode == "MASK")
                 scene_warn(s, "%s: alphaMode %s is not supported; surfaces are opaque", name.c_str(),
                            gm.alphaMode.c_str());
@@ -294,7 +391,7 @@ struct importer {
         mat4 r = mat4_identity();
         if (n.matrix.size() == 16) {
             for (int c = 0; c < 4; c++)
-                for (int row = 0; row < 4; row++) r.m[row][c] = (float)n.matrix[(size_t)(c * 4 + row)]; // column-major
+                for (int row = 0; row < 4; row++) r.m[row][c] = to_f(n.matrix[(size_t)(c * 4 + row)]); // column-major
             return r;
         }
         vec3 t = vec3_from(n.translation, v3s(0.0f));
@@ -311,7 +408,7 @@ struct importer {
                           {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
         float scl[3] = {sc.x, sc.y, sc.z};
         for (int row = 0; row < 3; row++)
-            for (int c = 0; c < 3; c++) r.m[row][c] = (float)(R[row][c] * scl[c]);
+            for (int c = 0; c < 3; c++) r.m[row][c] = to_f(R[row][c] * scl[c]);
         r.m[0][3] = t.x;
         r.m[1][3] = t.y;
         r.m[2][3] = t.z;
@@ -379,6 +476,10 @@ struct importer {
                 }
                 idx.swap(tri);
             }
+            // Each instance reads its mesh again: bound the total, or shared nodes multiply it.
+            if ((elements += nv + idx.size()) > MAX_INSTANCED_ELEMENTS)
+                fail(what + ": the scene's mesh instances hold more than " + std::to_string(MAX_INSTANCED_ELEMENTS) +
+                     " vertices and indices in all");
             size_t ncount = p.indices >= 0 || mode != TINYGLTF_MODE_TRIANGLES ? idx.size() : nv;
             if (ncount % 3 != 0) {
                 scene_warn(s, "%s: %s has %zu indices, not a multiple of 3; dropping the rest", name.c_str(),
@@ -411,7 +512,7 @@ struct importer {
     }
 
     void punctual(const Value &ext, const mat4 &xf) {
-        int li = (int)number_or(ext, "light", -1);
+        int li = index_or(ext, "light", -1, "KHR_lights_punctual");
         if (li < 0 || (size_t)li >= m.lights.size())
             fail("KHR_lights_punctual: light " + std::to_string(li) + " out of range");
         const tinygltf::Light &gl = m.lights[(size_t)li];
@@ -419,10 +520,15 @@ struct importer {
         std::memset(&l, 0, sizeof l);
         std::snprintf(l.name, sizeof l.name, "%s",
                       gl.name.empty() ? ("light " + std::to_string(li)).c_str() : gl.name.c_str());
-        l.color = scale3(vec3_from(gl.color, v3s(1.0f)), (float)gl.intensity);
+        std::string label = std::string("light '") + l.name + "'";
+        vec3 color = factor3_or(gl.color, v3s(1.0f), label, "color");
+        float intensity = factor(gl.intensity, label, "intensity");
+        double c[3] = {(double)color.x * intensity, (double)color.y * intensity, (double)color.z * intensity};
+        l.color = factor3(c, label, "color x intensity");
         l.position = xform_point(&xf, v3(0, 0, 0));
         l.direction = normalize3(xform_vector(&xf, v3(0, 0, -1)));
-        l.range = (float)gl.range;
+        l.range = factor(gl.range, label, "range");
+        check_position(l.position, label);
         if (gl.type == "point") {
             l.type = LIGHT_POINT;
         } else if (gl.type == "spot") {
@@ -456,12 +562,13 @@ struct importer {
         std::snprintf(c.name, sizeof c.name, "%s",
                       gc.name.empty() ? ("camera " + std::to_string(ci)).c_str() : gc.name.c_str());
         c.position = xform_point(&xf, v3(0, 0, 0));
+        check_position(c.position, "camera " + std::to_string(ci));
         c.forward = normalize3(xform_vector(&xf, v3(0, 0, -1)));
         vec3 up = xform_vector(&xf, v3(0, 1, 0));
         c.right = normalize3(cross3(c.forward, up));
         c.up = cross3(c.right, c.forward);
-        c.yfov = (float)gc.perspective.yfov;
-        if (!(c.yfov > 1e-4f && c.yfov < 3.1f) || !is_finite3(c.position) || !is_finite3(c.right) ||
+        c.yfov = to_f(gc.perspective.yfov);
+        if (!(c.yfov > 1e-4f && c.yfov < 3.1f) || !is_finite3(c.forward) || !is_finite3(c.right) || !is_finite3(c.up) ||
             length_sq3(c.right) < 0.5f) {
             scene_warn(s, "%s: camera %d has an invalid transform or field of view; ignored", name.c_str(), ci);
             return;
@@ -469,10 +576,28 @@ struct importer {
         if (scene_add_camera(s, &c) < 0) fail("out of memory");
     }
 
-    void node(int index, const mat4 &parent, int depth) {
+    // A point (a light's, a camera's) within the coordinate limit, else an error.
+    static void check_position(vec3 p, const std::string &what) {
+        if (!(std::fabs(p.x) < SCENE_MAX_COORD && std::fabs(p.y) < SCENE_MAX_COORD && std::fabs(p.z) < SCENE_MAX_COORD))
+            fail(what + " lies at (" + num(p.x) + ", " + num(p.y) + ", " + num(p.z) +
+                 ") after its transforms; coordinates must be finite and within +-" + num(SCENE_MAX_COORD));
+    }
+
+    // Enters node index under parent: checks, then its mesh, camera and light; pushes it.
+    struct frame {
+        int node;
+        size_t next_child;
+        mat4 xf;
+    };
+    void enter(int index, const mat4 &parent, std::vector<frame> &path) {
         if (index < 0 || (size_t)index >= m.nodes.size()) fail("node " + std::to_string(index) + " out of range");
-        if (on_stack[(size_t)index] || depth > 1000)
-            fail("node hierarchy has a cycle at node " + std::to_string(index));
+        if (on_stack[(size_t)index]) fail("node hierarchy has a cycle at node " + std::to_string(index));
+        if (path.size() >= (size_t)MAX_NODE_DEPTH)
+            fail("node hierarchy is deeper than " + std::to_string(MAX_NODE_DEPTH) + " levels (at node " +
+                 std::to_string(index) + ")");
+        if (++instances > MAX_NODE_INSTANCES)
+            fail("node hierarchy has more than " + std::to_string(MAX_NODE_INSTANCES) +
+                 " node instances (nodes shared by several parents count once per parent)");
         on_stack[(size_t)index] = 1;
         const tinygltf::Node &n = m.nodes[(size_t)index];
         mat4 xf = mat4_mul(parent, node_local(n));
@@ -480,8 +605,25 @@ struct importer {
         if (n.camera >= 0) add_camera(n.camera, xf);
         auto it = n.extensions.find("KHR_lights_punctual");
         if (it != n.extensions.end()) punctual(it->second, xf);
-        for (int c : n.children) node(c, xf, depth + 1);
-        on_stack[(size_t)index] = 0;
+        path.push_back(frame{index, 0, xf});
+    }
+
+    // The hierarchy under root, depth first, without recursion.
+    void node(int root) {
+        std::vector<frame> path;
+        enter(root, mat4_identity(), path);
+        while (!path.empty()) {
+            frame &top = path.back();
+            const std::vector<int> &children = m.nodes[(size_t)top.node].children;
+            if (top.next_child < children.size()) {
+                int c = children[top.next_child++];
+                mat4 xf = top.xf; // enter() may move the path
+                enter(c, xf, path);
+            } else {
+                on_stack[(size_t)top.node] = 0;
+                path.pop_back();
+            }
+        }
     }
 
     void run() {
@@ -496,10 +638,9 @@ struct importer {
         image_map.assign(m.images.size(), -1);
         on_stack.assign(m.nodes.size(), 0);
         materials();
-        mat4 id = mat4_identity();
         if (!m.scenes.empty()) {
             int si = m.defaultScene >= 0 && (size_t)m.defaultScene < m.scenes.size() ? m.defaultScene : 0;
-            for (int r : m.scenes[(size_t)si].nodes) node(r, id, 0);
+            for (int r : m.scenes[(size_t)si].nodes) node(r);
         } else {
             // No scene: render every root node (one that is nobody's child).
             std::vector<char> is_child(m.nodes.size(), 0);
@@ -507,76 +648,79 @@ struct importer {
                 for (int c : n.children)
                     if (c >= 0 && (size_t)c < m.nodes.size()) is_child[(size_t)c] = 1;
             for (size_t i = 0; i < m.nodes.size(); i++)
-                if (!is_child[i]) node((int)i, id, 0);
+                if (!is_child[i]) node((int)i);
         }
     }
 };
 
-// Images through stb (Debian's libstb), keeping 8 or 16 bits as stored.
-bool load_image(tinygltf::Image *image, const int index, std::string *err, std::string *warn, int, int,
-                const unsigned char *bytes, int size, void *) {
-    int w = 0, h = 0, comp = 0;
-    if (!stbi_info_from_memory(bytes, size, &w, &h, &comp) || w <= 0 || h <= 0 || (long long)w * h > (1LL << 28)) {
-        if (err)
-            *err += "image " + std::to_string(index) +
-                    " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown format") + "\n";
-        return false;
+// The JSON text of a .gltf, or a GLB's JSON chunk (as far as the data goes).
+void check_nesting(const unsigned char *data, size_t size, bool glb) {
+    const char *text = (const char *)data;
+    size_t n = size;
+    if (glb) {
+        uint32_t chunk = 0;
+        if (size >= 20) std::memcpy(&chunk, data + 12, 4);
+        text += size >= 20 ? 20 : size;
+        n = size >= 20 ? std::min<size_t>(chunk, size - 20) : 0;
     }
-    bool sixteen = stbi_is_16_bit_from_memory(bytes, size) != 0;
-    void *pixels = sixteen ? (void *)stbi_load_16_from_memory(bytes, size, &w, &h, &comp, 0)
-                           : (void *)stbi_load_from_memory(bytes, size, &w, &h, &comp, 0);
-    if (!pixels) {
-        if (err)
-            *err += "image " + std::to_string(index) +
-                    " cannot be decoded: " + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt data") + "\n";
-        return false;
+    if (gltf_input::json_depth(text, n, gltf_input::MAX_JSON_DEPTH) > gltf_input::MAX_JSON_DEPTH)
+        fail("JSON nests deeper than " + std::to_string(gltf_input::MAX_JSON_DEPTH) + " levels");
+}
+
+// The parser's warnings, less those about files and images, which the importer reports itself.
+void pass_warnings(scene *s, const std::string &name, const std::string &w) {
+    static const char *own[] = {"File not found", "File read error", "File is empty", "Failed to load external"};
+    for (size_t a = 0; a < w.size();) {
+        size_t b = w.find('\n', a);
+        std::string line = first_line(w.substr(a, b == std::string::npos ? std::string::npos : b - a));
+        bool skip = line.empty();
+        for (const char *o : own) skip = skip || line.compare(0, std::strlen(o), o) == 0;
+        if (!skip) scene_warn(s, "%s: %s", name.c_str(), line.c_str());
+        if (b == std::string::npos) break;
+        a = b + 1;
     }
-    size_t n = (size_t)w * (size_t)h * (size_t)comp * (sixteen ? 2u : 1u);
-    image->width = w;
-    image->height = h;
-    image->component = comp;
-    image->bits = sixteen ? 16 : 8;
-    image->pixel_type = sixteen ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
-    image->image.assign((const unsigned char *)pixels, (const unsigned char *)pixels + n);
-    stbi_image_free(pixels);
-    (void)warn;
-    return true;
 }
 
 int import(scene *s, const unsigned char *data, size_t size, const std::string &base_dir, const std::string &name,
            char *err, size_t errlen) {
     try {
         if (size < 4) fail("file is empty or truncated");
-        tinygltf::TinyGLTF loader;
-        loader.SetImageLoader(load_image, nullptr);
-        Model model;
-        std::string e, w;
+        if (size > 0x7fffffffu) fail("file is larger than 2 GiB");
         bool glb = std::memcmp(data, "glTF", 4) == 0;
-        if (size > 0x7fffffffu) fail("file is too large");
+        check_nesting(data, size, glb);
+        tinygltf::TinyGLTF loader;
+        Model model;
+        gltf_input::context input;
+        input.base_dir = base_dir;
+        input.model = &model;
+        gltf_input::install(&loader, &input);
+        std::string e, w;
         bool ok = glb ? loader.LoadBinaryFromMemory(&model, &e, &w, data, (unsigned int)size, base_dir)
                       : loader.LoadASCIIFromString(&model, &e, &w, (const char *)data, (unsigned int)size, base_dir);
         if (!ok) {
             std::string why = first_line(e);
+            // A buffer file not read: say why, as file access found it.
+            if (why.compare(0, 5, "File ") == 0 && !input.last_problem.empty()) why = "buffer " + input.last_problem;
             fail(why.empty() ? "not a valid glTF file" : why);
         }
-        // tinygltf only warns about missing external files; an image we need is checked when used.
-        std::string line;
-        for (size_t a = 0; a < w.size();) {
-            size_t b = w.find('\n', a);
-            line = w.substr(a, b == std::string::npos ? std::string::npos : b - a);
-            if (!line.empty()) scene_warn(s, "%s: %s", name.c_str(), line.c_str());
-            if (b == std::string::npos) break;
-            a = b + 1;
-        }
-        importer imp(s, model, name);
+        pass_warnings(s, name, w);
+        importer imp(s, model, name, input);
         imp.run();
+        // Images no texture uses are not needed; one that could not be read is worth a word.
+        for (size_t i = 0; i < model.images.size(); i++)
+            if (imp.image_map[i] < 0 && model.images[i].image.empty()) {
+                const std::string &uri = model.images[i].uri;
+                scene_warn(s, "%s: unused image %s not read: %s", name.c_str(),
+                           uri.empty() ? std::to_string(i).c_str() : printable("'" + uri + "'").c_str(),
+                           printable(imp.image_problem((int)i)).c_str());
+            }
         return 0;
     } catch (const import_error &ie) {
-        std::snprintf(err, errlen, "%s: %s", name.c_str(), ie.what.c_str());
+        std::snprintf(err, errlen, "%s: %s", name.c_str(), printable(ie.what).c_str());
     } catch (const std::bad_alloc &) {
         std::snprintf(err, errlen, "%s: out of memory", name.c_str());
     } catch (const std::exception &ex) {
-        std::snprintf(err, errlen, "%s: malformed glTF (%s)", name.c_str(), ex.what());
+        std::snprintf(err, errlen, "%s: malformed glTF (%s)", name.c_str(), first_line(ex.what()).c_str());
     }
     return -1;
 }
@@ -589,21 +733,14 @@ std::string dir_of(const std::string &path) {
 } // namespace
 
 extern "C" int gltf_import_file(scene *s, const char *path, char *err, size_t errlen) {
-    FILE *f = std::fopen(path, "rb");
-    if (!f) return std::snprintf(err, errlen, "%s: %s", path, std::strerror(errno)), -1;
     std::vector<unsigned char> data;
-    unsigned char buf[1 << 16];
-    size_t n;
-    bool read_error = false;
+    std::string why;
     try {
-        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) data.insert(data.end(), buf, buf + n);
-        read_error = std::ferror(f) != 0;
-    } catch (const std::bad_alloc &) {
-        std::fclose(f);
-        return std::snprintf(err, errlen, "%s: out of memory", path), -1;
+        why = gltf_input::read_regular_file(path, &data);
+    } catch (const std::exception &) {
+        why = "out of memory";
     }
-    std::fclose(f);
-    if (read_error) return std::snprintf(err, errlen, "%s: cannot read (is it a directory?)", path), -1;
+    if (!why.empty()) return std::snprintf(err, errlen, "%s: %s", path, why.c_str()), -1;
     return import(s, data.data(), data.size(), dir_of(path), path, err, errlen);
 }
 

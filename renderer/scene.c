@@ -42,6 +42,9 @@ void scene_warn(scene *s, const char *fmt, ...) {
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    /* One line, whatever a file's names hold. */
+    for (char *c = msg; *c; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
     /* Embree reports its errors from whichever thread hit them. */
     static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
     pthread_mutex_lock(&lock);
@@ -218,7 +221,19 @@ int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err
     int out_vertices = flat ? ni : nv;
     long long total_v = (long long)s->num_vertices + out_vertices;
     long long total_t = (long long)s->num_triangles + ni / 3;
-    if (total_v > (1LL << 30) || total_t > (1LL << 30)) return snprintf(err, errlen, "too many triangles"), -1;
+    if (total_t > SCENE_MAX_TRIANGLES || total_v > 3LL * SCENE_MAX_TRIANGLES)
+        return snprintf(err, errlen, "the scene would have more than %d triangles (the limit)", SCENE_MAX_TRIANGLES),
+               -1;
+    /* Far beyond the limit Embree refuses rays; non-finite vertices have no place at all. */
+    for (int k = 0; k < nv; k++) {
+        vec3 p = xform_point(xform, load3(mesh->positions, k));
+        if (!(fabsf(p.x) < SCENE_MAX_COORD && fabsf(p.y) < SCENE_MAX_COORD && fabsf(p.z) < SCENE_MAX_COORD))
+            return snprintf(err, errlen,
+                            "vertex %d lies at (%g, %g, %g) after its transforms; coordinates must be finite and "
+                            "within +-%g",
+                            k, (double)p.x, (double)p.y, (double)p.z, (double)SCENE_MAX_COORD),
+                   -1;
+    }
     if (reserve_vertices(s, (int)total_v) || reserve_triangles(s, (int)total_t)) goto oom;
 
     float cof[3][3], det;
@@ -280,7 +295,9 @@ int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err
             for (int c = 0; c < 3; c++) s->normals[v[c]] = n;
         }
     }
-    if (skipped) scene_warn(s, "skipped %d degenerate or non-finite triangle%s", skipped, skipped > 1 ? "s" : "");
+    if (skipped)
+        scene_warn(s, "skipped %d triangle%s with no area, or too large for float's squares (edges beyond ~1e9)",
+                   skipped, skipped > 1 ? "s" : "");
 
     /* Tangents from uv0 where the mesh has none (Lengyel): area-weighted per vertex, then
      * orthogonalised against the normal; a fallback frame where the uvs are degenerate. */
@@ -368,6 +385,11 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
     s->positions[s->num_vertices] = v3(0, 0, 0);
 
     if (scene_build_lights(s, err, errlen) != 0) return -1;
+    if (s->num_lights == 0)
+        scene_warn(s,
+                   "%s: no light (no punctual light, no emissive material): the image is black without an "
+                   "environment map",
+                   s->path);
 
     /* Hits need the geometric normal, which moving a light (a translation) never changes. */
     free(s->tri_normal);

@@ -197,8 +197,14 @@ typedef struct {
     int material;            /* index, or -1 for the default grey material */
 } mesh_desc;
 
-/* Adds a mesh instance transformed by xform. Returns 0, or -1 on bad input / out of memory with
- * err set (no "PATH:" prefix; the caller adds context). */
+/* Limits: every coordinate (vertices after their transforms, lights, cameras) finite and below
+ * SCENE_MAX_COORD in magnitude; at most SCENE_MAX_TRIANGLES triangles in all. */
+#define SCENE_MAX_COORD 1e15f
+#define SCENE_MAX_TRIANGLES (1 << 24)
+
+/* Adds a mesh instance transformed by xform. Returns 0, or -1 on bad input (a coordinate beyond
+ * the limit, too many triangles) / out of memory with err set (no "PATH:" prefix; the caller adds
+ * context). */
 int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err, size_t errlen);
 /* Adds an image given as 1-4 channels of 8 or 16 bits; returns its index or -1. */
 int scene_add_image(scene *s, int width, int height, int channels, int bits, const void *pixels);

@@ -5,6 +5,7 @@ GLINT_PACKAGES=(
   libglfw3-dev libembree-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev
   libimgui-dev libstb-dev libgl-dev libcjson-dev libcairo2-dev fonts-dejavu-core
   xvfb xauth embree-tools openexr clang-format
+  clang libclang-rt-14-dev
 )
 
 glint_install_deps() {

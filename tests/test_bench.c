@@ -40,7 +40,8 @@ static const char *const other_scene =
     "\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],\"meshes\":[{\"primitives\":[{"
     "\"attributes\":{\"POSITION\":0},\"indices\":1}]}],\"extensionsUsed\":[\"KHR_lights_punctual\"],\"extensions\":{"
     "\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\",\"intensity\":5}]}},\"cameras\":[{\"type\":"
-    "\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.01}}],\"nodes\":[{\"mesh\":0},{\"light\":0,"
+    "\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.01}}],\"nodes\":[{\"mesh\":0},{\"extensions\":{\"KHR_"
+    "lights_punctual\":{\"light\":0}},"
     "\"translation\":[0,1,0]},{\"camera\":0,\"translation\":[0,1,3]}],\"scenes\":[{\"nodes\":[0,1,2]}],\"scene\":0}\n";
 
 /* The extent of dark pixels (text, not the light grid) in [x0, x1) x [y0, y1) of an RGB image:
