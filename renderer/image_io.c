@@ -79,7 +79,9 @@ static int membuf_write_at(membuf *b, size_t offset, const void *src, size_t n) 
 /* Opens a regular file for reading; returns the descriptor and its size, or -1 with err set. */
 static int open_input(const char *path, int64_t *size, char *err, size_t errlen) {
     if (!path || !path[0]) return fail(err, errlen, path ? path : "", "empty file name");
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    /* Non-blocking: opening a FIFO would otherwise wait for a writer. Only regular files get
+     * further (where the flag changes nothing). */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
     if (fd < 0) return fail(err, errlen, path, "%s", strerror(errno));
     struct stat st;
     if (fstat(fd, &st) != 0) {
@@ -89,7 +91,8 @@ static int open_input(const char *path, int64_t *size, char *err, size_t errlen)
     }
     if (!S_ISREG(st.st_mode)) {
         close(fd);
-        return fail(err, errlen, path, "%s", S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
+        return fail(err, errlen, path, "%s",
+                    S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file (a pipe or a device?)");
     }
     *size = (int64_t)st.st_size;
     return fd;

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "image_io.h"
 #include "scene.h"
 #include "scratch.h"
 
@@ -333,6 +334,25 @@ static void test_special_files(void) {
     snprintf(extra, sizeof extra, tex, "folder.bin");
     expect_error("a directory as an image", write_text("dir-image.gltf", quad_json(NULL, 0, NULL, extra)),
                  "texture image 'folder.bin': is a directory");
+
+    /* The same for an environment map and a reference image (opened with O_NONBLOCK: a FIFO
+     * without a writer would otherwise block the open itself). */
+    CHECK(mkfifo(path_of("fifo.exr"), 0600) == 0, "mkfifo fifo.exr");
+    const char *specials[] = {path_of("fifo.exr"), "/dev/zero", path_of("folder.bin")};
+    const char *problems[] = {"not a regular file (a pipe or a device?)", "not a regular file (a pipe or a device?)",
+                              "is a directory"};
+    for (int k = 0; k < 3; k++) {
+        char err[1024] = "", want[1200];
+        snprintf(want, sizeof want, "%s: %s", specials[k], problems[k]);
+        scene *s = scene_create(NULL, NULL);
+        CHECK(scene_set_env(s, specials[k], 0.0f, err, sizeof err) != 0 && strcmp(err, want) == 0,
+              "environment map %s: '%s', expected '%s'", specials[k], err, want);
+        scene_destroy(s);
+        exr_image img;
+        err[0] = 0;
+        CHECK(exr_image_load(specials[k], &img, err, sizeof err) != 0 && strcmp(err, want) == 0,
+              "reference image %s: '%s', expected '%s'", specials[k], err, want);
+    }
 }
 
 /* Images declaring more pixels than the budget are refused from their header. */
