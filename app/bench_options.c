@@ -274,7 +274,7 @@ static int parse_pass(int argc, char **argv, bench_options *o, int *preset_at, c
         {.name = "--only", .kind = CLI_TEXT, .out = only},
         {.name = "--size", .kind = CLI_SIZE, .out = &o->width, .out2 = &o->height},
         {.name = "--camera", .kind = CLI_LONG, .out = &o->camera_index, .lo = 0, .hi = CLI_CAMERA_MAX},
-        {.name = "--max-depth", .kind = CLI_INT, .out = &o->max_depth, .lo = 1, .hi = CLI_MAX_DEPTH_MAX},
+        {.name = "--max-depth", .kind = CLI_INT, .out = &o->max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
         {.name = "--plan", .kind = CLI_PLAN, .out = &o->plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--env-rotation", .kind = CLI_FLOAT, .out = &o->env_rotation_deg, .lo = -36000.0, .hi = 36000.0},

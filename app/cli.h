@@ -55,7 +55,6 @@ typedef struct {
     int *given;
 } cli_opt;
 /* The ranges the commands share. */
-#define CLI_MAX_DEPTH_MAX 10000
 #define CLI_CAMERA_MAX 1000000
 #define CLI_THREADS_MAX 1024
 /* argv[*i] if it is one of the n options: 1 taken (with its value, advancing *i), 0 not one of

@@ -90,7 +90,7 @@ int cmd_info(int argc, char **argv) {
         } else if (strcmp(argv[i], "--max-depth") == 0) {
             const char *v = cli_value(argc, argv, &i);
             long long n;
-            if (!v || cli_parse_int("--max-depth", v, 1, 10000, &n)) return EXIT_USAGE;
+            if (!v || cli_parse_int("--max-depth", v, 1, MAX_DEPTH_LIMIT, &n)) return EXIT_USAGE;
             max_depth = (int)n;
         } else if (strcmp(argv[i], "--obj") == 0) {
             if (!(obj = cli_value(argc, argv, &i))) return EXIT_USAGE;

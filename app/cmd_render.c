@@ -83,7 +83,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000, .given = &spp_given},
         {.name = "--time", .kind = CLI_FLOAT, .out = &o->seconds, .lo = 1e-3, .hi = 1e7, .given = &time_given},
         {.name = "--size", .kind = CLI_SIZE, .out = &p->width, .out2 = &p->height},
-        {.name = "--max-depth", .kind = CLI_INT, .out = &p->max_depth, .lo = 1, .hi = CLI_MAX_DEPTH_MAX},
+        {.name = "--max-depth", .kind = CLI_INT, .out = &p->max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
         {.name = "--plan", .kind = CLI_PLAN, .out = &p->plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--env-rotation", .kind = CLI_FLOAT, .out = &o->env_rotation_deg, .lo = -36000.0, .hi = 36000.0},

@@ -59,7 +59,7 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     const cli_opt opts[] = {
         {.name = "--size", .kind = CLI_SIZE, .out = &o->width, .out2 = &o->height},
         {.name = "--method", .kind = CLI_METHOD, .out = &o->params.method},
-        {.name = "--max-depth", .kind = CLI_INT, .out = &o->params.max_depth, .lo = 1, .hi = CLI_MAX_DEPTH_MAX},
+        {.name = "--max-depth", .kind = CLI_INT, .out = &o->params.max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
         {.name = "--plan", .kind = CLI_PLAN, .out = &o->params.plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--camera", .kind = CLI_INT, .out = &o->camera, .lo = 0, .hi = CLI_CAMERA_MAX},

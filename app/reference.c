@@ -296,7 +296,7 @@ static int reference_parse(const char *text, size_t n, const char *label, refere
     r->highlights_layer = cJSON_IsTrue(hl);
     NEED(json_int(root, "spp", 0, (long long)1 << 50, &r->spp) == 0, "spp");
     NEED(json_number(root, "seconds", &r->seconds) == 0, "seconds");
-    NEED(json_int(root, "max_depth", 1, 10000, &ll) == 0, "max_depth");
+    NEED(json_int(root, "max_depth", 1, MAX_DEPTH_LIMIT, &ll) == 0, "max_depth");
     r->max_depth = (int)ll;
     NEED(json_seed(root, text, &r->seed) == 0, "seed");
     /* "variance": null when the reference rendered a single frame. */

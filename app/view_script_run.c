@@ -68,7 +68,8 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
         if (m < 0) return snprintf(err, errlen, "unknown method '%s'", value), -1;
         u->ctl.params.method = (render_method)m;
     } else if (strcmp(name, "max-depth") == 0) {
-        if (cli_parse_int(opt, value, 1, 1000, &n) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
+        if (cli_parse_int(opt, value, 1, MAX_DEPTH_LIMIT, &n) != 0)
+            return snprintf(err, errlen, "bad value '%s'", value), -1;
         u->ctl.params.max_depth = (int)n;
     } else if (strcmp(name, "exposure") == 0) {
         if (cli_parse_float(opt, value, -30, 30, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;

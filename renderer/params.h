@@ -26,6 +26,7 @@ const char *method_name(render_method m);
 int method_from_name(const char *name);
 
 #define DEFAULT_MAX_DEPTH 16
+#define MAX_DEPTH_LIMIT 10000 /* the deepest path any front end accepts */
 #define DEFAULT_WIDTH 960
 #define DEFAULT_HEIGHT 540
 
