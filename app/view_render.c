@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "envmap.h"
+#include "lights.h"
 #include "metrics.h"
 #include "view.h"
 
@@ -35,6 +37,7 @@ struct render_thread {
 void shared_state_init(shared_state *sh) {
     memset(sh, 0, sizeof *sh);
     pthread_mutex_init(&sh->lock, NULL);
+    pthread_rwlock_init(&sh->scene_lock, NULL);
     clear_light_edits(&sh->lights);
     sh->show_mask = COMP_MASK_ALL;
     sh->changed_at = -1e9;
@@ -43,6 +46,7 @@ void shared_state_init(shared_state *sh) {
 void shared_state_deinit(shared_state *sh) {
     image_rgb_free(&sh->reference_new);
     free(sh->image.rgb);
+    pthread_rwlock_destroy(&sh->scene_lock);
     pthread_mutex_destroy(&sh->lock);
 }
 
@@ -54,6 +58,7 @@ void fill_scene_info(scene_info *info, const scene *s) {
     info->diag = s->diag;
     int n = scene_light_groups(s, info->lights, MAX_LIGHT_GROUPS); /* -1 (out of memory): none listed */
     info->num_lights = n < 0 ? 0 : n < MAX_LIGHT_GROUPS ? n : MAX_LIGHT_GROUPS;
+    info->unlit = s->num_lights - (s->env_light >= 0 ? 1 : 0) == 0;
 }
 
 void clear_light_edits(light_edits *e) {
@@ -78,8 +83,11 @@ static render_session *create_preview(render_thread *rt, int divisor, const came
     render_params p = *params;
     p.width = fp->width / divisor > 0 ? fp->width / divisor : 1;
     p.height = fp->height / divisor > 0 ? fp->height / divisor : 1;
-    /* No abort flag: while things move every preview frame must finish, or none would be shown. */
-    return session_create(rt->scene, cam, &p, err, errlen);
+    /* Only quitting stops a preview frame: while things move every one must finish, or none would
+     * be shown. */
+    render_session *rs = session_create(rt->scene, cam, &p, err, errlen);
+    if (rs) session_set_abort_flag(rs, &rt->sh->abort_preview);
+    return rs;
 }
 
 /* (Re)creates both sessions for the current scene at w x h. Returns 0 or -1 (message set). */
@@ -122,52 +130,97 @@ static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam,
     rt->preview_divisor = d;
 }
 
-static void handle_load(render_thread *rt, int kind, const char *path, const camera *cam, const render_params *params) {
-    char err[1024];
-    if (kind == 1) {
+/* Gives s the environment named by source (a map's path, ENV_SKY, or "" for none). The scene
+ * must not be rendering. Returns 0, or -1 with err set (the scene keeps its old map). */
+static int set_environment(scene *s, const char *source, char *err, size_t errlen) {
+    if (strcmp(source, ENV_SKY) == 0) { /* a constant radiance of 1 from every direction */
+        image_rgb sky = {8, 4, malloc(sizeof(float) * 3 * 8 * 4)};
+        if (!sky.rgb) return snprintf(err, errlen, "uniform sky: out of memory"), -1;
+        for (int i = 0; i < 3 * 8 * 4; i++) sky.rgb[i] = 1.0f;
+        return scene_set_env_image(s, &sky, 0.0f, err, errlen);
+    }
+    if (source[0]) return scene_set_env(s, source, 0.0f, err, errlen);
+    if (!s->env) return 0;
+    env_map *old = s->env;
+    s->env = NULL;
+    if (scene_build_lights(s, err, errlen) != 0) {
+        s->env = old;
+        char ignored[256];
+        scene_build_lights(s, ignored, sizeof ignored);
+        return -1;
+    }
+    env_map_destroy(old);
+    return 0;
+}
+
+static void load_failed(render_thread *rt, const char *err) {
+    cli_error("%s", err);
+    set_message(rt, "%s%s", err, "");
+}
+
+/* A scene or an environment change, between frames. Returns 1 when the scene changed (the
+ * accumulation restarts), 0 when the load failed and nothing changed. */
+static int handle_load(render_thread *rt, int kind, const char *path, const camera *cam, const render_params *params) {
+    char err[1200], env[1024];
+    shared_state *sh = rt->sh;
+    pthread_mutex_lock(&sh->lock);
+    snprintf(env, sizeof env, "%s", sh->env_now);
+    pthread_mutex_unlock(&sh->lock);
+    if (kind == LOAD_SCENE) {
         scene *s = scene_load(path, cli_print_warning, NULL, err, sizeof err);
-        if (!s) {
-            cli_error("%s", err);
-            set_message(rt, "%s%s", err, "");
-            return;
+        if (!s) return load_failed(rt, err), 0;
+        /* The environment stays with the viewer, not with the scene. */
+        if (env[0] && set_environment(s, env, err, sizeof err) != 0) {
+            cli_warning("%s; %s opens without it", err, path);
+            env[0] = 0;
         }
         /* The sessions read the old scene: replace them with it. */
         int w = session_params(rt->full)->width, h = session_params(rt->full)->height;
         session_destroy(rt->full);
         session_destroy(rt->preview);
         rt->full = rt->preview = NULL;
+        pthread_rwlock_wrlock(&sh->scene_lock);
         scene_destroy(rt->scene);
         rt->scene = s;
+        sh->scene_now = s;
+        pthread_rwlock_unlock(&sh->scene_lock);
         clear_light_edits(&rt->lights_applied);
         camera c = scene_camera(s, -1, (float)w / (float)h);
         make_sessions(rt, w, h, &c, params);
-        pthread_mutex_lock(&rt->sh->lock);
-        fill_scene_info(&rt->sh->info, s);
-        rt->sh->info_serial++;
-        pthread_mutex_unlock(&rt->sh->lock);
+        pthread_mutex_lock(&sh->lock);
+        fill_scene_info(&sh->info, s);
+        sh->info_serial++;
+        snprintf(sh->env_now, sizeof sh->env_now, "%s", env);
+        pthread_mutex_unlock(&sh->lock);
         set_message(rt, "loaded %s%s", path, "");
-    } else {
-        if (scene_set_env(rt->scene, path, 0.0f, err, sizeof err) != 0) {
-            cli_error("%s", err);
-            set_message(rt, "%s%s", err, "");
-            return;
-        }
-        /* The plan depends on the map (its prefiltering, its light) */
-        if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0) {
-            cli_error("%s", session_error(rt->full));
-            set_message(rt, "%s%s", session_error(rt->full), "");
-            return;
-        }
-        session_set_camera(rt->full, cam);
-        session_set_camera(rt->preview, cam);
-        set_message(rt, "environment %s%s", path, "");
+        return 1;
     }
+    const char *source = kind == LOAD_SKY ? ENV_SKY : kind == LOAD_NO_ENV ? "" : path;
+    pthread_rwlock_wrlock(&sh->scene_lock);
+    int failed = set_environment(rt->scene, source, err, sizeof err) != 0;
+    pthread_rwlock_unlock(&sh->scene_lock);
+    if (failed) return load_failed(rt, err), 0;
+    pthread_mutex_lock(&sh->lock);
+    snprintf(sh->env_now, sizeof sh->env_now, "%s", source);
+    pthread_mutex_unlock(&sh->lock);
+    /* The plan depends on the map (its prefiltering, its light) */
+    if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0)
+        load_failed(rt, session_error(rt->full));
+    session_set_camera(rt->full, cam);
+    session_set_camera(rt->preview, cam);
+    set_message(rt,
+                kind == LOAD_SKY      ? "uniform sky%s%s"
+                : kind == LOAD_NO_ENV ? "no environment%s%s"
+                                      : "environment %s%s",
+                kind == LOAD_ENV ? path : "", "");
+    return 1;
 }
 
 /* Brings the scene's lights to the wanted offsets and gains (render thread, between frames). */
 static void apply_light_edits(render_thread *rt, const light_edits *wanted) {
     char err[512];
     light_edits *done = &rt->lights_applied;
+    pthread_rwlock_wrlock(&rt->sh->scene_lock); /* moving a light rebuilds the BVH */
     for (int g = 0; g < MAX_LIGHT_GROUPS; g++) {
         vec3 d = sub3(wanted->offset[g], done->offset[g]);
         float gain = wanted->gain[g];
@@ -182,6 +235,7 @@ static void apply_light_edits(render_thread *rt, const light_edits *wanted) {
         done->offset[g] = wanted->offset[g];
         done->gain[g] = gain;
     }
+    pthread_rwlock_unlock(&rt->sh->scene_lock);
 }
 
 /* The relative L2 error of the whole image (every component, whatever is shown) against the
@@ -207,8 +261,8 @@ static double frame_error(render_thread *rt, const film *f, unsigned mask, const
 /* before: the session's statistics before the frame, so the frame's own work is the difference.
  * The film is resolved with the components shown now, not when the frame started: a frame after a
  * display change shows that change. */
-static void publish(render_thread *rt, render_session *rs, int preview, double frame_ms, const render_stats *before,
-                    uint64_t resets_seen, uint64_t gen) {
+static void publish(render_thread *rt, render_session *rs, int preview, int measure, double frame_ms,
+                    const render_stats *before, uint64_t resets_seen, uint64_t gen) {
     shared_state *sh = rt->sh;
     const film *f = session_film(rs);
     if (rt->back.width != f->width || rt->back.height != f->height) {
@@ -223,7 +277,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, double f
     pthread_mutex_unlock(&sh->lock);
     film_resolve(f, mask, rt->back.rgb);
     rt->back.preview = preview;
-    double rel_error = preview ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
+    double rel_error = preview || !measure ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
     for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st.rays[k];
@@ -258,6 +312,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, double f
             sh->stats.hl_points = st.hl_points - before->hl_points;
             sh->stats.hl_lobes = st.hl_lobes - before->hl_lobes;
             sh->stats.hl_merge_share = merge_share;
+            sh->stats.error_paused = !measure;
         }
     }
     pthread_mutex_unlock(&sh->lock);
@@ -300,9 +355,10 @@ static void *render_main(void *arg) {
             camera cam = sh->cam;
             render_params params = sh->params;
             pthread_mutex_unlock(&sh->lock);
-            handle_load(rt, kind, path, &cam, &params);
+            int changed = handle_load(rt, kind, path, &cam, &params);
             pthread_mutex_lock(&sh->lock);
-            applied = 0; /* re-apply the camera and parameters to the new sessions */
+            if (changed) applied = 0; /* re-apply the camera and parameters: a new accumulation */
+            sh->loads_done++;
             continue;
         }
         const film *ff = session_film(rt->full);
@@ -312,6 +368,8 @@ static void *render_main(void *arg) {
         camera cam = sh->cam;
         render_params params = sh->params;
         int preview = seconds_since(sh->changed_at) < PREVIEW_HOLD_SECONDS;
+        /* Measured against the reference only from its camera (when its description names one). */
+        int measure = !sh->reference_cam_valid || same_view(&cam, &sh->reference_cam, rt->scene->diag);
         int rw = sh->render_w, rh = sh->render_h;
         /* Light requests made for a scene since replaced are stale: the new one starts as loaded. */
         int edit_lights = gen != applied && sh->lights_scene == sh->info_serial;
@@ -358,7 +416,7 @@ static void *render_main(void *arg) {
         }
         if (rs == rt->full) rt->full_film_partial = 0;
         double ms = 1e3 * seconds_since(t0);
-        publish(rt, rs, preview, ms, &before, resets_seen, gen);
+        publish(rt, rs, preview, measure, ms, &before, resets_seen, gen);
         if (preview) adapt_preview(rt, ms, &cam, &params);
         pthread_mutex_lock(&sh->lock);
     }
@@ -374,6 +432,7 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
     }
     rt->sh = sh;
     rt->scene = s;
+    sh->scene_now = s;
     clear_light_edits(&rt->lights_applied);
     sh->stats.reset_at = cli_now(); /* the first accumulation starts now, not at the clock's origin */
     if (make_sessions(rt, sh->render_w, sh->render_h, &sh->cam, &sh->params) != 0) {
@@ -389,6 +448,9 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
 void render_thread_stop(render_thread *rt) {
     pthread_mutex_lock(&rt->sh->lock);
     rt->sh->quit = 1;
+    /* The frame in flight stops at its next tile (unless an export waits for it). */
+    if (!rt->sh->export_pending) atomic_store(&rt->sh->abort_frame, 1);
+    atomic_store(&rt->sh->abort_preview, 1);
     pthread_mutex_unlock(&rt->sh->lock);
     pthread_join(rt->thread, NULL);
     session_destroy(rt->full);
