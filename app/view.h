@@ -111,8 +111,10 @@ typedef struct {
      * measured against it, so the error plot pauses while the view is away. */
     int reference_cam_valid;
     camera reference_cam;
-    /* Loads run between frames; a failed one changes nothing. A script waits for loads_done. */
+    /* Loads (load_kind, load_path) are read by a thread of their own while frames go on and
+     * applied between frames; a failed one changes nothing. A script waits for loads_done. */
     uint64_t load_requests, loads_done;
+    pthread_cond_t load_cond; /* signalled with each request, each result taken, and quit */
     /* The scene the render thread has, for the UI's ray queries (zoom, fly): the UI reads it under
      * scene_lock (never waiting: try-lock), which the render thread holds for writing whenever it
      * changes or replaces the scene. */

@@ -86,9 +86,10 @@ void request_load(ui_thread *u, int kind, const char *path) {
     pthread_mutex_lock(&sh->lock);
     snprintf(sh->load_path, sizeof sh->load_path, "%s", path);
     sh->load_kind = kind;
-    /* Not a change yet: the frame in flight finishes and the accumulation goes on unless the load
+    /* Not a change yet: the frame in flight goes on, and the accumulation too, unless the load
      * succeeds (a new scene then arrives, and with it a new view). */
     u->script_load_target = ++sh->load_requests;
+    pthread_cond_signal(&sh->load_cond);
     pthread_mutex_unlock(&sh->lock);
 }
 

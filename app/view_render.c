@@ -17,6 +17,20 @@
 #define PREVIEW_TARGET_MS 70.0 /* ...so that a preview frame takes about this long */
 #define PREVIEW_HOLD_SECONDS 0.3
 
+/* Loads go to a thread of their own, which reads files while frames go on: only a load that
+ * succeeds stops the frame in flight, so a failed one leaves the accumulation as it was. One at a
+ * time: the loader takes the next request once the render thread has taken the last result. */
+typedef struct {
+    int active; /* taken from the requests, not yet applied (under sh->lock) */
+    int done;   /* read (under sh->lock); the fields below are then the render thread's */
+    int ok;
+    int kind;
+    char path[1024], env[1024];
+    scene *scene;    /* LOAD_SCENE's result, with the environment env */
+    image_rgb image; /* LOAD_ENV's */
+    char err[1200];
+} load_job;
+
 /* Written and read by the render thread alone (the UI sees only shared_state). */
 struct render_thread {
     shared_state *sh;
@@ -29,7 +43,10 @@ struct render_thread {
     float *combined;            /* the whole image when another part is shown */
     size_t combined_len;
     int preview_divisor;
-    int scene_edited;      /* lights changed since the plan was made */
+    int scene_edited; /* lights changed since the plan was made */
+    pthread_t loader;
+    int loader_running;
+    load_job job;
     int full_film_partial; /* a stopped frame left samples in the full film; cleared
                                          * by the next full frame that completes */
 };
@@ -38,6 +55,7 @@ void shared_state_init(shared_state *sh) {
     memset(sh, 0, sizeof *sh);
     pthread_mutex_init(&sh->lock, NULL);
     pthread_rwlock_init(&sh->scene_lock, NULL);
+    pthread_cond_init(&sh->load_cond, NULL);
     clear_light_edits(&sh->lights);
     sh->show_mask = COMP_MASK_ALL;
     sh->changed_at = -1e9;
@@ -47,6 +65,7 @@ void shared_state_deinit(shared_state *sh) {
     image_rgb_free(&sh->reference_new);
     free(sh->image.rgb);
     pthread_rwlock_destroy(&sh->scene_lock);
+    pthread_cond_destroy(&sh->load_cond);
     pthread_mutex_destroy(&sh->lock);
 }
 
@@ -158,48 +177,100 @@ static void load_failed(render_thread *rt, const char *err) {
     set_message(rt, "%s%s", err, "");
 }
 
-/* A scene or an environment change, between frames. Returns 1 when the scene changed (the
- * accumulation restarts), 0 when the load failed and nothing changed. */
-static int handle_load(render_thread *rt, int kind, const char *path, const camera *cam, const render_params *params) {
-    char err[1200], env[1024];
-    shared_state *sh = rt->sh;
-    pthread_mutex_lock(&sh->lock);
-    snprintf(env, sizeof env, "%s", sh->env_now);
-    pthread_mutex_unlock(&sh->lock);
-    if (kind == LOAD_SCENE) {
-        scene *s = scene_load(path, cli_print_warning, NULL, err, sizeof err);
-        if (!s) return load_failed(rt, err), 0;
+/* Reads what the job names: a scene (given the viewer's environment) or a map. */
+static int load_files(load_job *j) {
+    if (j->kind == LOAD_SCENE) {
+        if (!(j->scene = scene_load(j->path, cli_print_warning, NULL, j->err, sizeof j->err))) return 0;
         /* The environment stays with the viewer, not with the scene. */
-        if (env[0] && set_environment(s, env, err, sizeof err) != 0) {
-            cli_warning("%s; %s opens without it", err, path);
-            env[0] = 0;
+        if (j->env[0] && set_environment(j->scene, j->env, j->err, sizeof j->err) != 0) {
+            cli_warning("%s; %s opens without it", j->err, j->path);
+            j->env[0] = 0;
         }
-        /* The sessions read the old scene: replace them with it. */
-        int w = session_params(rt->full)->width, h = session_params(rt->full)->height;
-        session_destroy(rt->full);
-        session_destroy(rt->preview);
-        rt->full = rt->preview = NULL;
-        pthread_rwlock_wrlock(&sh->scene_lock);
-        scene_destroy(rt->scene);
-        rt->scene = s;
-        sh->scene_now = s;
-        pthread_rwlock_unlock(&sh->scene_lock);
-        clear_light_edits(&rt->lights_applied);
-        camera c = scene_camera(s, -1, (float)w / (float)h);
-        make_sessions(rt, w, h, &c, params);
-        pthread_mutex_lock(&sh->lock);
-        fill_scene_info(&sh->info, s);
-        sh->info_serial++;
-        snprintf(sh->env_now, sizeof sh->env_now, "%s", env);
-        pthread_mutex_unlock(&sh->lock);
-        set_message(rt, "loaded %s%s", path, "");
         return 1;
     }
-    const char *source = kind == LOAD_SKY ? ENV_SKY : kind == LOAD_NO_ENV ? "" : path;
+    if (j->kind == LOAD_ENV) return image_rgb_load(j->path, &j->image, j->err, sizeof j->err) == 0;
+    return 1; /* the uniform sky, no environment: nothing to read */
+}
+
+static void *loader_main(void *arg) {
+    render_thread *rt = arg;
+    shared_state *sh = rt->sh;
+    load_job *j = &rt->job;
+    pthread_mutex_lock(&sh->lock);
+    for (;;) {
+        while (!sh->quit && !(sh->load_kind && !j->active)) pthread_cond_wait(&sh->load_cond, &sh->lock);
+        if (sh->quit) break;
+        *j = (load_job){.active = 1, .kind = sh->load_kind};
+        snprintf(j->path, sizeof j->path, "%s", sh->load_path);
+        snprintf(j->env, sizeof j->env, "%s", sh->env_now);
+        sh->load_kind = LOAD_NONE;
+        pthread_mutex_unlock(&sh->lock);
+        int ok = load_files(j);
+        pthread_mutex_lock(&sh->lock);
+        j->ok = ok;
+        j->done = 1;
+        if (ok && !sh->export_pending) atomic_store(&sh->abort_frame, 1); /* a change: stop the frame */
+    }
+    pthread_mutex_unlock(&sh->lock);
+    return NULL;
+}
+
+static void load_job_free(load_job *j) {
+    if (j->scene) scene_destroy(j->scene);
+    image_rgb_free(&j->image);
+    memset(j, 0, sizeof *j);
+}
+
+/* Puts scene s (its environment env) in place of the current one. */
+static void replace_scene(render_thread *rt, scene *s, const char *env, const char *path, const render_params *params) {
+    shared_state *sh = rt->sh;
+    /* The sessions read the old scene: replace them with it. */
+    int w = session_params(rt->full)->width, h = session_params(rt->full)->height;
+    session_destroy(rt->full);
+    session_destroy(rt->preview);
+    rt->full = rt->preview = NULL;
     pthread_rwlock_wrlock(&sh->scene_lock);
-    int failed = set_environment(rt->scene, source, err, sizeof err) != 0;
+    scene_destroy(rt->scene);
+    rt->scene = s;
+    sh->scene_now = s;
     pthread_rwlock_unlock(&sh->scene_lock);
-    if (failed) return load_failed(rt, err), 0;
+    clear_light_edits(&rt->lights_applied);
+    camera c = scene_camera(s, -1, (float)w / (float)h);
+    make_sessions(rt, w, h, &c, params);
+    pthread_mutex_lock(&sh->lock);
+    fill_scene_info(&sh->info, s);
+    sh->info_serial++;
+    snprintf(sh->env_now, sizeof sh->env_now, "%s", env);
+    pthread_mutex_unlock(&sh->lock);
+    set_message(rt, "loaded %s%s", path, "");
+}
+
+/* A finished load job, between frames. Returns 1 when the scene changed (the accumulation
+ * restarts), 0 when the load failed and nothing changed. */
+static int finish_load(render_thread *rt, load_job *j, const camera *cam, const render_params *params) {
+    char err[1200];
+    shared_state *sh = rt->sh;
+    int kind = j->kind;
+    if (!j->ok) return load_failed(rt, j->err), 0;
+    if (kind == LOAD_SCENE) {
+        replace_scene(rt, j->scene, j->env, j->path, params);
+        j->scene = NULL; /* the render thread's now */
+        return 1;
+    }
+    const char *source = kind == LOAD_SKY ? ENV_SKY : kind == LOAD_NO_ENV ? "" : j->path;
+    pthread_rwlock_wrlock(&sh->scene_lock);
+    char sub[512];
+    int failed = kind == LOAD_ENV ? scene_set_env_image(rt->scene, &j->image, 0.0f, sub, sizeof sub) != 0
+                                  : set_environment(rt->scene, source, sub, sizeof sub) != 0;
+    pthread_rwlock_unlock(&sh->scene_lock);
+    if (failed) {
+        snprintf(err, sizeof err, "%.600s: %.500s",
+                 kind == LOAD_ENV ? j->path
+                 : source[0]      ? "uniform sky"
+                                  : "no environment",
+                 sub);
+        return load_failed(rt, err), 0;
+    }
     pthread_mutex_lock(&sh->lock);
     snprintf(sh->env_now, sizeof sh->env_now, "%s", source);
     pthread_mutex_unlock(&sh->lock);
@@ -212,7 +283,7 @@ static int handle_load(render_thread *rt, int kind, const char *path, const came
                 kind == LOAD_SKY      ? "uniform sky%s%s"
                 : kind == LOAD_NO_ENV ? "no environment%s%s"
                                       : "environment %s%s",
-                kind == LOAD_ENV ? path : "", "");
+                kind == LOAD_ENV ? j->path : "", "");
     return 1;
 }
 
@@ -347,18 +418,17 @@ static void *render_main(void *arg) {
             continue;
         }
         if (sh->quit && !(sh->export_pending && rt->full_film_partial)) break;
-        if (sh->load_kind) {
-            int kind = sh->load_kind;
-            char path[1024];
-            snprintf(path, sizeof path, "%s", sh->load_path);
-            sh->load_kind = 0;
+        load_job *job = &rt->job;
+        if (job->active && job->done) { /* a load read (or failed): apply it between frames */
             camera cam = sh->cam;
             render_params params = sh->params;
             pthread_mutex_unlock(&sh->lock);
-            int changed = handle_load(rt, kind, path, &cam, &params);
+            int changed = finish_load(rt, job, &cam, &params);
+            load_job_free(job);
             pthread_mutex_lock(&sh->lock);
             if (changed) applied = 0; /* re-apply the camera and parameters: a new accumulation */
             sh->loads_done++;
+            pthread_cond_signal(&sh->load_cond); /* the loader may take the next */
             continue;
         }
         const film *ff = session_film(rt->full);
@@ -441,6 +511,14 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
         free(rt);
         return NULL;
     }
+    if (pthread_create(&rt->loader, NULL, loader_main, rt) != 0) {
+        snprintf(sh->message, sizeof sh->message, "cannot start the loading thread");
+        session_destroy(rt->full);
+        session_destroy(rt->preview);
+        free(rt);
+        return NULL;
+    }
+    rt->loader_running = 1;
     pthread_create(&rt->thread, NULL, render_main, rt);
     return rt;
 }
@@ -448,11 +526,14 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
 void render_thread_stop(render_thread *rt) {
     pthread_mutex_lock(&rt->sh->lock);
     rt->sh->quit = 1;
+    pthread_cond_broadcast(&rt->sh->load_cond);
     /* The frame in flight stops at its next tile (unless an export waits for it). */
     if (!rt->sh->export_pending) atomic_store(&rt->sh->abort_frame, 1);
     atomic_store(&rt->sh->abort_preview, 1);
     pthread_mutex_unlock(&rt->sh->lock);
     pthread_join(rt->thread, NULL);
+    if (rt->loader_running) pthread_join(rt->loader, NULL); /* a load under way is waited for */
+    load_job_free(&rt->job);
     session_destroy(rt->full);
     session_destroy(rt->preview);
     scene_destroy(rt->scene);

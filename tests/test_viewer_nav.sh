@@ -210,6 +210,14 @@ t1=$(now)
 took=$(awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }')
 below "$took" 5 || fail "quit took $took s"
 echo "quit by the script: $took s"
+# A load is a change too: once read, it stops the frame in flight (time= is the viewer's clock).
+printf 'sleep 2\nstats\nload builtin:showcase\nstats\nquit\n' >loadstop.txt
+view --size 960x540 --method vsl+hl --script loadstop.txt
+grep '^stats ' out.txt >stats.txt
+took=$(awk -v a="$(field 1 time)" -v b="$(field 2 time)" 'BEGIN { print b - a }')
+[ "$(field 2 scene)" = "builtin:showcase" ] || fail "the load during a slow frame did not happen: $(cat err.txt)"
+below "$took" 5 || fail "a load waited $took s for the frame in flight"
+echo "load during a vsl+hl frame: $took s"
 printf 'sleep 2\nstats\nsleep 120\nquit\n' >escape.txt
 view --size 960x540 --method vsl+hl --script escape.txt &
 viewer=$!
