@@ -1,8 +1,10 @@
 /* glint view: the interactive viewer's internals, shared by its files (not a public interface).
  *
- * Two threads. The render thread (view_render.c) owns the scene and the render sessions: it
- * renders frame after frame, applies requested changes between frames, and publishes each
- * resolved image by swapping buffers under a lock held only for the swap. The UI thread owns the
+ * Two threads, and a third for loading. The render thread (view_render.c) owns the scene and the
+ * render sessions: it renders frame after frame, applies requested changes between frames, and
+ * publishes each resolved image by swapping buffers under a lock held only for the swap. The
+ * loader reads the scenes and maps asked for while frames go on; the render thread puts them in
+ * place between frames. The UI thread owns the
  * window: it handles input (view_input.c, view_camera.c) and scripts (view_script_run.c),
  * tone-maps and draws the newest image with the panel (view_display.c), and never waits for a
  * frame. The two meet only in shared_state, under its lock.
