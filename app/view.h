@@ -274,6 +274,9 @@ int handle_input(ui_thread *u, double dt);
 float scene_distance(ui_thread *u, vec3 o, vec3 d);
 /* Zoom by factor (< 1 closer) about what is under the centre of the view, never through a wall. */
 void nav_zoom(ui_thread *u, float factor);
+/* Orbit and pan as ctl_orbit and ctl_pan, without passing through a wall. */
+void nav_orbit(ui_thread *u, float dyaw, float dpitch);
+void nav_pan(ui_thread *u, float dx, float dy);
 /* Flies by a step along dir (unit), at a speed set by what is ahead, stopping short of walls. */
 void nav_fly(ui_thread *u, vec3 dir, double dt);
 /* A view of the whole scene, lit when possible. */

@@ -224,7 +224,7 @@ int handle_input(ui_thread *u, double dt) {
             changed = 1;
     }
     if (cli_now() < u->spin_until) { /* a scripted drag */
-        ctl_orbit(&u->cam, (float)(u->spin_rate * dt * 3.14159265358979 / 180.0), 0.0f);
+        nav_orbit(u, (float)(u->spin_rate * dt * 3.14159265358979 / 180.0), 0.0f);
         changed = 1;
     }
     double x, y;
@@ -259,11 +259,11 @@ int handle_input(ui_thread *u, double dt) {
         glfwGetWindowSize(u->win, NULL, &wh);
         float scale = 1.0f / (float)(wh > 0 ? wh : 1);
         if (left) {
-            ctl_orbit(&u->cam, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
+            nav_orbit(u, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
             changed = 1;
         } else if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
                    glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) {
-            ctl_pan(&u->cam, (float)-dx * scale, (float)dy * scale);
+            nav_pan(u, (float)-dx * scale, (float)dy * scale);
             changed = 1;
         }
     }

@@ -53,6 +53,33 @@ void nav_fly(ui_thread *u, vec3 dir, double dt) {
     c->pos = madd3(c->pos, dir, step);
 }
 
+void nav_orbit(ui_thread *u, float dyaw, float dpitch) {
+    cam_ctl *c = &u->cam;
+    ctl_orbit(c, dyaw, dpitch);
+    /* As a camera on a boom: when a wall stands between the orbit centre and the camera, the
+     * camera comes in front of it (from just off the centre, which may lie on a surface). */
+    vec3 back = scale3(ctl_camera(c).forward, -1.0f);
+    vec3 target = madd3(c->pos, back, -c->dist);
+    float eps = 1e-3f * u->info.diag;
+    if (c->dist <= 2.0f * eps) return;
+    float wall = scene_distance(u, madd3(target, back, eps), back);
+    if (isfinite(wall) && eps + wall < c->dist) {
+        c->dist = eps + 0.9f * wall;
+        c->pos = madd3(target, back, c->dist);
+    }
+}
+
+void nav_pan(ui_thread *u, float dx, float dy) {
+    cam_ctl *c = &u->cam;
+    camera cam = ctl_camera(c);
+    vec3 d = add3(scale3(cam.right, dx * c->dist), scale3(cam.up, dy * c->dist));
+    float len = length3(d);
+    if (!(len > 0.0f)) return;
+    float free = scene_distance(u, c->pos, scale3(d, 1.0f / len)); /* at most half-way to a wall */
+    if (isfinite(free) && len > 0.5f * free) d = scale3(d, 0.5f * free / len);
+    c->pos = add3(c->pos, d);
+}
+
 /* Whether the view from cam towards the scene's centre first meets a surface on the scene's
  * bounding box: the outside of a wall that closes the scene. */
 static int walled_off(ui_thread *u, const camera *cam, vec3 centre) {

@@ -173,11 +173,11 @@ void run_script(ui_thread *u) {
             }
             break;
         case ACT_ORBIT:
-            ctl_orbit(&u->cam, (float)(a->a * 3.14159265358979 / 180.0), (float)(a->b * 3.14159265358979 / 180.0));
+            nav_orbit(u, (float)(a->a * 3.14159265358979 / 180.0), (float)(a->b * 3.14159265358979 / 180.0));
             send_change(u);
             break;
         case ACT_PAN:
-            ctl_pan(&u->cam, (float)a->a, (float)a->b);
+            nav_pan(u, (float)a->a, (float)a->b);
             send_change(u);
             break;
         case ACT_ZOOM:

@@ -1,7 +1,7 @@
 #!/bin/sh
 # The viewer's navigation and safety nets in a real window under Xvfb, driven by --script and by
-# real X events (xdotool): a wheel step back from the default view stays in the room, F / frame
-# views the whole scene from outside it; a reference of another scene or size is refused, the
+# real X events (xdotool): a wheel step back from the default view, orbits and pans stay in the
+# room, F / frame views the whole scene from outside it; a reference of another scene or size is refused, the
 # error plot pauses away from the reference's camera and resumes back there; a failed load keeps
 # the accumulation; quitting stops the frame in flight; an unlit scene is reported and a uniform
 # sky lights it, and the environment is kept across loads; the viewer and glint info start with
@@ -51,7 +51,9 @@ stats_lines() {
 }
 
 # ---- navigation through the script: the default view, one wheel step back (zoom by 1/0.85),
-# far out (pan through the walls: black), then frame.
+# far out, an orbit and a pan as far as they go, then a bookmark outside the room (black: its
+# walls are lit only inside) and frame.
+printf '1 0 1.5 40 0 0 40 0.8\n' >atelier.glint-bookmarks
 cat >nav.txt <<'EOF'
 wait 2
 stats
@@ -61,27 +63,33 @@ stats
 zoom 50
 wait 1
 stats
-pan 30 0
+restore-bookmark 1
 wait 1
 stats
 frame
 wait 2
 stats
 screenshot framed.png
+key r
+orbit 60 0
+pan 30 0
+wait 1
+stats
 quit
 EOF
 view --size 160x90 --script nav.txt
 rc=$?
 [ $rc -eq 0 ] || fail "navigation session exited $rc: $(cat err.txt)"
 grep '^stats ' out.txt >stats.txt
-[ "$(wc -l <stats.txt)" -eq 5 ] || fail "navigation: expected 5 stats lines, got: $(cat out.txt)"
+[ "$(wc -l <stats.txt)" -eq 6 ] || fail "navigation: expected 6 stats lines, got: $(cat out.txt)"
 lit=$(awk -v m="$(field 1 mean)" 'BEGIN { print m / 10 }')
 below 0 "$(field 1 mean)" || fail "the default view of the default scene is black"
 below "$lit" "$(field 2 mean)" || fail "a wheel step back from the default view darkened it: $(field 1 mean) -> $(field 2 mean)"
 below "$lit" "$(field 3 mean)" || fail "zooming far out left the room: mean $(field 3 mean)"
-below "$(field 4 mean)" 1e-6 || fail "panning through the walls did not leave the scene (mean $(field 4 mean))"
+below "$(field 4 mean)" 1e-6 || fail "the bookmark outside the room is not black (mean $(field 4 mean))"
 below "$lit" "$(field 5 mean)" || fail "frame did not bring the scene back: mean $(field 5 mean)"
 [ -s framed.png ] || fail "no screenshot of the framed view"
+below "$lit" "$(field 6 mean)" || fail "an orbit and a pan left the room: mean $(field 6 mean)"
 
 # Every built-in scene's default view sees something lit, and keeps it one wheel step back.
 for scene in atelier doorway showcase; do
@@ -101,7 +109,7 @@ stats
 sleep 4
 wait 2
 stats
-pan 30 0
+restore-bookmark 1
 wait 1
 stats
 sleep 4
@@ -127,7 +135,7 @@ grep '^stats ' out.txt >stats.txt
 [ "$(field 2 cam)" != "$(field 1 cam)" ] || fail "the wheel did not move the camera"
 lit=$(awk -v m="$(field 1 mean)" 'BEGIN { print m / 10 }')
 below "$lit" "$(field 2 mean)" || fail "a real wheel step back darkened the view: $(field 1 mean) -> $(field 2 mean)"
-below "$(field 3 mean)" 1e-6 || fail "panning through the walls did not leave the scene"
+below "$(field 3 mean)" 1e-6 || fail "the bookmark outside the room is not black"
 below "$lit" "$(field 4 mean)" || fail "the F key did not bring the scene back: mean $(field 4 mean)"
 
 # ---- references: one with a description of this scene and size is taken; the error plot pauses
