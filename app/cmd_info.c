@@ -15,13 +15,14 @@ static void print_info_help(void) {
            "\n"
            "Prints a summary of SCENE: geometry, materials, lights, cameras, size; then what the\n"
            "scene calls for (material classes, emitters, whether indirect and glossy-to-glossy\n"
-           "transport exist) and the passes method NAME would run (default vsl+hl, which has them\n"
-           "all), each with its reason.\n"
+           "transport exist) and the passes method NAME would run (default %s, as the viewer's;\n"
+           "vsl+hl has every pass), each with its reason.\n"
            "\n"
            "--obj FILE.obj writes the triangles as loaded (world space, with normals) as Wavefront\n"
            "OBJ, and beside it FILE.mtl with each material's diffuse colour (its base colour or\n"
            "Phong/Ward kd; nothing else of the material): the same geometry for another renderer.\n"
-           "\n");
+           "\n",
+           method_name(DEFAULT_METHOD));
     cli_print_scenes();
 }
 
@@ -73,7 +74,7 @@ static int write_obj(const scene *s, const char *obj_path) {
 
 int cmd_info(int argc, char **argv) {
     const char *path = NULL, *env = NULL, *obj = NULL;
-    int method = METHOD_VSL_HL, max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
+    int method = DEFAULT_METHOD, max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             print_info_help();

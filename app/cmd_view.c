@@ -29,7 +29,7 @@ static void print_view_help(void) {
            "\n"
            "options:\n"
            "  --size WxH           window and render size [%dx%d]\n"
-           "  --method NAME        estimator: pt, vpl, vsl, vsl+hl [pt]\n"
+           "  --method NAME        estimator: pt, vpl, vsl, vsl+hl [%s]\n"
            "  --max-depth D        scattering events per path [%d]\n"
            "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
@@ -43,11 +43,12 @@ static void print_view_help(void) {
            "%s"
            "\n"
            "controls: left drag orbit, right/middle drag pan, wheel zoom, WASD/QE fly, R reset view,\n"
+           "F frame the whole scene, C the reference's camera, K uniform sky on/off,\n"
            "1-9 scene cameras, ctrl+1-9 save and shift+1-9 restore a camera bookmark, arrows and\n"
            "PageUp/PageDown move the selected light, ctrl+click picks a light, ctrl+drag moves it,\n"
            "F12 screenshot (PNG), F11 export (EXR), Tab panel, Esc quit.\n"
            "Drop a .gltf/.glb on the window to open it, an .exr/.hdr to light the scene with it.\n",
-           DEFAULT_WIDTH, DEFAULT_HEIGHT, DEFAULT_MAX_DEPTH, cli_vl_help());
+           DEFAULT_WIDTH, DEFAULT_HEIGHT, method_name(DEFAULT_METHOD), DEFAULT_MAX_DEPTH, cli_vl_help());
 }
 
 static int parse_view_options(int argc, char **argv, view_options *o) {
@@ -56,6 +57,7 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     o->height = DEFAULT_HEIGHT;
     o->camera = -1;
     o->params.max_depth = DEFAULT_MAX_DEPTH;
+    o->params.method = DEFAULT_METHOD;
     const cli_opt opts[] = {
         {.name = "--size", .kind = CLI_SIZE, .out = &o->width, .out2 = &o->height},
         {.name = "--method", .kind = CLI_METHOD, .out = &o->params.method},
@@ -186,6 +188,7 @@ int cmd_view(int argc, char **argv) {
     sh.params = o.params;
     sh.render_w = fw > 0 ? fw : o.width;
     sh.render_h = fh > 0 ? fh : o.height;
+    snprintf(sh.env_now, sizeof sh.env_now, "%s", o.env_path ? o.env_path : "");
     render_thread *rt = render_thread_start(&sh, s);
     if (!rt) {
         cli_error("%s", sh.message);
@@ -197,7 +200,7 @@ int cmd_view(int argc, char **argv) {
         view_script_free(&u.script);
         return EXIT_FAILURE_;
     }
-    if (o.reference_path) load_reference(&u, o.reference_path); /* a bad one is shown; the viewer runs on */
+    if (o.reference_path) open_reference(&u, o.reference_path); /* a bad one is shown; the viewer runs on */
 
     glfwGetCursorPos(win, &u.mouse_x, &u.mouse_y);
     u.last_time = cli_now();
@@ -209,6 +212,7 @@ int cmd_view(int argc, char **argv) {
         u.last_time = now;
         if (fetch_published(&u)) u.need_tonemap = 1;
         run_script(&u);
+        update_status(&u);
 
         ui_begin_frame();
         draw_image_and_panel(&u);

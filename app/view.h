@@ -1,8 +1,10 @@
 /* glint view: the interactive viewer's internals, shared by its files (not a public interface).
  *
- * Two threads. The render thread (view_render.c) owns the scene and the render sessions: it
- * renders frame after frame, applies requested changes between frames, and publishes each
- * resolved image by swapping buffers under a lock held only for the swap. The UI thread owns the
+ * Two threads, and a third for loading. The render thread (view_render.c) owns the scene and the
+ * render sessions: it renders frame after frame, applies requested changes between frames, and
+ * publishes each resolved image by swapping buffers under a lock held only for the swap. The
+ * loader reads the scenes and maps asked for while frames go on; the render thread puts them in
+ * place between frames. The UI thread owns the
  * window: it handles input (view_input.c, view_camera.c) and scripts (view_script_run.c),
  * tone-maps and draws the newest image with the panel (view_display.c), and never waits for a
  * frame. The two meet only in shared_state, under its lock.
@@ -53,6 +55,7 @@ typedef struct {
     float diag;
     int num_lights;
     light_group lights[MAX_LIGHT_GROUPS]; /* as loaded */
+    int unlit;                            /* no light of its own (punctual or emissive): black without an environment */
 } scene_info;
 
 /* Light edits: the offset and intensity multiplier of every light, against the scene as loaded. */
@@ -79,6 +82,7 @@ typedef struct {
     double rel_error_at;                    /* ... and its seconds since the reset */
     uint64_t rel_error_serial, rel_error_resets;
     uint64_t preview_frames; /* reduced-resolution frames published, ever */
+    int error_paused;        /* the last full frame was not from the reference's camera: no error */
 } view_stats;
 
 /* Everything the two threads hand each other; every field under lock except abort_frame. */
@@ -104,6 +108,20 @@ typedef struct {
      * thread when it takes the change: a full-resolution frame in flight stops at its next tile,
      * so a slow frame never holds up the first preview of a new view. */
     atomic_int abort_frame;
+    atomic_int abort_preview; /* set on quit alone: a preview frame in flight stops too */
+    /* The reference's camera (when its description gives one): frames from elsewhere are not
+     * measured against it, so the error plot pauses while the view is away. */
+    int reference_cam_valid;
+    camera reference_cam;
+    /* Loads (load_kind, load_path) are read by a thread of their own while frames go on and
+     * applied between frames; a failed one changes nothing. A script waits for loads_done. */
+    uint64_t load_requests, loads_done;
+    pthread_cond_t load_cond; /* signalled with each request, each result taken, and quit */
+    /* The scene the render thread has, for the UI's ray queries (zoom, fly): the UI reads it under
+     * scene_lock (never waiting: try-lock), which the render thread holds for writing whenever it
+     * changes or replaces the scene. */
+    pthread_rwlock_t scene_lock;
+    const scene *scene_now;
     /* results: render thread -> UI */
     image_buf image;
     uint64_t image_serial;
@@ -112,7 +130,13 @@ typedef struct {
     uint64_t message_serial;
     scene_info info;
     uint64_t info_serial;
+    /* The environment, kept across scene loads until cleared: a map's path, ENV_SKY or "". */
+    char env_now[1024];
 } shared_state;
+
+#define ENV_SKY "sky" /* the uniform sky's name in env_now and in requests */
+/* load_kind values */
+enum { LOAD_NONE = 0, LOAD_SCENE, LOAD_ENV, LOAD_SKY, LOAD_NO_ENV };
 
 /* The render thread's own state, private to view_render.c. */
 typedef struct render_thread render_thread;
@@ -187,6 +211,14 @@ typedef struct {
     error_curve curves[MAX_CURVES];
     int num_curves, current_curve;
     ui_curve ui_curves[MAX_CURVES];
+    /* the reference's camera, from its description (view_nav.c) */
+    int reference_cam_valid;
+    camera reference_cam;
+    int error_paused_shown; /* the note about the paused error plot is up */
+    char status[600];       /* what the panel should say about the view: pauses, an unlit scene */
+    uint64_t unlit_noted;   /* 1 + the info_serial of the last unlit scene reported */
+    uint64_t script_load_target;
+    double script_sleep_until;
     /* a scripted continuous orbit */
     double spin_rate, spin_until; /* degrees per second, until when */
     /* input */
@@ -206,6 +238,8 @@ typedef struct {
 
 /* view_camera.c: the free camera, the scene's cameras and the bookmarks file */
 camera ctl_camera(const cam_ctl *c);
+/* The free camera at cam, orbiting a centre in front of it. */
+cam_ctl ctl_from_camera(const camera *cam, const scene_info *info);
 void ctl_orbit(cam_ctl *c, float dyaw, float dpitch);
 void ctl_pan(cam_ctl *c, float dx, float dy);
 void ctl_zoom(cam_ctl *c, float factor);
@@ -222,7 +256,7 @@ void send_change(ui_thread *u);
 void apply_controls(ui_thread *u, int camera_changed);
 long long frames_of_current_state(const ui_thread *u);
 void request_export(ui_thread *u, const char *name);
-/* kind: 1 a scene, 2 an environment map. */
+/* kind: LOAD_SCENE, LOAD_ENV (path), LOAD_SKY, LOAD_NO_ENV. */
 void request_load(ui_thread *u, int kind, const char *path);
 vec3 light_position(const ui_thread *u, int g);
 int light_movable(const ui_thread *u, int g);
@@ -234,6 +268,28 @@ void on_key(GLFWwindow *win, int key, int scancode, int action, int mods);
 void on_scroll(GLFWwindow *win, double dx, double dy);
 void on_drop(GLFWwindow *win, int count, const char **paths);
 int handle_input(ui_thread *u, double dt);
+
+/* view_nav.c: navigation that cannot get lost, the reference's description and camera, status */
+/* Distance to the first surface along o + t d, or INFINITY (also when the scene is busy). */
+float scene_distance(ui_thread *u, vec3 o, vec3 d);
+/* Zoom by factor (< 1 closer) about what is under the centre of the view, never through a wall. */
+void nav_zoom(ui_thread *u, float factor);
+/* Orbit and pan as ctl_orbit and ctl_pan, without passing through a wall. */
+void nav_orbit(ui_thread *u, float dyaw, float dpitch);
+void nav_pan(ui_thread *u, float dx, float dy);
+/* Flies by a step along dir (unit), at a speed set by what is ahead, stopping short of walls. */
+void nav_fly(ui_thread *u, vec3 dir, double dt);
+/* A view of the whole scene, lit when possible. */
+void frame_scene(ui_thread *u);
+/* Loads a reference after checking its description against the viewer's scene, environment and
+ * size; returns 0 or -1 (refused, message shown). */
+int open_reference(ui_thread *u, const char *path);
+/* Back to the reference's camera; -1 (message set) without one. */
+int reference_view(ui_thread *u);
+/* Whether two cameras are the same view (scale: the scene's size). */
+int same_view(const camera *a, const camera *b, float scale);
+/* Refreshes u->status and its notes (every UI frame). */
+void update_status(ui_thread *u);
 
 /* view_script_run.c */
 void run_script(ui_thread *u);

@@ -17,7 +17,7 @@ camera ctl_camera(const cam_ctl *c) {
     return camera_look_at(c->pos, add3(c->pos, ctl_forward(c)), v3(0, 1, 0), c->yfov);
 }
 
-static cam_ctl ctl_from_camera(const camera *cam, const scene_info *info) {
+cam_ctl ctl_from_camera(const camera *cam, const scene_info *info) {
     cam_ctl c;
     c.pos = cam->position;
     c.yaw = atan2f(cam->forward.x, -cam->forward.z);

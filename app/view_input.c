@@ -86,9 +86,10 @@ void request_load(ui_thread *u, int kind, const char *path) {
     pthread_mutex_lock(&sh->lock);
     snprintf(sh->load_path, sizeof sh->load_path, "%s", path);
     sh->load_kind = kind;
-    /* A new generation: frames counted after this show the result of the load. */
-    u->sent_generation = ++sh->generation;
-    if (!sh->export_pending) atomic_store(&sh->abort_frame, 1);
+    /* Not a change yet: the frame in flight goes on, and the accumulation too, unless the load
+     * succeeds (a new scene then arrives, and with it a new view). */
+    u->script_load_target = ++sh->load_requests;
+    pthread_cond_signal(&sh->load_cond);
     pthread_mutex_unlock(&sh->lock);
 }
 
@@ -189,13 +190,13 @@ void on_drop(GLFWwindow *win, int count, const char **paths) {
     /* An image is an environment map; anything else is taken for a scene. */
     const char *dot = strrchr(paths[0], '.');
     int env = dot && (strcmp(dot, ".exr") == 0 || strcmp(dot, ".hdr") == 0);
-    request_load(u, env ? 2 : 1, paths[0]);
+    request_load(u, env ? LOAD_ENV : LOAD_SCENE, paths[0]);
 }
 
 /* Keys, mouse and the panel's actions. Returns 1 when the camera changed. */
 int handle_input(ui_thread *u, double dt) {
     int changed = 0;
-    float speed = 0.25f * u->info.diag; /* scene sizes per second */
+    float speed = 0.25f * u->info.diag; /* for lights: scene sizes per second */
     if (!ui_wants_keyboard()) {
         camera c = ctl_camera(&u->cam);
         vec3 move = v3s(0.0f);
@@ -206,7 +207,7 @@ int handle_input(ui_thread *u, double dt) {
         if (glfwGetKey(u->win, GLFW_KEY_E) == GLFW_PRESS) move = add3(move, v3(0, 1, 0));
         if (glfwGetKey(u->win, GLFW_KEY_Q) == GLFW_PRESS) move = sub3(move, v3(0, 1, 0));
         if (!is_black3(move)) {
-            u->cam.pos = madd3(u->cam.pos, normalize3(move), speed * (float)dt);
+            nav_fly(u, normalize3(move), dt);
             changed = 1;
         }
         /* The selected light: arrows along the view plane, PageUp/PageDown along the view. */
@@ -223,7 +224,7 @@ int handle_input(ui_thread *u, double dt) {
             changed = 1;
     }
     if (cli_now() < u->spin_until) { /* a scripted drag */
-        ctl_orbit(&u->cam, (float)(u->spin_rate * dt * 3.14159265358979 / 180.0), 0.0f);
+        nav_orbit(u, (float)(u->spin_rate * dt * 3.14159265358979 / 180.0), 0.0f);
         changed = 1;
     }
     double x, y;
@@ -258,16 +259,16 @@ int handle_input(ui_thread *u, double dt) {
         glfwGetWindowSize(u->win, NULL, &wh);
         float scale = 1.0f / (float)(wh > 0 ? wh : 1);
         if (left) {
-            ctl_orbit(&u->cam, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
+            nav_orbit(u, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
             changed = 1;
         } else if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
                    glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) {
-            ctl_pan(&u->cam, (float)-dx * scale, (float)dy * scale);
+            nav_pan(u, (float)-dx * scale, (float)dy * scale);
             changed = 1;
         }
     }
     if (u->scroll != 0.0) {
-        ctl_zoom(&u->cam, powf(0.85f, (float)u->scroll));
+        nav_zoom(u, powf(0.85f, (float)u->scroll));
         u->scroll = 0.0;
         changed = 1;
     }
@@ -276,6 +277,9 @@ int handle_input(ui_thread *u, double dt) {
     if (u->keys_pressed[GLFW_KEY_F11]) u->ctl.export_exr = 1;
     if (u->keys_pressed[GLFW_KEY_TAB]) u->ctl.show_panel = !u->ctl.show_panel;
     if (u->keys_pressed[GLFW_KEY_ESCAPE]) u->quit = 1;
+    if (u->keys_pressed[GLFW_KEY_F]) u->ctl.frame_scene = 1;
+    if (u->keys_pressed[GLFW_KEY_C]) u->ctl.reference_view = 1;
+    if (u->keys_pressed[GLFW_KEY_K]) u->ctl.uniform_sky = 1;
     /* 1-9 the scene's cameras; with ctrl, save bookmark N; with shift, restore it. */
     for (int k = 1; k <= 9; k++) {
         int pressed = u->keys_pressed[GLFW_KEY_0 + k];
@@ -296,11 +300,23 @@ int handle_input(ui_thread *u, double dt) {
         u->ctl.reset_view = 0;
         changed = 1;
     }
+    if (u->ctl.frame_scene) {
+        frame_scene(u);
+        changed = 1;
+    }
+    if (u->ctl.reference_view && reference_view(u) == 0) changed = 1;
+    if (u->ctl.uniform_sky) { /* a toggle: the uniform sky on, or off again */
+        pthread_mutex_lock(&u->sh->lock);
+        int sky = strcmp(u->sh->env_now, ENV_SKY) == 0;
+        pthread_mutex_unlock(&u->sh->lock);
+        request_load(u, sky ? LOAD_NO_ENV : LOAD_SKY, "");
+    }
+    u->ctl.frame_scene = u->ctl.reference_view = u->ctl.uniform_sky = 0;
     if (u->ctl.screenshot) take_screenshot(u, "glint-screenshot.png");
     if (u->ctl.export_exr) request_export(u, "glint-export.exr");
-    if (u->ctl.load_scene) request_load(u, 1, u->ctl.path);
-    if (u->ctl.load_env) request_load(u, 2, u->ctl.path);
-    if (u->ctl.load_reference) load_reference(u, u->ctl.path);
+    if (u->ctl.load_scene) request_load(u, LOAD_SCENE, u->ctl.path);
+    if (u->ctl.load_env) request_load(u, LOAD_ENV, u->ctl.path);
+    if (u->ctl.load_reference) open_reference(u, u->ctl.path);
     u->ctl.screenshot = u->ctl.export_exr = u->ctl.load_scene = u->ctl.load_env = u->ctl.load_reference = 0;
     return changed;
 }

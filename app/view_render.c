@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "envmap.h"
+#include "lights.h"
 #include "metrics.h"
 #include "view.h"
 
@@ -14,6 +16,20 @@
 #define PREVIEW_MAX_DIVISOR 8
 #define PREVIEW_TARGET_MS 70.0 /* ...so that a preview frame takes about this long */
 #define PREVIEW_HOLD_SECONDS 0.3
+
+/* Loads go to a thread of their own, which reads files while frames go on: only a load that
+ * succeeds stops the frame in flight, so a failed one leaves the accumulation as it was. One at a
+ * time: the loader takes the next request once the render thread has taken the last result. */
+typedef struct {
+    int active; /* taken from the requests, not yet applied (under sh->lock) */
+    int done;   /* read (under sh->lock); the fields below are then the render thread's */
+    int ok;
+    int kind;
+    char path[1024], env[1024];
+    scene *scene;    /* LOAD_SCENE's result, with the environment env */
+    image_rgb image; /* LOAD_ENV's */
+    char err[1200];
+} load_job;
 
 /* Written and read by the render thread alone (the UI sees only shared_state). */
 struct render_thread {
@@ -27,7 +43,10 @@ struct render_thread {
     float *combined;            /* the whole image when another part is shown */
     size_t combined_len;
     int preview_divisor;
-    int scene_edited;      /* lights changed since the plan was made */
+    int scene_edited; /* lights changed since the plan was made */
+    pthread_t loader;
+    int loader_running;
+    load_job job;
     int full_film_partial; /* a stopped frame left samples in the full film; cleared
                                          * by the next full frame that completes */
 };
@@ -35,6 +54,8 @@ struct render_thread {
 void shared_state_init(shared_state *sh) {
     memset(sh, 0, sizeof *sh);
     pthread_mutex_init(&sh->lock, NULL);
+    pthread_rwlock_init(&sh->scene_lock, NULL);
+    pthread_cond_init(&sh->load_cond, NULL);
     clear_light_edits(&sh->lights);
     sh->show_mask = COMP_MASK_ALL;
     sh->changed_at = -1e9;
@@ -43,6 +64,8 @@ void shared_state_init(shared_state *sh) {
 void shared_state_deinit(shared_state *sh) {
     image_rgb_free(&sh->reference_new);
     free(sh->image.rgb);
+    pthread_rwlock_destroy(&sh->scene_lock);
+    pthread_cond_destroy(&sh->load_cond);
     pthread_mutex_destroy(&sh->lock);
 }
 
@@ -54,6 +77,7 @@ void fill_scene_info(scene_info *info, const scene *s) {
     info->diag = s->diag;
     int n = scene_light_groups(s, info->lights, MAX_LIGHT_GROUPS); /* -1 (out of memory): none listed */
     info->num_lights = n < 0 ? 0 : n < MAX_LIGHT_GROUPS ? n : MAX_LIGHT_GROUPS;
+    info->unlit = s->num_lights - (s->env_light >= 0 ? 1 : 0) == 0;
 }
 
 void clear_light_edits(light_edits *e) {
@@ -78,8 +102,11 @@ static render_session *create_preview(render_thread *rt, int divisor, const came
     render_params p = *params;
     p.width = fp->width / divisor > 0 ? fp->width / divisor : 1;
     p.height = fp->height / divisor > 0 ? fp->height / divisor : 1;
-    /* No abort flag: while things move every preview frame must finish, or none would be shown. */
-    return session_create(rt->scene, cam, &p, err, errlen);
+    /* Only quitting stops a preview frame: while things move every one must finish, or none would
+     * be shown. */
+    render_session *rs = session_create(rt->scene, cam, &p, err, errlen);
+    if (rs) session_set_abort_flag(rs, &rt->sh->abort_preview);
+    return rs;
 }
 
 /* (Re)creates both sessions for the current scene at w x h. Returns 0 or -1 (message set). */
@@ -122,52 +149,149 @@ static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam,
     rt->preview_divisor = d;
 }
 
-static void handle_load(render_thread *rt, int kind, const char *path, const camera *cam, const render_params *params) {
-    char err[1024];
-    if (kind == 1) {
-        scene *s = scene_load(path, cli_print_warning, NULL, err, sizeof err);
-        if (!s) {
-            cli_error("%s", err);
-            set_message(rt, "%s%s", err, "");
-            return;
-        }
-        /* The sessions read the old scene: replace them with it. */
-        int w = session_params(rt->full)->width, h = session_params(rt->full)->height;
-        session_destroy(rt->full);
-        session_destroy(rt->preview);
-        rt->full = rt->preview = NULL;
-        scene_destroy(rt->scene);
-        rt->scene = s;
-        clear_light_edits(&rt->lights_applied);
-        camera c = scene_camera(s, -1, (float)w / (float)h);
-        make_sessions(rt, w, h, &c, params);
-        pthread_mutex_lock(&rt->sh->lock);
-        fill_scene_info(&rt->sh->info, s);
-        rt->sh->info_serial++;
-        pthread_mutex_unlock(&rt->sh->lock);
-        set_message(rt, "loaded %s%s", path, "");
-    } else {
-        if (scene_set_env(rt->scene, path, 0.0f, err, sizeof err) != 0) {
-            cli_error("%s", err);
-            set_message(rt, "%s%s", err, "");
-            return;
-        }
-        /* The plan depends on the map (its prefiltering, its light) */
-        if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0) {
-            cli_error("%s", session_error(rt->full));
-            set_message(rt, "%s%s", session_error(rt->full), "");
-            return;
-        }
-        session_set_camera(rt->full, cam);
-        session_set_camera(rt->preview, cam);
-        set_message(rt, "environment %s%s", path, "");
+/* Gives s the environment named by source (a map's path, ENV_SKY, or "" for none). The scene
+ * must not be rendering. Returns 0, or -1 with err set (the scene keeps its old map). */
+static int set_environment(scene *s, const char *source, char *err, size_t errlen) {
+    if (strcmp(source, ENV_SKY) == 0) { /* a constant radiance of 1 from every direction */
+        image_rgb sky = {8, 4, malloc(sizeof(float) * 3 * 8 * 4)};
+        if (!sky.rgb) return snprintf(err, errlen, "uniform sky: out of memory"), -1;
+        for (int i = 0; i < 3 * 8 * 4; i++) sky.rgb[i] = 1.0f;
+        return scene_set_env_image(s, &sky, 0.0f, err, errlen);
     }
+    if (source[0]) return scene_set_env(s, source, 0.0f, err, errlen);
+    if (!s->env) return 0;
+    env_map *old = s->env;
+    s->env = NULL;
+    if (scene_build_lights(s, err, errlen) != 0) {
+        s->env = old;
+        char ignored[256];
+        scene_build_lights(s, ignored, sizeof ignored);
+        return -1;
+    }
+    env_map_destroy(old);
+    return 0;
+}
+
+static void load_failed(render_thread *rt, const char *err) {
+    cli_error("%s", err);
+    set_message(rt, "%s%s", err, "");
+}
+
+/* Reads what the job names: a scene (given the viewer's environment) or a map. */
+static int load_files(load_job *j) {
+    if (j->kind == LOAD_SCENE) {
+        if (!(j->scene = scene_load(j->path, cli_print_warning, NULL, j->err, sizeof j->err))) return 0;
+        /* The environment stays with the viewer, not with the scene. */
+        if (j->env[0] && set_environment(j->scene, j->env, j->err, sizeof j->err) != 0) {
+            cli_warning("%s; %s opens without it", j->err, j->path);
+            j->env[0] = 0;
+        }
+        return 1;
+    }
+    if (j->kind == LOAD_ENV) return image_rgb_load(j->path, &j->image, j->err, sizeof j->err) == 0;
+    return 1; /* the uniform sky, no environment: nothing to read */
+}
+
+static void *loader_main(void *arg) {
+    render_thread *rt = arg;
+    shared_state *sh = rt->sh;
+    load_job *j = &rt->job;
+    pthread_mutex_lock(&sh->lock);
+    for (;;) {
+        while (!sh->quit && !(sh->load_kind && !j->active)) pthread_cond_wait(&sh->load_cond, &sh->lock);
+        if (sh->quit) break;
+        *j = (load_job){.active = 1, .kind = sh->load_kind};
+        snprintf(j->path, sizeof j->path, "%s", sh->load_path);
+        snprintf(j->env, sizeof j->env, "%s", sh->env_now);
+        sh->load_kind = LOAD_NONE;
+        pthread_mutex_unlock(&sh->lock);
+        int ok = load_files(j);
+        pthread_mutex_lock(&sh->lock);
+        j->ok = ok;
+        j->done = 1;
+        if (ok && !sh->export_pending) atomic_store(&sh->abort_frame, 1); /* a change: stop the frame */
+    }
+    pthread_mutex_unlock(&sh->lock);
+    return NULL;
+}
+
+static void load_job_free(load_job *j) {
+    if (j->scene) scene_destroy(j->scene);
+    image_rgb_free(&j->image);
+    memset(j, 0, sizeof *j);
+}
+
+/* Puts scene s (its environment env) in place of the current one. */
+static void replace_scene(render_thread *rt, scene *s, const char *env, const char *path, const render_params *params) {
+    shared_state *sh = rt->sh;
+    /* The sessions read the old scene: replace them with it. */
+    int w = session_params(rt->full)->width, h = session_params(rt->full)->height;
+    session_destroy(rt->full);
+    session_destroy(rt->preview);
+    rt->full = rt->preview = NULL;
+    pthread_rwlock_wrlock(&sh->scene_lock);
+    scene_destroy(rt->scene);
+    rt->scene = s;
+    sh->scene_now = s;
+    pthread_rwlock_unlock(&sh->scene_lock);
+    clear_light_edits(&rt->lights_applied);
+    camera c = scene_camera(s, -1, (float)w / (float)h);
+    make_sessions(rt, w, h, &c, params);
+    pthread_mutex_lock(&sh->lock);
+    fill_scene_info(&sh->info, s);
+    sh->info_serial++;
+    snprintf(sh->env_now, sizeof sh->env_now, "%s", env);
+    pthread_mutex_unlock(&sh->lock);
+    set_message(rt, "loaded %s%s", path, "");
+}
+
+/* A finished load job, between frames. Returns 1 when the scene changed (the accumulation
+ * restarts), 0 when the load failed and nothing changed. */
+static int finish_load(render_thread *rt, load_job *j, const camera *cam, const render_params *params) {
+    char err[1200];
+    shared_state *sh = rt->sh;
+    int kind = j->kind;
+    if (!j->ok) return load_failed(rt, j->err), 0;
+    if (kind == LOAD_SCENE) {
+        replace_scene(rt, j->scene, j->env, j->path, params);
+        j->scene = NULL; /* the render thread's now */
+        return 1;
+    }
+    const char *source = kind == LOAD_SKY ? ENV_SKY : kind == LOAD_NO_ENV ? "" : j->path;
+    pthread_rwlock_wrlock(&sh->scene_lock);
+    char sub[512];
+    int failed = kind == LOAD_ENV ? scene_set_env_image(rt->scene, &j->image, 0.0f, sub, sizeof sub) != 0
+                                  : set_environment(rt->scene, source, sub, sizeof sub) != 0;
+    pthread_rwlock_unlock(&sh->scene_lock);
+    if (failed) {
+        snprintf(err, sizeof err, "%.600s: %.500s",
+                 kind == LOAD_ENV ? j->path
+                 : source[0]      ? "uniform sky"
+                                  : "no environment",
+                 sub);
+        return load_failed(rt, err), 0;
+    }
+    pthread_mutex_lock(&sh->lock);
+    snprintf(sh->env_now, sizeof sh->env_now, "%s", source);
+    pthread_mutex_unlock(&sh->lock);
+    /* The plan depends on the map (its prefiltering, its light) */
+    if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0)
+        load_failed(rt, session_error(rt->full));
+    session_set_camera(rt->full, cam);
+    session_set_camera(rt->preview, cam);
+    set_message(rt,
+                kind == LOAD_SKY      ? "uniform sky%s%s"
+                : kind == LOAD_NO_ENV ? "no environment%s%s"
+                                      : "environment %s%s",
+                kind == LOAD_ENV ? j->path : "", "");
+    return 1;
 }
 
 /* Brings the scene's lights to the wanted offsets and gains (render thread, between frames). */
 static void apply_light_edits(render_thread *rt, const light_edits *wanted) {
     char err[512];
     light_edits *done = &rt->lights_applied;
+    pthread_rwlock_wrlock(&rt->sh->scene_lock); /* moving a light rebuilds the BVH */
     for (int g = 0; g < MAX_LIGHT_GROUPS; g++) {
         vec3 d = sub3(wanted->offset[g], done->offset[g]);
         float gain = wanted->gain[g];
@@ -182,6 +306,7 @@ static void apply_light_edits(render_thread *rt, const light_edits *wanted) {
         done->offset[g] = wanted->offset[g];
         done->gain[g] = gain;
     }
+    pthread_rwlock_unlock(&rt->sh->scene_lock);
 }
 
 /* The relative L2 error of the whole image (every component, whatever is shown) against the
@@ -207,8 +332,8 @@ static double frame_error(render_thread *rt, const film *f, unsigned mask, const
 /* before: the session's statistics before the frame, so the frame's own work is the difference.
  * The film is resolved with the components shown now, not when the frame started: a frame after a
  * display change shows that change. */
-static void publish(render_thread *rt, render_session *rs, int preview, double frame_ms, const render_stats *before,
-                    uint64_t resets_seen, uint64_t gen) {
+static void publish(render_thread *rt, render_session *rs, int preview, int measure, double frame_ms,
+                    const render_stats *before, uint64_t resets_seen, uint64_t gen) {
     shared_state *sh = rt->sh;
     const film *f = session_film(rs);
     if (rt->back.width != f->width || rt->back.height != f->height) {
@@ -223,7 +348,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, double f
     pthread_mutex_unlock(&sh->lock);
     film_resolve(f, mask, rt->back.rgb);
     rt->back.preview = preview;
-    double rel_error = preview ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
+    double rel_error = preview || !measure ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
     for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st.rays[k];
@@ -258,6 +383,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, double f
             sh->stats.hl_points = st.hl_points - before->hl_points;
             sh->stats.hl_lobes = st.hl_lobes - before->hl_lobes;
             sh->stats.hl_merge_share = merge_share;
+            sh->stats.error_paused = !measure;
         }
     }
     pthread_mutex_unlock(&sh->lock);
@@ -292,17 +418,17 @@ static void *render_main(void *arg) {
             continue;
         }
         if (sh->quit && !(sh->export_pending && rt->full_film_partial)) break;
-        if (sh->load_kind) {
-            int kind = sh->load_kind;
-            char path[1024];
-            snprintf(path, sizeof path, "%s", sh->load_path);
-            sh->load_kind = 0;
+        load_job *job = &rt->job;
+        if (job->active && job->done) { /* a load read (or failed): apply it between frames */
             camera cam = sh->cam;
             render_params params = sh->params;
             pthread_mutex_unlock(&sh->lock);
-            handle_load(rt, kind, path, &cam, &params);
+            int changed = finish_load(rt, job, &cam, &params);
+            load_job_free(job);
             pthread_mutex_lock(&sh->lock);
-            applied = 0; /* re-apply the camera and parameters to the new sessions */
+            if (changed) applied = 0; /* re-apply the camera and parameters: a new accumulation */
+            sh->loads_done++;
+            pthread_cond_signal(&sh->load_cond); /* the loader may take the next */
             continue;
         }
         const film *ff = session_film(rt->full);
@@ -312,6 +438,8 @@ static void *render_main(void *arg) {
         camera cam = sh->cam;
         render_params params = sh->params;
         int preview = seconds_since(sh->changed_at) < PREVIEW_HOLD_SECONDS;
+        /* Measured against the reference only from its camera (when its description names one). */
+        int measure = !sh->reference_cam_valid || same_view(&cam, &sh->reference_cam, rt->scene->diag);
         int rw = sh->render_w, rh = sh->render_h;
         /* Light requests made for a scene since replaced are stale: the new one starts as loaded. */
         int edit_lights = gen != applied && sh->lights_scene == sh->info_serial;
@@ -358,7 +486,7 @@ static void *render_main(void *arg) {
         }
         if (rs == rt->full) rt->full_film_partial = 0;
         double ms = 1e3 * seconds_since(t0);
-        publish(rt, rs, preview, ms, &before, resets_seen, gen);
+        publish(rt, rs, preview, measure, ms, &before, resets_seen, gen);
         if (preview) adapt_preview(rt, ms, &cam, &params);
         pthread_mutex_lock(&sh->lock);
     }
@@ -374,6 +502,7 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
     }
     rt->sh = sh;
     rt->scene = s;
+    sh->scene_now = s;
     clear_light_edits(&rt->lights_applied);
     sh->stats.reset_at = cli_now(); /* the first accumulation starts now, not at the clock's origin */
     if (make_sessions(rt, sh->render_w, sh->render_h, &sh->cam, &sh->params) != 0) {
@@ -382,6 +511,14 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
         free(rt);
         return NULL;
     }
+    if (pthread_create(&rt->loader, NULL, loader_main, rt) != 0) {
+        snprintf(sh->message, sizeof sh->message, "cannot start the loading thread");
+        session_destroy(rt->full);
+        session_destroy(rt->preview);
+        free(rt);
+        return NULL;
+    }
+    rt->loader_running = 1;
     pthread_create(&rt->thread, NULL, render_main, rt);
     return rt;
 }
@@ -389,8 +526,14 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
 void render_thread_stop(render_thread *rt) {
     pthread_mutex_lock(&rt->sh->lock);
     rt->sh->quit = 1;
+    pthread_cond_broadcast(&rt->sh->load_cond);
+    /* The frame in flight stops at its next tile (unless an export waits for it). */
+    if (!rt->sh->export_pending) atomic_store(&rt->sh->abort_frame, 1);
+    atomic_store(&rt->sh->abort_preview, 1);
     pthread_mutex_unlock(&rt->sh->lock);
     pthread_join(rt->thread, NULL);
+    if (rt->loader_running) pthread_join(rt->loader, NULL); /* a load under way is waited for */
+    load_job_free(&rt->job);
     session_destroy(rt->full);
     session_destroy(rt->preview);
     scene_destroy(rt->scene);

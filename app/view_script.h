@@ -7,12 +7,17 @@
  *   load SCENE                env MAP.exr|MAP.hdr    window-shot FILE.png
  *   move-light INDEX DX DY DZ save-bookmark N        restore-bookmark N
  *   reference FILE.exr        spin DEG_PER_S SECONDS stats
+ *   frame                     reference-camera       sky
+ *   sleep SECONDS
  *   quit
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
  * prints one line of the viewer's counters to stdout; `key` presses a named key (r, f11, f12,
- * tab, escape, 1-9, ctrl+N, shift+N). `move-light` moves light INDEX (as the panel lists them)
+ * tab, escape, f, c, k, 1-9, ctrl+N, shift+N). `load`, `env` and `sky` wait until the render thread
+ * has tried them (a failed one changes nothing); `env none` clears the environment. `frame` views
+ * the whole scene, `reference-camera` goes back to the reference's. `sleep` lets time pass, changing
+ * nothing (while a test sends real input events). `move-light` moves light INDEX (as the panel lists them)
  * by a world-space offset and selects it; `spin` orbits continuously, a little every drawn
  * frame, as a held mouse drag would. */
 #ifndef GLINT_VIEW_SCRIPT_H
@@ -39,6 +44,10 @@ typedef enum {
     ACT_SPIN,
     ACT_STATS,
     ACT_QUIT,
+    ACT_FRAME,
+    ACT_REFERENCE_CAMERA,
+    ACT_SKY,
+    ACT_SLEEP,
 } script_action_kind;
 
 typedef struct {

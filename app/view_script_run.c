@@ -2,6 +2,7 @@
  * UI frame at a time, so tests drive the real window. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -33,11 +34,19 @@ static void print_stats(ui_thread *u) {
         (unsigned long long)u->stats.preview_frames, u->preview_w, u->preview_h, seconds_since(u->started_at),
         (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z, nb ? marks : "-");
     printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
-           "max_depth=%d method=%s rejected=%llu virtual_lights=%llu hl_lobes=%llu plan_highlights=%d",
+           "max_depth=%d method=%s rejected=%llu virtual_lights=%llu hl_lobes=%llu plan_highlights=%d ",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->stats.frames_total,
            (unsigned long long)u->stats.resets, u->front.width, u->front.height, u->front.preview,
            (double)u->ctl.exposure, u->ctl.show, u->ctl.params.max_depth, method_name(u->ctl.params.method),
            u->stats.rejected, u->stats.virtual_lights, u->stats.hl_lobes, u->stats.plan_highlights);
+    /* The environment, and the standing notes (the panel's status line) as flags. */
+    char env[1024];
+    pthread_mutex_lock(&u->sh->lock);
+    snprintf(env, sizeof env, "%s", u->sh->env_now[0] ? u->sh->env_now : "-");
+    pthread_mutex_unlock(&u->sh->lock);
+    printf("env=%s unlit_note=%d paused_note=%d error_paused=%d errors_measured=%llu", env,
+           strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->stats.error_paused,
+           (unsigned long long)u->stats.rel_error_serial);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
     const param_desc *table = params_table(&nparams);
@@ -120,8 +129,19 @@ static int key_from_name(const char *name, int *mods) {
     if (strcmp(name, "f12") == 0) return GLFW_KEY_F12;
     if (strcmp(name, "tab") == 0) return GLFW_KEY_TAB;
     if (strcmp(name, "escape") == 0) return GLFW_KEY_ESCAPE;
+    if (strcmp(name, "f") == 0) return GLFW_KEY_F;
+    if (strcmp(name, "c") == 0) return GLFW_KEY_C;
+    if (strcmp(name, "k") == 0) return GLFW_KEY_K;
     if (strlen(name) == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
     return -1;
+}
+
+/* Whether the last load asked for has been tried and its outcome (a new scene) taken in. */
+static int load_settled(ui_thread *u) {
+    pthread_mutex_lock(&u->sh->lock);
+    int done = u->sh->loads_done >= u->script_load_target && u->sh->info_serial == u->info_serial;
+    pthread_mutex_unlock(&u->sh->lock);
+    return done;
 }
 
 /* Runs script actions until one has to wait. */
@@ -153,15 +173,15 @@ void run_script(ui_thread *u) {
             }
             break;
         case ACT_ORBIT:
-            ctl_orbit(&u->cam, (float)(a->a * 3.14159265358979 / 180.0), (float)(a->b * 3.14159265358979 / 180.0));
+            nav_orbit(u, (float)(a->a * 3.14159265358979 / 180.0), (float)(a->b * 3.14159265358979 / 180.0));
             send_change(u);
             break;
         case ACT_PAN:
-            ctl_pan(&u->cam, (float)a->a, (float)a->b);
+            nav_pan(u, (float)a->a, (float)a->b);
             send_change(u);
             break;
         case ACT_ZOOM:
-            ctl_zoom(&u->cam, (float)a->a);
+            nav_zoom(u, (float)a->a); /* as the wheel zooms */
             send_change(u);
             break;
         case ACT_KEY: {
@@ -192,7 +212,19 @@ void run_script(ui_thread *u) {
                 u->script_errors++;
             }
             break;
-        case ACT_REFERENCE: load_reference(u, a->text); break;
+        case ACT_REFERENCE: open_reference(u, a->text); break;
+        case ACT_FRAME:
+            frame_scene(u);
+            send_change(u);
+            break;
+        case ACT_REFERENCE_CAMERA:
+            if (reference_view(u) != 0) {
+                cli_error("%s:%d: %s", u->script_path_for_errors, a->line, u->message);
+                u->script_errors++;
+            } else {
+                send_change(u);
+            }
+            break;
         case ACT_SPIN:
             if (!u->script_waiting) {
                 u->script_waiting = 1;
@@ -202,10 +234,30 @@ void run_script(ui_thread *u) {
             if (cli_now() < u->spin_until) return;
             u->script_waiting = 0;
             break;
+        case ACT_SLEEP:
+            if (!u->script_waiting) {
+                u->script_waiting = 1;
+                u->script_sleep_until = cli_now() + a->a;
+            }
+            if (cli_now() < u->script_sleep_until) return;
+            u->script_waiting = 0;
+            break;
         case ACT_SCREENSHOT: take_screenshot(u, a->text); break;
         case ACT_EXPORT: request_export(u, a->text); break;
-        case ACT_LOAD: request_load(u, 1, a->text); break;
-        case ACT_ENV: request_load(u, 2, a->text); break;
+        case ACT_LOAD:
+        case ACT_ENV:
+        case ACT_SKY:
+            if (!u->script_waiting) {
+                int kind = a->kind == ACT_LOAD            ? LOAD_SCENE
+                           : a->kind == ACT_SKY           ? LOAD_SKY
+                           : strcmp(a->text, "none") == 0 ? LOAD_NO_ENV
+                                                          : LOAD_ENV;
+                request_load(u, kind, a->text);
+                u->script_waiting = 1;
+            }
+            if (!load_settled(u)) return;
+            u->script_waiting = 0;
+            break;
         case ACT_WINDOW_SHOT: /* taken after this frame's draw: later actions wait for it */
             snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text);
             u->script_pos++;

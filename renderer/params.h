@@ -25,6 +25,10 @@ typedef enum {
 const char *method_name(render_method m);
 int method_from_name(const char *name);
 
+/* The method the viewer and glint info start with: vsl, the estimator that converges fastest on
+ * the default scene (docs/benchmarks.md). glint render keeps path tracing, its references'
+ * unbiased method, unless told otherwise. */
+#define DEFAULT_METHOD METHOD_VSL
 #define DEFAULT_MAX_DEPTH 16
 #define MAX_DEPTH_LIMIT 10000 /* the deepest path any front end accepts */
 #define DEFAULT_WIDTH 960

@@ -34,6 +34,9 @@ typedef struct {
     /* one-shot actions, set by the panel, cleared by the viewer */
     int screenshot, export_exr, reset_view, load_scene, load_env, load_reference;
     char path[1024]; /* the panel's path field for loading */
+    /* more one-shot actions (keys F, C, K; the panel may offer buttons): frame the whole scene,
+     * return to the reference's camera, toggle a uniform sky */
+    int frame_scene, reference_view, uniform_sky;
 } ui_controls;
 
 /* One curve of the error plot: relative L2 error against seconds since a reset. */
@@ -74,6 +77,7 @@ typedef struct {
     int num_curves;
     const char *bookmarks; /* which of bookmarks 1-9 are set, e.g. "1 3", and where they live */
     const char *message;   /* last export path or error, shown until replaced */
+    const char *status;    /* standing notes (error plot paused, no light in the scene), "" for none */
 } ui_stats;
 
 /* Sets up Dear ImGui for a window with a current OpenGL 3.3 context. Returns 0 or -1. */

@@ -1,0 +1,211 @@
+/* glint view: navigation that cannot get lost (UI thread). Zoom and fly take their steps from the
+ * distance to what the view looks at, found by tracing the render thread's scene under its lock,
+ * and never step through a wall in one go; F frames the whole scene. Also the reference's
+ * description (checked as glint bench checks it) and camera, and the standing notes the panel
+ * shows: the error plot paused away from the reference's camera, a scene without light. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "reference.h"
+#include "view.h"
+
+float scene_distance(ui_thread *u, vec3 o, vec3 d) {
+    shared_state *sh = u->sh;
+    /* Never wait: while the render thread loads or edits the scene, navigate without it. */
+    if (pthread_rwlock_tryrdlock(&sh->scene_lock) != 0) return INFINITY;
+    float t = INFINITY;
+    surface_hit h;
+    if (sh->scene_now && scene_intersect(sh->scene_now, o, d, 1e30f, &h)) t = h.t;
+    pthread_rwlock_unlock(&sh->scene_lock);
+    return t;
+}
+
+void nav_zoom(ui_thread *u, float factor) {
+    cam_ctl *c = &u->cam;
+    vec3 f = ctl_camera(c).forward;
+    float floor_dist = 1e-5f * u->info.diag;
+    /* The step is relative to what is under the centre of the view, which becomes the orbit
+     * centre; without anything there, to the orbit distance. */
+    float ahead = scene_distance(u, c->pos, f);
+    if (isfinite(ahead) && ahead > floor_dist) c->dist = ahead;
+    float step = c->dist * (1.0f - factor); /* > 0: forward */
+    if (step < 0.0f) {                      /* backward: at most half-way to the wall behind */
+        float behind = scene_distance(u, c->pos, scale3(f, -1.0f));
+        if (isfinite(behind)) step = fmaxf(step, -0.5f * behind);
+    }
+    c->pos = madd3(c->pos, f, step);
+    c->dist = fmaxf(c->dist - step, floor_dist);
+}
+
+void nav_fly(ui_thread *u, vec3 dir, double dt) {
+    cam_ctl *c = &u->cam;
+    float diag = u->info.diag;
+    /* Half the distance to what the view looks at per second: slow near a detail, quick across a
+     * hall, whatever the scene's size. */
+    float ahead = scene_distance(u, c->pos, ctl_camera(c).forward);
+    float speed = isfinite(ahead) ? clampf(0.5f * ahead, 1e-4f * diag, 0.25f * diag) : 0.25f * diag;
+    float step = speed * (float)dt;
+    float free = scene_distance(u, c->pos, dir); /* at most half-way to a wall */
+    if (isfinite(free)) step = fminf(step, 0.5f * free);
+    c->pos = madd3(c->pos, dir, step);
+}
+
+void nav_orbit(ui_thread *u, float dyaw, float dpitch) {
+    cam_ctl *c = &u->cam;
+    ctl_orbit(c, dyaw, dpitch);
+    /* As a camera on a boom: when a wall stands between the orbit centre and the camera, the
+     * camera comes in front of it (from just off the centre, which may lie on a surface). */
+    vec3 back = scale3(ctl_camera(c).forward, -1.0f);
+    vec3 target = madd3(c->pos, back, -c->dist);
+    float eps = 1e-3f * u->info.diag;
+    if (c->dist <= 2.0f * eps) return;
+    float wall = scene_distance(u, madd3(target, back, eps), back);
+    if (isfinite(wall) && eps + wall < c->dist) {
+        c->dist = eps + 0.9f * wall;
+        c->pos = madd3(target, back, c->dist);
+    }
+}
+
+void nav_pan(ui_thread *u, float dx, float dy) {
+    cam_ctl *c = &u->cam;
+    camera cam = ctl_camera(c);
+    vec3 d = add3(scale3(cam.right, dx * c->dist), scale3(cam.up, dy * c->dist));
+    float len = length3(d);
+    if (!(len > 0.0f)) return;
+    float free = scene_distance(u, c->pos, scale3(d, 1.0f / len)); /* at most half-way to a wall */
+    if (isfinite(free) && len > 0.5f * free) d = scale3(d, 0.5f * free / len);
+    c->pos = add3(c->pos, d);
+}
+
+/* Whether the view from cam towards the scene's centre first meets a surface on the scene's
+ * bounding box: the outside of a wall that closes the scene. */
+static int walled_off(ui_thread *u, const camera *cam, vec3 centre) {
+    vec3 dir = normalize3(sub3(centre, cam->position));
+    float t = scene_distance(u, cam->position, dir);
+    if (!isfinite(t)) return 0;
+    vec3 p = madd3(cam->position, dir, t), lo = u->info.bounds.lo, hi = u->info.bounds.hi;
+    float edge = fminf(fminf(fminf(fabsf(p.x - lo.x), fabsf(p.x - hi.x)), fminf(fabsf(p.y - lo.y), fabsf(p.y - hi.y))),
+                       fminf(fabsf(p.z - lo.z), fabsf(p.z - hi.z)));
+    return edge <= 0.01f * u->info.diag;
+}
+
+void frame_scene(ui_thread *u) {
+    int w, h;
+    glfwGetFramebufferSize(u->win, &w, &h);
+    float aspect = h > 0 ? (float)w / (float)h : 16.0f / 9.0f;
+    bounds3 b = u->info.bounds;
+    vec3 centre = bounds_center(b);
+    camera cam = camera_frame_bounds(b, u->cam.yfov > 0.0f ? u->cam.yfov : 0.8f, aspect);
+    /* A closed room framed from outside shows only its unlit walls: then move in along the same
+     * line until the centre is in sight, just inside the wall that hid it. */
+    if (walled_off(u, &cam, centre)) {
+        vec3 back = normalize3(sub3(cam.position, centre));
+        float wall = scene_distance(u, centre, back);
+        if (isfinite(wall) && wall > 0.02f * u->info.diag)
+            cam = camera_look_at(madd3(centre, back, 0.9f * wall), centre, v3(0, 1, 0), cam.yfov);
+    }
+    u->cam = ctl_from_camera(&cam, &u->info);
+    u->ctl.camera = u->applied_ctl.camera = -1; /* a free camera, not the scene's */
+    snprintf(u->message, sizeof u->message, "framed the whole scene");
+}
+
+/* ---- the reference --------------------------------------------------------------------------- */
+
+static int refuse(ui_thread *u, const char *why) {
+    snprintf(u->message, sizeof u->message, "%.1150s; reference not used", why);
+    cli_error("%s", u->message);
+    return -1;
+}
+
+int open_reference(ui_thread *u, const char *path) {
+    reference_info have, want;
+    char err[1200];
+    int described = reference_load(path, &have, err, sizeof err);
+    if (described < 0) return refuse(u, err);
+    if (described == 0) { /* what this view renders, against what the reference was rendered from */
+        shared_state *sh = u->sh;
+        char env[1024];
+        memset(&want, 0, sizeof want);
+        pthread_mutex_lock(&sh->lock);
+        snprintf(env, sizeof env, "%s", sh->env_now);
+        want.width = sh->render_w;
+        want.height = sh->render_h;
+        pthread_mutex_unlock(&sh->lock);
+        snprintf(want.scene, sizeof want.scene, "%s", u->info.name);
+        if (reference_hash_file(want.scene, want.scene_hash, err, sizeof err) != 0) return refuse(u, err);
+        if (strcmp(env, ENV_SKY) == 0) { /* no file renders it */
+            snprintf(want.env, sizeof want.env, "the uniform sky");
+            snprintf(want.env_hash, sizeof want.env_hash, "uniform-sky");
+        } else if (env[0]) {
+            snprintf(want.env, sizeof want.env, "%s", env);
+            if (reference_hash_file(env, want.env_hash, err, sizeof err) != 0) return refuse(u, err);
+        }
+        /* The view may be anywhere: the reference's camera is where the error is measured. */
+        want.camera_index = have.camera_index;
+        want.cam = have.cam;
+        if (reference_check(path, &have, &want, err, sizeof err) != 0) return refuse(u, err);
+    }
+    if (load_reference(u, path) != 0) return -1;
+    u->reference_cam_valid = described == 0;
+    if (described == 0) u->reference_cam = have.cam;
+    pthread_mutex_lock(&u->sh->lock);
+    u->sh->reference_cam_valid = u->reference_cam_valid;
+    u->sh->reference_cam = u->reference_cam;
+    pthread_mutex_unlock(&u->sh->lock);
+    u->error_paused_shown = 0;
+    if (described == 1) {
+        snprintf(u->message, sizeof u->message, "reference %s: no description, its scene and camera unchecked", path);
+        cli_warning("%s", u->message);
+    }
+    return 0;
+}
+
+int reference_view(ui_thread *u) {
+    if (!u->reference.rgb || !u->reference_cam_valid) {
+        snprintf(u->message, sizeof u->message, "no reference camera (a reference with a description has one)");
+        return -1;
+    }
+    u->cam = ctl_from_camera(&u->reference_cam, &u->info);
+    u->ctl.camera = u->applied_ctl.camera = -1;
+    snprintf(u->message, sizeof u->message, "the reference's camera");
+    return 0;
+}
+
+int same_view(const camera *a, const camera *b, float scale) {
+    return length3(sub3(a->position, b->position)) <= 1e-4f * scale && dot3(a->forward, b->forward) >= 1.0f - 1e-5f &&
+           dot3(a->up, b->up) >= 1.0f - 1e-5f && fabsf(a->yfov - b->yfov) <= 1e-4f;
+}
+
+/* ---- standing notes -------------------------------------------------------------------------- */
+
+void update_status(ui_thread *u) {
+    char env[1024];
+    pthread_mutex_lock(&u->sh->lock);
+    snprintf(env, sizeof env, "%s", u->sh->env_now);
+    pthread_mutex_unlock(&u->sh->lock);
+    int len = 0;
+    u->status[0] = 0;
+    if (u->info.unlit && !env[0]) {
+        len += snprintf(u->status, sizeof u->status, "no light in the scene: the image is black (K: a uniform sky)");
+        if (u->unlit_noted != u->info_serial + 1) { /* once per scene in the terminal */
+            cli_warning("%s has no light; K (or the script's sky) lights it with a uniform sky", u->info.name);
+            u->unlit_noted = u->info_serial + 1;
+        }
+    }
+    camera now = ctl_camera(&u->cam);
+    int paused = u->reference.rgb && u->reference_cam_valid && !same_view(&now, &u->reference_cam, u->info.diag);
+    if (paused && len < (int)sizeof u->status)
+        snprintf(u->status + len, sizeof u->status - (size_t)len,
+                 "%serror plot paused: away from the reference's "
+                 "camera (C returns)",
+                 len ? "; " : "");
+    if (paused != u->error_paused_shown) { /* the message line says it when it happens */
+        snprintf(u->message, sizeof u->message, "%s",
+                 paused ? "error plot paused: the view left the reference's camera (C returns to it)"
+                        : "error plot resumed: the reference's camera");
+        u->error_paused_shown = paused;
+    }
+}

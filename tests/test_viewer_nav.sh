@@ -1,0 +1,292 @@
+#!/bin/sh
+# The viewer's navigation and safety nets in a real window under Xvfb, driven by --script and by
+# real X events (xdotool): a wheel step back from the default view, orbits and pans stay in the
+# room, F / frame views the whole scene from outside it; a reference of another scene or size is refused, the
+# error plot pauses away from the reference's camera and resumes back there; a failed load keeps
+# the accumulation; quitting stops the frame in flight; an unlit scene is reported and a uniform
+# sky lights it, and the environment is kept across loads; the viewer and glint info start with
+# the same method.
+# Usage: test_viewer_nav.sh GLINT TMPDIR [KEEP_MODULES_LIB]
+set -u
+glint=$1
+dir=$2/viewer_nav
+keep_modules=${3:-}
+command -v Xvfb >/dev/null && command -v xdotool >/dev/null || { echo "Xvfb or xdotool not installed: skipped"; exit 77; }
+rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+# Leak checks exempt Mesa and X11 alone (as test_viewer.sh).
+printf 'leak:libGLX_mesa\nleak:swrast_dri\nleak:libgallium\nleak:libLLVM\nleak:libX11\nleak:libxcb\nleak:libdbus\nleak:libglfw\nleak:libGL\nleak:dri\n' >lsan.supp
+export LSAN_OPTIONS="suppressions=$dir/lsan.supp:print_suppressions=0"
+asan=$(ldd "$glint" | sed -n 's/.*libasan[^ ]* => \([^ ]*\).*/\1/p')
+preload=
+if [ -n "$asan" ] && [ -n "$keep_modules" ]; then preload="$asan $keep_modules"; fi
+
+Xvfb -displayfd 3 -screen 0 1280x800x24 -nolisten tcp 3>display.txt 2>xvfb.log &
+xvfb_pid=$!
+trap 'kill $xvfb_pid 2>/dev/null; wait $xvfb_pid 2>/dev/null' EXIT
+tries=0
+until [ -s display.txt ]; do
+  tries=$((tries + 1))
+  [ $tries -le 300 ] && kill -0 $xvfb_pid 2>/dev/null || { echo "Xvfb did not start: $(cat xvfb.log)"; exit 1; }
+  sleep 0.1
+done
+export DISPLAY=":$(head -n 1 display.txt)"
+
+view() { # view ARGS... : runs the viewer headless, stdout to out.txt, stderr to err.txt
+  timeout 300 env LD_PRELOAD="$preload" "$glint" "$@" >out.txt 2>err.txt
+}
+field() { sed -n "$1p" stats.txt | tr ' ' '\n' | sed -n "s/^$2=//p"; }
+below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; } # below A B: A < B
+now() { date +%s.%N; }
+# stats_lines N [TRIES]: waits (0.1 s steps) until out.txt holds N stats lines
+stats_lines() {
+  n=0
+  while [ "$(grep -c '^stats ' out.txt 2>/dev/null)" -lt "$1" ]; do
+    n=$((n + 1))
+    [ $n -le "${2:-1500}" ] || return 1
+    sleep 0.1
+  done
+}
+
+# ---- navigation through the script: the default view, one wheel step back (zoom by 1/0.85),
+# far out, an orbit and a pan as far as they go, then a bookmark outside the room (black: its
+# walls are lit only inside) and frame.
+printf '1 0 1.5 40 0 0 40 0.8\n' >atelier.glint-bookmarks
+cat >nav.txt <<'EOF'
+wait 2
+stats
+zoom 1.17647
+wait 2
+stats
+zoom 50
+wait 1
+stats
+restore-bookmark 1
+wait 1
+stats
+frame
+wait 2
+stats
+screenshot framed.png
+key r
+orbit 60 0
+pan 30 0
+wait 1
+stats
+quit
+EOF
+view --size 160x90 --script nav.txt
+rc=$?
+[ $rc -eq 0 ] || fail "navigation session exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 6 ] || fail "navigation: expected 6 stats lines, got: $(cat out.txt)"
+lit=$(awk -v m="$(field 1 mean)" 'BEGIN { print m / 10 }')
+below 0 "$(field 1 mean)" || fail "the default view of the default scene is black"
+below "$lit" "$(field 2 mean)" || fail "a wheel step back from the default view darkened it: $(field 1 mean) -> $(field 2 mean)"
+below "$lit" "$(field 3 mean)" || fail "zooming far out left the room: mean $(field 3 mean)"
+below "$(field 4 mean)" 1e-6 || fail "the bookmark outside the room is not black (mean $(field 4 mean))"
+below "$lit" "$(field 5 mean)" || fail "frame did not bring the scene back: mean $(field 5 mean)"
+[ -s framed.png ] || fail "no screenshot of the framed view"
+below "$lit" "$(field 6 mean)" || fail "an orbit and a pan left the room: mean $(field 6 mean)"
+
+# Every built-in scene's default view sees something lit, and keeps it one wheel step back.
+for scene in atelier doorway showcase; do
+  printf 'wait 1\nstats\nzoom 1.17647\nwait 1\nstats\nquit\n' >builtin.txt
+  view "builtin:$scene" --size 96x54 --script builtin.txt
+  grep '^stats ' out.txt >stats.txt
+  below 0 "$(field 1 mean)" || fail "builtin:$scene: the default view is black"
+  below 0 "$(field 2 mean)" || fail "builtin:$scene: a wheel step back is black"
+done
+
+# ---- the same through real X events: the wheel (button 5, a step back) and F after leaving the
+# scene; the script sleeps while they arrive.
+cat >xnav.txt <<'EOF'
+set panel 0
+wait 2
+stats
+sleep 4
+wait 2
+stats
+restore-bookmark 1
+wait 1
+stats
+sleep 4
+wait 2
+stats
+quit
+EOF
+view --size 320x180 --script xnav.txt &
+viewer=$!
+window=
+if stats_lines 1; then
+  window=$(xdotool search --sync --onlyvisible --name glint 2>/dev/null | head -n 1)
+  # away from the panel, in the window's lower right
+  xdotool mousemove --window "$window" 300 170 click 5
+fi
+stats_lines 3 && { xdotool windowfocus --sync "$window" 2>/dev/null; xdotool key f; }
+wait $viewer
+rc=$?
+[ -n "$window" ] || fail "the viewer's window was not found: $(cat err.txt)"
+[ $rc -eq 0 ] || fail "X-event navigation exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 4 ] || fail "X-event navigation: expected 4 stats lines, got: $(cat out.txt)"
+[ "$(field 2 cam)" != "$(field 1 cam)" ] || fail "the wheel did not move the camera"
+lit=$(awk -v m="$(field 1 mean)" 'BEGIN { print m / 10 }')
+below "$lit" "$(field 2 mean)" || fail "a real wheel step back darkened the view: $(field 1 mean) -> $(field 2 mean)"
+below "$(field 3 mean)" 1e-6 || fail "the bookmark outside the room is not black"
+below "$lit" "$(field 4 mean)" || fail "the F key did not bring the scene back: mean $(field 4 mean)"
+
+# ---- references: one with a description of this scene and size is taken; the error plot pauses
+# (a note, no measurements) away from its camera and resumes at it (script and the C key); one
+# of another scene or size is refused with the reason.
+"$glint" render --size 96x54 --spp 4 --out ref.exr --quiet 2>err.txt || fail "render ref.exr: $(cat err.txt)"
+"$glint" render builtin:doorway --size 96x54 --spp 1 --out other.exr --quiet 2>err.txt || fail "render other.exr: $(cat err.txt)"
+"$glint" render --size 48x27 --spp 1 --out small.exr --quiet 2>err.txt || fail "render small.exr: $(cat err.txt)"
+cat >reference.txt <<'EOF'
+wait 2
+stats
+orbit 20 0
+wait 1
+stats
+wait 2
+stats
+reference-camera
+wait 2
+stats
+orbit -15 5
+wait 1
+key c
+wait 2
+stats
+reference other.exr
+reference small.exr
+quit
+EOF
+view --size 96x54 --reference ref.exr --script reference.txt
+rc=$?
+[ $rc -eq 0 ] || fail "reference session exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 5 ] || fail "reference session: expected 5 stats lines, got: $(cat out.txt)"
+[ "$(field 1 paused_note)" = "0" ] && [ "$(field 1 errors_measured)" -ge 1 ] ||
+  fail "no error measured at the reference's camera: $(sed -n 1p stats.txt)"
+[ "$(field 2 paused_note)" = "1" ] && [ "$(field 3 error_paused)" = "1" ] || fail "no pause note away from the reference's camera"
+[ "$(field 3 errors_measured)" = "$(field 2 errors_measured)" ] || fail "the error was measured away from the reference's camera"
+[ "$(field 4 paused_note)" = "0" ] && [ "$(field 4 error_paused)" = "0" ] || fail "reference-camera did not resume the plot"
+[ "$(field 4 errors_measured)" -gt "$(field 3 errors_measured)" ] || fail "no error measured back at the reference's camera"
+[ "$(field 4 cam)" = "$(field 1 cam)" ] || fail "reference-camera did not return to it: $(field 1 cam) vs $(field 4 cam)"
+[ "$(field 5 paused_note)" = "0" ] && [ "$(field 5 cam)" = "$(field 1 cam)" ] || fail "the C key did not return to the reference's camera"
+grep -q 'other.exr: rendered from another scene' err.txt || fail "a reference of another scene not refused: $(cat err.txt)"
+grep -q 'small.exr: rendered at 48x27, not 96x54' err.txt || fail "a reference of another size not refused: $(cat err.txt)"
+
+# ---- failed loads (a truncated GLB, an invalid glTF, a broken map) keep the accumulation
+printf 'glTF\002\000\000\000\377\377\000\000' >truncated.glb
+printf '{"asset": {"version": "2.0"}, "scenes": [{"nodes": [7]}]}' >invalid.gltf
+printf 'not an image' >broken.exr
+cat >loads.txt <<'EOF'
+wait 3
+stats
+load truncated.glb
+load invalid.gltf
+env broken.exr
+stats
+wait 1
+stats
+quit
+EOF
+view --size 96x54 --script loads.txt
+rc=$?
+[ $rc -eq 0 ] || fail "failed-load session exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(field 2 resets)" = "$(field 1 resets)" ] || fail "a failed load reset the accumulation"
+[ "$(field 2 frames)" -ge "$(field 1 frames)" ] && [ "$(field 3 frames)" -gt "$(field 1 frames)" ] ||
+  fail "a failed load threw away frames: $(field 1 frames) -> $(field 2 frames), $(field 3 frames)"
+for f in truncated.glb invalid.gltf broken.exr; do grep -q "$f" err.txt || fail "$f: no error reported"; done
+
+# ---- quitting stops the frame in flight: vsl+hl at 960x540, whose frames take seconds here; by
+# the script, then by the Escape key. Generous bounds, for a loaded machine and the sanitizers'
+# exit (about 0.1-0.5 s is usual; a frame finished instead takes many seconds here).
+printf 'sleep 2\nstats\nquit\n' >quit.txt
+view --size 960x540 --method vsl+hl --script quit.txt &
+viewer=$!
+stats_lines 1 && t0=$(now)
+wait $viewer
+rc=$?
+t1=$(now)
+[ $rc -eq 0 ] || fail "quit session exited $rc: $(cat err.txt)"
+took=$(awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }')
+below "$took" 5 || fail "quit took $took s"
+echo "quit by the script: $took s"
+# A load is a change too: once read, it stops the frame in flight (time= is the viewer's clock).
+printf 'sleep 2\nstats\nload builtin:showcase\nstats\nquit\n' >loadstop.txt
+view --size 960x540 --method vsl+hl --script loadstop.txt
+grep '^stats ' out.txt >stats.txt
+took=$(awk -v a="$(field 1 time)" -v b="$(field 2 time)" 'BEGIN { print b - a }')
+[ "$(field 2 scene)" = "builtin:showcase" ] || fail "the load during a slow frame did not happen: $(cat err.txt)"
+below "$took" 5 || fail "a load waited $took s for the frame in flight"
+echo "load during a vsl+hl frame: $took s"
+printf 'sleep 2\nstats\nsleep 120\nquit\n' >escape.txt
+view --size 960x540 --method vsl+hl --script escape.txt &
+viewer=$!
+if stats_lines 1; then
+  window=$(xdotool search --sync --onlyvisible --name glint 2>/dev/null | head -n 1)
+  xdotool windowfocus --sync "$window" 2>/dev/null
+  t0=$(now)
+  xdotool key Escape
+fi
+wait $viewer
+t1=$(now)
+took=$(awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }')
+below "$took" 5 || fail "Escape took $took s to quit"
+echo "quit after Escape: $took s"
+
+# ---- a scene without light: warned in the terminal and noted for the panel; the uniform sky
+# lights it, the K key takes it away again; the environment stays across loads until cleared.
+cat >unlit.gltf <<'EOF'
+{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+ "buffers": [{"byteLength": 60, "uri": "data:application/octet-stream;base64,AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAACAPwAAgD8AAAAAAACAvwAAgD8AAAAAAAABAAIAAAACAAMA"}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+               {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}]}
+EOF
+cat >sky.txt <<'EOF'
+wait 1
+stats
+sky
+wait 2
+stats
+key k
+wait 2
+stats
+sky
+load builtin:doorway
+wait 1
+stats
+env none
+wait 1
+stats
+quit
+EOF
+view unlit.gltf --size 96x54 --script sky.txt
+rc=$?
+[ $rc -eq 0 ] || fail "unlit session exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(wc -l <stats.txt)" -eq 5 ] || fail "unlit session: expected 5 stats lines, got: $(cat out.txt)"
+grep -q 'no light' err.txt || fail "no warning about the missing light: $(cat err.txt)"
+grep -q 'uniform sky' err.txt || fail "the warning does not offer the uniform sky: $(cat err.txt)"
+[ "$(field 1 unlit_note)" = "1" ] && below "$(field 1 mean)" 1e-6 || fail "the unlit scene: no note, or not black: $(sed -n 1p stats.txt)"
+[ "$(field 2 env)" = "sky" ] && [ "$(field 2 unlit_note)" = "0" ] && below 0.01 "$(field 2 mean)" ||
+  fail "the uniform sky did not light the scene: $(sed -n 2p stats.txt)"
+[ "$(field 3 env)" = "-" ] && [ "$(field 3 unlit_note)" = "1" ] || fail "the K key did not take the sky away: $(sed -n 3p stats.txt)"
+[ "$(field 4 scene)" = "builtin:doorway" ] && [ "$(field 4 env)" = "sky" ] || fail "the sky did not stay across a load: $(sed -n 4p stats.txt)"
+[ "$(field 5 env)" = "-" ] || fail "env none did not clear the environment"
+
+# ---- one default method: the viewer's and glint info's
+[ "$(field 1 method)" = "vsl" ] || fail "the viewer does not start with vsl: $(field 1 method)"
+"$glint" info >info.txt 2>&1 || fail "glint info failed: $(cat info.txt)"
+grep -q '^method: *vsl$' info.txt || fail "glint info's default method is not vsl: $(grep method info.txt)"
+
+if [ $failures -ne 0 ]; then echo "test_viewer_nav: $failures failures"; exit 1; fi
+echo "test_viewer_nav: all checks passed"
