@@ -67,6 +67,9 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
         {"spin", ACT_SPIN, 2, 2, 0},
         {"stats", ACT_STATS, 0, 0, 0},
         {"quit", ACT_QUIT, 0, 0, 0},
+        {"pause", ACT_PAUSE, 0, 0, 0},
+        {"resume", ACT_RESUME, 0, 0, 0},
+        {"sleep", ACT_SLEEP, 1, 1, 0},
     };
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
         if (strcmp(w[0], commands[i].name) != 0) continue;
@@ -87,6 +90,8 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
         if ((out->kind == ACT_SAVE_BOOKMARK || out->kind == ACT_RESTORE_BOOKMARK) &&
             (out->a < 1 || out->a > 9 || out->a != floor(out->a)))
             return snprintf(err, errlen, "'%s' needs a bookmark number 1 to 9", w[0]), -1;
+        if (out->kind == ACT_SLEEP && !(out->a >= 0 && out->a <= 3600))
+            return snprintf(err, errlen, "'sleep' needs 0 to 3600 seconds"), -1;
         if (out->kind == ACT_SPIN && !(out->b >= 0 && out->b <= 3600))
             return snprintf(err, errlen, "'spin' needs 0 to 3600 seconds"), -1;
         if (out->kind == ACT_SET || out->kind == ACT_KEY) snprintf(out->name, sizeof out->name, "%s", w[1]);

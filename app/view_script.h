@@ -7,7 +7,8 @@
  *   load SCENE                env MAP.exr|MAP.hdr    window-shot FILE.png
  *   move-light INDEX DX DY DZ save-bookmark N        restore-bookmark N
  *   reference FILE.exr        spin DEG_PER_S SECONDS stats
- *   quit
+ *   quit                      pause                  resume
+ *   sleep SECONDS
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -39,6 +40,9 @@ typedef enum {
     ACT_SPIN,
     ACT_STATS,
     ACT_QUIT,
+    ACT_PAUSE,  /* refinement stops... */
+    ACT_RESUME, /* ...and goes on */
+    ACT_SLEEP,  /* the script waits SECONDS, the viewer runs on */
 } script_action_kind;
 
 typedef struct {

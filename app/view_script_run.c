@@ -38,6 +38,7 @@ static void print_stats(ui_thread *u) {
            (unsigned long long)u->stats.resets, u->front.width, u->front.height, u->front.preview,
            (double)u->ctl.exposure, u->ctl.show, u->ctl.params.max_depth, method_name(u->ctl.params.method),
            u->stats.rejected, u->stats.virtual_lights, u->stats.hl_lobes, u->stats.plan_highlights);
+    print_panel_stats(u);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
     const param_desc *table = params_table(&nparams);
@@ -60,6 +61,8 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     double x;
     /* The many-light settings, as glint render's options (the parameter table). */
     char why[256];
+    int limit = panel_set(u, name, value, err, errlen); /* spp, time */
+    if (limit <= 0) return limit;
     int applied = params_set(&u->ctl.params.vl, name, value, why, sizeof why);
     if (applied < 0) return snprintf(err, errlen, "%s: %s", name, why), -1;
     if (applied > 0) return 0;
@@ -120,6 +123,9 @@ static int key_from_name(const char *name, int *mods) {
     if (strcmp(name, "f12") == 0) return GLFW_KEY_F12;
     if (strcmp(name, "tab") == 0) return GLFW_KEY_TAB;
     if (strcmp(name, "escape") == 0) return GLFW_KEY_ESCAPE;
+    if (strcmp(name, "f1") == 0) return GLFW_KEY_F1;
+    if (strcmp(name, "space") == 0) return GLFW_KEY_SPACE;
+    if (strcmp(name, "slash") == 0) return GLFW_KEY_SLASH;
     if (strlen(name) == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
     return -1;
 }
@@ -212,6 +218,11 @@ void run_script(ui_thread *u) {
             return;
         case ACT_STATS: print_stats(u); break;
         case ACT_QUIT: u->quit = 1; break;
+        case ACT_PAUSE:
+        case ACT_RESUME:
+        case ACT_SLEEP:
+            if (!panel_script_action(u, a)) return;
+            break;
         }
         u->script_pos++;
     }
