@@ -468,15 +468,22 @@ static void overlay(const ui_controls *c, const ui_stats *s) {
     ImGui::End();
 }
 
-// Every shortcut, over the image's centre.
+// Every shortcut, over the image's centre, or the window's when the image is narrower; never
+// larger than the window (it scrolls then).
 static void help(ui_controls *c, const ui_stats *s) {
+    static ImVec2 last_size(0.0f, 0.0f);
     ImVec2 display = ImGui::GetIO().DisplaySize;
-    ImGui::SetNextWindowPos(ImVec2(0.5f * (display.x - g_image_dock), 0.5f * display.y), ImGuiCond_Always,
-                            ImVec2(0.5f, 0.5f));
+    float image_w = display.x - g_image_dock;
+    float cx = last_size.x <= image_w ? 0.5f * image_w : 0.5f * display.x;
+    float x = std::fmax(0.0f, std::fmin(cx - 0.5f * last_size.x, display.x - last_size.x));
+    float y = std::fmax(0.0f, 0.5f * (display.y - last_size.y));
+    ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_Always);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f), display);
     ImGui::SetNextWindowBgAlpha(0.92f);
     bool open = true;
     if (ImGui::Begin("keys and mouse (F1 or ? closes)", &open,
-                     ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse)) {
+                     ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
+                         ImGuiWindowFlags_HorizontalScrollbar)) {
         if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
             for (int i = 0; i < s->num_shortcuts; i++) {
                 ImGui::TableNextRow();
@@ -488,6 +495,7 @@ static void help(ui_controls *c, const ui_stats *s) {
             ImGui::EndTable();
         }
     }
+    last_size = ImGui::GetWindowSize();
     ImGui::End();
     if (!open) c->show_help = 0;
 }
