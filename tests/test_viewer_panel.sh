@@ -155,12 +155,12 @@ else
   echo "no preview frame on screen after the spin: blockiness not checked"
 fi
 
-# ---- real X events: resizes keep the panel on-screen, F1 and Space ----------------------------
+# ---- real X events: resizes keep the panel on-screen, its edge drags, F1 and Space -------------
 if command -v xdotool >/dev/null; then
   cat >xevents.txt <<'EOF'
 wait 1
 screenshot ready.png
-sleep 5
+sleep 7
 stats
 window-shot resized.png
 quit
@@ -175,6 +175,11 @@ EOF
     sleep 0.5
     xdotool windowsize "$win" 700 300
     sleep 0.5
+    # Drag the panel's left edge 40 to the left: it widens from its default 360.
+    xdotool mousemove --window "$win" 341 150 sleep 0.2 mousedown 1 sleep 0.1
+    for x in 331 321 311 301; do xdotool mousemove --window "$win" $x 150 sleep 0.1; done
+    xdotool mouseup 1
+    sleep 0.5
     xdotool windowfocus "$win" 2>/dev/null
     xdotool key F1
     xdotool key space
@@ -188,6 +193,7 @@ EOF
   [ "$(field 1 window)" = 700x300 ] || fail "the window was not resized: $(field 1 window)"
   dock=$(field 1 dock)
   [ "$dock" -gt 0 ] && [ "$dock" -le 420 ] || fail "after resizes the panel is $dock wide in 700"
+  [ "$dock" -ge 390 ] || fail "dragging its edge did not widen the panel: $dock"
   [ "$(field 1 image)" = "$((700 - dock))x300" ] || fail "image $(field 1 image) beside a $dock panel"
   [ "$(probe resized.png ink $((700 - dock)) 0 700 300)" -ge 10 ] || fail "no panel on-screen after resizes"
   [ "$(field 1 help)" = 1 ] || fail "the F1 key did not show the help"
