@@ -19,6 +19,8 @@ typedef struct {
     double exposure;
     int tonemap;
     const char *reference_path;
+    long long spp;  /* refinement stops here; 0: never */
+    double seconds; /* ...or after this long; 0: never */
 } view_options;
 
 static void print_view_help(void) {
@@ -38,17 +40,15 @@ static void print_view_help(void) {
            "  --exposure STOPS     display exposure [0]\n"
            "  --tonemap NAME       display tone mapper: reinhard, clamp, exponential [reinhard]\n"
            "  --reference FILE.exr an image of the render's size: error view and plot\n"
+           "  --spp N              stop refining at N samples per pixel (frames) [never]\n"
+           "  --time SECONDS       stop refining after this long [never]\n"
            "  --script FILE        replay a script of viewer actions (docs/viewer.md)\n"
            "\n"
            "%s"
            "\n"
-           "controls: left drag orbit, right/middle drag pan, wheel zoom, WASD/QE fly, R reset view,\n"
-           "F frame the whole scene, C the reference's camera, K uniform sky on/off,\n"
-           "1-9 scene cameras, ctrl+1-9 save and shift+1-9 restore a camera bookmark, arrows and\n"
-           "PageUp/PageDown move the selected light, ctrl+click picks a light, ctrl+drag moves it,\n"
-           "F12 screenshot (PNG), F11 export (EXR), Tab panel, Esc quit.\n"
-           "Drop a .gltf/.glb on the window to open it, an .exr/.hdr to light the scene with it.\n",
+           "keys and mouse (F1 in the window shows them):\n",
            DEFAULT_WIDTH, DEFAULT_HEIGHT, method_name(DEFAULT_METHOD), DEFAULT_MAX_DEPTH, cli_vl_help());
+    print_shortcuts(stdout);
 }
 
 static int parse_view_options(int argc, char **argv, view_options *o) {
@@ -69,6 +69,8 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -30.0, .hi = 30.0},
         {.name = "--reference", .kind = CLI_TEXT, .out = &o->reference_path},
         {.name = "--script", .kind = CLI_TEXT, .out = &o->script_path},
+        {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000},
+        {.name = "--time", .kind = CLI_FLOAT, .out = &o->seconds, .lo = 1e-3, .hi = 1e7},
     };
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *v;
@@ -173,7 +175,9 @@ int cmd_view(int argc, char **argv) {
                           .exposure = (float)o.exposure,
                           .tonemap = o.tonemap,
                           .show = UI_SHOW_ALL,
-                          .show_panel = 1};
+                          .show_panel = 1,
+                          .spp_limit = o.spp,
+                          .time_limit = o.seconds};
     u.ctl.params.vl = vl_params_resolve(&o.params.vl);
     u.applied_ctl = u.ctl;
     reset_lights(&u);
@@ -181,8 +185,10 @@ int cmd_view(int argc, char **argv) {
     u.rel_error = -1.0;
     u.current_curve = -1;
     u.started_at = cli_now();
+    view_fit_window(&u, o.width, o.height); /* the image at --size beside the panel */
     int fw, fh;
-    glfwGetFramebufferSize(win, &fw, &fh);
+    view_image_size(&u, &fw, &fh);
+    push_refinement(&u);
     reset_view(&u);
     sh.cam = ctl_camera(&u.cam);
     sh.params = o.params;
@@ -219,17 +225,19 @@ int cmd_view(int argc, char **argv) {
 
         apply_controls(&u, handle_input(&u, dt));
 
-        /* A new window size becomes the render size once it has stopped changing. */
+        /* A new size of the image beside the panel becomes the render size once it has stopped changing. */
+        int iw, ih;
+        view_image_size(&u, &iw, &ih);
         glfwGetFramebufferSize(win, &fw, &fh);
-        if (fw > 0 && fh > 0 && (fw != sh.render_w || fh != sh.render_h)) {
-            if (fw != pending_w || fh != pending_h) {
-                pending_w = fw;
-                pending_h = fh;
+        if (iw > 0 && ih > 0 && (iw != sh.render_w || ih != sh.render_h)) {
+            if (iw != pending_w || ih != pending_h) {
+                pending_w = iw;
+                pending_h = ih;
                 resized_at = now;
             } else if (now - resized_at > 0.2) {
                 pthread_mutex_lock(&sh.lock);
-                sh.render_w = fw;
-                sh.render_h = fh;
+                sh.render_w = iw;
+                sh.render_h = ih;
                 pthread_mutex_unlock(&sh.lock);
                 /* the aspect ratio changed: recompute the camera */
                 send_change(&u);

@@ -23,6 +23,7 @@
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include <GLFW/glfw3.h>
 
@@ -132,6 +133,10 @@ typedef struct {
     uint64_t info_serial;
     /* The environment, kept across scene loads until cleared: a map's path, ENV_SKY or "". */
     char env_now[1024];
+    /* refinement: full-resolution frames stop while paused or at a limit (view_panel.c) */
+    int paused;
+    long long spp_limit; /* 0: none */
+    double time_limit;   /* seconds since the reset; 0: none */
 } shared_state;
 
 #define ENV_SKY "sky" /* the uniform sky's name in env_now and in requests */
@@ -218,7 +223,6 @@ typedef struct {
     char status[600];       /* what the panel should say about the view: pauses, an unlit scene */
     uint64_t unlit_noted;   /* 1 + the info_serial of the last unlit scene reported */
     uint64_t script_load_target;
-    double script_sleep_until;
     /* a scripted continuous orbit */
     double spin_rate, spin_until; /* degrees per second, until when */
     /* input */
@@ -234,6 +238,10 @@ typedef struct {
     long long script_wait_target;
     uint64_t script_wait_generation;
     int quit;
+    double reference_noise; /* the reference's own relative L2 noise, from its description; < 0 unknown */
+    double sleep_until;     /* a script's sleep */
+    int was_held;           /* refinement stood still at the last frame drawn... */
+    double held_seconds;    /* ...since this time */
 } ui_thread;
 
 /* view_camera.c: the free camera, the scene's cameras and the bookmarks file */
@@ -301,5 +309,33 @@ void tonemap_and_upload(ui_thread *u);
 void take_screenshot(ui_thread *u, const char *name);
 void capture_window(ui_thread *u, int w, int h);
 void draw_image_and_panel(ui_thread *u);
+
+/* view_panel.c: the shortcut list, the image beside the docked panel, pause and limits */
+typedef struct {
+    const char *keys, *action;
+} view_shortcut;
+extern const view_shortcut view_shortcuts[];
+extern const int num_view_shortcuts;
+void print_shortcuts(FILE *f);
+/* The image's size beside the panel: in framebuffer pixels (the render size), in window units. */
+void view_image_size(ui_thread *u, int *w, int *h);
+void view_image_window_size(ui_thread *u, int *w, int *h);
+/* Makes the window hold an image of image_w x image_h beside the panel. */
+void view_fit_window(ui_thread *u, int image_w, int image_h);
+/* Render thread, under the lock: whether the full-resolution image of frames frames stops here. */
+int refinement_held(const shared_state *sh, long long frames);
+/* Render thread, without the lock: waits a little, and returns with the lock taken. */
+void refinement_hold(shared_state *sh);
+/* The pause and limits of the controls, to the render thread. */
+void push_refinement(ui_thread *u);
+/* `set spp N`, `set time S`: 0, -1 with a message, or 1 for a name not theirs. */
+int panel_set(ui_thread *u, const char *name, const char *value, char *err, size_t errlen);
+/* pause, resume, sleep. Returns 0 while the script has to wait. */
+int panel_script_action(ui_thread *u, const script_action *a);
+/* More of a stats line: pause, limits, window, image and panel sizes. */
+void print_panel_stats(ui_thread *u);
+/* Before the panel: its keys, and the overlay's and help's part of st. After: its buttons. */
+void panel_frame(ui_thread *u, ui_stats *st);
+void panel_after(ui_thread *u);
 
 #endif

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "image_io.h"
+#include "reference.h"
 #include "view.h"
 
 /* ---- the reference image and the error plot -------------------------------------------------- */
@@ -49,6 +50,10 @@ int load_reference(ui_thread *u, const char *path) {
     image_rgb_free(&u->reference);
     u->reference = img;
     snprintf(u->reference_path, sizeof u->reference_path, "%s", path);
+    /* Its own noise, when glint render described it: the error plot's floor. */
+    reference_info info;
+    char why[1200];
+    u->reference_noise = reference_load(path, &info, why, sizeof why) == 0 && info.has_noise ? info.rel_l2_noise : -1.0;
     u->rel_error = -1.0;
     u->num_curves = 0; /* errors against another image do not compare */
     u->current_curve = -1;
@@ -254,11 +259,6 @@ void capture_window(ui_thread *u, int w, int h) {
 /* The image behind the panel, the light markers over it, and the panel with the statistics and
  * controls; the panel edits u->ctl in place. */
 void draw_image_and_panel(ui_thread *u) {
-    ui_draw_image(u->texture);
-    if (u->ctl.show_panel) {
-        update_light_screen(u);
-        ui_draw_lights(u->light_xy, u->info.num_lights, u->ctl.light);
-    }
     for (int c = 0; c < u->num_curves; c++)
         u->ui_curves[c] = (ui_curve){u->curves[c].label, u->curves[c].seconds, u->curves[c].error, u->curves[c].n};
     describe_bookmarks(u);
@@ -290,10 +290,18 @@ void draw_image_and_panel(ui_thread *u) {
                    .curves = u->ui_curves,
                    .num_curves = u->num_curves,
                    .bookmarks = u->bookmarks_text,
-                   .message = u->message};
+                   .message = u->message,
+                   .status = u->status};
     const char *methods[METHOD_COUNT];
     for (int m = 0; m < METHOD_COUNT; m++) methods[m] = method_name((render_method)m);
     st.method_names = methods;
     st.num_methods = METHOD_COUNT;
-    ui_panel(&u->ctl, &st);
+    panel_frame(u, &st);
+    ui_panel(&u->ctl, &st); /* first: the image goes beside the panel as it is drawn now */
+    ui_draw_image(u->texture);
+    if (u->ctl.show_panel) {
+        update_light_screen(u);
+        ui_draw_lights(u->light_xy, u->info.num_lights, u->ctl.light);
+    }
+    panel_after(u);
 }

@@ -111,7 +111,7 @@ static float pixel_footprint(const ui_thread *u, float z) {
 /* Where each light appears in the window (for markers and picking). */
 void update_light_screen(ui_thread *u) {
     int ww, wh;
-    glfwGetWindowSize(u->win, &ww, &wh);
+    view_image_window_size(u, &ww, &wh);
     camera c = ctl_camera(&u->cam);
     float t = tanf(0.5f * c.yfov), aspect = wh > 0 ? (float)ww / (float)wh : 1.0f;
     for (int g = 0; g < u->info.num_lights; g++) {

@@ -457,7 +457,12 @@ static void *render_main(void *arg) {
             sh->stats.frames = 0;
         }
         uint64_t resets_seen = sh->stats.resets;
+        int held = !preview && gen == applied && !resize && refinement_held(sh, session_frames(rt->full));
         pthread_mutex_unlock(&sh->lock);
+        if (held) { /* paused, or at the spp or time limit */
+            refinement_hold(sh);
+            continue;
+        }
 
         if (edit_lights) apply_light_edits(rt, &lights);
         /* The scene's analysis follows light edits once they settle, not at every step of a drag. */

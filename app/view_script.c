@@ -70,6 +70,8 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
         {"frame", ACT_FRAME, 0, 0, 0},
         {"reference-camera", ACT_REFERENCE_CAMERA, 0, 0, 0},
         {"sky", ACT_SKY, 0, 0, 0},
+        {"pause", ACT_PAUSE, 0, 0, 0},
+        {"resume", ACT_RESUME, 0, 0, 0},
         {"sleep", ACT_SLEEP, 1, 1, 0},
     };
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {

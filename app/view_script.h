@@ -8,8 +8,8 @@
  *   move-light INDEX DX DY DZ save-bookmark N        restore-bookmark N
  *   reference FILE.exr        spin DEG_PER_S SECONDS stats
  *   frame                     reference-camera       sky
+ *   quit                      pause                  resume
  *   sleep SECONDS
- *   quit
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -47,7 +47,9 @@ typedef enum {
     ACT_FRAME,
     ACT_REFERENCE_CAMERA,
     ACT_SKY,
-    ACT_SLEEP,
+    ACT_PAUSE,  /* refinement stops... */
+    ACT_RESUME, /* ...and goes on */
+    ACT_SLEEP,  /* the script waits SECONDS, the viewer runs on */
 } script_action_kind;
 
 typedef struct {

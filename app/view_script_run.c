@@ -47,6 +47,7 @@ static void print_stats(ui_thread *u) {
     printf("env=%s unlit_note=%d paused_note=%d error_paused=%d errors_measured=%llu", env,
            strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->stats.error_paused,
            (unsigned long long)u->stats.rel_error_serial);
+    print_panel_stats(u);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
     const param_desc *table = params_table(&nparams);
@@ -69,6 +70,8 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     double x;
     /* The many-light settings, as glint render's options (the parameter table). */
     char why[256];
+    int limit = panel_set(u, name, value, err, errlen); /* spp, time */
+    if (limit <= 0) return limit;
     int applied = params_set(&u->ctl.params.vl, name, value, why, sizeof why);
     if (applied < 0) return snprintf(err, errlen, "%s: %s", name, why), -1;
     if (applied > 0) return 0;
@@ -132,6 +135,9 @@ static int key_from_name(const char *name, int *mods) {
     if (strcmp(name, "f") == 0) return GLFW_KEY_F;
     if (strcmp(name, "c") == 0) return GLFW_KEY_C;
     if (strcmp(name, "k") == 0) return GLFW_KEY_K;
+    if (strcmp(name, "f1") == 0) return GLFW_KEY_F1;
+    if (strcmp(name, "space") == 0) return GLFW_KEY_SPACE;
+    if (strcmp(name, "slash") == 0) return GLFW_KEY_SLASH;
     if (strlen(name) == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
     return -1;
 }
@@ -234,14 +240,6 @@ void run_script(ui_thread *u) {
             if (cli_now() < u->spin_until) return;
             u->script_waiting = 0;
             break;
-        case ACT_SLEEP:
-            if (!u->script_waiting) {
-                u->script_waiting = 1;
-                u->script_sleep_until = cli_now() + a->a;
-            }
-            if (cli_now() < u->script_sleep_until) return;
-            u->script_waiting = 0;
-            break;
         case ACT_SCREENSHOT: take_screenshot(u, a->text); break;
         case ACT_EXPORT: request_export(u, a->text); break;
         case ACT_LOAD:
@@ -264,6 +262,11 @@ void run_script(ui_thread *u) {
             return;
         case ACT_STATS: print_stats(u); break;
         case ACT_QUIT: u->quit = 1; break;
+        case ACT_PAUSE:
+        case ACT_RESUME:
+        case ACT_SLEEP:
+            if (!panel_script_action(u, a)) return;
+            break;
         }
         u->script_pos++;
     }

@@ -7,16 +7,65 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <cfloat>
 #include <cmath>
+#include <cstdarg>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+
+namespace {
+GLFWwindow *g_window;
+float g_content_scale = 0.0f; // the window's content scale the fonts and sizes were made for
+float g_scale = 1.0f;         // sizes in window units: the content scale over the framebuffer's pixels per unit
+float g_dock_w = 0.0f;        // the panel's width as the user left it (window units); 0: the default
+bool g_collapsed = false;
+float g_image_dock = 0.0f; // this frame's: the image is drawn beside it
+} // namespace
+
+// Fonts and sizes for the window's content scale (HiDPI): glyphs rasterised at the framebuffer's
+// resolution, everything else sized in window units, so text is sharp and the mouse maps 1:1.
+static void fit_content_scale(void) {
+    float xs = 1.0f, ys = 1.0f;
+    glfwGetWindowContentScale(g_window, &xs, &ys);
+    float cs = std::fmin(std::fmax(std::fmax(xs, ys), 0.5f), 4.0f);
+    if (cs == g_content_scale) return;
+    int ww, wh, fw, fh;
+    glfwGetWindowSize(g_window, &ww, &wh);
+    glfwGetFramebufferSize(g_window, &fw, &fh);
+    float ratio = ww > 0 && fw > 0 ? (float)fw / (float)ww : 1.0f; // framebuffer pixels per window unit
+    ImGuiIO &io = ImGui::GetIO();
+    io.Fonts->Clear();
+    static const char *dejavu = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+    FILE *f = cs > 1.2f ? std::fopen(dejavu, "rb") : nullptr; // the built-in font is a 13-pixel bitmap
+    if (f) {
+        std::fclose(f);
+        io.Fonts->AddFontFromFileTTF(dejavu, std::round(14.0f * cs));
+    } else {
+        ImFontConfig cfg;
+        cfg.SizePixels = std::round(13.0f * cs);
+        io.Fonts->AddFontDefault(&cfg);
+    }
+    io.FontGlobalScale = 1.0f / ratio;
+    g_scale = cs / ratio;
+    ImGuiStyle style;
+    ImGui::StyleColorsDark(&style);
+    style.ScaleAllSizes(g_scale);
+    ImGui::GetStyle() = style;
+    if (g_content_scale > 0.0f) { // a change while running (the window moved to another screen)
+        ImGui_ImplOpenGL3_DestroyFontsTexture();
+        ImGui_ImplOpenGL3_CreateFontsTexture();
+    }
+    g_content_scale = cs;
+}
 
 extern "C" int ui_init(GLFWwindow *window) {
     IMGUI_CHECKVERSION();
     if (!ImGui::CreateContext()) return -1;
     ImGui::GetIO().IniFilename = nullptr; // no imgui.ini littering the working directory
-    ImGui::StyleColorsDark();
+    g_window = window;
+    g_content_scale = 0.0f;
+    fit_content_scale();
     if (!ImGui_ImplGlfw_InitForOpenGL(window, true)) return -1;
     if (!ImGui_ImplOpenGL3_Init("#version 330 core")) return -1;
     return 0;
@@ -29,15 +78,37 @@ extern "C" void ui_shutdown(void) {
 }
 
 extern "C" void ui_begin_frame(void) {
+    fit_content_scale();
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
 }
 
+// The panel's width: as the user dragged it, within limits that keep it and the image on-screen.
+static float dock_width(float window_w) {
+    float w = g_dock_w > 0.0f ? g_dock_w : 360.0f * g_scale;
+    float lo = std::fmin(200.0f * g_scale, 0.6f * window_w), hi = 0.6f * window_w;
+    return std::fmax(std::fmin(w, hi), lo);
+}
+
+extern "C" float ui_dock_width(const ui_controls *c) {
+    if (!c->show_panel || g_collapsed) return 0.0f;
+    int ww = 0;
+    glfwGetWindowSize(g_window, &ww, nullptr);
+    return dock_width((float)ww);
+}
+
+extern "C" float ui_dock_width_beside(const ui_controls *c, float image_w) {
+    if (!c->show_panel || g_collapsed) return 0.0f;
+    // dock_width(image_w + d) == d: the default, unless that is over 60% of the window
+    return std::fmin(g_dock_w > 0.0f ? g_dock_w : 360.0f * g_scale, 1.5f * image_w);
+}
+
 extern "C" void ui_draw_image(unsigned texture) {
     if (!texture) return;
     ImVec2 size = ImGui::GetIO().DisplaySize;
-    ImGui::GetBackgroundDrawList()->AddImage((ImTextureID)(intptr_t)texture, ImVec2(0, 0), size);
+    ImGui::GetBackgroundDrawList()->AddImage((ImTextureID)(intptr_t)texture, ImVec2(0, 0),
+                                             ImVec2(size.x - g_image_dock, size.y));
 }
 
 extern "C" void ui_draw_lights(const float *xy, int n, int selected) {
@@ -70,17 +141,27 @@ static void error_plot(const ui_stats *s) {
         ImGui::TextUnformatted("error plot: no full-resolution frame yet");
         return;
     }
+    float noise = (float)s->reference_noise; // the floor no curve can go below on average
+    if (noise > 0.0f && std::isfinite(noise)) {
+        emin = std::fmin(emin, noise);
+        emax = std::fmax(emax, noise);
+    }
     float lo = std::floor(std::log10(emin)), hi = std::ceil(std::log10(emax));
     if (hi <= lo) hi = lo + 1.0f;
     if (!(tmax > 0.0f)) tmax = 1.0f;
     ImVec2 p0 = ImGui::GetCursorScreenPos();
-    float w = std::fmax(ImGui::GetContentRegionAvail().x, 50.0f), h = 110.0f;
+    float w = std::fmax(ImGui::GetContentRegionAvail().x, 50.0f), h = 110.0f * g_scale;
     ImGui::Dummy(ImVec2(w, h));
     ImDrawList *dl = ImGui::GetWindowDrawList();
     dl->AddRectFilled(p0, ImVec2(p0.x + w, p0.y + h), IM_COL32(15, 15, 20, 255));
     for (float d = lo + 1.0f; d < hi; d += 1.0f) { // decade lines
         float y = p0.y + h * (1.0f - (d - lo) / (hi - lo));
         dl->AddLine(ImVec2(p0.x, y), ImVec2(p0.x + w, y), IM_COL32(60, 60, 70, 255));
+    }
+    if (noise > 0.0f && std::isfinite(noise)) { // dashed
+        float y = p0.y + h * (1.0f - (std::log10(noise) - lo) / (hi - lo)), dash = 6.0f * g_scale;
+        for (float x = p0.x; x < p0.x + w; x += 2.0f * dash)
+            dl->AddLine(ImVec2(x, y), ImVec2(std::fmin(x + dash, p0.x + w), y), IM_COL32(200, 200, 200, 200), 1.5f);
     }
     ImVector<ImVec2> pts;
     for (int c = 0; c < s->num_curves; c++) {
@@ -101,9 +182,10 @@ static void error_plot(const ui_stats *s) {
     std::snprintf(label, sizeof label, "1e%+.0f", (double)hi);
     dl->AddText(ImVec2(p0.x + 2, p0.y + 1), IM_COL32(200, 200, 200, 255), label);
     std::snprintf(label, sizeof label, "1e%+.0f", (double)lo);
-    dl->AddText(ImVec2(p0.x + 2, p0.y + h - 15), IM_COL32(200, 200, 200, 255), label);
+    float line = ImGui::GetTextLineHeight();
+    dl->AddText(ImVec2(p0.x + 2, p0.y + h - line - 1), IM_COL32(200, 200, 200, 255), label);
     std::snprintf(label, sizeof label, "%.1f s", (double)tmax);
-    dl->AddText(ImVec2(p0.x + w - 8.0f * (float)std::strlen(label), p0.y + h - 15), IM_COL32(200, 200, 200, 255),
+    dl->AddText(ImVec2(p0.x + w - ImGui::CalcTextSize(label).x - 2, p0.y + h - line - 1), IM_COL32(200, 200, 200, 255),
                 label);
     for (int c = 0; c < s->num_curves; c++) ImGui::TextColored(ImColor(curve_colours[c % 6]), "%s", s->curves[c].label);
 }
@@ -150,17 +232,114 @@ static void param_widgets(param_group group, vl_params *vl) {
     }
 }
 
-extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
-    if (!c->show_panel) return;
-    ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowBgAlpha(0.85f);
-    if (!ImGui::Begin("glint", nullptr)) {
+// Grey text for notes.
+static void note(const char *fmt, ...) IM_FMTARGS(1);
+static void note(const char *fmt, ...) {
+    char buf[1400];
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextUnformatted(buf);
+    ImGui::PopTextWrapPos();
+    ImGui::PopStyleColor();
+}
+
+// Why refinement stands still, or NULL while it runs.
+static const char *held_reason(const ui_controls *c, const ui_stats *s, char *buf, size_t n) {
+    if (!s->held) return nullptr;
+    if (c->paused) return "paused (Space resumes)";
+    if (c->spp_limit > 0 && s->frames >= c->spp_limit)
+        std::snprintf(buf, n, "done: %lld spp limit reached", c->spp_limit);
+    else
+        std::snprintf(buf, n, "done: %.3g s limit reached", c->time_limit);
+    return buf;
+}
+
+// Progress first: what the image has, how fast it grows, pause and the limits.
+static void progress_section(ui_controls *c, const ui_stats *s) {
+    char buf[160];
+    double fraction = -1.0;
+    if (c->spp_limit > 0) fraction = s->spp / (double)c->spp_limit;
+    if (c->time_limit > 0) fraction = std::fmax(fraction, s->seconds / c->time_limit);
+    if (fraction >= 0.0) {
+        if (c->spp_limit > 0)
+            std::snprintf(buf, sizeof buf, "%.0f / %lld spp", s->spp, c->spp_limit);
+        else
+            std::snprintf(buf, sizeof buf, "%.1f / %.3g s", s->seconds, c->time_limit);
+        ImGui::ProgressBar((float)std::fmin(fraction, 1.0), ImVec2(-FLT_MIN, 0), buf);
+    }
+    ImGui::Text("%.0f spp (frames %lld) in %.1f s", s->spp, s->frames, s->seconds);
+    const char *why = held_reason(c, s, buf, sizeof buf);
+    if (why)
+        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", why);
+    else
+        ImGui::TextUnformatted(s->previewing ? "moving: a reduced-resolution preview" : "refining");
+    /* Standing notes: the error plot paused away from the reference's camera, no light. */
+    if (s->status && s->status[0]) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", s->status);
+    if (ImGui::Button(c->paused ? "resume (Space)" : "pause (Space)")) c->paused = !c->paused;
+    ImGui::SameLine();
+    if (ImGui::Button("help (F1)")) c->show_help = !c->show_help;
+    int spp = (int)std::fmin((double)c->spp_limit, 1e8);
+    if (ImGui::InputInt("stop at spp", &spp, 16, 256)) c->spp_limit = spp < 0 ? 0 : spp;
+    float t = (float)c->time_limit;
+    if (ImGui::InputFloat("stop at seconds", &t, 1.0f, 10.0f, "%.1f")) c->time_limit = t < 0.0f ? 0.0 : t;
+    note("0: never stop");
+    ImGui::Text("%d x %d   last frame %.0f ms   %.2f M rays/s", s->width, s->height, s->frame_ms,
+                s->rays_per_second * 1e-6);
+    if (s->reference) {
+        if (s->rel_error >= 0.0)
+            ImGui::Text("relative L2 error %.4f", s->rel_error);
+        else
+            ImGui::TextUnformatted("relative L2 error -");
+    }
+}
+
+// Bookmarks 1-9: a button restores each one that is set; "save" stores the view in a slot.
+static void bookmark_buttons(ui_controls *c, const ui_stats *s) {
+    ImGui::TextUnformatted("bookmarks (shift+N restores, ctrl+N saves)");
+    for (int k = 1; k <= 9; k++) {
+        char label[16];
+        std::snprintf(label, sizeof label, "%d##go", k);
+        bool set = (s->bookmarks_set >> k) & 1u;
+        if (k > 1) ImGui::SameLine();
+        if (!set) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, 0.35f);
+        if (ImGui::Button(label) && set) c->bookmark_restore = k;
+        if (!set) ImGui::PopStyleVar();
+    }
+    ImGui::TextUnformatted("save the view as");
+    for (int k = 1; k <= 9; k++) {
+        char label[16];
+        std::snprintf(label, sizeof label, "%d##save", k);
+        ImGui::SameLine();
+        if (ImGui::Button(label)) c->bookmark_save = k;
+    }
+    if (s->bookmarks) note("%s", s->bookmarks);
+}
+
+// The panel, docked at the window's right edge over its whole height: the width is the user's
+// (dragging its left edge), kept between limits so that it and the image stay on-screen.
+static void panel(ui_controls *c, const ui_stats *s) {
+    ImVec2 display = ImGui::GetIO().DisplaySize;
+    float w = dock_width(display.x);
+    ImGui::SetNextWindowPos(ImVec2(display.x, 0.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+    ImGui::SetNextWindowSize(ImVec2(w, display.y), ImGuiCond_Always);
+    ImGui::SetNextWindowBgAlpha(0.94f);
+    g_collapsed = !ImGui::Begin("glint: settings and progress", nullptr, ImGuiWindowFlags_NoMove);
+    // A drag of the left edge resized it this frame: keep the width asked for.
+    float now_w = ImGui::GetWindowWidth();
+    if (!g_collapsed && std::fabs(now_w - w) > 0.5f) g_dock_w = now_w;
+    if (g_collapsed) {
         ImGui::End();
         return;
     }
+    g_image_dock = w;
     ImGui::TextUnformatted(s->scene_name ? s->scene_name : "");
-    ImGui::PushItemWidth(-ImGui::GetFontSize() * 10.0f); /* room for the longest label */
+    ImGui::PushItemWidth(-ImGui::GetFontSize() * 11.0f); // room for the longest label
+
+    if (ImGui::CollapsingHeader("Progress", ImGuiTreeNodeFlags_DefaultOpen)) progress_section(c, s);
 
     if (ImGui::CollapsingHeader("Estimator", ImGuiTreeNodeFlags_DefaultOpen)) {
         if (s->num_methods > 0) {
@@ -169,8 +348,14 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
         }
         ImGui::SliderInt("max depth", &c->params.max_depth, 1, 64);
         if (s->many_light) param_widgets(PARAM_MANY_LIGHT, &c->params.vl);
+        // Cost and bias where known: the last full frame's time and the plan's reasons.
+        note("cost: %.0f ms a frame at %d x %d", s->frame_ms, s->width, s->height);
+        if (s->plan && s->plan[0] &&
+            ImGui::TreeNodeEx("what runs, and why (effect plan)", ImGuiTreeNodeFlags_DefaultOpen)) {
+            note("%s", s->plan);
+            ImGui::TreePop();
+        }
     }
-
     if (s->highlights && ImGui::CollapsingHeader("Highlights", ImGuiTreeNodeFlags_DefaultOpen))
         param_widgets(PARAM_HIGHLIGHTS, &c->params.vl);
 
@@ -202,6 +387,11 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
             ImGui::Text("relative L2 error %.4f", s->rel_error);
         else
             ImGui::TextUnformatted("relative L2 error -");
+        if (s->reference_noise >= 0.0)
+            note("the reference's own noise: %.4f (the dashed line); below it, error is the reference's",
+                 s->reference_noise);
+        else
+            note("the reference's own noise: unknown (no description in its file)");
         error_plot(s);
     }
 
@@ -217,7 +407,13 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
             ImGui::EndCombo();
         }
         if (ImGui::Button("reset view (R)")) c->reset_view = 1;
-        if (s->bookmarks) ImGui::TextWrapped("bookmarks (ctrl+N saves, shift+N restores): %s", s->bookmarks);
+        ImGui::SameLine();
+        if (ImGui::Button("frame scene (F)")) c->frame_scene = 1;
+        if (s->reference) {
+            ImGui::SameLine();
+            if (ImGui::Button("reference camera (C)")) c->reference_view = 1;
+        }
+        bookmark_buttons(c, s);
     }
 
     if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
@@ -230,10 +426,11 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
         if (ImGui::Button("load environment")) c->load_env = 1;
         ImGui::SameLine();
         if (ImGui::Button("load reference")) c->load_reference = 1;
+        if (ImGui::Button("uniform sky on/off (K)")) c->uniform_sky = 1;
         if (s->message && s->message[0]) ImGui::TextWrapped("%s", s->message);
     }
 
-    if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (ImGui::CollapsingHeader("Statistics")) {
         ImGui::Text("%d x %d%s", s->width, s->height, s->previewing ? "  (preview while moving)" : "");
         ImGui::Text("frames %lld   spp %.0f", s->frames, s->spp);
         ImGui::Text("time %.1f s   frame %.0f ms", s->seconds, s->frame_ms);
@@ -249,15 +446,74 @@ extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
                 ImGui::TextUnformatted("merging -");
             }
         }
-        if (s->plan && s->plan[0] && ImGui::TreeNode("effect plan")) {
-            ImGui::PushTextWrapPos(0.0f);
-            ImGui::TextUnformatted(s->plan);
-            ImGui::PopTextWrapPos();
-            ImGui::TreePop();
-        }
     }
     ImGui::PopItemWidth();
     ImGui::End();
+}
+
+// The overlay in the image's top-left corner: method, samples, time, speed, error.
+static void overlay(const ui_controls *c, const ui_stats *s) {
+    float pad = 8.0f * g_scale;
+    ImGui::SetNextWindowPos(ImVec2(pad, pad), ImGuiCond_Always);
+    ImGui::SetNextWindowBgAlpha(0.75f);
+    const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                   ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoNav |
+                                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoSavedSettings;
+    if (ImGui::Begin("##overlay", nullptr, flags)) {
+        char err[48] = "";
+        if (s->reference && s->rel_error >= 0.0) std::snprintf(err, sizeof err, "   error %.4f", s->rel_error);
+        double fps = s->frame_ms > 0.0 ? 1e3 / s->frame_ms : 0.0;
+        ImGui::Text("%s   %.0f spp   %.1f s   %.1f fps%s", s->method ? s->method : "", s->spp, s->seconds, fps, err);
+        char buf[160];
+        const char *why = held_reason(c, s, buf, sizeof buf);
+        if (why)
+            ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", why);
+        else if (s->previewing)
+            ImGui::TextUnformatted("preview while moving");
+        ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+        ImGui::TextUnformatted(c->show_panel ? "F1 or ?: keys" : "F1 or ?: keys   Tab: panel");
+        ImGui::PopStyleColor();
+    }
+    ImGui::End();
+}
+
+// Every shortcut, over the image's centre, or the window's when the image is narrower; never
+// larger than the window (it scrolls then).
+static void help(ui_controls *c, const ui_stats *s) {
+    static ImVec2 last_size(0.0f, 0.0f);
+    ImVec2 display = ImGui::GetIO().DisplaySize;
+    float image_w = display.x - g_image_dock;
+    float cx = last_size.x <= image_w ? 0.5f * image_w : 0.5f * display.x;
+    float x = std::fmax(0.0f, std::fmin(cx - 0.5f * last_size.x, display.x - last_size.x));
+    float y = std::fmax(0.0f, 0.5f * (display.y - last_size.y));
+    ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_Always);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f), display);
+    ImGui::SetNextWindowBgAlpha(0.92f);
+    bool open = true;
+    if (ImGui::Begin("keys and mouse (F1 or ? closes)", &open,
+                     ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
+                         ImGuiWindowFlags_HorizontalScrollbar)) {
+        if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+            for (int i = 0; i < s->num_shortcuts; i++) {
+                ImGui::TableNextRow();
+                ImGui::TableNextColumn();
+                ImGui::TextColored(ImVec4(1.0f, 0.85f, 0.45f, 1.0f), "%s", s->shortcut_keys[i]);
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(s->shortcut_actions[i]);
+            }
+            ImGui::EndTable();
+        }
+    }
+    last_size = ImGui::GetWindowSize();
+    ImGui::End();
+    if (!open) c->show_help = 0;
+}
+
+extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
+    g_image_dock = 0.0f;
+    if (c->show_panel) panel(c, s);
+    overlay(c, s);
+    if (c->show_help) help(c, s);
 }
 
 extern "C" void ui_end_frame(void) {

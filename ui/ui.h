@@ -37,6 +37,12 @@ typedef struct {
     /* more one-shot actions (keys F, C, K; the panel may offer buttons): frame the whole scene,
      * return to the reference's camera, toggle a uniform sky */
     int frame_scene, reference_view, uniform_sky;
+    /* refinement: paused, or stopped at a limit (0: none); the full image keeps its frames */
+    int paused;
+    long long spp_limit;
+    double time_limit;                   /* seconds since the last reset */
+    int show_help;                       /* the shortcut overlay */
+    int bookmark_save, bookmark_restore; /* one-shot: a slot 1-9, 0 none */
 } ui_controls;
 
 /* One curve of the error plot: relative L2 error against seconds since a reset. */
@@ -75,20 +81,32 @@ typedef struct {
     double rel_error;       /* of the full-resolution image against it; < 0: none yet */
     const ui_curve *curves; /* the error plot, one curve per method and setting */
     int num_curves;
-    const char *bookmarks; /* which of bookmarks 1-9 are set, e.g. "1 3", and where they live */
-    const char *message;   /* last export path or error, shown until replaced */
-    const char *status;    /* standing notes (error plot paused, no light in the scene), "" for none */
+    const char *bookmarks;  /* which of bookmarks 1-9 are set, e.g. "1 3", and where they live */
+    const char *message;    /* last export path or error, shown until replaced */
+    const char *status;     /* standing notes (error plot paused, no light in the scene), "" for none */
+    const char *method;     /* the current method's name, for the overlay */
+    int held;               /* refinement stopped: paused or at a limit */
+    double reference_noise; /* the reference's own relative L2 noise; < 0: unknown */
+    unsigned bookmarks_set; /* bit N: bookmark N is set */
+    const char *const *shortcut_keys, *const *shortcut_actions; /* the help overlay's lines */
+    int num_shortcuts;
 } ui_stats;
 
 /* Sets up Dear ImGui for a window with a current OpenGL 3.3 context. Returns 0 or -1. */
 int ui_init(struct GLFWwindow *window);
 void ui_shutdown(void);
 void ui_begin_frame(void);
-/* The image fills the window (a textured quad behind the panel). texture 0 draws nothing. */
+/* The image fills the window beside the docked panel (a textured quad). texture 0 draws nothing. */
 void ui_draw_image(unsigned texture);
+/* The width the panel docked at the window's right edge takes from the image, in window units: 0
+ * while it is hidden or collapsed. Before the first frame, its default width. */
+float ui_dock_width(const ui_controls *c);
+/* The panel's width in a window that leaves image_w (window units) to the image. */
+float ui_dock_width_beside(const ui_controls *c, float image_w);
 /* Markers over the image at the lights' window positions (2 floats per light; NaN: off
  * screen); the selected one stands out. */
 void ui_draw_lights(const float *xy, int n, int selected);
+/* The panel (when c->show_panel), the overlay on the image and the shortcut help (c->show_help). */
 void ui_panel(ui_controls *c, const ui_stats *s);
 void ui_end_frame(void);
 /* Whether the panel has the mouse or keyboard (the viewer then ignores them for the camera). */

@@ -1,0 +1,182 @@
+/* glint view: what the panel adds to the viewer (UI thread, but for the render thread's hold):
+ * the list of shortcuts the help overlay and --help share, the image's place beside the docked
+ * panel, pausing and the spp and time limits, and the panel's own keys and buttons. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "view.h"
+
+/* Every key and mouse action: `glint view --help` prints them, F1 shows them. */
+const view_shortcut view_shortcuts[] = {
+    {"left drag", "orbit around the point in front of the camera"},
+    {"right or middle drag", "pan"},
+    {"wheel", "zoom"},
+    {"W A S D, Q E", "fly: forward, left, back, right; down, up"},
+    {"R", "reset the view"},
+    {"F", "frame the whole scene"},
+    {"C", "back to the reference's camera"},
+    {"K", "a uniform sky on or off"},
+    {"1-9", "the scene's cameras"},
+    {"ctrl+1-9", "save the view as bookmark N"},
+    {"shift+1-9", "restore bookmark N"},
+    {"arrows, PageUp/PageDown", "move the selected light"},
+    {"ctrl+click", "select the light nearest the cursor"},
+    {"ctrl+drag", "move the selected light with the cursor"},
+    {"Space", "pause or resume refinement"},
+    {"F1 or ?", "show or hide this list"},
+    {"F12", "screenshot of the image (PNG)"},
+    {"F11", "export the image and its layers (EXR)"},
+    {"Tab", "show or hide the panel"},
+    {"Esc", "quit"},
+    {"drop a file", ".gltf/.glb opens it, .exr/.hdr lights the scene"},
+};
+const int num_view_shortcuts = (int)(sizeof view_shortcuts / sizeof view_shortcuts[0]);
+
+void print_shortcuts(FILE *f) {
+    for (int i = 0; i < num_view_shortcuts; i++)
+        fprintf(f, "  %-24s %s\n", view_shortcuts[i].keys, view_shortcuts[i].action);
+}
+
+/* ---- the image beside the panel ---------------------------------------------------------------- */
+
+void view_image_window_size(ui_thread *u, int *w, int *h) {
+    int ww, wh;
+    glfwGetWindowSize(u->win, &ww, &wh);
+    int dock = (int)(ui_dock_width(&u->ctl) + 0.5f);
+    *w = ww - dock > 1 ? ww - dock : 1;
+    *h = wh > 1 ? wh : 1;
+}
+
+void view_image_size(ui_thread *u, int *w, int *h) {
+    int ww, wh, fw, fh;
+    glfwGetWindowSize(u->win, &ww, &wh);
+    glfwGetFramebufferSize(u->win, &fw, &fh);
+    if (fw <= 0 || fh <= 0) { /* minimised */
+        *w = *h = 0;
+        return;
+    }
+    double ratio = ww > 0 ? (double)fw / ww : 1.0;
+    int dock = (int)(ratio * (double)ui_dock_width(&u->ctl) + 0.5);
+    *w = fw - dock > 1 ? fw - dock : 1;
+    *h = fh > 1 ? fh : 1;
+}
+
+void view_fit_window(ui_thread *u, int image_w, int image_h) {
+    float dock = ui_dock_width_beside(&u->ctl, (float)image_w);
+    if (dock > 0.0f) glfwSetWindowSize(u->win, image_w + (int)(dock + 0.5f), image_h);
+}
+
+/* ---- pause and limits ------------------------------------------------------------------------ */
+
+int refinement_held(const shared_state *sh, long long frames) {
+    if (frames < 1) return 0; /* every new view gets one full frame */
+    return sh->paused || (sh->spp_limit > 0 && frames >= sh->spp_limit) ||
+           (sh->time_limit > 0.0 && seconds_since(sh->stats.reset_at) >= sh->time_limit);
+}
+
+void refinement_hold(shared_state *sh) {
+    double t0 = cli_now();
+    nanosleep(&(struct timespec){0, 10 * 1000 * 1000}, NULL);
+    pthread_mutex_lock(&sh->lock);
+    sh->stats.reset_at += cli_now() - t0; /* time held is not refinement time */
+}
+
+static int held(const ui_thread *u) {
+    const ui_controls *c = &u->ctl;
+    long long frames = frames_of_current_state(u);
+    return frames >= 1 && (c->paused || (c->spp_limit > 0 && frames >= c->spp_limit) ||
+                           (c->time_limit > 0.0 && seconds_since(u->stats.reset_at) >= c->time_limit));
+}
+
+void push_refinement(ui_thread *u) {
+    shared_state *sh = u->sh;
+    pthread_mutex_lock(&sh->lock);
+    sh->paused = u->ctl.paused;
+    sh->spp_limit = u->ctl.spp_limit;
+    sh->time_limit = u->ctl.time_limit;
+    pthread_mutex_unlock(&sh->lock);
+}
+
+int panel_set(ui_thread *u, const char *name, const char *value, char *err, size_t errlen) {
+    long long n;
+    double x;
+    if (strcmp(name, "spp") == 0) {
+        if (cli_parse_int("spp", value, 0, 100000000, &n) != 0)
+            return snprintf(err, errlen, "spp: 0 (no limit) to 100000000"), -1;
+        u->ctl.spp_limit = n;
+    } else if (strcmp(name, "time") == 0) {
+        if (cli_parse_float("time", value, 0.0, 1e7, &x) != 0)
+            return snprintf(err, errlen, "time: 0 (no limit) to 1e7 seconds"), -1;
+        u->ctl.time_limit = x;
+    } else {
+        return 1;
+    }
+    push_refinement(u);
+    return 0;
+}
+
+int panel_script_action(ui_thread *u, const script_action *a) {
+    switch (a->kind) {
+    case ACT_PAUSE:
+    case ACT_RESUME:
+        u->ctl.paused = a->kind == ACT_PAUSE;
+        push_refinement(u);
+        return 1;
+    case ACT_SLEEP:
+        if (!u->script_waiting) {
+            u->script_waiting = 1;
+            u->sleep_until = cli_now() + a->a;
+        }
+        if (cli_now() < u->sleep_until) return 0;
+        u->script_waiting = 0;
+        return 1;
+    default: return 1;
+    }
+}
+
+void print_panel_stats(ui_thread *u) {
+    int ww, wh, iw, ih;
+    glfwGetWindowSize(u->win, &ww, &wh);
+    view_image_window_size(u, &iw, &ih);
+    printf(" paused=%d spp_limit=%lld time_limit=%g held=%d help=%d window=%dx%d image=%dx%d dock=%d", u->ctl.paused,
+           u->ctl.spp_limit, u->ctl.time_limit, held(u), u->ctl.show_help, ww, wh, iw, ih, ww - iw);
+}
+
+/* ---- the panel's keys and buttons ------------------------------------------------------------ */
+
+/* Before the panel is drawn: F1 or ? (shift+/) toggles the help, Space pausing; after it, the
+ * bookmark buttons. keys_pressed holds 1 + the modifiers of each key pressed this frame. */
+static void panel_keys(ui_thread *u) {
+    int slash = u->keys_pressed[GLFW_KEY_SLASH];
+    if (u->keys_pressed[GLFW_KEY_F1] || (slash && ((slash - 1) & GLFW_MOD_SHIFT))) u->ctl.show_help = !u->ctl.show_help;
+    if (u->keys_pressed[GLFW_KEY_SPACE]) u->ctl.paused = !u->ctl.paused;
+}
+
+void panel_frame(ui_thread *u, ui_stats *st) {
+    panel_keys(u);
+    st->method = method_name(u->ctl.params.method);
+    st->held = held(u);
+    if (st->held) { /* the image's time stands with it */
+        if (!u->was_held) u->held_seconds = st->seconds;
+        st->seconds = u->held_seconds;
+    }
+    u->was_held = st->held;
+    st->reference_noise = u->reference.rgb ? u->reference_noise : -1.0;
+    for (int k = 1; k <= 9; k++)
+        if (u->bookmark_set[k]) st->bookmarks_set |= 1u << k;
+    static const char *keys[64], *actions[64];
+    for (int i = 0; i < num_view_shortcuts && i < 64; i++)
+        keys[i] = view_shortcuts[i].keys, actions[i] = view_shortcuts[i].action;
+    st->shortcut_keys = keys;
+    st->shortcut_actions = actions;
+    st->num_shortcuts = num_view_shortcuts < 64 ? num_view_shortcuts : 64;
+}
+
+void panel_after(ui_thread *u) {
+    if (u->ctl.bookmark_save) bookmark_save(u, u->ctl.bookmark_save);
+    if (u->ctl.bookmark_restore) bookmark_restore(u, u->ctl.bookmark_restore);
+    u->ctl.bookmark_save = u->ctl.bookmark_restore = 0;
+    push_refinement(u);
+}
