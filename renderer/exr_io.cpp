@@ -109,9 +109,86 @@ std::string read_name(FdStream &in) {
     }
 }
 
+uint32_t le32(const unsigned char *b) {
+    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+// The value size of the library's fixed-size attribute types, 0 for the others.
+int64_t fixed_size(const std::string &type) {
+    static const struct {
+        const char *type;
+        int64_t size;
+    } sizes[] = {{"box2i", 16},
+                 {"box2f", 16},
+                 {"chromaticities", 32},
+                 {"compression", 1},
+                 {"deepImageState", 1},
+                 {"double", 8},
+                 {"envmap", 1},
+                 {"float", 4},
+                 {"int", 4},
+                 {"keycode", 28},
+                 {"lineOrder", 1},
+                 {"m33d", 72},
+                 {"m33f", 36},
+                 {"m44d", 128},
+                 {"m44f", 64},
+                 {"rational", 8},
+                 {"tiledesc", 9},
+                 {"timecode", 8},
+                 {"v2d", 16},
+                 {"v2f", 8},
+                 {"v2i", 8},
+                 {"v3d", 24},
+                 {"v3f", 12},
+                 {"v3i", 12}};
+    for (const auto &t : sizes)
+        if (type == t.type) return t.size;
+    return 0;
+}
+
+// Whether an attribute's value, n bytes at the stream's position, is what the library's reader for
+// its type consumes, exactly: the channel list's entries ending with its terminator at n, a
+// preview's 8 + 4 x width x height bytes, a string vector's strings filling n.
+bool value_fits(FdStream &in, const std::string &type, int64_t n) {
+    if (int64_t fixed = fixed_size(type)) return n == fixed;
+    if (type == "floatvector") return n % 4 == 0;
+    if (type == "idmanifest") return n >= 4;
+    if (type == "preview") {
+        if (n < 8) return false;
+        unsigned char b[8];
+        in.read(reinterpret_cast<char *>(b), 8);
+        return (uint64_t)n == 8 + 4 * (uint64_t)le32(b) * le32(b + 4);
+    }
+    if (type != "chlist" && type != "stringvector") return true; // string, or opaque: n bytes
+    std::vector<char> v((size_t)n);
+    if (n > 0) in.read(v.data(), (int)n);
+    const unsigned char *b = reinterpret_cast<const unsigned char *>(v.data());
+    int64_t at = 0;
+    if (type == "stringvector") {
+        while (at < n) {
+            if (n - at < 4 || (int64_t)le32(b + at) > n - at - 4) return false;
+            at += 4 + (int64_t)le32(b + at);
+        }
+        return true;
+    }
+    for (;;) { // chlist: name, NUL, 16 bytes of description, ..., and an empty name
+        const void *nul = at < n ? std::memchr(b + at, 0, (size_t)(n - at)) : nullptr;
+        if (!nul) return false;
+        int64_t len = static_cast<const unsigned char *>(nul) - (b + at);
+        if (len == 0) return at + 1 == n;
+        if (len > 255 || n - at - len - 1 < 16) return false;
+        at += len + 1 + 16;
+    }
+}
+
 // OpenEXR 3.1's header reader makes room for an attribute's value at the size the file declares
 // before reading it (a string is resized, so zero-filled, first): 40 bytes declaring a 2 GB string
 // would cost 2 GB. So every declared size is checked against the bytes left in the file first.
+// The reader takes the size on trust only for strings and unknown types; the others read their own
+// layout (a channel list up to its terminator, a preview by its width and height), which must then
+// fill the declared size exactly: else the two walks through the header part, and the library's
+// would meet sizes this one never checked.
 void check_attribute_sizes(FdStream &in) {
     char version[4];
     in.seekg(4);
@@ -120,14 +197,18 @@ void check_attribute_sizes(FdStream &in) {
     for (bool more = true; more;) {            // one header, or a multi-part file's up to an empty one
         int attrs = 0;
         for (std::string name; !(name = read_name(in)).empty(); attrs++) {
-            read_name(in); // the type
+            std::string type = read_name(in);
             unsigned char b[4];
             in.read(reinterpret_cast<char *>(b), 4);
-            int64_t n = (int32_t)((uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24);
+            int64_t n = (int32_t)le32(b);
             if (n < 0 || (uint64_t)n > in.size() - in.tellg())
                 throw Iex::InputExc("header attribute " + name + " claims " + std::to_string(n) +
                                     " bytes, more than the file holds");
-            in.seekg(in.tellg() + (uint64_t)n);
+            uint64_t end = in.tellg() + (uint64_t)n;
+            if (!value_fits(in, type, n))
+                throw Iex::InputExc("header attribute " + name + " is not a valid " + type + " of " +
+                                    std::to_string(n) + " bytes");
+            in.seekg(end);
         }
         more = multipart && attrs > 0;
     }
@@ -200,7 +281,7 @@ void check_layout(const Imf::Header &h) {
     }
     const Imf::TileDescription *tile = h.hasTileDescription() ? &h.tileDescription() : nullptr;
     uint64_t chunk = tile ? (uint64_t)tile->xSize * tile->ySize * pixel_bytes : (uint64_t)w * 256 * pixel_bytes;
-    if (chunk > ((uint64_t)1 << 30)) {
+    if (chunk > ((uint64_t)1 << 28)) { // 256 MiB: a 16384-wide DWAB chunk of 4 floats is 64 MiB
         std::string what =
             std::to_string(pixel_bytes) + " bytes a pixel over " + std::to_string(w) + "x" + std::to_string(ht);
         if (tile) what += " in tiles of " + std::to_string(tile->xSize) + "x" + std::to_string(tile->ySize);
@@ -227,8 +308,10 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
     check_layout(h);
     std::vector<std::string> pick = pick_channels(h.channels(), select);
     const Imath::Box2i dw = h.dataWindow(), disp = h.displayWindow();
-    for (const Imath::Box2i &b : {dw, disp}) // the planes as read, and as re-framed
-        if ((uint64_t)box_width(b) * (uint64_t)box_height(b) * pick.size() > ((uint64_t)1 << 30))
+    // The planes as read, and as re-framed: at most 2^29 floats (2 GiB), which still holds a
+    // 16384x8192 RGB environment map.
+    for (const Imath::Box2i &b : {dw, disp})
+        if ((uint64_t)box_width(b) * (uint64_t)box_height(b) * pick.size() > ((uint64_t)1 << 29))
             throw Refused("unsupported image size (" + std::to_string(pick.size()) + " channels of " +
                           std::to_string(box_width(b)) + "x" + std::to_string(box_height(b)) + ")");
 
