@@ -158,7 +158,8 @@ bool value_fits(FdStream &in, const std::string &type, int64_t n) {
         if (n < 8) return false;
         unsigned char b[8];
         in.read(reinterpret_cast<char *>(b), 8);
-        return (uint64_t)n == 8 + 4 * (uint64_t)le32(b) * le32(b + 4);
+        uint64_t pixels = (uint64_t)le32(b) * le32(b + 4); // < 2^64: both are 32-bit
+        return pixels <= (uint64_t)(n - 8) / 4 && (uint64_t)n == 8 + 4 * pixels;
     }
     if (type != "chlist" && type != "stringvector") return true; // string, or opaque: n bytes
     std::vector<char> v((size_t)n);
