@@ -15,6 +15,7 @@
 #include <ImfStringAttribute.h>
 #include <ImfTiledInputPart.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdarg>
 #include <cstdio>
@@ -223,21 +224,22 @@ bool size_ok(int64_t w, int64_t h) {
     return w > 0 && h > 0 && w <= MAX_IMAGE_DIM && h <= MAX_IMAGE_DIM && w * h <= MAX_IMAGE_PIXELS;
 }
 
-// Re-frames img from its data window onto the display window: pixels outside the data window are
-// zero (as EXR defines them), data outside the display window is dropped.
-void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2i &disp) {
+// Re-frames img (fpp floats a pixel in each plane) from its data window onto the display window:
+// pixels outside the data window are zero (as EXR defines them), data outside the display window
+// is dropped.
+void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2i &disp, size_t fpp) {
     int dispw = (int)box_width(disp), disph = (int)box_height(disp);
     int64_t x_lo = dw.min.x > disp.min.x ? dw.min.x : disp.min.x;
     int64_t x_hi = dw.max.x < disp.max.x ? dw.max.x : disp.max.x;
     for (int k = 0; k < img->num_channels; k++) {
-        float *dst = static_cast<float *>(std::calloc((size_t)dispw * (size_t)disph, sizeof(float)));
+        float *dst = static_cast<float *>(std::calloc((size_t)dispw * (size_t)disph * fpp, sizeof(float)));
         if (!dst) throw std::bad_alloc();
         const float *src = img->planes[k];
         for (int64_t y = disp.min.y; y <= disp.max.y && x_lo <= x_hi; y++) {
             if (y < dw.min.y || y > dw.max.y) continue;
-            std::memcpy(dst + (size_t)(y - disp.min.y) * (size_t)dispw + (size_t)(x_lo - disp.min.x),
-                        src + (size_t)(y - dw.min.y) * (size_t)img->width + (size_t)(x_lo - dw.min.x),
-                        sizeof(float) * (size_t)(x_hi - x_lo + 1));
+            std::memcpy(dst + ((size_t)(y - disp.min.y) * (size_t)dispw + (size_t)(x_lo - disp.min.x)) * fpp,
+                        src + ((size_t)(y - dw.min.y) * (size_t)img->width + (size_t)(x_lo - dw.min.x)) * fpp,
+                        sizeof(float) * (size_t)(x_hi - x_lo + 1) * fpp);
         }
         std::free(img->planes[k]);
         img->planes[k] = dst;
@@ -249,7 +251,7 @@ void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2
 // The channels to read, in output order.
 std::vector<std::string> pick_channels(const Imf::ChannelList &chans, exr_read_select select) {
     std::vector<std::string> pick;
-    if (select == EXR_READ_RGB) {
+    if (select != EXR_READ_ALL) {
         if (chans.findChannel("R") && chans.findChannel("G") && chans.findChannel("B"))
             pick = {"R", "G", "B"};
         else if (chans.findChannel("Y"))
@@ -257,7 +259,7 @@ std::vector<std::string> pick_channels(const Imf::ChannelList &chans, exr_read_s
     } else {
         for (auto it = chans.begin(); it != chans.end(); ++it) pick.emplace_back(it.name());
     }
-    if (pick.empty()) throw Refused(select == EXR_READ_RGB ? "no R, G, B or Y channel" : "no channels");
+    if (pick.empty()) throw Refused(select != EXR_READ_ALL ? "no R, G, B or Y channel" : "no channels");
     return pick;
 }
 
@@ -309,25 +311,43 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
     check_layout(h);
     std::vector<std::string> pick = pick_channels(h.channels(), select);
     const Imath::Box2i dw = h.dataWindow(), disp = h.displayWindow();
-    // The planes as read, and as re-framed: at most 2^29 floats (2 GiB), which still holds a
-    // 16384x8192 RGB environment map.
-    for (const Imath::Box2i &b : {dw, disp})
-        if ((uint64_t)box_width(b) * (uint64_t)box_height(b) * pick.size() > ((uint64_t)1 << 29))
-            throw Refused("unsupported image size (" + std::to_string(pick.size()) + " channels of " +
-                          std::to_string(box_width(b)) + "x" + std::to_string(box_height(b)) + ")");
+    // What is held at once, at most 2^29 floats (2 GiB), which still holds a 16384x8192 RGB
+    // environment map: the planes as read and as re-framed (one at a time); or the interleaved
+    // RGB, read in place when the data window lies inside the display window, else read and then
+    // re-framed.
+    const bool rgb = select == EXR_READ_RGB_INTERLEAVED;
+    const bool inside =
+        dw.min.x >= disp.min.x && dw.min.y >= disp.min.y && dw.max.x <= disp.max.x && dw.max.y <= disp.max.y;
+    const uint64_t dw_px = (uint64_t)box_width(dw) * (uint64_t)box_height(dw);
+    const uint64_t disp_px = (uint64_t)box_width(disp) * (uint64_t)box_height(disp);
+    const uint64_t held = rgb ? 3 * (disp_px + (inside ? 0 : dw_px)) : pick.size() * std::max(dw_px, disp_px);
+    if (held > ((uint64_t)1 << 29))
+        throw Refused("unsupported image size (" + std::to_string(pick.size()) + " channels of " +
+                      std::to_string(box_width(dw)) + "x" + std::to_string(box_height(dw)) + " in " +
+                      std::to_string(box_width(disp)) + "x" + std::to_string(box_height(disp)) + ")");
 
-    out->width = (int)box_width(dw);
-    out->height = (int)box_height(dw);
-    out->names = static_cast<char **>(std::calloc(pick.size(), sizeof(char *)));
-    out->planes = static_cast<float **>(std::calloc(pick.size(), sizeof(float *)));
+    const bool in_place = rgb && inside;
+    const Imath::Box2i &frame = in_place ? disp : dw; // what the planes cover
+    const size_t planes = rgb ? 1 : pick.size(), fpp = rgb ? 3 : 1;
+    out->width = (int)box_width(frame);
+    out->height = (int)box_height(frame);
+    out->names = static_cast<char **>(std::calloc(planes, sizeof(char *)));
+    out->planes = static_cast<float **>(std::calloc(planes, sizeof(float *)));
     if (!out->names || !out->planes) throw std::bad_alloc();
-    Imf::FrameBuffer fb;
-    for (size_t k = 0; k < pick.size(); k++) {
+    for (size_t k = 0; k < planes; k++) {
         out->num_channels = (int)k + 1;
-        out->names[k] = strdup(pick[k].c_str());
-        out->planes[k] = static_cast<float *>(std::calloc((size_t)out->width * (size_t)out->height, sizeof(float)));
+        out->names[k] = strdup(rgb ? "RGB" : pick[k].c_str());
+        out->planes[k] =
+            static_cast<float *>(std::calloc((size_t)out->width * (size_t)out->height * fpp, sizeof(float)));
         if (!out->names[k] || !out->planes[k]) throw std::bad_alloc();
-        fb.insert(pick[k], Imf::Slice::Make(Imf::FLOAT, out->planes[k], dw)); // half and uint convert
+    }
+    Imf::FrameBuffer fb; // half and uint convert to float
+    for (size_t k = 0; k < pick.size(); k++) {
+        float *first = rgb ? out->planes[0] + k : out->planes[k]; // the frame's first pixel
+        if (in_place)
+            first += ((size_t)(dw.min.y - disp.min.y) * (size_t)out->width + (size_t)(dw.min.x - disp.min.x)) * 3;
+        fb.insert(pick[k], Imf::Slice::Make(Imf::FLOAT, first, dw, sizeof(float) * fpp,
+                                            sizeof(float) * fpp * (size_t)out->width));
     }
 
     *stage = "corrupt or truncated file";
@@ -341,7 +361,10 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
         lines.readPixels(dw.min.y, dw.max.y);
     }
     if (lossy_dct) *lossy_dct = h.compression() == Imf::DWAA_COMPRESSION || h.compression() == Imf::DWAB_COMPRESSION;
-    if (dw != disp) to_display_window(out, dw, disp);
+    if (frame != disp) to_display_window(out, dw, disp, fpp);
+    if (rgb && pick.size() == 1) // Y: gray
+        for (float *p = out->planes[0], *end = p + (size_t)out->width * (size_t)out->height * 3; p < end; p += 3)
+            p[1] = p[2] = p[0];
 }
 
 // The string attribute name of the first flat part's header, copied with malloc into *value;

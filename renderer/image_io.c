@@ -180,17 +180,11 @@ static int check_texels(const char *path, const image_rgb *img, char *err, size_
 static int load_exr_rgb(const char *path, int fd, int64_t size, image_rgb *out, char *err, size_t errlen) {
     exr_image ex;
     int lossy_dct = 0;
-    if (exr_read_fd(path, fd, size, EXR_READ_RGB, &ex, &lossy_dct, err, errlen) != 0) return -1;
+    /* Read straight into one interleaved buffer: no second copy of a large map. */
+    if (exr_read_fd(path, fd, size, EXR_READ_RGB_INTERLEAVED, &ex, &lossy_dct, err, errlen) != 0) return -1;
     size_t n = (size_t)ex.width * (size_t)ex.height;
-    float *rgb = malloc(sizeof(float) * 3 * n);
-    if (!rgb) {
-        exr_image_free(&ex);
-        return fail(err, errlen, path, "out of memory");
-    }
-    for (int c = 0; c < 3; c++) {
-        const float *plane = ex.planes[ex.num_channels == 3 ? c : 0]; /* Y: gray */
-        for (size_t i = 0; i < n; i++) rgb[3 * i + (size_t)c] = plane[i];
-    }
+    float *rgb = ex.planes[0];
+    ex.planes[0] = NULL;
     /* DWA's DCT rings slightly below zero next to dark texels (even in Blender's own studio
      * lights); those are coding noise, not data, so they read as zero. */
     if (lossy_dct)

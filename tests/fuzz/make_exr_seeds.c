@@ -27,6 +27,7 @@ int main(int argc, char **argv) {
     const test_chan subsampled[] = {{"BY", EXR_PIXEL_HALF, 2}, {"RY", EXR_PIXEL_HALF, 2}, {"Y", EXR_PIXEL_HALF, 0}};
     const exr_attr_box2i_t box = {.min.x = 0, .min.y = 0, .max.x = 7, .max.y = 3};
     const exr_attr_box2i_t shifted = {.min.x = -2, .min.y = 1, .max.x = 5, .max.y = 6};
+    const exr_attr_box2i_t inside = {.min.x = 1, .min.y = 1, .max.x = 5, .max.y = 2};
     static const struct {
         const char *name;
         exr_compression_t comp;
@@ -45,6 +46,9 @@ int main(int argc, char **argv) {
     bad |= write_one(dir, "scanline-piz-uint-y.exr", EXR_STORAGE_SCANLINE, EXR_COMPRESSION_PIZ, uint_y, 1, box, box);
     bad |= write_one(dir, "scanline-none-windows.exr", EXR_STORAGE_SCANLINE, EXR_COMPRESSION_NONE, half_rgb, 3, shifted,
                      box);
+    bad |=
+        write_one(dir, "scanline-zip-inside.exr", EXR_STORAGE_SCANLINE, EXR_COMPRESSION_ZIP, half_rgb, 3, inside, box);
+    bad |= write_one(dir, "tiled-rle-y-inside.exr", EXR_STORAGE_TILED, EXR_COMPRESSION_RLE, uint_y, 1, inside, box);
     bad |= write_one(dir, "scanline-zip-subsampled.exr", EXR_STORAGE_SCANLINE, EXR_COMPRESSION_ZIP, subsampled, 3, box,
                      box);
     bad |= write_one(dir, "tiled-none-float.exr", EXR_STORAGE_TILED, EXR_COMPRESSION_NONE, float_rgba, 4, box, box);
