@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -248,6 +249,29 @@ void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2
     img->height = disph;
 }
 
+// An environment map's texels, interleaved RGB over the display window: Y spread to G and B, DWA's
+// slightly negative coding noise (lossy) read as zero, then every texel finite and non-negative.
+// Only the data window's part of the display window holds anything but zeros, so only it is
+// visited: a tiny data window in a huge display window costs little.
+void finish_rgb(exr_image *img, const Imath::Box2i &dw, const Imath::Box2i &disp, bool gray, bool lossy) {
+    int64_t x_lo = std::max(dw.min.x, disp.min.x), x_hi = std::min(dw.max.x, disp.max.x);
+    int64_t y_lo = std::max(dw.min.y, disp.min.y), y_hi = std::min(dw.max.y, disp.max.y);
+    for (int64_t y = y_lo; y <= y_hi; y++)
+        for (int64_t x = x_lo; x <= x_hi; x++) {
+            float *p = img->planes[0] + ((size_t)(y - disp.min.y) * (size_t)img->width + (size_t)(x - disp.min.x)) * 3;
+            if (gray) p[1] = p[2] = p[0];
+            for (int c = 0; c < 3; c++) {
+                if (lossy && p[c] < 0.0f) p[c] = 0.0f;
+                if (std::isfinite(p[c]) && p[c] >= 0.0f) continue;
+                char what[160];
+                std::snprintf(what, sizeof what, "pixel (%lld, %lld) channel %c is %s (%g)",
+                              (long long)(x - disp.min.x), (long long)(y - disp.min.y), "RGB"[c],
+                              std::isfinite(p[c]) ? "negative" : "not finite", (double)p[c]);
+                throw Refused(what);
+            }
+        }
+}
+
 // The channels to read, in output order.
 std::vector<std::string> pick_channels(const Imf::ChannelList &chans, exr_read_select select) {
     std::vector<std::string> pick;
@@ -360,11 +384,10 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
         lines.setFrameBuffer(fb);
         lines.readPixels(dw.min.y, dw.max.y);
     }
-    if (lossy_dct) *lossy_dct = h.compression() == Imf::DWAA_COMPRESSION || h.compression() == Imf::DWAB_COMPRESSION;
+    const bool lossy = h.compression() == Imf::DWAA_COMPRESSION || h.compression() == Imf::DWAB_COMPRESSION;
+    if (lossy_dct) *lossy_dct = lossy;
     if (frame != disp) to_display_window(out, dw, disp, fpp);
-    if (rgb && pick.size() == 1) // Y: gray
-        for (float *p = out->planes[0], *end = p + (size_t)out->width * (size_t)out->height * 3; p < end; p += 3)
-            p[1] = p[2] = p[0];
+    if (rgb) finish_rgb(out, dw, disp, pick.size() == 1, lossy);
 }
 
 // The string attribute name of the first flat part's header, copied with malloc into *value;

@@ -21,7 +21,9 @@ extern "C" {
 
 typedef enum {
     EXR_READ_ALL, /* every channel, in the file's (sorted) order */
-    /* R, G, B, else Y three times, interleaved in one plane "RGB" of 3 floats a pixel */
+    /* R, G, B, else Y three times, interleaved in one plane "RGB" of 3 floats a pixel, for an
+     * environment map: DWA's slightly negative texels read as zero, and any other negative or
+     * non-finite texel fails the read */
     EXR_READ_RGB_INTERLEAVED,
 } exr_read_select;
 
