@@ -137,9 +137,18 @@ char *reference_json(const reference_info *r) {
     if (!f) return NULL;
     fprintf(f, "{\n  \"glint_reference\": 1,\n  \"scene\": ");
     reference_json_string(f, r->scene);
-    fprintf(f, ",\n  \"scene_hash\": \"%s\",\n  \"env\": ", r->scene_hash);
+    /* Every string escaped, the hashes too: a description read from a file holds what it held. */
+    fputs(",\n  \"scene_hash\": ", f);
+    reference_json_string(f, r->scene_hash);
+    fputs(",\n  \"env\": ", f);
     reference_json_string(f, r->env);
-    fprintf(f, ",\n  \"env_hash\": \"%s\",\n  \"env_rotation\": %.9g,\n", r->env_hash, r->env_rotation);
+    fputs(",\n  \"env_hash\": ", f);
+    reference_json_string(f, r->env_hash);
+    /* The rotation reads back exactly, however large, for reference_check's comparison. */
+    char rot[32];
+    snprintf(rot, sizeof rot, "%.15g", r->env_rotation);
+    if (strtod(rot, NULL) != r->env_rotation) snprintf(rot, sizeof rot, "%.17g", r->env_rotation);
+    fprintf(f, ",\n  \"env_rotation\": %s,\n", rot);
     fprintf(f, "  \"camera\": {\"index\": %d, ", r->camera_index);
     json_vec3(f, "position", r->cam.position);
     fputs(", ", f);
@@ -149,8 +158,9 @@ char *reference_json(const reference_info *r) {
     fputs(", ", f);
     json_vec3(f, "forward", r->cam.forward);
     fprintf(f, ", \"yfov\": %.9g},\n", (double)r->cam.yfov);
-    fprintf(f, "  \"width\": %d,\n  \"height\": %d,\n  \"method\": \"%s\",\n  \"highlights_layer\": %s,\n", r->width,
-            r->height, r->method, r->highlights_layer ? "true" : "false");
+    fprintf(f, "  \"width\": %d,\n  \"height\": %d,\n  \"method\": ", r->width, r->height);
+    reference_json_string(f, r->method);
+    fprintf(f, ",\n  \"highlights_layer\": %s,\n", r->highlights_layer ? "true" : "false");
     fprintf(f, "  \"spp\": %lld,\n  \"frames\": %lld,\n  \"seconds\": %.6f,\n  \"max_depth\": %d,\n", r->spp, r->spp,
             r->seconds, r->max_depth);
     fprintf(f, "  \"seed\": %llu,\n  \"threads\": %d,\n", (unsigned long long)r->seed, r->threads);
@@ -243,9 +253,7 @@ static int json_seed(const cJSON *obj, const char *text, uint64_t *out) {
 /* A description is small; this bounds what a damaged or hostile file can make the parser do. */
 enum { MAX_DESCRIPTION = 1 << 20 };
 
-/* Parses the description text (n bytes, NUL-terminated) into r; label starts every message
- * ("PATH: not a glint reference sidecar"). */
-static int reference_parse(const char *text, size_t n, const char *label, reference_info *r, char *err, size_t errlen) {
+int reference_parse(const char *text, size_t n, const char *label, reference_info *r, char *err, size_t errlen) {
     memset(r, 0, sizeof *r);
     if (n > MAX_DESCRIPTION) return fail(err, errlen, "%s (too large: more than 1 MiB)", label);
     if (memchr(text, '\0', n)) return fail(err, errlen, "%s (binary data)", label);

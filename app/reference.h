@@ -55,6 +55,10 @@ void reference_json_string(FILE *f, const char *s);
 
 /* info as JSON text (malloc'ed; free it), or NULL when out of memory. */
 char *reference_json(const reference_info *info);
+/* Parses a description (text: n bytes, then a NUL) into info, checking every field's type and
+ * range. label starts every message ("PATH: not a glint reference sidecar"). Returns 0, or -1 with
+ * err = "LABEL (problem)". reference_load's parser, exposed for the fuzzer (tests/fuzz). */
+int reference_parse(const char *text, size_t n, const char *label, reference_info *info, char *err, size_t errlen);
 /* Reads the description of the reference EXR at exr_path: its header attribute REFERENCE_ATTR,
  * or, when the header has none, its sidecar (an older reference). Returns 0, 1 when there is
  * neither, -1 when the file is unreadable or the description malformed (err = "PATH: problem"). */

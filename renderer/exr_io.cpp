@@ -15,7 +15,9 @@
 #include <ImfStringAttribute.h>
 #include <ImfTiledInputPart.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -109,9 +111,87 @@ std::string read_name(FdStream &in) {
     }
 }
 
+uint32_t le32(const unsigned char *b) {
+    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+// The value size of the library's fixed-size attribute types, 0 for the others.
+int64_t fixed_size(const std::string &type) {
+    static const struct {
+        const char *type;
+        int64_t size;
+    } sizes[] = {{"box2i", 16},
+                 {"box2f", 16},
+                 {"chromaticities", 32},
+                 {"compression", 1},
+                 {"deepImageState", 1},
+                 {"double", 8},
+                 {"envmap", 1},
+                 {"float", 4},
+                 {"int", 4},
+                 {"keycode", 28},
+                 {"lineOrder", 1},
+                 {"m33d", 72},
+                 {"m33f", 36},
+                 {"m44d", 128},
+                 {"m44f", 64},
+                 {"rational", 8},
+                 {"tiledesc", 9},
+                 {"timecode", 8},
+                 {"v2d", 16},
+                 {"v2f", 8},
+                 {"v2i", 8},
+                 {"v3d", 24},
+                 {"v3f", 12},
+                 {"v3i", 12}};
+    for (const auto &t : sizes)
+        if (type == t.type) return t.size;
+    return 0;
+}
+
+// Whether an attribute's value, n bytes at the stream's position, is what the library's reader for
+// its type consumes, exactly: the channel list's entries ending with its terminator at n, a
+// preview's 8 + 4 x width x height bytes, a string vector's strings filling n.
+bool value_fits(FdStream &in, const std::string &type, int64_t n) {
+    if (int64_t fixed = fixed_size(type)) return n == fixed;
+    if (type == "floatvector") return n % 4 == 0;
+    if (type == "idmanifest") return n >= 4;
+    if (type == "preview") {
+        if (n < 8) return false;
+        unsigned char b[8];
+        in.read(reinterpret_cast<char *>(b), 8);
+        uint64_t pixels = (uint64_t)le32(b) * le32(b + 4); // < 2^64: both are 32-bit
+        return pixels <= (uint64_t)(n - 8) / 4 && (uint64_t)n == 8 + 4 * pixels;
+    }
+    if (type != "chlist" && type != "stringvector") return true; // string, or opaque: n bytes
+    std::vector<char> v((size_t)n);
+    if (n > 0) in.read(v.data(), (int)n);
+    const unsigned char *b = reinterpret_cast<const unsigned char *>(v.data());
+    int64_t at = 0;
+    if (type == "stringvector") {
+        while (at < n) {
+            if (n - at < 4 || (int64_t)le32(b + at) > n - at - 4) return false;
+            at += 4 + (int64_t)le32(b + at);
+        }
+        return true;
+    }
+    for (;;) { // chlist: name, NUL, 16 bytes of description, ..., and an empty name
+        const void *nul = at < n ? std::memchr(b + at, 0, (size_t)(n - at)) : nullptr;
+        if (!nul) return false;
+        int64_t len = static_cast<const unsigned char *>(nul) - (b + at);
+        if (len == 0) return at + 1 == n;
+        if (len > 255 || n - at - len - 1 < 16) return false;
+        at += len + 1 + 16;
+    }
+}
+
 // OpenEXR 3.1's header reader makes room for an attribute's value at the size the file declares
 // before reading it (a string is resized, so zero-filled, first): 40 bytes declaring a 2 GB string
 // would cost 2 GB. So every declared size is checked against the bytes left in the file first.
+// The reader takes the size on trust only for strings and unknown types; the others read their own
+// layout (a channel list up to its terminator, a preview by its width and height), which must then
+// fill the declared size exactly: else the two walks through the header part, and the library's
+// would meet sizes this one never checked.
 void check_attribute_sizes(FdStream &in) {
     char version[4];
     in.seekg(4);
@@ -120,14 +200,18 @@ void check_attribute_sizes(FdStream &in) {
     for (bool more = true; more;) {            // one header, or a multi-part file's up to an empty one
         int attrs = 0;
         for (std::string name; !(name = read_name(in)).empty(); attrs++) {
-            read_name(in); // the type
+            std::string type = read_name(in);
             unsigned char b[4];
             in.read(reinterpret_cast<char *>(b), 4);
-            int64_t n = (int32_t)((uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24);
+            int64_t n = (int32_t)le32(b);
             if (n < 0 || (uint64_t)n > in.size() - in.tellg())
                 throw Iex::InputExc("header attribute " + name + " claims " + std::to_string(n) +
                                     " bytes, more than the file holds");
-            in.seekg(in.tellg() + (uint64_t)n);
+            uint64_t end = in.tellg() + (uint64_t)n;
+            if (!value_fits(in, type, n))
+                throw Iex::InputExc("header attribute " + name + " is not a valid " + type + " of " +
+                                    std::to_string(n) + " bytes");
+            in.seekg(end);
         }
         more = multipart && attrs > 0;
     }
@@ -141,21 +225,22 @@ bool size_ok(int64_t w, int64_t h) {
     return w > 0 && h > 0 && w <= MAX_IMAGE_DIM && h <= MAX_IMAGE_DIM && w * h <= MAX_IMAGE_PIXELS;
 }
 
-// Re-frames img from its data window onto the display window: pixels outside the data window are
-// zero (as EXR defines them), data outside the display window is dropped.
-void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2i &disp) {
+// Re-frames img (fpp floats a pixel in each plane) from its data window onto the display window:
+// pixels outside the data window are zero (as EXR defines them), data outside the display window
+// is dropped.
+void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2i &disp, size_t fpp) {
     int dispw = (int)box_width(disp), disph = (int)box_height(disp);
     int64_t x_lo = dw.min.x > disp.min.x ? dw.min.x : disp.min.x;
     int64_t x_hi = dw.max.x < disp.max.x ? dw.max.x : disp.max.x;
     for (int k = 0; k < img->num_channels; k++) {
-        float *dst = static_cast<float *>(std::calloc((size_t)dispw * (size_t)disph, sizeof(float)));
+        float *dst = static_cast<float *>(std::calloc((size_t)dispw * (size_t)disph * fpp, sizeof(float)));
         if (!dst) throw std::bad_alloc();
         const float *src = img->planes[k];
         for (int64_t y = disp.min.y; y <= disp.max.y && x_lo <= x_hi; y++) {
             if (y < dw.min.y || y > dw.max.y) continue;
-            std::memcpy(dst + (size_t)(y - disp.min.y) * (size_t)dispw + (size_t)(x_lo - disp.min.x),
-                        src + (size_t)(y - dw.min.y) * (size_t)img->width + (size_t)(x_lo - dw.min.x),
-                        sizeof(float) * (size_t)(x_hi - x_lo + 1));
+            std::memcpy(dst + ((size_t)(y - disp.min.y) * (size_t)dispw + (size_t)(x_lo - disp.min.x)) * fpp,
+                        src + ((size_t)(y - dw.min.y) * (size_t)img->width + (size_t)(x_lo - dw.min.x)) * fpp,
+                        sizeof(float) * (size_t)(x_hi - x_lo + 1) * fpp);
         }
         std::free(img->planes[k]);
         img->planes[k] = dst;
@@ -164,10 +249,33 @@ void to_display_window(exr_image *img, const Imath::Box2i &dw, const Imath::Box2
     img->height = disph;
 }
 
+// An environment map's texels, interleaved RGB over the display window: Y spread to G and B, DWA's
+// slightly negative coding noise (lossy) read as zero, then every texel finite and non-negative.
+// Only the data window's part of the display window holds anything but zeros, so only it is
+// visited: a tiny data window in a huge display window costs little.
+void finish_rgb(exr_image *img, const Imath::Box2i &dw, const Imath::Box2i &disp, bool gray, bool lossy) {
+    int64_t x_lo = std::max(dw.min.x, disp.min.x), x_hi = std::min(dw.max.x, disp.max.x);
+    int64_t y_lo = std::max(dw.min.y, disp.min.y), y_hi = std::min(dw.max.y, disp.max.y);
+    for (int64_t y = y_lo; y <= y_hi; y++)
+        for (int64_t x = x_lo; x <= x_hi; x++) {
+            float *p = img->planes[0] + ((size_t)(y - disp.min.y) * (size_t)img->width + (size_t)(x - disp.min.x)) * 3;
+            if (gray) p[1] = p[2] = p[0];
+            for (int c = 0; c < 3; c++) {
+                if (lossy && p[c] < 0.0f) p[c] = 0.0f;
+                if (std::isfinite(p[c]) && p[c] >= 0.0f) continue;
+                char what[160];
+                std::snprintf(what, sizeof what, "pixel (%lld, %lld) channel %c is %s (%g)",
+                              (long long)(x - disp.min.x), (long long)(y - disp.min.y), "RGB"[c],
+                              std::isfinite(p[c]) ? "negative" : "not finite", (double)p[c]);
+                throw Refused(what);
+            }
+        }
+}
+
 // The channels to read, in output order.
 std::vector<std::string> pick_channels(const Imf::ChannelList &chans, exr_read_select select) {
     std::vector<std::string> pick;
-    if (select == EXR_READ_RGB) {
+    if (select != EXR_READ_ALL) {
         if (chans.findChannel("R") && chans.findChannel("G") && chans.findChannel("B"))
             pick = {"R", "G", "B"};
         else if (chans.findChannel("Y"))
@@ -175,7 +283,7 @@ std::vector<std::string> pick_channels(const Imf::ChannelList &chans, exr_read_s
     } else {
         for (auto it = chans.begin(); it != chans.end(); ++it) pick.emplace_back(it.name());
     }
-    if (pick.empty()) throw Refused(select == EXR_READ_RGB ? "no R, G, B or Y channel" : "no channels");
+    if (pick.empty()) throw Refused(select != EXR_READ_ALL ? "no R, G, B or Y channel" : "no channels");
     return pick;
 }
 
@@ -200,7 +308,7 @@ void check_layout(const Imf::Header &h) {
     }
     const Imf::TileDescription *tile = h.hasTileDescription() ? &h.tileDescription() : nullptr;
     uint64_t chunk = tile ? (uint64_t)tile->xSize * tile->ySize * pixel_bytes : (uint64_t)w * 256 * pixel_bytes;
-    if (chunk > ((uint64_t)1 << 30)) {
+    if (chunk > ((uint64_t)1 << 28)) { // 256 MiB: a 16384-wide DWAB chunk of 4 floats is 64 MiB
         std::string what =
             std::to_string(pixel_bytes) + " bytes a pixel over " + std::to_string(w) + "x" + std::to_string(ht);
         if (tile) what += " in tiles of " + std::to_string(tile->xSize) + "x" + std::to_string(tile->ySize);
@@ -227,23 +335,43 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
     check_layout(h);
     std::vector<std::string> pick = pick_channels(h.channels(), select);
     const Imath::Box2i dw = h.dataWindow(), disp = h.displayWindow();
-    for (const Imath::Box2i &b : {dw, disp}) // the planes as read, and as re-framed
-        if ((uint64_t)box_width(b) * (uint64_t)box_height(b) * pick.size() > ((uint64_t)1 << 30))
-            throw Refused("unsupported image size (" + std::to_string(pick.size()) + " channels of " +
-                          std::to_string(box_width(b)) + "x" + std::to_string(box_height(b)) + ")");
+    // What is held at once, at most 2^29 floats (2 GiB), which still holds a 16384x8192 RGB
+    // environment map: the planes as read and as re-framed (one at a time); or the interleaved
+    // RGB, read in place when the data window lies inside the display window, else read and then
+    // re-framed.
+    const bool rgb = select == EXR_READ_RGB_INTERLEAVED;
+    const bool inside =
+        dw.min.x >= disp.min.x && dw.min.y >= disp.min.y && dw.max.x <= disp.max.x && dw.max.y <= disp.max.y;
+    const uint64_t dw_px = (uint64_t)box_width(dw) * (uint64_t)box_height(dw);
+    const uint64_t disp_px = (uint64_t)box_width(disp) * (uint64_t)box_height(disp);
+    const uint64_t held = rgb ? 3 * (disp_px + (inside ? 0 : dw_px)) : pick.size() * std::max(dw_px, disp_px);
+    if (held > ((uint64_t)1 << 29))
+        throw Refused("unsupported image size (" + std::to_string(pick.size()) + " channels of " +
+                      std::to_string(box_width(dw)) + "x" + std::to_string(box_height(dw)) + " in " +
+                      std::to_string(box_width(disp)) + "x" + std::to_string(box_height(disp)) + ")");
 
-    out->width = (int)box_width(dw);
-    out->height = (int)box_height(dw);
-    out->names = static_cast<char **>(std::calloc(pick.size(), sizeof(char *)));
-    out->planes = static_cast<float **>(std::calloc(pick.size(), sizeof(float *)));
+    const bool in_place = rgb && inside;
+    const Imath::Box2i &frame = in_place ? disp : dw; // what the planes cover
+    const size_t planes = rgb ? 1 : pick.size(), fpp = rgb ? 3 : 1;
+    out->width = (int)box_width(frame);
+    out->height = (int)box_height(frame);
+    out->names = static_cast<char **>(std::calloc(planes, sizeof(char *)));
+    out->planes = static_cast<float **>(std::calloc(planes, sizeof(float *)));
     if (!out->names || !out->planes) throw std::bad_alloc();
-    Imf::FrameBuffer fb;
-    for (size_t k = 0; k < pick.size(); k++) {
+    for (size_t k = 0; k < planes; k++) {
         out->num_channels = (int)k + 1;
-        out->names[k] = strdup(pick[k].c_str());
-        out->planes[k] = static_cast<float *>(std::calloc((size_t)out->width * (size_t)out->height, sizeof(float)));
+        out->names[k] = strdup(rgb ? "RGB" : pick[k].c_str());
+        out->planes[k] =
+            static_cast<float *>(std::calloc((size_t)out->width * (size_t)out->height * fpp, sizeof(float)));
         if (!out->names[k] || !out->planes[k]) throw std::bad_alloc();
-        fb.insert(pick[k], Imf::Slice::Make(Imf::FLOAT, out->planes[k], dw)); // half and uint convert
+    }
+    Imf::FrameBuffer fb; // half and uint convert to float
+    for (size_t k = 0; k < pick.size(); k++) {
+        float *first = rgb ? out->planes[0] + k : out->planes[k]; // the frame's first pixel
+        if (in_place)
+            first += ((size_t)(dw.min.y - disp.min.y) * (size_t)out->width + (size_t)(dw.min.x - disp.min.x)) * 3;
+        fb.insert(pick[k], Imf::Slice::Make(Imf::FLOAT, first, dw, sizeof(float) * fpp,
+                                            sizeof(float) * fpp * (size_t)out->width));
     }
 
     *stage = "corrupt or truncated file";
@@ -256,8 +384,10 @@ void read_file(const char *path, int fd, int64_t size, exr_read_select select, e
         lines.setFrameBuffer(fb);
         lines.readPixels(dw.min.y, dw.max.y);
     }
-    if (lossy_dct) *lossy_dct = h.compression() == Imf::DWAA_COMPRESSION || h.compression() == Imf::DWAB_COMPRESSION;
-    if (dw != disp) to_display_window(out, dw, disp);
+    const bool lossy = h.compression() == Imf::DWAA_COMPRESSION || h.compression() == Imf::DWAB_COMPRESSION;
+    if (lossy_dct) *lossy_dct = lossy;
+    if (frame != disp) to_display_window(out, dw, disp, fpp);
+    if (rgb) finish_rgb(out, dw, disp, pick.size() == 1, lossy);
 }
 
 // The string attribute name of the first flat part's header, copied with malloc into *value;

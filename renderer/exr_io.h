@@ -21,7 +21,10 @@ extern "C" {
 
 typedef enum {
     EXR_READ_ALL, /* every channel, in the file's (sorted) order */
-    EXR_READ_RGB, /* R, G, B in that order, else Y */
+    /* R, G, B, else Y three times, interleaved in one plane "RGB" of 3 floats a pixel, for an
+     * environment map: DWA's slightly negative texels read as zero, and any other negative or
+     * non-finite texel fails the read */
+    EXR_READ_RGB_INTERLEAVED,
 } exr_read_select;
 
 /* Reads the first flat (not deep) part of the EXR file open on fd (size bytes; path is used in

@@ -177,28 +177,16 @@ static int check_texels(const char *path, const image_rgb *img, char *err, size_
     return 0;
 }
 
+/* Read straight into one interleaved buffer (no second copy of a large map), its texels checked
+ * there, within the data window: DWA's DCT rings slightly below zero next to dark texels (even in
+ * Blender's own studio lights), coding noise, not data, which reads as zero. */
 static int load_exr_rgb(const char *path, int fd, int64_t size, image_rgb *out, char *err, size_t errlen) {
     exr_image ex;
-    int lossy_dct = 0;
-    if (exr_read_fd(path, fd, size, EXR_READ_RGB, &ex, &lossy_dct, err, errlen) != 0) return -1;
-    size_t n = (size_t)ex.width * (size_t)ex.height;
-    float *rgb = malloc(sizeof(float) * 3 * n);
-    if (!rgb) {
-        exr_image_free(&ex);
-        return fail(err, errlen, path, "out of memory");
-    }
-    for (int c = 0; c < 3; c++) {
-        const float *plane = ex.planes[ex.num_channels == 3 ? c : 0]; /* Y: gray */
-        for (size_t i = 0; i < n; i++) rgb[3 * i + (size_t)c] = plane[i];
-    }
-    /* DWA's DCT rings slightly below zero next to dark texels (even in Blender's own studio
-     * lights); those are coding noise, not data, so they read as zero. */
-    if (lossy_dct)
-        for (size_t i = 0; i < 3 * n; i++)
-            if (rgb[i] < 0.0f) rgb[i] = 0.0f;
+    if (exr_read_fd(path, fd, size, EXR_READ_RGB_INTERLEAVED, &ex, NULL, err, errlen) != 0) return -1;
     out->width = ex.width;
     out->height = ex.height;
-    out->rgb = rgb;
+    out->rgb = ex.planes[0];
+    ex.planes[0] = NULL;
     exr_image_free(&ex);
     return 0;
 }
@@ -308,12 +296,11 @@ int image_rgb_load(const char *path, image_rgb *out, char *err, size_t errlen) {
         status = fail(err, errlen, path, "empty file");
     else if (got == 4 && memcmp(magic, exr_magic, 4) == 0)
         status = load_exr_rgb(path, fd, size, out, err, errlen);
-    else if (got >= 2 && magic[0] == '#' && magic[1] == '?')
-        status = load_hdr_rgb(path, fd, size, out, err, errlen);
+    else if (got >= 2 && magic[0] == '#' && magic[1] == '?') /* EXR's texels are checked as read */
+        status = load_hdr_rgb(path, fd, size, out, err, errlen) == 0 ? check_texels(path, out, err, errlen) : -1;
     else
         status = fail(err, errlen, path, "not an OpenEXR or Radiance HDR image");
     close(fd);
-    if (status == 0 && check_texels(path, out, err, errlen) != 0) status = -1;
     if (status != 0) image_rgb_free(out);
     return status;
 }

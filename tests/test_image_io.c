@@ -420,13 +420,15 @@ static void test_hostile_headers(void) {
         int chunks;
         const char *problem;
     } cases[] = {
-        {16, 16, 3, 0, 0, INT32_MAX, 16, "more than the file holds"},   /* a 2 GB string */
-        {200000, 4, 3, 0, 0, 0, 4, "unsupported image size"},           /* too wide */
-        {16384, 16384, 64, 0, 0, 0, 16384, "unsupported image size"},   /* 64 GB of planes */
-        {131072, 2, 64, 0, 0, 0, 2, "unsupported image size"},          /* 4 GB for 256 lines */
-        {16, 16, 3, 65536, 65536, 0, 1, "unsupported image size"},      /* a 24 GB tile */
-        {16384, 16384, 3, 1, 1, 0, 0, "not a readable OpenEXR file"},   /* 2 GB of tile offsets */
-        {16384, 16384, 3, 0, 0, 0, 16384, "corrupt or truncated file"}, /* just no pixels */
+        {16, 16, 3, 0, 0, INT32_MAX, 16, "more than the file holds"}, /* a 2 GB string */
+        {200000, 4, 3, 0, 0, 0, 4, "unsupported image size"},         /* too wide */
+        {16384, 16384, 64, 0, 0, 0, 16384, "unsupported image size"}, /* 64 GB of planes */
+        {131072, 2, 64, 0, 0, 0, 2, "unsupported image size"},        /* 4 GB for 256 lines */
+        {16, 16, 3, 65536, 65536, 0, 1, "unsupported image size"},    /* a 24 GB tile */
+        {16384, 16384, 3, 1, 1, 0, 0, "not a readable OpenEXR file"}, /* 2 GB of tile offsets */
+        {16384, 16384, 3, 0, 0, 0, 16384, "unsupported image size"},  /* 3 GB of planes */
+        {16384, 2, 40, 0, 0, 0, 2, "unsupported image size"},         /* 320 MB for 256 lines */
+        {16384, 8192, 3, 0, 0, 0, 8192, "corrupt or truncated file"}, /* just no pixels */
     };
     char path[1200], err[512];
     path_in(path, sizeof path, "hostile.exr");
@@ -449,6 +451,25 @@ static void test_hostile_headers(void) {
         CHECK(max_rss_kb() - rss < 256 * 1024, "hostile header %zu took %ld MB", k, (max_rss_kb() - rss) / 1024);
         if (k == 0) printf("hostile header: %s\n", err);
     }
+}
+
+/* A channel list whose declared size leaves out its terminator: OpenEXR's reader reads on to its
+ * own end, out of step with the declared sizes, and found a 1.7 GB string size there (a fuzzer's
+ * find). Every attribute the library reads by its own layout must fill its declared size. */
+static void test_attribute_layouts(void) {
+    char path[1200], err[512];
+    path_in(path, sizeof path, "hostile-chlist.exr");
+    size_t size = 0;
+    unsigned char *b = hostile_exr(&size, 16, 16, 3, 0, 0, 0, 16);
+    CHECK(memcmp(b + 8, "channels\0chlist\0", 16) == 0, "the channel list is the first attribute");
+    b[24]--; /* its size, little-endian, below 256 */
+    put_file(path, b, size);
+    free(b);
+    exr_image img;
+    int rc = exr_image_load(path, &img, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, path) && one_line(err) && strstr(err, "is not a valid chlist"), "rc %d, '%s'", rc,
+          err);
+    printf("hostile channel list: %s\n", err);
 }
 
 /* ---- the shared environment maps ------------------------------------------------------------- */
@@ -840,6 +861,7 @@ int main(void) {
     test_compressions();
     test_damaged_dwab();
     test_hostile_headers();
+    test_attribute_layouts();
     test_shared_env_maps();
     test_errors();
     test_film_means();

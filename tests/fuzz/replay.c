@@ -1,5 +1,6 @@
 /* glint — runs stored fuzzer inputs through the harness once each, in any build: the
- * regressions the fuzzer found, and the seed corpus. Arguments are files or folders. */
+ * regressions the fuzzer found, and the seed corpus. Arguments are files or folders (their files,
+ * not their sub-folders). */
 #include <dirent.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -46,6 +47,7 @@ int main(int argc, char **argv) {
             if (e->d_name[0] == '.') continue;
             char path[4096];
             snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
+            if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) continue; /* another harness's inputs */
             failures += run_file(path);
             count++;
         }
