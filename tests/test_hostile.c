@@ -33,19 +33,6 @@ static void make_bin(const float pos[12]) {
 
 static const float UNIT_QUAD[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
 
-static void base64(const unsigned char *in, size_t n, char *out) {
-    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = tab[v >> 18 & 63];
-        out[o++] = tab[v >> 12 & 63];
-        out[o++] = i + 1 < n ? tab[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? tab[v & 63] : '=';
-    }
-    out[o] = 0;
-}
-
 /* A glTF of the quad (mesh 0, material mat_index or none when < 0), with nodes (default: one
  * holding the mesh), the buffer at uri (NULL: embedded; "": none, for a GLB) and extra members. */
 static char *quad_json(const char *nodes, int mat_index, const char *uri, const char *extra) {

@@ -13,6 +13,7 @@
 #include "rng.h"
 #include "sampling.h"
 #include "scene.h"
+#include "scratch.h"
 
 static char tmp_dir[512];
 
@@ -62,19 +63,6 @@ enum { ACC_POS = 0, ACC_NRM, ACC_I16, ACC_I8, ACC_I32, ACC_BAD_INDEX, ACC_POS_OV
 static const char *DEFAULT_MESH =
     "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}]";
 static const char *DEFAULT_NODES = "\"nodes\":[{\"mesh\":0}]";
-
-static void base64(const unsigned char *in, size_t n, char *out) {
-    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = tab[v >> 18 & 63];
-        out[o++] = tab[v >> 12 & 63];
-        out[o++] = i + 1 < n ? tab[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? tab[v & 63] : '=';
-    }
-    out[o] = 0;
-}
 
 static void write_bytes(const char *path, const void *data, size_t size) {
     FILE *f = fopen(path, "wb");

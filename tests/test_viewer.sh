@@ -13,36 +13,8 @@ set -u
 glint=$1
 dir=$2/viewer
 keep_modules=${3:-}
-command -v Xvfb >/dev/null || { echo "Xvfb not installed: skipped"; exit 77; }
-rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-
-# Mesa's llvmpipe and X11 keep allocations past exit; only they are exempt from leak checks.
-printf 'leak:libGLX_mesa\nleak:swrast_dri\nleak:libgallium\nleak:libLLVM\nleak:libX11\nleak:libxcb\nleak:libdbus\nleak:libglfw\nleak:libGL\nleak:dri\n' >lsan.supp
-export LSAN_OPTIONS="suppressions=$dir/lsan.supp:print_suppressions=0"
-# Under ASan the driver's modules must stay loaded for those names to be known (keep_modules.c);
-# the ASan runtime has to come first among preloaded libraries.
-asan=$(ldd "$glint" | sed -n 's/.*libasan[^ ]* => \([^ ]*\).*/\1/p')
-preload=
-if [ -n "$asan" ] && [ -n "$keep_modules" ]; then preload="$asan $keep_modules"; fi
-
-# One X server for the whole script, on a display it picks itself: xvfb-run per call would replace
-# the viewer's exit status with its own when its clean-up fails (exit 5), and costs a start each.
-Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp 3>display.txt 2>xvfb.log &
-xvfb_pid=$!
-trap 'kill $xvfb_pid 2>/dev/null; wait $xvfb_pid 2>/dev/null' EXIT
-tries=0
-until [ -s display.txt ]; do
-  tries=$((tries + 1))
-  [ $tries -le 300 ] && kill -0 $xvfb_pid 2>/dev/null || { echo "Xvfb did not start: $(cat xvfb.log)"; exit 1; }
-  sleep 0.1
-done
-export DISPLAY=":$(head -n 1 display.txt)"
-
-view() { # view ARGS... : runs the viewer headless, stdout to out.txt, stderr to err.txt
-  timeout 300 env LD_PRELOAD="$preload" "$glint" "$@" >out.txt 2>err.txt
-}
+screen=1024x768x24
+. "$(dirname "$0")/viewer_harness.sh"
 
 printf 'not a scene' >broken.gltf
 cat >session.txt <<'EOF'
@@ -79,7 +51,6 @@ rc=$?
 [ $rc -eq 0 ] || fail "scripted session exited $rc: $(cat err.txt)"
 # stats lines: 1 start, 2 after display changes, 3 after max-depth, 4 after camera motion, 5 after a
 # bad load, 6 after loading another built-in scene
-field() { sed -n "$1p" stats.txt | tr ' ' '\n' | sed -n "s/^$2=//p"; }
 grep '^stats ' out.txt >stats.txt
 [ "$(wc -l <stats.txt)" -eq 6 ] || fail "expected 6 stats lines, got: $(cat out.txt)"
 default_scene=$(field 1 scene)

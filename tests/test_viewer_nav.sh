@@ -11,38 +11,14 @@ set -u
 glint=$1
 dir=$2/viewer_nav
 keep_modules=${3:-}
-command -v Xvfb >/dev/null && command -v xdotool >/dev/null || { echo "Xvfb or xdotool not installed: skipped"; exit 77; }
-rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-
-# Leak checks exempt Mesa and X11 alone (as test_viewer.sh).
-printf 'leak:libGLX_mesa\nleak:swrast_dri\nleak:libgallium\nleak:libLLVM\nleak:libX11\nleak:libxcb\nleak:libdbus\nleak:libglfw\nleak:libGL\nleak:dri\n' >lsan.supp
-export LSAN_OPTIONS="suppressions=$dir/lsan.supp:print_suppressions=0"
-asan=$(ldd "$glint" | sed -n 's/.*libasan[^ ]* => \([^ ]*\).*/\1/p')
-preload=
-if [ -n "$asan" ] && [ -n "$keep_modules" ]; then preload="$asan $keep_modules"; fi
-
-Xvfb -displayfd 3 -screen 0 1280x800x24 -nolisten tcp 3>display.txt 2>xvfb.log &
-xvfb_pid=$!
-trap 'kill $xvfb_pid 2>/dev/null; wait $xvfb_pid 2>/dev/null' EXIT
-tries=0
-until [ -s display.txt ]; do
-  tries=$((tries + 1))
-  [ $tries -le 300 ] && kill -0 $xvfb_pid 2>/dev/null || { echo "Xvfb did not start: $(cat xvfb.log)"; exit 1; }
-  sleep 0.1
-done
-export DISPLAY=":$(head -n 1 display.txt)"
-
-view() { # view ARGS... : runs the viewer headless, stdout to out.txt, stderr to err.txt
-  timeout 300 env LD_PRELOAD="$preload" "$glint" "$@" >out.txt 2>err.txt
-}
+command -v xdotool >/dev/null || { echo "xdotool not installed: skipped"; exit 77; }
+screen=1280x800x24
+. "$(dirname "$0")/viewer_harness.sh"
 # The same for the timed sessions: without the leak check at exit, which takes seconds of its own
 # on a loaded machine (the other sessions check for leaks).
 view_timed() {
   timeout 300 env LD_PRELOAD="$preload" ASAN_OPTIONS="${ASAN_OPTIONS:-}:detect_leaks=0" "$glint" "$@" >out.txt 2>err.txt
 }
-field() { sed -n "$1p" stats.txt | tr ' ' '\n' | sed -n "s/^$2=//p"; }
 below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; } # below A B: A < B
 now() { date +%s.%N; }
 # stats_lines N [TRIES]: waits (0.1 s steps) until out.txt holds N stats lines

@@ -11,34 +11,9 @@ glint=$1
 dir=$2/viewer_panel
 keep_modules=$3
 probe=$4
-command -v Xvfb >/dev/null || { echo "Xvfb not installed: skipped"; exit 77; }
-rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-
-# As test_viewer.sh: Mesa and X11 keep allocations past exit; their modules stay loaded under ASan.
-printf 'leak:libGLX_mesa\nleak:swrast_dri\nleak:libgallium\nleak:libLLVM\nleak:libX11\nleak:libxcb\nleak:libdbus\nleak:libglfw\nleak:libGL\nleak:dri\nleak:libxdo\n' >lsan.supp
-export LSAN_OPTIONS="suppressions=$dir/lsan.supp:print_suppressions=0"
-asan=$(ldd "$glint" | sed -n 's/.*libasan[^ ]* => \([^ ]*\).*/\1/p')
-preload=
-if [ -n "$asan" ]; then preload="$asan $keep_modules"; fi
-
 # A screen wide enough for a 960x540 image beside the panel.
-Xvfb -displayfd 3 -screen 0 1920x1080x24 -nolisten tcp 3>display.txt 2>xvfb.log &
-xvfb_pid=$!
-trap 'kill $xvfb_pid 2>/dev/null; wait $xvfb_pid 2>/dev/null' EXIT
-tries=0
-until [ -s display.txt ]; do
-  tries=$((tries + 1))
-  [ $tries -le 300 ] && kill -0 $xvfb_pid 2>/dev/null || { echo "Xvfb did not start: $(cat xvfb.log)"; exit 1; }
-  sleep 0.1
-done
-export DISPLAY=":$(head -n 1 display.txt)"
-
-view() { # view ARGS... : stdout to out.txt, stderr to err.txt
-  timeout 300 env LD_PRELOAD="$preload" "$glint" "$@" >out.txt 2>err.txt
-}
-field() { sed -n "$1p" stats.txt | tr ' ' '\n' | sed -n "s/^$2=//p"; }
+screen=1920x1080x24
+. "$(dirname "$0")/viewer_harness.sh"
 probe() { "$probe" "$@" || echo 999999; }
 
 # ---- the panel beside the image, the overlay, the help ----------------------------------------
