@@ -5,6 +5,7 @@
  * edit re-analyses the scene and restarts. And the frames' positions inside a pixel cover it evenly:
  * an emitter's straight edge seen directly converges faster than independent positions would.
  * render_params.only: the components left out stay exactly zero and their passes never run. */
+#include <float.h>
 #include <math.h>
 
 #include "check.h"
@@ -115,8 +116,44 @@ static void check_only(void) {
     scene_destroy(s);
 }
 
+/* A sky of finite texels near FLT_MAX over a white floor (a hostile environment map): samples
+ * that overflow are dropped and counted, and every value of the image and of each layer stays
+ * finite and non-negative, for the path tracer and for vsl+hl. */
+static void check_huge_sky(void) {
+    enum { EW = 8, EH = 6, EN = 3 };
+    for (int method = METHOD_PT; method <= METHOD_VSL_HL; method += METHOD_VSL_HL - METHOD_PT) {
+        scene *s = ts_new("huge sky");
+        ts_quad(s, v3(-50, -1, 50), v3(50, -1, 50), v3(50, -1, -50), v3(-50, -1, -50),
+                ts_lambert(s, v3s(0.9f), v3s(0), 0));
+        image_rgb sky = {EW, EH, malloc(sizeof(float) * 3 * EW * EH)};
+        for (int i = 0; i < 3 * EW * EH; i++) sky.rgb[i] = 0.9f * FLT_MAX;
+        char err[256];
+        CHECK(scene_set_env_image(s, &sky, 0.0f, err, sizeof err) == 0, "env: %s", err);
+        ts_finalize(s);
+        camera cam = camera_look_at(v3(0, 0, 0), v3(0, -0.3f, -1), v3(0, 1, 0), 1.0f);
+        render_params p = {.width = EW, .height = EH, .method = (render_method)method, .max_depth = 3, .seed = 5};
+        p.vl.count = 16;
+        render_session *rs = session_create(s, &cam, &p, err, sizeof err);
+        CHECK(rs != NULL, "session: %s", err);
+        for (int f = 0; rs && f < EN; f++) session_render_frame(rs);
+        int bad = 0;
+        for (unsigned mask = 1; rs && mask <= COMP_MASK_ALL; mask++) {
+            float img[3 * EW * EH];
+            film_resolve(session_film(rs), mask, img);
+            for (int i = 0; i < 3 * EW * EH; i++) bad += !isfinite(img[i]) || img[i] < 0.0f;
+        }
+        CHECK(bad == 0, "%s: %d values of the image or its layers are not finite and non-negative",
+              method_name((render_method)method), bad);
+        CHECK(rs && session_stats(rs).rejected_samples > 0, "%s: no overflowing sample was counted",
+              method_name((render_method)method));
+        session_destroy(rs);
+        scene_destroy(s);
+    }
+}
+
 int main(void) {
     check_edge_coverage();
+    check_huge_sky();
     check_only();
     scene *s = ts_new("box");
     ts_box(s, v3(-1, 0, -1), v3(1, 2, 1), 1, ts_lambert(s, v3s(0.6f), v3s(0.0f), 0));
