@@ -2,6 +2,7 @@
  * the UI's requests from the shared state, and after each frame publishes the image and its
  * statistics there (see view.h). */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -140,6 +141,21 @@ static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam,
         d++;
     else if (frame_ms < 0.45 * PREVIEW_TARGET_MS && d > PREVIEW_DIVISOR)
         d--;
+    if (d == rt->preview_divisor) return;
+    char err[512];
+    render_session *p = create_preview(rt, d, cam, params, err, sizeof err);
+    if (!p) return; /* keep the one there is */
+    session_destroy(rt->preview);
+    rt->preview = p;
+    rt->preview_divisor = d;
+}
+
+/* After a full frame of frame_ms: the preview size whose frames take about PREVIEW_TARGET_MS (a
+ * preview at divisor d costs about a full frame / d^2), so that the first preview after a change
+ * comes quickly instead of after adapt_preview's steps from the finest size. */
+static void fit_preview(render_thread *rt, double frame_ms, const camera *cam, const render_params *params) {
+    int d = (int)ceil(sqrt(frame_ms / PREVIEW_TARGET_MS));
+    d = d < PREVIEW_DIVISOR ? PREVIEW_DIVISOR : d > PREVIEW_MAX_DIVISOR ? PREVIEW_MAX_DIVISOR : d;
     if (d == rt->preview_divisor) return;
     char err[512];
     render_session *p = create_preview(rt, d, cam, params, err, sizeof err);
@@ -492,7 +508,10 @@ static void *render_main(void *arg) {
         if (rs == rt->full) rt->full_film_partial = 0;
         double ms = 1e3 * seconds_since(t0);
         publish(rt, rs, preview, measure, ms, &before, resets_seen, gen);
-        if (preview) adapt_preview(rt, ms, &cam, &params);
+        if (preview)
+            adapt_preview(rt, ms, &cam, &params);
+        else if (session_frames(rt->full) == 1)
+            fit_preview(rt, ms, &cam, &params);
         pthread_mutex_lock(&sh->lock);
     }
     pthread_mutex_unlock(&sh->lock);

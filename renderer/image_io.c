@@ -259,6 +259,14 @@ static int load_hdr_rgb(const char *path, int fd, int64_t size, image_rgb *out, 
         return fail(err, errlen, path, "not a readable Radiance HDR file (%s)", why ? why : "bad header");
     }
     if (!size_ok(w, h)) return fail(err, errlen, path, "unsupported image size %dx%d", w, h);
+    /* stb decodes every declared pixel, past the end of the data too: a few bytes declaring a
+     * large image would cost its whole allocation and decoding. A scanline takes at least 4
+     * bytes a pixel flat (widths below 8 or above 32767), or with run-length encoding its
+     * 4-byte marker and one 2-byte run of at most 127 pixels per channel. */
+    int64_t row = w < 8 || w > 32767 ? 4 * (int64_t)w : 4 + 8 * (((int64_t)w + 126) / 127);
+    if ((int64_t)h * row > size)
+        return fail(err, errlen, path, "truncated Radiance HDR file (%dx%d pixels need at least %lld bytes)", w, h,
+                    (long long)((int64_t)h * row));
     src = (hdr_source){fd, size, 0, 0, 0};
     float *px = stbi_loadf_from_callbacks(&io, &src, &w, &h, &comp, 3);
     if (!px || src.io_error || src.past_end) {

@@ -746,6 +746,14 @@ static void test_errors(void) {
     expect_load_error(path, NULL);
     put_file(path, "#?", 2);
     expect_load_error(path, NULL);
+    /* A few bytes declaring 88898 x 898 pixels (found by the fuzzer: stb decoded all 80 million
+     * past the data's end, a gigabyte and seconds) are refused from the header. */
+    static const char huge[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 898 +X 88898\n\x88\x80";
+    put_file(path, huge, sizeof huge - 1);
+    expect_load_error(path, "88898x898 pixels need at least");
+    static const char wide[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4000 +X 4000\n\x02\x02\x0f\xa0";
+    put_file(path, wide, sizeof wide - 1);
+    expect_load_error(path, "4000x4000 pixels need at least");
 
     /* A directory, and a file in a format it does not read (by content, whatever the name: a PNG). */
     expect_load_error(scratch_dir, NULL);
