@@ -641,6 +641,9 @@ static void init_ray(struct RTCRay *r, vec3 o, vec3 d, float tmax) {
 /* Fills h from Embree's hit (triangle t, barycentrics b1 b2, distance tfar) of the ray along d. */
 static void complete_hit(const scene *s, vec3 d, int t, float b1, float b2, float tfar, surface_hit *h) {
     const uint32_t *v = &s->indices[3 * t];
+    /* A ray in the triangle's plane through one of its corners can come back with NaN
+     * barycentrics: the hit is that triangle, so keep the point on it. */
+    if (!isfinite(b1) || !isfinite(b2)) b1 = b2 = 0.0f;
     float b0 = 1.0f - b1 - b2;
     vec3 p0 = s->positions[v[0]], p1 = s->positions[v[1]], p2 = s->positions[v[2]];
     h->t = tfar;
