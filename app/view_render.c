@@ -131,6 +131,17 @@ static int make_sessions(render_thread *rt, int w, int h, const camera *cam, con
     return 0;
 }
 
+/* The preview session at full size / d, replacing the one there is (kept when that fails). */
+static void set_preview_divisor(render_thread *rt, int d, const camera *cam, const render_params *params) {
+    if (d == rt->preview_divisor) return;
+    char err[512];
+    render_session *p = create_preview(rt, d, cam, params, err, sizeof err);
+    if (!p) return;
+    session_destroy(rt->preview);
+    rt->preview = p;
+    rt->preview_divisor = d;
+}
+
 /* Coarser previews when their frames are slow (a large window, a costly method, a busy
  * machine), finer again when they are quick, so the image follows motion at about 10 frames a
  * second or more. The thresholds leave room: one step changes the time by a factor of 0.56 to
@@ -141,13 +152,7 @@ static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam,
         d++;
     else if (frame_ms < 0.45 * PREVIEW_TARGET_MS && d > PREVIEW_DIVISOR)
         d--;
-    if (d == rt->preview_divisor) return;
-    char err[512];
-    render_session *p = create_preview(rt, d, cam, params, err, sizeof err);
-    if (!p) return; /* keep the one there is */
-    session_destroy(rt->preview);
-    rt->preview = p;
-    rt->preview_divisor = d;
+    set_preview_divisor(rt, d, cam, params);
 }
 
 /* After a full frame of frame_ms: the preview size whose frames take about PREVIEW_TARGET_MS (a
@@ -156,13 +161,7 @@ static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam,
 static void fit_preview(render_thread *rt, double frame_ms, const camera *cam, const render_params *params) {
     int d = (int)ceil(sqrt(frame_ms / PREVIEW_TARGET_MS));
     d = d < PREVIEW_DIVISOR ? PREVIEW_DIVISOR : d > PREVIEW_MAX_DIVISOR ? PREVIEW_MAX_DIVISOR : d;
-    if (d == rt->preview_divisor) return;
-    char err[512];
-    render_session *p = create_preview(rt, d, cam, params, err, sizeof err);
-    if (!p) return; /* keep the one there is */
-    session_destroy(rt->preview);
-    rt->preview = p;
-    rt->preview_divisor = d;
+    set_preview_divisor(rt, d, cam, params);
 }
 
 /* Gives s the environment named by source (a map's path, ENV_SKY, or "" for none). The scene
