@@ -152,7 +152,7 @@ static unsigned exr_layers(const render_options *o) {
 }
 
 static int write_stats(const char *path, const render_options *o, const render_session *rs, const scene *s,
-                       const camera *cam, double seconds) {
+                       const camera *cam, double seconds, size_t clamped) {
     char *buf = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&buf, &size);
@@ -181,7 +181,7 @@ static int write_stats(const char *path, const render_options *o, const render_s
     fprintf(f, "\"total\": %llu},\n", (unsigned long long)total);
     fprintf(f, "  \"rays_per_second\": %.1f,\n", seconds > 0 ? (double)total / seconds : 0.0);
     fprintf(f, "  \"rejected_samples\": %llu,\n", (unsigned long long)st.rejected_samples);
-    fprintf(f, "  \"values_clamped_to_float\": %zu", film_count_clamped(session_film(rs), exr_layers(o)));
+    fprintf(f, "  \"values_clamped_to_float\": %zu", clamped);
     if (p->method != METHOD_PT) {
         const vl_params vp = vl_params_resolve(&p->vl); /* the values the frames used */
         fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"virtual_lights_total\": %llu,\n", vp.count,
@@ -245,7 +245,7 @@ static char *describe_reference(const render_options *o, const render_session *r
 }
 
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, const camera *cam,
-                         double seconds, reference_noise *rn) {
+                         double seconds, reference_noise *rn, size_t clamped) {
     const film *fm = session_film(rs);
     char err[1024];
     const unsigned layers = exr_layers(o);
@@ -278,7 +278,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
         }
         if (png == fallback) printf("wrote %s\n", png);
     }
-    if (o->out_stats) return write_stats(o->out_stats, o, rs, s, cam, seconds);
+    if (o->out_stats) return write_stats(o->out_stats, o, rs, s, cam, seconds, clamped);
     return 0;
 }
 
@@ -355,7 +355,7 @@ int cmd_render(int argc, char **argv) {
     size_t clamped = film_count_clamped(session_film(rs), exr_layers(&o));
     if (clamped) cli_warning("%zu pixel values beyond float's range were written as the largest float", clamped);
 
-    int status = write_outputs(&o, rs, s, &cam, elapsed, &rn);
+    int status = write_outputs(&o, rs, s, &cam, elapsed, &rn, clamped);
     reference_noise_deinit(&rn);
     session_destroy(rs);
     scene_destroy(s);
