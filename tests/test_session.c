@@ -121,7 +121,9 @@ static void check_only(void) {
  * finite and non-negative, for the path tracer and for vsl+hl. */
 static void check_huge_sky(void) {
     enum { EW = 8, EH = 6, EN = 3 };
-    for (int method = METHOD_PT; method <= METHOD_VSL_HL; method += METHOD_VSL_HL - METHOD_PT) {
+    const render_method methods[] = {METHOD_PT, METHOD_VSL_HL};
+    for (int k = 0; k < 2; k++) {
+        render_method method = methods[k];
         scene *s = ts_new("huge sky");
         ts_quad(s, v3(-50, -1, 50), v3(50, -1, 50), v3(50, -1, -50), v3(-50, -1, -50),
                 ts_lambert(s, v3s(0.9f), v3s(0), 0));
@@ -131,7 +133,7 @@ static void check_huge_sky(void) {
         CHECK(scene_set_env_image(s, &sky, 0.0f, err, sizeof err) == 0, "env: %s", err);
         ts_finalize(s);
         camera cam = camera_look_at(v3(0, 0, 0), v3(0, -0.3f, -1), v3(0, 1, 0), 1.0f);
-        render_params p = {.width = EW, .height = EH, .method = (render_method)method, .max_depth = 3, .seed = 5};
+        render_params p = {.width = EW, .height = EH, .method = method, .max_depth = 3, .seed = 5};
         p.vl.count = 16;
         render_session *rs = session_create(s, &cam, &p, err, sizeof err);
         CHECK(rs != NULL, "session: %s", err);
@@ -142,10 +144,10 @@ static void check_huge_sky(void) {
             film_resolve(session_film(rs), mask, img);
             for (int i = 0; i < 3 * EW * EH; i++) bad += !isfinite(img[i]) || img[i] < 0.0f;
         }
-        CHECK(bad == 0, "%s: %d values of the image or its layers are not finite and non-negative",
-              method_name((render_method)method), bad);
+        CHECK(bad == 0, "%s: %d values of the image or its layers are not finite and non-negative", method_name(method),
+              bad);
         CHECK(rs && session_stats(rs).rejected_samples > 0, "%s: no overflowing sample was counted",
-              method_name((render_method)method));
+              method_name(method));
         session_destroy(rs);
         scene_destroy(s);
     }
