@@ -43,6 +43,7 @@ struct render_session {
     render_stats totals;
     int tiles_x, tiles_y;
     manylight ml;            /* vpl, vsl, vsl+hl: this frame's virtual lights */
+    glossy_alloc glossy;     /* ... and the directions each pixel traces through sharp lobes */
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
@@ -87,6 +88,10 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         session_destroy(rs);
         return NULL;
     }
+    if (glossy_alloc_init(&rs->glossy, p->width * p->height) != 0) {
+        session_destroy(rs);
+        return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
+    }
     rs->plan = session_make_plan(rs);
     rs->tiles_x = (p->width + TILE - 1) / TILE;
     rs->tiles_y = (p->height + TILE - 1) / TILE;
@@ -97,6 +102,7 @@ void session_destroy(render_session *rs) {
     if (!rs) return;
     threadpool_destroy(rs->pool);
     manylight_deinit(&rs->ml);
+    glossy_alloc_free(&rs->glossy);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -132,7 +138,10 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
             shading_point sp = shading_point_at(s, first, d);
             rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
             if (rs->plan.virtual_lights) {
-                L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, rng, st);
+                int adapt = rs->ml.glossy_adapt;
+                L[COMP_INDIRECT] =
+                    manylight_indirect(&rs->ml, s, &sp, depth, adapt ? rs->glossy.split[pixel] : rs->ml.glossy_split,
+                                       adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
                 uint64_t t2 = clock_ns();
                 st->pass_ns[PASS_GATHER] += t2 - t1;
                 t1 = t2;
@@ -217,6 +226,9 @@ int session_render_frame(render_session *rs) {
         if (manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, &rs->plan, rs->frames, rs->pool,
                                   &rs->totals, rs->error, sizeof rs->error) != 0)
             return -1;
+        if (rs->ml.glossy_adapt)
+            glossy_alloc_plan(&rs->glossy, rs->ml.glossy_split, VL_MAX_GLOSSY_RAYS, (uint64_t)rs->frames,
+                              rs->params.seed);
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
     }
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
@@ -251,6 +263,7 @@ const char *session_error(const render_session *rs) { return rs->error; }
 
 void session_reset(render_session *rs) {
     film_clear(&rs->film);
+    glossy_alloc_reset(&rs->glossy);
     rs->frames = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }

@@ -1,0 +1,51 @@
+#include "glossy_alloc.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rng.h"
+
+/* Fewer single-direction samples than this: the pixel keeps the budget (its variance is not known). */
+#define GLOSSY_MIN_RECORD 16.0f
+
+int glossy_alloc_init(glossy_alloc *a, int pixels) {
+    a->pixels = pixels;
+    a->rec = calloc((size_t)pixels, sizeof *a->rec);
+    a->split = calloc((size_t)pixels, 1);
+    return a->rec && a->split ? 0 : -1;
+}
+
+void glossy_alloc_free(glossy_alloc *a) {
+    free(a->rec);
+    free(a->split);
+    memset(a, 0, sizeof *a);
+}
+
+void glossy_alloc_reset(glossy_alloc *a) { memset(a->rec, 0, (size_t)a->pixels * sizeof *a->rec); }
+
+/* The spread of one direction's light at the pixel. */
+static double record_sd(const glossy_record *r) { return sqrt(fmax((double)r->m2 / ((double)r->n - 1.0), 0.0)); }
+
+void glossy_alloc_plan(glossy_alloc *a, int budget, int max, uint64_t frame, uint64_t seed) {
+    double sum = 0.0;
+    int known = 0;
+    for (int i = 0; i < a->pixels; i++) {
+        const glossy_record *r = &a->rec[i];
+        if (r->n < GLOSSY_MIN_RECORD) continue;
+        sum += record_sd(r);
+        known++;
+    }
+    double mean = known ? sum / known : 0.0;
+    for (int i = 0; i < a->pixels; i++) {
+        const glossy_record *r = &a->rec[i];
+        if (r->n < GLOSSY_MIN_RECORD || !(mean > 0.0)) {
+            a->split[i] = (uint8_t)budget;
+            continue;
+        }
+        double want = budget * record_sd(r) / mean;
+        rng_state rng = rng_for((uint64_t)i, frame, seed ^ 0x676c6f7373ULL);
+        int n = (int)floor(want + (double)rng_float(&rng)); /* stochastic rounding: the mean is kept */
+        a->split[i] = (uint8_t)(n < 1 ? 1 : n > max ? max : n);
+    }
+}
