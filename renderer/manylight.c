@@ -256,7 +256,7 @@ static int glossy_direction(const scene *s, const shading_point *x, vec3 beta, i
 }
 
 vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, int max_depth, int split_first,
-                        glossy_record *rec, rng_state *rng, render_stats *st) {
+                        pixel_record *rec, rng_state *rng, render_stats *st) {
     vec3 sum = v3(0, 0, 0), beta = v3s(1.0f);
     shading_point x = *x0;
     /* x is scattering event k: gathering there makes paths of k + 1 events or more. */
@@ -289,7 +289,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
             vec3 wi;
             int ok = glossy_direction(s, &x, beta, k, lobes, split > 1 ? sample_r2(j, shift) : shift, rng, st, &t, &b,
                                       &h, &wi);
-            if (k == 1 && rec) glossy_record_add(rec, avg3(t));
+            if (k == 1 && rec) pixel_record_add(rec, avg3(t));
             if (!ok) continue;
             sum = madd3(sum, t, 1.0f / (float)split);
             if (j == chosen) next_beta = b, next = h, next_wi = wi, have_next = 1;
@@ -337,7 +337,6 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     if (m->per_pixel >= (clustering ? vp->columns : m->set.count)) m->per_pixel = 0;
     m->candidates = vp->candidates;
     m->glossy_split = vp->glossy_rays;
-    m->glossy_adapt = vp->glossy_adapt == VL_ADAPT_ON;
     m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : 0.0f;
     /* The light tree's per-light estimates serve resampling; its hierarchy, drawing through it. */
     if (m->per_pixel > 0 && (vp->select == VL_SELECT_TREE || m->candidates > 1) &&

@@ -5,9 +5,9 @@
 #define GLINT_MANYLIGHT_H
 
 #include "camera.h"
-#include "glossy_alloc.h"
 #include "lighttree.h"
 #include "params.h"
+#include "pixel_alloc.h"
 #include "plan.h"
 #include "threadpool.h"
 #include "vsl.h"
@@ -30,7 +30,6 @@ typedef struct {
     int candidates;     /* resampling candidates per pixel (1: the draws are shaded as they come) */
     float trace_alpha;  /* glossy lobes sharper than this are traced through, not gathered */
     int glossy_split;   /* directions traced through such a lobe at the camera hit (the mean with adapt) */
-    int glossy_adapt;   /* ... per pixel, from the session's glossy_alloc */
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;
@@ -60,7 +59,7 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
  * direct light at the next hit and gathers there (the same rule again). At the camera hit the
  * lobe is sampled in `split` directions; rec, when not NULL, records each one's light. */
 vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, int max_depth, int split,
-                        glossy_record *rec, rng_state *rng, render_stats *st);
+                        pixel_record *rec, rng_state *rng, render_stats *st);
 
 /* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
 shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);

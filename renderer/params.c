@@ -37,7 +37,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     if (vp->select == VL_SELECT_DEFAULT) r.select = VL_SELECT_POWER;
     r.trace_glossy = float_or(vp->trace_glossy, VL_DEFAULT_TRACE_GLOSSY);
     r.glossy_rays = int_or(vp->glossy_rays, VL_DEFAULT_GLOSSY_RAYS, VL_MAX_GLOSSY_RAYS);
-    if (vp->glossy_adapt == VL_ADAPT_DEFAULT) r.glossy_adapt = VL_ADAPT_ON;
+    if (vp->adapt == VL_ADAPT_DEFAULT) r.adapt = VL_ADAPT_ON;
     r.secondary_rays = int_or(vp->secondary_rays, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_SECONDARY_RAYS);
     r.clusters = int_or(vp->clusters, HL_DEFAULT_CLUSTERS, HL_MAX_CLUSTERS);
     if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_ON;
@@ -150,7 +150,7 @@ static const param_desc table[] = {
      .help = "directions traced through such a lobe at the camera hit, 1.." STR(VL_MAX_GLOSSY_RAYS),
      .label = "glossy rays", .unit = "rays per camera hit", .panel_lo = 1, .panel_hi = VL_MAX_GLOSSY_RAYS,
      .panel_format = "%d"},
-    {.name = "glossy-adapt", .type = PARAM_CHOICE, .offset = F(glossy_adapt), .choices = adapts, .num_choices = 2,
+    {.name = "adapt", .type = PARAM_CHOICE, .offset = F(adapt), .choices = adapts, .num_choices = 2,
      .def = VL_ADAPT_ON,
      .help = "on: N is the mean; each pixel traces more where one direction's\n"
              "light varied more in earlier frames; off: N at every pixel",

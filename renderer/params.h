@@ -61,8 +61,8 @@ typedef struct {
                           * [VL_DEFAULT_TRACE_GLOSSY] */
     int glossy_rays;     /* directions traced through such a lobe at the camera hit, each taking the
                           * direct light at its next hit, one carrying the path on; with
-                          * glossy_adapt, their mean over the pixels [VL_DEFAULT_GLOSSY_RAYS] */
-    int glossy_adapt;    /* VL_ADAPT_*: each pixel's number of those directions follows how much one
+                          * adapt, their mean over the pixels [VL_DEFAULT_GLOSSY_RAYS] */
+    int adapt;           /* VL_ADAPT_*: each pixel's number of those directions follows how much one
                           * direction's light varied there in earlier frames [on] */
     /* vsl+hl: the highlight estimator (which owns the camera - glossy - glossy - light paths) */
     int secondary_rays; /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */

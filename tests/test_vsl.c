@@ -692,23 +692,23 @@ static void test_counts_beyond_the_frame(void) {
 /* The traced directions' allocation: a pixel whose record is too short keeps the budget; the others
  * get the budget in proportion to the spread of one direction's light there (stochastic rounding
  * keeps fractional shares on average), clamped to [1, max]. */
-static void test_glossy_alloc_plan(void) {
-    glossy_alloc a;
-    CHECK(glossy_alloc_init(&a, 5) == 0, "allocation");
+static void test_pixel_alloc_plan(void) {
+    pixel_alloc a;
+    CHECK(pixel_alloc_init(&a, 5) == 0, "allocation");
     /* pixel 0: constant light (spread 0); 1: spread 1; 2: spread 3; 3: unrecorded; 4: two samples */
     for (int k = 0; k < 40; k++) {
-        glossy_record_add(&a.rec[0], 2.0f);
-        glossy_record_add(&a.rec[1], k % 2 ? 1.0f : -1.0f);
-        glossy_record_add(&a.rec[2], k % 2 ? 5.0f : -1.0f);
+        pixel_record_add(&a.rec[0], 2.0f);
+        pixel_record_add(&a.rec[1], k % 2 ? 1.0f : -1.0f);
+        pixel_record_add(&a.rec[2], k % 2 ? 5.0f : -1.0f);
     }
-    glossy_record_add(&a.rec[4], 0.0f);
-    glossy_record_add(&a.rec[4], 100.0f);
+    pixel_record_add(&a.rec[4], 0.0f);
+    pixel_record_add(&a.rec[4], 100.0f);
     /* The sample spreads of +-1 and 2 +- 3 over 40 values: sqrt(40/39) and 3 sqrt(40/39); the mean
      * over the three recorded pixels is 4/3 sqrt(40/39), so budget 4 wants 0, 3 and 9 directions. */
     double sum[5] = {0};
     int frames = 4000, over = 0;
     for (int f = 0; f < frames; f++) {
-        glossy_alloc_plan(&a, 4, 8, (uint64_t)f, 7);
+        pixel_alloc_plan(&a, 4, 8, (uint64_t)f, 7);
         for (int i = 0; i < 5; i++) sum[i] += a.split[i];
         over |= a.split[2] > 8;
     }
@@ -720,14 +720,14 @@ static void test_glossy_alloc_plan(void) {
     /* A fractional share: budget 3 wants 2.25 directions at pixel 1, on average. */
     sum[1] = 0.0;
     for (int f = 0; f < frames; f++) {
-        glossy_alloc_plan(&a, 3, 8, (uint64_t)f, 7);
+        pixel_alloc_plan(&a, 3, 8, (uint64_t)f, 7);
         sum[1] += a.split[1];
     }
     CHECK_NEAR(sum[1] / frames, 2.25, 0.03, "stochastic rounding");
-    glossy_alloc_reset(&a);
-    glossy_alloc_plan(&a, 4, 8, 0, 7);
+    pixel_alloc_reset(&a);
+    pixel_alloc_plan(&a, 4, 8, 0, 7);
     CHECK(a.split[1] == 4 && a.split[2] == 4, "after a reset every pixel takes the budget");
-    glossy_alloc_free(&a);
+    pixel_alloc_free(&a);
 }
 
 int main(void) {
@@ -740,7 +740,7 @@ int main(void) {
     test_diffuse_box_against_pt();
     test_glossy_box_energy();
     test_light_selection_unbiased();
-    test_glossy_alloc_plan();
+    test_pixel_alloc_plan();
     test_trace_glossy_matches_pt();
     test_no_leak_through_thin_walls();
     test_lights_touching_surfaces();

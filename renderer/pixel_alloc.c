@@ -1,4 +1,4 @@
-#include "glossy_alloc.h"
+#include "pixel_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -7,39 +7,39 @@
 #include "rng.h"
 
 /* Fewer single-direction samples than this: the pixel keeps the budget (its variance is not known). */
-#define GLOSSY_MIN_RECORD 16.0f
+#define PIXEL_MIN_RECORD 16.0f
 
-int glossy_alloc_init(glossy_alloc *a, int pixels) {
+int pixel_alloc_init(pixel_alloc *a, int pixels) {
     a->pixels = pixels;
     a->rec = calloc((size_t)pixels, sizeof *a->rec);
     a->split = calloc((size_t)pixels, 1);
     return a->rec && a->split ? 0 : -1;
 }
 
-void glossy_alloc_free(glossy_alloc *a) {
+void pixel_alloc_free(pixel_alloc *a) {
     free(a->rec);
     free(a->split);
     memset(a, 0, sizeof *a);
 }
 
-void glossy_alloc_reset(glossy_alloc *a) { memset(a->rec, 0, (size_t)a->pixels * sizeof *a->rec); }
+void pixel_alloc_reset(pixel_alloc *a) { memset(a->rec, 0, (size_t)a->pixels * sizeof *a->rec); }
 
 /* The spread of one direction's light at the pixel. */
-static double record_sd(const glossy_record *r) { return sqrt(fmax((double)r->m2 / ((double)r->n - 1.0), 0.0)); }
+static double record_sd(const pixel_record *r) { return sqrt(fmax((double)r->m2 / ((double)r->n - 1.0), 0.0)); }
 
-void glossy_alloc_plan(glossy_alloc *a, int budget, int max, uint64_t frame, uint64_t seed) {
+void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint64_t seed) {
     double sum = 0.0;
     int known = 0;
     for (int i = 0; i < a->pixels; i++) {
-        const glossy_record *r = &a->rec[i];
-        if (r->n < GLOSSY_MIN_RECORD) continue;
+        const pixel_record *r = &a->rec[i];
+        if (r->n < PIXEL_MIN_RECORD) continue;
         sum += record_sd(r);
         known++;
     }
     double mean = known ? sum / known : 0.0;
     for (int i = 0; i < a->pixels; i++) {
-        const glossy_record *r = &a->rec[i];
-        if (r->n < GLOSSY_MIN_RECORD || !(mean > 0.0)) {
+        const pixel_record *r = &a->rec[i];
+        if (r->n < PIXEL_MIN_RECORD || !(mean > 0.0)) {
             a->split[i] = (uint8_t)budget;
             continue;
         }
