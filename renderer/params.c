@@ -152,9 +152,10 @@ static const param_desc table[] = {
      .panel_format = "%d"},
     {.name = "adapt", .type = PARAM_CHOICE, .offset = F(adapt), .choices = adapts, .num_choices = 2,
      .def = VL_ADAPT_ON,
-     .help = "on: N is the mean; each pixel traces more where one direction's\n"
-             "light varied more in earlier frames; off: N at every pixel",
-     .label = "adapt glossy rays"},
+     .help = "on: each pixel's glossy rays (N on average) and direct-light\n"
+             "samples (4) follow how much one sample's light varied there in\n"
+             "earlier frames; off: the same at every pixel",
+     .label = "adapt samples"},
     {.name = "secondary-rays", .type = PARAM_INT, .group = PARAM_HIGHLIGHTS, .offset = F(secondary_rays), .lo = 1,
      .hi = HL_MAX_SECONDARY_RAYS, .def = HL_DEFAULT_SECONDARY_RAYS, .value_name = "N",
      .help = "rays sampled from a camera hit's glossy lobe, 1.." STR(HL_MAX_SECONDARY_RAYS),
