@@ -12,13 +12,13 @@
 int pixel_alloc_init(pixel_alloc *a, int pixels) {
     a->pixels = pixels;
     a->rec = calloc((size_t)pixels, sizeof *a->rec);
-    a->split = calloc((size_t)pixels, 1);
-    return a->rec && a->split ? 0 : -1;
+    a->samples = calloc((size_t)pixels, 1);
+    return a->rec && a->samples ? 0 : -1;
 }
 
 void pixel_alloc_free(pixel_alloc *a) {
     free(a->rec);
-    free(a->split);
+    free(a->samples);
     memset(a, 0, sizeof *a);
 }
 
@@ -40,12 +40,12 @@ void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint6
     for (int i = 0; i < a->pixels; i++) {
         const pixel_record *r = &a->rec[i];
         if (r->n < PIXEL_MIN_RECORD || !(mean > 0.0)) {
-            a->split[i] = (uint8_t)budget;
+            a->samples[i] = (uint8_t)budget;
             continue;
         }
         double want = budget * record_sd(r) / mean;
         rng_state rng = rng_for((uint64_t)i, frame, seed ^ 0x676c6f7373ULL);
         int n = (int)floor(want + (double)rng_float(&rng)); /* stochastic rounding: the mean is kept */
-        a->split[i] = (uint8_t)(n < 1 ? 1 : n > max ? max : n);
+        a->samples[i] = (uint8_t)(n < 1 ? 1 : n > max ? max : n);
     }
 }

@@ -14,15 +14,16 @@ typedef struct {
 typedef struct {
     int pixels;
     pixel_record *rec;
-    uint8_t *split; /* this frame's samples per pixel */
+    uint8_t *samples; /* this frame's samples per pixel */
 } pixel_alloc;
 
 int pixel_alloc_init(pixel_alloc *a, int pixels);
 void pixel_alloc_free(pixel_alloc *a);
 void pixel_alloc_reset(pixel_alloc *a);
-/* Sets every pixel's directions for the next frame: mean `budget` over the pixels that have a
- * record, in proportion to their contributions' standard deviations, within [1, max]. The
- * frame's own samples never decide its allocation, so each frame stays unbiased. */
+/* Sets every pixel's samples for the next frame: `budget` on average over the pixels with a
+ * record, in proportion to the standard deviation of one sample's light there, within [1, max];
+ * the others take the budget. The frame's own samples never decide its allocation, so each frame
+ * stays unbiased. */
 void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint64_t seed);
 static inline void pixel_record_add(pixel_record *r, float v) {
     r->n += 1.0f;

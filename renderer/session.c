@@ -136,7 +136,7 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
         uint64_t t0 = clock_ns();
         if (!p->only || p->only & (1u << COMP_DIRECT))
             L[COMP_DIRECT] =
-                pt_direct(s, rs->cam.position, d, first, rs->adapt ? rs->direct.split[pixel] : MANYLIGHT_DIRECT_SAMPLES,
+                pt_direct(s, rs->cam.position, d, first, rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES,
                           rs->adapt ? &rs->direct.rec[pixel] : NULL, rng, st->rays);
         else
             st->rays[RAY_CAMERA]++;
@@ -147,7 +147,7 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
             rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
             if (rs->plan.virtual_lights) {
                 L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth,
-                                                      rs->adapt ? rs->glossy.split[pixel] : rs->ml.glossy_split,
+                                                      rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
                                                       rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
                 uint64_t t2 = clock_ns();
                 st->pass_ns[PASS_GATHER] += t2 - t1;

@@ -709,8 +709,8 @@ static void test_pixel_alloc_plan(void) {
     int frames = 4000, over = 0;
     for (int f = 0; f < frames; f++) {
         pixel_alloc_plan(&a, 4, 8, (uint64_t)f, 7);
-        for (int i = 0; i < 5; i++) sum[i] += a.split[i];
-        over |= a.split[2] > 8;
+        for (int i = 0; i < 5; i++) sum[i] += a.samples[i];
+        over |= a.samples[2] > 8;
     }
     CHECK(sum[0] == frames, "constant light: %.3f directions, expected 1 (the floor)", sum[0] / frames);
     CHECK_NEAR(sum[1] / frames, 3.0, 0.05, "spread 1");
@@ -721,12 +721,12 @@ static void test_pixel_alloc_plan(void) {
     sum[1] = 0.0;
     for (int f = 0; f < frames; f++) {
         pixel_alloc_plan(&a, 3, 8, (uint64_t)f, 7);
-        sum[1] += a.split[1];
+        sum[1] += a.samples[1];
     }
     CHECK_NEAR(sum[1] / frames, 2.25, 0.03, "stochastic rounding");
     pixel_alloc_reset(&a);
     pixel_alloc_plan(&a, 4, 8, 0, 7);
-    CHECK(a.split[1] == 4 && a.split[2] == 4, "after a reset every pixel takes the budget");
+    CHECK(a.samples[1] == 4 && a.samples[2] == 4, "after a reset every pixel takes the budget");
     pixel_alloc_free(&a);
 }
 
