@@ -363,6 +363,9 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
     pthread_mutex_unlock(&sh->lock);
     film_resolve(f, mask, rt->back.rgb);
     rt->back.preview = preview;
+    rt->back.full_w = session_film(rt->full)->width;
+    rt->back.full_h = session_film(rt->full)->height;
+    rt->back.generation = gen;
     double rel_error = preview || !measure ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
@@ -392,6 +395,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
             sh->stats.rel_error_serial++;
         }
         if (!preview) {
+            sh->stats.full_frame_ms = frame_ms;
             plan_summary(session_plan(rs), sh->stats.plan, sizeof sh->stats.plan);
             sh->stats.plan_highlights = session_plan(rs)->highlights;
             sh->stats.virtual_lights = st.virtual_lights;
