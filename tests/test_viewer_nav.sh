@@ -267,6 +267,7 @@ set panel 0
 sky
 wait 1
 stats
+screenshot ready.png
 wait-file wheeled
 sleep 0.5
 wait 1
@@ -279,24 +280,16 @@ quit
 EOF
 for s in 0.001 1000; do
   sed "s/\"nodes\": \[{\"mesh\": 0}\]/\"nodes\": [{\"mesh\": 0, \"scale\": [$s, $s, $s]}]/" unlit.gltf >scaled.gltf
-  rm -f out.txt wheeled flown
-  view scaled.gltf --size 160x90 --script scaled.txt &
-  viewer=$!
-  window=
-  stats_lines 1 && window=$(xdotool search --sync --onlyvisible --name glint 2>/dev/null | head -n 1)
-  if [ -n "$window" ]; then
-    xdotool mousemove --window "$window" 80 45 click 4 sleep 0.3 click 4 sleep 0.3 click 4
+  rm -f wheeled flown
+  view_bg ready.png scaled.gltf --size 160x90 --script scaled.txt
+  if [ -n "$win" ]; then
+    xdotool mousemove --window "$win" 80 45 click 4 sleep 0.3 click 4 sleep 0.3 click 4
     touch wheeled
     stats_lines 2
-    xdotool windowfocus --sync "$window" 2>/dev/null
+    xdotool windowfocus --sync "$win" 2>/dev/null
     xdotool keydown w sleep 1 keyup w
   fi
-  touch flown
-  wait $viewer
-  rc=$?
-  [ -n "$window" ] || fail "scale $s: the viewer's window was not found: $(cat err.txt)"
-  [ $rc -eq 0 ] || fail "scale $s: exited $rc: $(cat err.txt)"
-  grep '^stats ' out.txt >stats.txt
+  view_end "scale $s" wheeled flown
   # distances from the camera to the quad's centre (the origin), over the scale
   d=$(for i in 1 2 3; do field $i cam; done | awk -F, -v s="$s" '{ printf "%g ", sqrt($1 * $1 + $2 * $2 + $3 * $3) / s }')
   set -- $d

@@ -151,11 +151,8 @@ stats
 window-shot resized.png
 quit
 EOF
-  rm -f ready.png sent out.txt
-  view --size 480x270 --script xevents.txt &
-  viewer=$!
-  win=
-  file_made ready.png && win=$(xdotool search --name 'glint' | head -n 1)
+  rm -f sent
+  view_bg ready.png --size 480x270 --script xevents.txt
   if [ -n "$win" ]; then
     xdotool windowsize "$win" 200 120
     sleep 0.5
@@ -169,14 +166,8 @@ EOF
     xdotool windowfocus "$win" 2>/dev/null
     # F1 shows the list, ? hides it, F1 shows it again (a key lost leaves it hidden)
     xdotool key F1 sleep 0.5 key question sleep 0.5 key F1 sleep 0.5 key space
-  else
-    fail "xdotool found no viewer window"
   fi
-  touch sent
-  wait $viewer
-  rc=$?
-  [ $rc -eq 0 ] || fail "X events session exited $rc: $(cat err.txt)"
-  grep '^stats ' out.txt >stats.txt
+  view_end "the X events session" sent
   [ "$(field 1 window)" = 700x300 ] || fail "the window was not resized: $(field 1 window)"
   dock=$(field 1 dock)
   [ "$dock" -gt 0 ] && [ "$dock" -le 420 ] || fail "after resizes the panel is $dock wide in 700"
@@ -216,11 +207,8 @@ window-shot collapsed.png
 screenshot collapsed-image.png
 quit
 EOF
-  rm -f ready.png held dropped collapsed stats-2.png stats-3.png out.txt
-  view --size 480x270 --spp 2 --script dragging.txt &
-  viewer=$!
-  win=
-  file_made ready.png && win=$(xdotool search --name 'glint' | head -n 1)
+  rm -f held dropped collapsed stats-2.png stats-3.png
+  view_bg ready.png --size 480x270 --spp 2 --script dragging.txt
   if [ -n "$win" ]; then
     xdotool mousemove --window "$win" 481 150 sleep 0.2 mousedown 1 sleep 0.1
     for x in 460 440 420 400 380; do xdotool mousemove --window "$win" $x 150 sleep 0.1; done
@@ -232,14 +220,8 @@ EOF
     # the collapse arrow, at the start of the panel's title bar
     dock=$(grep '^stats ' out.txt | sed -n 3p | tr ' ' '\n' | sed -n 's/^dock=//p')
     xdotool mousemove --window "$win" $((840 - ${dock:-0} + 10)) 9 click 1
-  else
-    fail "xdotool found no viewer window"
   fi
-  touch collapsed
-  wait $viewer
-  rc=$?
-  [ $rc -eq 0 ] || fail "panel drag session exited $rc: $(cat err.txt)"
-  grep '^stats ' out.txt >stats.txt
+  view_end "the panel drag session" held dropped collapsed
   [ "$(wc -l <stats.txt)" -eq 4 ] || fail "panel drag session: expected 4 stats lines, got: $(cat out.txt)"
   [ "$(field 2 image)" = 379x270 ] || fail "the held drag did not widen the panel: image $(field 2 image)"
   [ "$(field 2 resets)" = "$(field 1 resets)" ] && [ "$(field 2 width)x$(field 2 height)" = 480x270 ] ||
@@ -281,11 +263,8 @@ sleep 0.5
 stats
 quit
 EOF
-  rm -f ready.png moved.png saved restored out.txt
-  view --size 240x1000 --method pt --script bookmarks.txt &
-  viewer=$!
-  win=
-  file_made ready.png && win=$(xdotool search --name 'glint' | head -n 1)
+  rm -f moved.png saved restored
+  view_bg ready.png --size 240x1000 --method pt --script bookmarks.txt
   click() { # click LABEL: the centre of the panel's button LABEL, where it was last listed
     set -- $(grep "^button .* $1\$" out.txt | tail -n 1)
     [ $# -ge 5 ] && xdotool mousemove --window "$win" $((($2 + $4) / 2)) $((($3 + $5) / 2)) click 1
@@ -295,14 +274,8 @@ EOF
     touch saved
     file_made moved.png
     click '3##go' || fail "no restore button for bookmark 3"
-  else
-    fail "xdotool found no viewer window"
   fi
-  touch saved restored
-  wait $viewer
-  rc=$?
-  [ $rc -eq 0 ] || fail "bookmark buttons session exited $rc: $(cat err.txt)"
-  grep '^stats ' out.txt >stats.txt
+  view_end "the bookmark buttons session" saved restored
   [ "$(field 2 bookmarks)" = 3 ] || fail "the save button did not set bookmark 3: $(field 2 bookmarks)"
   [ "$(field 2 cam)" != "$(field 1 cam)" ] || fail "the orbit did not move the camera"
   [ "$(field 3 cam)" = "$(field 1 cam)" ] || fail "the bookmark button did not restore the view: $(field 1 cam) vs $(field 3 cam)"
@@ -329,11 +302,8 @@ quit
 EOF
   for dpi in 96 192; do
     echo "Xft.dpi: $dpi" | xrdb -nocpp -merge
-    rm -f hidpi.png sent out.txt
-    view --size 480x540 --spp 1 --script hidpi.txt &
-    viewer=$!
-    win=
-    file_made hidpi.png && win=$(xdotool search --name 'glint' | head -n 1)
+    rm -f sent
+    view_bg hidpi.png --size 480x540 --spp 1 --script hidpi.txt
     if [ -n "$win" ]; then
       # the pause button's centre, as the panel drew it
       set -- $(grep '^button .* pause (Space)$' out.txt)
@@ -344,14 +314,8 @@ EOF
       xdotool mousemove --window "$win" "$lx" "$ly" keydown ctrl sleep 0.3 mousedown 1 sleep 0.3
       for d in 10 20 30 40; do xdotool mousemove --window "$win" $((lx + d)) $((ly + d / 2)) sleep 0.2; done
       xdotool sleep 0.5 mouseup 1 sleep 0.2 keyup ctrl
-    else
-      fail "$dpi dpi: xdotool found no viewer window"
     fi
-    touch sent
-    wait $viewer
-    rc=$?
-    [ $rc -eq 0 ] || fail "$dpi dpi: exited $rc: $(cat err.txt)"
-    grep '^stats ' out.txt >stats.txt
+    view_end "the $dpi dpi session" sent
     scale=$(field 1 content_scale)
     [ "$scale" = $((dpi / 96)) ] || fail "$dpi dpi: content scale $scale"
     [ "$(field 2 paused)" = 1 ] || fail "$dpi dpi: a click on the pause button did not pause"

@@ -54,3 +54,26 @@ file_made() {
     sleep 0.1
   done
 }
+# view_bg READY ARGS...: the viewer in the background (its pid in viewer) until its script has made
+# the file READY; then win is its window, empty (a failure noted) when none came.
+view_bg() {
+  ready=$1
+  shift
+  rm -f "$ready" out.txt
+  view "$@" &
+  viewer=$!
+  win=
+  file_made "$ready" && win=$(xdotool search --name 'glint' | head -n 1)
+  [ -n "$win" ] || fail "no viewer window for $*: $(cat err.txt)"
+}
+# view_end NAME FILE...: makes the FILEs the script waits for, waits for the viewer (a failure noted
+# unless it exits 0) and puts its stats lines in stats.txt.
+view_end() {
+  name=$1
+  shift
+  touch "$@"
+  wait $viewer
+  rc=$?
+  [ $rc -eq 0 ] || fail "$name exited $rc: $(cat err.txt)"
+  grep '^stats ' out.txt >stats.txt
+}
