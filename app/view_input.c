@@ -189,7 +189,14 @@ void on_key(GLFWwindow *win, int key, int scancode, int action, int mods) {
 void on_scroll(GLFWwindow *win, double dx, double dy) {
     (void)dx;
     ui_thread *u = glfwGetWindowUserPointer(win);
-    if (!ui_wants_mouse()) u->scroll += dy;
+    /* Over the image only: the panel's hover state is the last frame's, and a cursor that has
+     * just moved onto the panel would zoom instead of scrolling it. */
+    double x, y;
+    float r[4];
+    glfwGetCursorPos(win, &x, &y);
+    view_image_rect(u, r);
+    int over_image = x >= (double)r[0] && x < (double)r[2] && y >= (double)r[1] && y < (double)r[3];
+    if (!ui_wants_mouse() && over_image) u->scroll += dy;
 }
 
 void on_drop(GLFWwindow *win, int count, const char **paths) {

@@ -10,6 +10,7 @@
  *   frame                     reference-camera       sky
  *   quit                      pause                  resume
  *   sleep SECONDS             wait-file FILE         buttons
+ *   wheel X Y STEPS
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -18,10 +19,12 @@
  * has tried them (a failed one changes nothing); `env none` clears the environment. `frame` views
  * the whole scene, `reference-camera` goes back to the reference's. `sleep` lets time pass, changing
  * nothing (while a test sends real input events); `wait-file` waits until FILE exists (a test
- * makes it once its input events are sent); `buttons` prints where the panel's visible buttons are,
- * one line each ("button X0 Y0 X1 Y1 LABEL", window units), for a test to click. `move-light` moves light INDEX (as the panel lists them)
- * by a world-space offset and selects it; `spin` orbits continuously, a little every drawn
- * frame, as a held mouse drag would. */
+ * makes it once its input events are sent); `buttons` prints where the panel's visible buttons
+ * are, one line each ("button X0 Y0 X1 Y1 LABEL", window units), for a test to click; `wheel`
+ * puts the cursor at X Y (window units) and turns the wheel there by STEPS (up positive) in the
+ * same frame, as a wheel event arriving with the cursor's move does.
+ * `move-light` moves light INDEX (as the panel lists them) by a world-space offset and selects it;
+ * `spin` orbits continuously, a little every drawn frame, as a held mouse drag would. */
 #ifndef GLINT_VIEW_SCRIPT_H
 #define GLINT_VIEW_SCRIPT_H
 
@@ -54,6 +57,7 @@ typedef enum {
     ACT_SLEEP,     /* the script waits SECONDS, the viewer runs on */
     ACT_WAIT_FILE, /* the script waits until a file exists */
     ACT_BUTTONS,   /* where the panel's buttons are */
+    ACT_WHEEL,     /* the cursor moved and the wheel turned at once */
 } script_action_kind;
 
 typedef struct {

@@ -263,6 +263,10 @@ void run_script(ui_thread *u) {
             snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text);
             u->script_pos++;
             return;
+        case ACT_WHEEL: /* through the wheel's own handler, before this frame updates the panel's hover */
+            glfwSetCursorPos(u->win, a->a, a->b);
+            on_scroll(u->win, 0.0, a->c);
+            break;
         case ACT_WAIT_FILE: /* a test's input events are sent */
             if (access(a->text, F_OK) != 0) return;
             break;

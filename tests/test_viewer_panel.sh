@@ -117,6 +117,28 @@ view --size 160x90 --spp 0 --script limit.txt && fail "--spp 0 accepted"
 view view --help
 grep -q 'F1 or ?' out.txt && grep -q -- '--spp N' out.txt || fail "--help lacks the key list or --spp"
 
+# ---- the wheel zooms over the image only: turned in the frame the cursor arrives on the panel
+# (the panel's hover still the last frame's, over the image), it does nothing to the view.
+cat >wheel.txt <<'EOF'
+wait 1
+stats
+wheel 80 45 1
+wait 1
+stats
+sleep 0.3
+wheel 300 45 1
+sleep 0.3
+stats
+quit
+EOF
+view --size 160x90 --script wheel.txt
+rc=$?
+[ $rc -eq 0 ] || fail "wheel script exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(field 1 window)" = 400x90 ] || fail "the wheel session's window is $(field 1 window), not 400x90"
+[ "$(field 2 cam)" != "$(field 1 cam)" ] || fail "the wheel over the image did not zoom"
+[ "$(field 3 cam)" = "$(field 2 cam)" ] || fail "the wheel over the panel zoomed: $(field 2 cam) -> $(field 3 cam)"
+
 # ---- previews magnified smoothly ----------------------------------------------------------------
 rm -f preview.png
 cat >preview.txt <<'EOF'
@@ -144,6 +166,7 @@ if command -v xdotool >/dev/null; then
   cat >xevents.txt <<'EOF'
 wait 1
 set exposure -30
+stats
 screenshot ready.png
 wait-file sent
 sleep 1
@@ -168,14 +191,14 @@ EOF
     xdotool key F1 sleep 0.5 key question sleep 0.5 key F1 sleep 0.5 key space
   fi
   view_end "the X events session" sent
-  [ "$(field 1 window)" = 700x300 ] || fail "the window was not resized: $(field 1 window)"
-  dock=$(field 1 dock)
+  [ "$(field 2 window)" = 700x300 ] || fail "the window was not resized: $(field 2 window)"
+  dock=$(field 2 dock)
   [ "$dock" -gt 0 ] && [ "$dock" -le 420 ] || fail "after resizes the panel is $dock wide in 700"
   [ "$dock" -ge 390 ] || fail "dragging its edge did not widen the panel: $dock"
-  [ "$(field 1 image)" = "$((700 - dock))x300" ] || fail "image $(field 1 image) beside a $dock panel"
+  [ "$(field 2 image)" = "$((700 - dock))x300" ] || fail "image $(field 2 image) beside a $dock panel"
   [ "$(probe resized.png ink $((700 - dock)) 0 700 300)" -ge 10 ] || fail "no panel on-screen after resizes"
-  [ "$(field 1 help)" = 1 ] || fail "F1, ?, F1 did not leave the key list shown"
-  [ "$(field 1 paused)" = 1 ] || fail "the Space key did not pause"
+  [ "$(field 2 help)" = 1 ] || fail "F1, ?, F1 did not leave the key list shown"
+  [ "$(field 2 paused)" = 1 ] || fail "the Space key did not pause"
   cx=$(((700 - dock) / 2))
   # The list's text over the image (shown black: exposure -30, so a noisy render has no ink; the
   # panel, right of it, has ink of its own).
