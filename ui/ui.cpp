@@ -166,15 +166,20 @@ static void error_plot(const ui_stats *s) {
         emin = std::fmin(emin, noise);
         emax = std::fmax(emax, noise);
     }
-    float lo = std::floor(std::log10(emin)), hi = std::ceil(std::log10(emax));
-    if (hi <= lo) hi = lo + 1.0f;
     if (!(tmax > 0.0f)) tmax = 1.0f;
     ImVec2 p0 = ImGui::GetCursorScreenPos();
     float w = std::fmax(ImGui::GetContentRegionAvail().x, 50.0f), h = 110.0f * g_scale;
+    // Log scale with a label's height of room above and below: neither a curve nor the noise floor
+    // runs under the axis labels
+    float line = ImGui::GetTextLineHeight(), room = line + 4.0f;
+    float lo = std::log10(emin), hi = std::log10(emax);
+    float pad = std::fmax(room * (hi - lo) / std::fmax(h - 2.0f * room, 1.0f), 0.1f);
+    lo -= pad;
+    hi += pad;
     ImGui::Dummy(ImVec2(w, h));
     ImDrawList *dl = ImGui::GetWindowDrawList();
     dl->AddRectFilled(p0, ImVec2(p0.x + w, p0.y + h), IM_COL32(15, 15, 20, 255));
-    for (float d = lo + 1.0f; d < hi; d += 1.0f) { // decade lines
+    for (float d = std::ceil(lo); d < hi; d += 1.0f) { // decade lines
         float y = p0.y + h * (1.0f - (d - lo) / (hi - lo));
         dl->AddLine(ImVec2(p0.x, y), ImVec2(p0.x + w, y), IM_COL32(60, 60, 70, 255));
     }
@@ -199,10 +204,9 @@ static void error_plot(const ui_stats *s) {
             dl->AddPolyline(pts.Data, pts.Size, curve_colours[c % 6], 0, 1.5f);
     }
     char label[32];
-    std::snprintf(label, sizeof label, "1e%+.0f", (double)hi);
+    std::snprintf(label, sizeof label, "%.2g", std::pow(10.0, (double)hi));
     dl->AddText(ImVec2(p0.x + 2, p0.y + 1), IM_COL32(200, 200, 200, 255), label);
-    std::snprintf(label, sizeof label, "1e%+.0f", (double)lo);
-    float line = ImGui::GetTextLineHeight();
+    std::snprintf(label, sizeof label, "%.2g", std::pow(10.0, (double)lo));
     dl->AddText(ImVec2(p0.x + 2, p0.y + h - line - 1), IM_COL32(200, 200, 200, 255), label);
     std::snprintf(label, sizeof label, "%.1f s", (double)tmax);
     dl->AddText(ImVec2(p0.x + w - ImGui::CalcTextSize(label).x - 2, p0.y + h - line - 1), IM_COL32(200, 200, 200, 255),
