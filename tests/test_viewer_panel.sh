@@ -266,6 +266,7 @@ EOF
   d=$(probe collapsed.png diff collapsed-image.png $((w - 200)) 0 "$w" 30)
   awk -v d="$d" 'BEGIN { exit !(d < 3) }' || fail "something covers the image's top-right corner (differs by $d)"
   [ "$(probe collapsed.png ink "$w" 0 840 30)" -ge 10 ] || fail "no arrow in the collapsed panel's column"
+
   # ---- the bookmark buttons, clicked: "save 3" keeps the view, "3" brings it back after an orbit
   # (pt: its panel is short enough for the Camera section to show in a tall window).
   cat >bookmarks.txt <<'EOF'
@@ -302,7 +303,6 @@ EOF
   [ "$(field 2 bookmarks)" = 3 ] || fail "the save button did not set bookmark 3: $(field 2 bookmarks)"
   [ "$(field 2 cam)" != "$(field 1 cam)" ] || fail "the orbit did not move the camera"
   [ "$(field 3 cam)" = "$(field 1 cam)" ] || fail "the bookmark button did not restore the view: $(field 1 cam) vs $(field 3 cam)"
-
 else
   echo "xdotool not installed: real X events not checked"
 fi
