@@ -4,7 +4,7 @@ GLINT_PACKAGES=(
   build-essential cmake pkg-config
   libglfw3-dev libembree-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev
   libimgui-dev libstb-dev libgl-dev libcjson-dev libcairo2-dev fonts-dejavu-core
-  xvfb xauth xdotool embree-tools openexr clang-format
+  xvfb xauth xdotool x11-xserver-utils embree-tools openexr clang-format
   clang libclang-rt-14-dev
 )
 
