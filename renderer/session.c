@@ -135,9 +135,9 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
         for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
         uint64_t t0 = clock_ns();
         if (!p->only || p->only & (1u << COMP_DIRECT))
-            L[COMP_DIRECT] =
-                pt_direct(s, rs->cam.position, d, first, rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES,
-                          rs->adapt ? &rs->direct.rec[pixel] : NULL, rng, st->rays);
+            L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first,
+                                       rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES,
+                                       rs->adapt ? &rs->direct.rec[pixel] : NULL, rng, st->rays);
         else
             st->rays[RAY_CAMERA]++;
         uint64_t t1 = clock_ns();
