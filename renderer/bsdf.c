@@ -16,9 +16,10 @@ static float schlick_weight(float cos_theta) {
     return m2 * m2 * m;
 }
 
-static vec3 schlick_fresnel(vec3 f0, float cos_theta) {
+/* Schlick's Fresnel from F0 at normal incidence to F90 at grazing. */
+static vec3 schlick_fresnel(vec3 f0, float f90, float cos_theta) {
     float w = schlick_weight(cos_theta);
-    return add3(f0, scale3(sub3(v3s(1.0f), f0), w));
+    return add3(f0, scale3(sub3(v3s(f90), f0), w));
 }
 
 /* ---- constructors -------------------------------------------------------------------------- */
@@ -30,9 +31,10 @@ bsdf make_bsdf_gltf(vec3 base_color, float metallic, float roughness, float anis
     anisotropy = clampf(anisotropy, 0.0f, 1.0f);
     /* glTF appendix B: mix(dielectric, conductor, metallic). Schlick is linear in F0, so both
      * specular terms merge into one GGX lobe with F0 = mix(0.04, base, metallic); the dielectric's
-     * diffuse keeps its (1 - F) weight through diffuse_f0. */
+     * diffuse is coupled to its own specular lobe (F0 0.04), not to the mixed one. */
     b.diffuse = scale3(base_color, 1.0f - metallic);
-    b.diffuse_f0 = 0.04f;
+    b.couple_f0 = 0.04f;
+    b.couple_f90 = 1.0f;
     b.model = GLOSSY_GGX;
     b.specular = lerp3(v3s(0.04f), base_color, metallic);
     float alpha = fmaxf(roughness * roughness, BSDF_MIN_ALPHA);
@@ -82,6 +84,10 @@ float bsdf_glossy_aspect(const bsdf *b) {
 #define ALBEDO_STRATA 16 /* per axis: 256 samples an entry */
 enum { ALBEDO_GGX_SCALE, ALBEDO_GGX_BIAS, ALBEDO_PHONG, ALBEDO_WARD, ALBEDO_TABLES };
 static float albedo_table[ALBEDO_TABLES][ALBEDO_N][ALBEDO_N]; /* [table][alpha][cos theta_o] */
+/* GGX's cosine-weighted mean albedo 2 int E(mu) mu dmu per alpha, scale and bias, integrated
+ * exactly over the table's linear interpolation so that the coupled diffuse lobe's integral
+ * over wi, (1 - E_avg), is the one the lookups make. */
+static float albedo_avg[2][ALBEDO_N];
 static pthread_once_t albedo_once = PTHREAD_ONCE_INIT;
 
 static float lobe_albedo_sampled(const bsdf *b, float cos_o) {
@@ -114,6 +120,16 @@ static void build_albedo_tables(void) {
             bsdf ward = make_bsdf_ward(v3s(0.0f), v3s(1.0f), alpha, alpha);
             albedo_table[ALBEDO_WARD][a][c] = lobe_albedo_sampled(&ward, cos_o);
         }
+        for (int t = 0; t < 2; t++) {
+            /* int over [m0, m1] of mu times the linear interpolant: h/6 (E0 (2 m0 + m1) + E1 (m0 + 2 m1)) */
+            const float *e = albedo_table[t == 0 ? ALBEDO_GGX_SCALE : ALBEDO_GGX_BIAS][a];
+            double sum = 0.0, h = 1.0 / (ALBEDO_N - 1);
+            for (int c = 0; c + 1 < ALBEDO_N; c++) {
+                double m0 = c * h, m1 = (c + 1) * h;
+                sum += h / 6.0 * ((double)e[c] * (2.0 * m0 + m1) + (double)e[c + 1] * (m0 + 2.0 * m1));
+            }
+            albedo_avg[t][a] = (float)(2.0 * sum);
+        }
     }
 }
 
@@ -125,13 +141,29 @@ static float albedo_lookup(int table, float alpha, float cos_o) {
     return lerpf(lerpf(t[j][i], t[j][i + 1], fx), lerpf(t[j + 1][i], t[j + 1][i + 1], fx), fy);
 }
 
+/* Directional albedo of a GGX lobe of width alpha with Schlick's F0 and F90 (scalars). */
+static float ggx_albedo(float alpha, float f0, float f90, float cos_o) {
+    pthread_once(&albedo_once, build_albedo_tables);
+    return f0 * albedo_lookup(ALBEDO_GGX_SCALE, alpha, cos_o) + f90 * albedo_lookup(ALBEDO_GGX_BIAS, alpha, cos_o);
+}
+
+/* Its cosine-weighted mean over the hemisphere. */
+static float ggx_albedo_avg(float alpha, float f0, float f90) {
+    pthread_once(&albedo_once, build_albedo_tables);
+    float y = clampf(alpha, 0.0f, 1.0f) * (ALBEDO_N - 1);
+    int j = y < ALBEDO_N - 2 ? (int)y : ALBEDO_N - 2;
+    float fy = y - (float)j;
+    return f0 * lerpf(albedo_avg[0][j], albedo_avg[0][j + 1], fy) +
+           f90 * lerpf(albedo_avg[1][j], albedo_avg[1][j + 1], fy);
+}
+
 vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo) {
     if (!(bsdf_lobes(b) & BSDF_GLOSSY) || wo.z <= 0.0f) return v3s(0.0f);
     pthread_once(&albedo_once, build_albedo_tables);
     float alpha = bsdf_glossy_alpha(b);
     if (b->model == GLOSSY_GGX) {
         float scale = albedo_lookup(ALBEDO_GGX_SCALE, alpha, wo.z), bias = albedo_lookup(ALBEDO_GGX_BIAS, alpha, wo.z);
-        return add3(scale3(b->specular, scale), v3s(bias));
+        return add3(scale3(b->specular, scale), v3s((1.0f - b->f90_loss) * bias));
     }
     return scale3(b->specular, albedo_lookup(b->model == GLOSSY_PHONG ? ALBEDO_PHONG : ALBEDO_WARD, alpha, wo.z));
 }
@@ -219,7 +251,7 @@ static vec3 eval_glossy(const bsdf *b, vec3 wo, vec3 wi) {
     case GLOSSY_GGX: {
         vec3 h = normalize3(add3(wo, wi));
         float dv = ggx_d(b, h) * ggx_visibility(b, wo, wi);
-        return scale3(schlick_fresnel(b->specular, dot3(wo, h)), dv);
+        return scale3(schlick_fresnel(b->specular, 1.0f - b->f90_loss, dot3(wo, h)), dv);
     }
     case GLOSSY_PHONG: {
         float lobe = power_cosine(phong_one_minus_cos(wo, wi), b->exponent);
@@ -274,17 +306,24 @@ static int sample_glossy(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
     return wi->z > 0.0f;
 }
 
+/* The width of the dielectric specular lobe the diffuse is coupled to: the glossy lobe's. */
+static float coupled_alpha(const bsdf *b) { return sqrtf(b->alpha_x * b->alpha_y); }
+
+/* The coupled diffuse lobe's weight for one direction: 1 - E(w) of the dielectric's specular lobe. */
+static float coupled_transmittance(const bsdf *b, float cos_w) {
+    return 1.0f - fminf(ggx_albedo(coupled_alpha(b), b->couple_f0, b->couple_f90, cos_w), 1.0f);
+}
+
 static vec3 eval_diffuse(const bsdf *b, vec3 wo, vec3 wi) {
     vec3 f = scale3(b->diffuse, INV_PI_F);
-    if (b->diffuse_f0 > 0.0f) {
-        /* glTF dielectric: light the specular layer reflects never reaches the diffuse base. The
-         * spec weighs by 1 - F(wo.h), which lets the sum exceed 1 at grazing angles; weighing by
-         * the Fresnel transmittance on the way in and on the way out conserves energy and stays
-         * reciprocal. */
-        float f0 = b->diffuse_f0;
-        float t_o = 1.0f - (f0 + (1.0f - f0) * schlick_weight(wo.z));
-        float t_i = 1.0f - (f0 + (1.0f - f0) * schlick_weight(wi.z));
-        f = scale3(f, t_o * t_i);
+    if (b->couple_f0 > 0.0f || b->couple_f90 > 0.0f) {
+        /* glTF dielectric (docs/design.md): the diffuse base gets what the specular layer does
+         * not reflect, on the way in and on the way out, and 1 / (1 - E_avg) restores the energy
+         * the cosine-weighted mean of (1 - E(wi)) takes: its albedo is exactly base (1 - E(wo)),
+         * the spec's model where that conserves energy, and it stays reciprocal. */
+        float rest = 1.0f - fminf(ggx_albedo_avg(coupled_alpha(b), b->couple_f0, b->couple_f90), 1.0f);
+        float k = rest > 1e-4f ? coupled_transmittance(b, wo.z) * coupled_transmittance(b, wi.z) / rest : 0.0f;
+        f = scale3(f, k);
     }
     return f;
 }
@@ -297,9 +336,9 @@ float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes) {
      * samples ever become rare enough to make fireflies. */
     float c = fmaxf(wo.z, 0.0f);
     float wd = avg3(b->diffuse), wg;
+    if (b->couple_f0 > 0.0f || b->couple_f90 > 0.0f) wd *= coupled_transmittance(b, c);
     if (b->model == GLOSSY_GGX) {
-        wg = avg3(schlick_fresnel(b->specular, c));
-        if (b->diffuse_f0 > 0.0f) wd *= 1.0f - (b->diffuse_f0 + (1.0f - b->diffuse_f0) * schlick_weight(c));
+        wg = avg3(schlick_fresnel(b->specular, 1.0f - b->f90_loss, c));
     } else {
         wg = avg3(b->specular);
     }

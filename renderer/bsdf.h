@@ -4,7 +4,9 @@
  *
  * A bsdf is a diffuse (Lambert) lobe plus at most one glossy lobe, in the local shading frame:
  * +z is the shading normal, +x the tangent (the anisotropy direction). Reflection only: any
- * direction with z <= 0 gets f = 0 and pdf = 0. f excludes the cosine factor. */
+ * direction with z <= 0 gets f = 0 and pdf = 0. f excludes the cosine factor. The glTF model
+ * couples its diffuse lobe to the dielectric's specular lobe (docs/design.md, "The glTF
+ * material"). */
 #ifndef GLINT_BSDF_H
 #define GLINT_BSDF_H
 
@@ -37,10 +39,14 @@ typedef enum {
 #define BSDF_MAX_PHONG_EXPONENT 1e6f
 
 typedef struct {
-    vec3 diffuse;     /* Lambert albedo (already multiplied by 1 - metallic for glTF) */
-    float diffuse_f0; /* > 0: diffuse scaled by (1 - F(wo.z)) (1 - F(wi.z)), Schlick with this F0 (glTF dielectric) */
+    vec3 diffuse; /* Lambert albedo (already multiplied by 1 - metallic for glTF) */
+    /* glTF dielectric: the diffuse lobe takes what a GGX lobe of the glossy lobe's roughness with
+     * this Schlick F0 and F90 (scalars) does not reflect, reciprocally: f_d = diffuse / pi
+     * (1 - E(wo)) (1 - E(wi)) / (1 - E_avg), E that lobe's directional albedo. 0, 0: plain Lambert. */
+    float couple_f0, couple_f90;
     glossy_model model;
     vec3 specular;  /* GGX: F0 of Schlick's Fresnel; Phong and Ward: ks (no Fresnel) */
+    float f90_loss; /* GGX: 1 - Schlick's F90 (KHR_materials_specular's factor below 1), 0 by default */
     float alpha_x;  /* GGX, Ward: roughness along +x */
     float alpha_y;  /* GGX, Ward: roughness along +y */
     float exponent; /* Phong exponent */
@@ -53,9 +59,10 @@ typedef struct {
     int lobe;  /* BSDF_DIFFUSE or BSDF_GLOSSY: which lobe produced wi */
 } bsdf_sample_result;
 
-/* glTF 2.0 metallic-roughness (Lambert + GGX, Fresnel-weighted as the glTF spec's appendix B):
- * roughness is perceptual (alpha = roughness^2); anisotropy in [0,1] stretches alpha along +x as
- * KHR_materials_anisotropy does. */
+/* glTF 2.0 metallic-roughness, the spec's appendix B: mix(dielectric, metal, metallic), the
+ * dielectric a Fresnel mix of Lambert and GGX (F0 0.04), the diffuse coupled to the specular lobe
+ * by its directional albedo; roughness is perceptual (alpha = roughness^2); anisotropy in [0,1]
+ * stretches alpha along +x as KHR_materials_anisotropy does. */
 bsdf make_bsdf_gltf(vec3 base_color, float metallic, float roughness, float anisotropy);
 /* Diffuse kd plus modified Phong with ks and exponent n (kd + ks <= 1 conserves energy). */
 bsdf make_bsdf_phong(vec3 kd, vec3 ks, float exponent);
