@@ -16,6 +16,12 @@
 extern "C" {
 #endif
 
+/* What the materials render as, for references (their descriptions record it; glint bench
+ * refuses one rendered by another): bump it whenever any BSDF's values change. Version 1, never
+ * written, was the glTF diffuse weighted by (1 - F(wo)) (1 - F(wi)); 2 is the spec's model with
+ * the coupled diffuse and the ior, specular, sheen and clear coat extensions. */
+#define BSDF_MODEL_STAMP "glint-bsdf-2"
+
 /* Lobe masks: estimators that split path space ask for one lobe or both. BSDF_NOT_HIGHLIGHT,
  * for estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe. */
 enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_ALL = 3, BSDF_NOT_HIGHLIGHT = 4 };
