@@ -2,7 +2,8 @@
  * evaluates, samples and asks pdfs through these three functions. Adding a lobe is one edit in
  * bsdf.c.
  *
- * A bsdf is a diffuse (Lambert) lobe plus at most one glossy lobe, in the local shading frame:
+ * A bsdf is a diffuse lobe (Lambert, and glTF's sheen) plus a glossy lobe (one GGX, Phong or Ward
+ * lobe, and glTF's clear coat, a second GGX lobe over everything), in the local shading frame:
  * +z is the shading normal, +x the tangent (the anisotropy direction). Reflection only: any
  * direction with z <= 0 gets f = 0 and pdf = 0. f excludes the cosine factor. The glTF model
  * couples its diffuse lobe to the dielectric's specular lobe (docs/design.md, "The glTF
