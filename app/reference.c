@@ -418,12 +418,12 @@ static int near(float a, float b) { return fabsf(a - b) <= 1e-5f * (1.0f + fmaxf
 static int near3(vec3 a, vec3 b) { return near(a.x, b.x) && near(a.y, b.y) && near(a.z, b.z); }
 
 int reference_check(const char *ref, const reference_info *have, const reference_info *want, char *err, size_t errlen) {
-    if (strcmp(have->model, BSDF_MODEL_STAMP) != 0) /* whoever describes want, this glint renders it */
+    if (strcmp(have->model, want->model) != 0)
         return fail(err, errlen,
                     "%s: rendered by %s%s%s, not this glint's material model '%s': its values are stale; "
                     "re-render the reference",
                     ref, have->model[0] ? "material model '" : "an older glint (no material model recorded)",
-                    have->model, have->model[0] ? "'" : "", BSDF_MODEL_STAMP);
+                    have->model, have->model[0] ? "'" : "", want->model);
     if (strcmp(have->scene_hash, want->scene_hash) != 0)
         return fail(err, errlen, "%s: rendered from another scene ('%s', %s), not '%s' (%s)", ref, have->scene,
                     have->scene_hash, want->scene, want->scene_hash);
