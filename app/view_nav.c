@@ -129,6 +129,7 @@ int open_reference(ui_thread *u, const char *path) {
         shared_state *sh = u->sh;
         char env[1024];
         memset(&want, 0, sizeof want);
+        snprintf(want.model, sizeof want.model, "%s", BSDF_MODEL_STAMP);
         pthread_mutex_lock(&sh->lock);
         snprintf(env, sizeof env, "%s", sh->env_now);
         want.width = sh->render_w;

@@ -266,7 +266,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         int sharp = (bsdf_lobes(&x.b) & BSDF_GLOSSY) && bsdf_glossy_alpha(&x.b) < m->trace_alpha;
         if (!sharp) return add3(sum, mul3(beta, manylight_shade(m, s, &x, terms, rng, st)));
         shading_point diffuse_only = x;
-        diffuse_only.b.model = GLOSSY_NONE;
+        diffuse_only.b = bsdf_only(&x.b, BSDF_DIFFUSE);
         sum = add3(sum, mul3(beta, manylight_shade(m, s, &diffuse_only, terms, rng, st)));
 
         /* At the camera hit the lobe is split: `split` stratified directions each take the direct

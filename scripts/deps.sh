@@ -7,6 +7,9 @@ GLINT_PACKAGES=(
   xvfb xauth xdotool x11-xserver-utils embree-tools openexr clang-format
   clang libclang-rt-14-dev
 )
+# Opt-in, large: Blender (with the numpy its glTF importer needs) for the comparison against
+# Cycles (tests/bench/blender_twin.py, the blender ctest).
+if [ "${GLINT_BLENDER:-}" = 1 ]; then GLINT_PACKAGES+=(blender python3-numpy); fi
 
 glint_install_deps() {
   local missing=()
