@@ -315,6 +315,18 @@ struct importer {
                        label.c_str());
     }
 
+    // normalTexture: tangent-space normals in glTF's convention, x and y scaled. The
+    // occlusionTexture is ignored on purpose: a path tracer computes occlusion (docs/design.md).
+    void normal_map(const tinygltf::Material &gm, material &mat, const std::string &label, const std::string &what) {
+        const tinygltf::NormalTextureInfo &nt = gm.normalTexture;
+        if (nt.index < 0) return;
+        mat.normal_tex = texture(nt.index, nt.texCoord, what);
+        if (!(std::fabs(nt.scale) <= MAX_INTENSITY))
+            fail(label + ": normalTexture.scale " + num(nt.scale) + " is not a finite number up to " +
+                 num(MAX_INTENSITY));
+        mat.normal_scale = (float)nt.scale;
+    }
+
     void materials() {
         material_map.assign(m.materials.size(), -1);
         for (size_t i = 0; i < m.materials.size(); i++) {
@@ -378,8 +390,7 @@ struct importer {
             if (gm.alphaMode == "BLEND" || gm.alphaMode == "MASK")
                 scene_warn(s, "%s: alphaMode %s is not supported; surfaces are opaque", name.c_str(),
                            gm.alphaMode.c_str());
-            if (gm.normalTexture.index >= 0)
-                scene_warn(s, "%s: normal maps are not supported yet; using interpolated normals", name.c_str());
+            normal_map(gm, mat, label, what);
             material_map[i] = scene_add_material(s, &mat);
             if (material_map[i] < 0) fail("out of memory");
         }

@@ -10,6 +10,7 @@
 
 #include "gltf_import.h"
 #include "lights.h"
+#include "scene_parts.h"
 
 typedef struct {
     scene_warn_fn fn;
@@ -162,11 +163,13 @@ material material_default(void) {
     material m;
     memset(&m, 0, sizeof m);
     snprintf(m.name, sizeof m.name, "default");
+    m.normal_tex = (texture_slot){.texture = -1};
+    m.normal_scale = 1.0f;
     m.model = MATERIAL_GLTF;
     m.base_color = v3s(1.0f);
     m.metallic = 1.0f;
     m.roughness = 1.0f;
-    m.base_color_tex = m.metal_rough_tex = m.anisotropy_tex = m.emissive_tex = (texture_slot){-1, 0};
+    m.base_color_tex = m.metal_rough_tex = m.anisotropy_tex = m.emissive_tex = (texture_slot){.texture = -1};
     return m;
 }
 
@@ -214,6 +217,19 @@ int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err
             if (found < 0) return snprintf(err, errlen, "out of memory"), -1;
         }
         mat_index = found;
+    }
+
+    /* Tangents (normal maps, anisotropy) from the file, else as MikkTSpace makes them from the
+     * normal map's uv set; glTF ignores the file's when it has no normals. */
+    const material *mat = &s->materials[mat_index];
+    int tangent_uv = mat->normal_tex.texture >= 0 ? mat->normal_tex.texcoord : 0;
+    if ((mesh->uv0 || mesh->uv1) && (!mesh->tangents || !mesh->normals)) {
+        tangent_mesh tm;
+        if (tangents_generate(mesh, tangent_uv, &tm) != 0) goto oom;
+        tm.mesh.material = mat_index;
+        int status = scene_add_mesh(s, &tm.mesh, xform, err, errlen);
+        tangent_mesh_free(&tm);
+        return status;
     }
 
     /* Without normals, glTF asks for flat shading: every triangle gets its own vertices. */
@@ -299,54 +315,13 @@ int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err
         scene_warn(s, "skipped %d triangle%s with no area, or too large for float's squares (edges beyond ~1e9)",
                    skipped, skipped > 1 ? "s" : "");
 
-    /* Tangents from uv0 where the mesh has none (Lengyel): area-weighted per vertex, then
-     * orthogonalised against the normal; a fallback frame where the uvs are degenerate. */
-    if (!mesh->tangents || flat) {
-        vec3 *tan = calloc((size_t)out_vertices, sizeof(vec3));
-        vec3 *bit = calloc((size_t)out_vertices, sizeof(vec3));
-        if (!tan || !bit) {
-            free(tan);
-            free(bit);
-            goto oom;
-        }
-        if (mesh->uv0) {
-            for (int t = tri_base; t < tri_base + kept; t++) {
-                uint32_t *v = &s->indices[3 * t];
-                vec3 e1 = sub3(s->positions[v[1]], s->positions[v[0]]);
-                vec3 e2 = sub3(s->positions[v[2]], s->positions[v[0]]);
-                vec2 a = s->uv0[v[0]], b = s->uv0[v[1]], c = s->uv0[v[2]];
-                float du1 = b.x - a.x, dv1 = b.y - a.y, du2 = c.x - a.x, dv2 = c.y - a.y;
-                float d = du1 * dv2 - du2 * dv1;
-                if (!(fabsf(d) > 1e-20f)) continue;
-                float r = 1.0f / d;
-                /* Weighting by |d| turns r into sign(d): area-weighted in uv space. */
-                float w = fabsf(d);
-                vec3 sdir = scale3(sub3(scale3(e1, dv2), scale3(e2, dv1)), r * w);
-                vec3 tdir = scale3(sub3(scale3(e2, du1), scale3(e1, du2)), r * w);
-                for (int c2 = 0; c2 < 3; c2++) {
-                    tan[v[c2] - (uint32_t)base] = add3(tan[v[c2] - (uint32_t)base], sdir);
-                    bit[v[c2] - (uint32_t)base] = add3(bit[v[c2] - (uint32_t)base], tdir);
-                }
-            }
-        }
+    /* No uvs to derive tangents from (tangents_generate had them otherwise): any frame. */
+    if (!mesh->tangents || flat)
         for (int k = 0; k < out_vertices; k++) {
             vec3 n = s->normals[base + k];
-            vec3 t = tan[k];
-            vec3 to = sub3(t, scale3(n, dot3(n, t)));
-            float l2 = length_sq3(to);
-            vec3 tt;
-            float w = 1.0f;
-            if (l2 > 1e-30f && isfinite(l2)) {
-                tt = scale3(to, 1.0f / sqrtf(l2));
-                w = dot3(cross3(n, tt), bit[k]) < 0.0f ? -1.0f : 1.0f;
-            } else {
-                tt = length_sq3(n) > 0.0f ? any_tangent(n) : v3(1, 0, 0);
-            }
-            s->tangents[base + k] = (vec4){tt.x, tt.y, tt.z, w};
+            vec3 t = length_sq3(n) > 0.0f ? any_tangent(n) : v3(1, 0, 0);
+            s->tangents[base + k] = (vec4){t.x, t.y, t.z, 1.0f};
         }
-        free(tan);
-        free(bit);
-    }
 
     s->num_vertices += out_vertices;
     s->num_triangles += kept;
@@ -660,32 +635,7 @@ static void complete_hit(const scene *s, vec3 d, int t, float b1, float b2, floa
     h->uv1 = v2(b0 * s->uv1[v[0]].x + b1 * s->uv1[v[1]].x + b2 * s->uv1[v[2]].x,
                 b0 * s->uv1[v[0]].y + b1 * s->uv1[v[1]].y + b2 * s->uv1[v[2]].y);
 
-    vec3 ns = add3(add3(scale3(s->normals[v[0]], b0), scale3(s->normals[v[1]], b1)), scale3(s->normals[v[2]], b2));
-    float l2 = length_sq3(ns);
-    ns = (l2 > 1e-12f && isfinite(l2)) ? scale3(ns, 1.0f / sqrtf(l2)) : ng;
-    /* The shading normal lives on the same side as the geometric one... */
-    if (dot3(ns, ng) < 0.0f) ns = neg3(ns);
-    /* ...and must see the viewer: bend it toward wo when interpolation tilts it away. */
-    vec3 wo = neg3(d);
-    float cos_o = dot3(ns, wo);
-    const float min_cos = 1e-3f;
-    if (cos_o < min_cos) ns = normalize3(madd3(ns, wo, min_cos - cos_o));
-
-    /* Only anisotropic lobes care which way the tangent points; the rest take any frame. */
-    const material *m = &s->materials[h->material];
-    int anisotropic = (m->model == MATERIAL_WARD && m->alpha_x != m->alpha_y) ||
-                      (m->model == MATERIAL_GLTF && m->anisotropy_strength > 0.0f);
-    if (!anisotropic) {
-        h->shading = frame_from_normal(ns);
-        return;
-    }
-    const vec4 *tg = s->tangents;
-    vec3 tan = add3(
-        add3(scale3(v3(tg[v[0]].x, tg[v[0]].y, tg[v[0]].z), b0), scale3(v3(tg[v[1]].x, tg[v[1]].y, tg[v[1]].z), b1)),
-        scale3(v3(tg[v[2]].x, tg[v[2]].y, tg[v[2]].z), b2));
-    h->shading = frame_from_normal_tangent(ns, tan);
-    /* glTF bitangent = cross(n, t) * w; keep the handedness so anisotropy rotations turn the right way. */
-    if (tg[v[0]].w < 0.0f) h->shading.b = neg3(h->shading.b);
+    shading_frame_at_hit(s, h, b1, b2, d);
 }
 
 int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) {

@@ -53,6 +53,9 @@ typedef enum {
 typedef struct {
     char name[64];
     material_model model;
+    /* Geometry and texturing (docs/design.md, "Surfaces as glTF draws them") */
+    texture_slot normal_tex; /* linear: tangent-space normal, glTF's convention */
+    float normal_scale;      /* normalTexture.scale: multiplies the map's x and y */
     /* glTF metallic-roughness */
     vec3 base_color;
     float metallic, roughness;
