@@ -62,6 +62,7 @@ constexpr int MAX_NODE_DEPTH = 4096;                       // nesting of the nod
 constexpr long MAX_NODE_INSTANCES = 1000000;               // node visits, counting each instance of a shared node
 constexpr double MAX_INTENSITY = 1e20;                     // light intensities, emission, material factors
 constexpr size_t MAX_INSTANCED_ELEMENTS = (size_t)1 << 27; // vertices + indices over all mesh instances
+constexpr double MAX_UV_TRANSFORM = 1e6;                   // KHR_texture_transform offsets, scales, rotation
 
 // ---- accessors ----------------------------------------------------------------------------
 
@@ -303,6 +304,64 @@ struct importer {
         return texture_slot{mapped, texcoord};
     }
 
+    // A texture reference (index, texCoord, the reference's extensions) with its
+    // KHR_texture_transform: offset, rotation and scale as the extension's matrix T R S, and a
+    // texCoord that overrides the reference's. Every texture slot comes through here.
+    texture_slot texture_ref(int index, int texcoord, const Value *transform, const std::string &what) {
+        if (index < 0) return texture_slot{-1, 0};
+        float xf[6] = {1, 0, 0, 0, 1, 0};
+        if (transform) {
+            std::string label = what + ": KHR_texture_transform";
+            double offset[2] = {0.0, 0.0}, scale[2] = {1.0, 1.0};
+            pair_or(*transform, "offset", offset, label);
+            pair_or(*transform, "scale", scale, label);
+            double rotation = number_or(*transform, "rotation", 0.0);
+            if (!(std::fabs(rotation) <= MAX_UV_TRANSFORM))
+                fail(label + ": rotation " + num(rotation) + " is not a finite number up to " + num(MAX_UV_TRANSFORM));
+            texcoord = index_or(*transform, "texCoord", texcoord, label);
+            double c = std::cos(rotation), sn = std::sin(rotation);
+            const double m[6] = {c * scale[0], sn * scale[1], offset[0], -sn * scale[0], c * scale[1], offset[1]};
+            for (int k = 0; k < 6; k++) xf[k] = (float)m[k];
+        }
+        texture_slot slot = texture(index, texcoord, what);
+        slot.transformed = transform != nullptr;
+        std::memcpy(slot.uv_xf, xf, sizeof xf);
+        return slot;
+    }
+
+    // Two numbers under key (fallback untouched when absent), each finite and at most
+    // MAX_UV_TRANSFORM in magnitude; anything else is an error.
+    static void pair_or(const Value &obj, const char *key, double out[2], const std::string &what) {
+        if (!obj.IsObject() || !obj.Has(key)) return;
+        const Value &v = obj.Get(key);
+        if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber())
+            fail(what + ": " + key + " is not two numbers");
+        for (int i = 0; i < 2; i++) {
+            out[i] = v.Get(i).GetNumberAsDouble();
+            if (!(std::fabs(out[i]) <= MAX_UV_TRANSFORM))
+                fail(what + ": " + key + " " + num(out[i]) + " is not a finite number up to " + num(MAX_UV_TRANSFORM));
+        }
+    }
+
+    static const Value *transform_of(const tinygltf::ExtensionMap &ext) {
+        auto it = ext.find("KHR_texture_transform");
+        return it == ext.end() ? nullptr : &it->second;
+    }
+    texture_slot texture(const tinygltf::TextureInfo &t, const std::string &what) {
+        return texture_ref(t.index, t.texCoord, transform_of(t.extensions), what);
+    }
+    texture_slot texture(const tinygltf::NormalTextureInfo &t, const std::string &what) {
+        return texture_ref(t.index, t.texCoord, transform_of(t.extensions), what);
+    }
+    // A textureInfo object inside a material extension (JSON as tinygltf keeps it).
+    texture_slot texture(const Value &t, const std::string &what) {
+        const Value *transform = nullptr;
+        if (t.IsObject() && t.Has("extensions") && t.Get("extensions").Has("KHR_texture_transform"))
+            transform = &t.Get("extensions").Get("KHR_texture_transform");
+        return texture_ref(index_or(t, "index", -1, what), std::min(index_or(t, "texCoord", 0, what), 2), transform,
+                           what);
+    }
+
     // glTF's [0, 1] factors: a value above 1 is clamped, with one warning per material.
     void clamp_unit(material &mat, const std::string &label) {
         float *f[] = {&mat.base_color.x, &mat.base_color.y, &mat.base_color.z,
@@ -320,7 +379,7 @@ struct importer {
     void normal_map(const tinygltf::Material &gm, material &mat, const std::string &label, const std::string &what) {
         const tinygltf::NormalTextureInfo &nt = gm.normalTexture;
         if (nt.index < 0) return;
-        mat.normal_tex = texture(nt.index, nt.texCoord, what);
+        mat.normal_tex = texture(nt, what);
         if (!(std::fabs(nt.scale) <= MAX_INTENSITY))
             fail(label + ": normalTexture.scale " + num(nt.scale) + " is not a finite number up to " +
                  num(MAX_INTENSITY));
@@ -339,11 +398,10 @@ struct importer {
             mat.base_color = factor3_or(pbr.baseColorFactor, v3s(1.0f), label, "baseColorFactor");
             mat.metallic = factor(pbr.metallicFactor, label, "metallicFactor");
             mat.roughness = factor(pbr.roughnessFactor, label, "roughnessFactor");
-            mat.base_color_tex = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what);
-            mat.metal_rough_tex =
-                texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what);
+            mat.base_color_tex = texture(pbr.baseColorTexture, what);
+            mat.metal_rough_tex = texture(pbr.metallicRoughnessTexture, what);
             mat.emission = factor3_or(gm.emissiveFactor, v3s(0.0f), label, "emissiveFactor");
-            mat.emissive_tex = texture(gm.emissiveTexture.index, gm.emissiveTexture.texCoord, what);
+            mat.emissive_tex = texture(gm.emissiveTexture, what);
             mat.double_sided = gm.doubleSided;
             for (const auto &ext : gm.extensions) {
                 const Value &e = ext.second;
@@ -358,11 +416,8 @@ struct importer {
                     double rot = number_or(e, "anisotropyRotation", 0.0);
                     if (!(std::fabs(rot) <= 1e6)) fail(label + ": anisotropyRotation " + num(rot) + " is not an angle");
                     mat.anisotropy_rotation = (float)rot;
-                    if (e.Has("anisotropyTexture")) {
-                        const Value &t = e.Get("anisotropyTexture");
-                        mat.anisotropy_tex = texture(index_or(t, "index", -1, label + ": anisotropyTexture"),
-                                                     std::min(index_or(t, "texCoord", 0, label), 2), what);
-                    }
+                    if (e.Has("anisotropyTexture"))
+                        mat.anisotropy_tex = texture(e.Get("anisotropyTexture"), label + ": anisotropyTexture");
                 }
             }
             // The papers' lobes: extras.glint = {model: "phong"|"ward", kd, ks, exponent, alpha_x, alpha_y, rotation}
@@ -639,7 +694,7 @@ struct importer {
 
     void run() {
         static const char *supported[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                          "KHR_materials_anisotropy"};
+                                          "KHR_materials_anisotropy", "KHR_texture_transform"};
         for (const std::string &e : m.extensionsUsed) {
             bool ok = false;
             for (const char *sup : supported) ok = ok || e == sup;

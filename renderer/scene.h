@@ -40,6 +40,10 @@ typedef struct {
 typedef struct {
     int texture;
     int texcoord; /* 0 or 1 */
+    /* KHR_texture_transform, applied where uv is looked up (texture_lookup): when transformed,
+     * u' = uv_xf[0] u + uv_xf[1] v + uv_xf[2], v' = uv_xf[3] u + uv_xf[4] v + uv_xf[5]. */
+    int transformed;
+    float uv_xf[6];
 } texture_slot;
 
 /* ---- materials ----------------------------------------------------------------------------- */

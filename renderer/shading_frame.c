@@ -41,11 +41,28 @@ static vec3 guard_normal(vec3 n, vec3 ng, vec3 wo) {
     return bend_toward(keep_reflection_above(bend_toward(n, ng), ng, wo), wo);
 }
 
-/* The normal map's tangent-space normal at the hit. */
+/* The normal map's tangent-space normal at the hit, its x and y turned (and mirrored) as
+ * KHR_texture_transform turns the texture on the surface, so that they follow the texture's own
+ * u and v there (as tangents made from the transformed uvs would). */
 static vec3 map_normal(const scene *s, const material *m, const surface_hit *h) {
-    vec4 c = texture_lookup(s, m->normal_tex, h->uv0, h->uv1, 0);
+    const texture_slot *slot = &m->normal_tex;
+    vec4 c = texture_lookup(s, *slot, h->uv0, h->uv1, 0);
     float k = m->normal_scale;
-    return v3((2.0f * c.x - 1.0f) * k, (2.0f * c.y - 1.0f) * k, 2.0f * c.z - 1.0f);
+    float x = (2.0f * c.x - 1.0f) * k, y = (2.0f * c.y - 1.0f) * k, z = 2.0f * c.z - 1.0f;
+    if (slot->transformed) {
+        /* The texture's u axis in (tangent, bitangent) axes: A^-1 (1, 0) with v turned up the
+         * image, for A the transform's linear part; det(A) < 0 mirrors the map's y. */
+        const float *a = slot->uv_xf;
+        float det = a[0] * a[4] - a[1] * a[3];
+        float cu = a[4] * det, su = a[3] * det, len = sqrtf(cu * cu + su * su);
+        if (len > 0.0f && isfinite(len)) {
+            float hy = det < 0.0f ? -y : y;
+            float rx = (cu * x - su * hy) / len, ry = (su * x + cu * hy) / len;
+            x = rx;
+            y = ry;
+        }
+    }
+    return v3(x, y, z);
 }
 
 void shading_frame_at_hit(const scene *s, surface_hit *h, float b1, float b2, vec3 d) {

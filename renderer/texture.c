@@ -72,6 +72,10 @@ vec4 texture_lookup(const scene *s, texture_slot slot, vec2 uv0, vec2 uv1, int s
     const scene_texture *t = &s->textures[slot.texture];
     const scene_image *img = &s->images[t->image];
     vec2 uv = slot.texcoord == 1 ? uv1 : uv0;
+    if (slot.transformed) { /* KHR_texture_transform */
+        const float *m = slot.uv_xf;
+        uv = v2(m[0] * uv.x + m[1] * uv.y + m[2], m[3] * uv.x + m[4] * uv.y + m[5]);
+    }
     /* Texel centres at half-integers; floor via a large positive shift keeps negative uv exact. */
     float x = uv.x * (float)img->width - 0.5f, y = uv.y * (float)img->height - 0.5f;
     if (!isfinite(x) || !isfinite(y) || fabsf(x) > 1e8f || fabsf(y) > 1e8f) x = y = 0.0f;
