@@ -386,6 +386,25 @@ struct importer {
         mat.normal_scale = (float)nt.scale;
     }
 
+    // alphaMode with its cutoff, and baseColorFactor's alpha (the base colour texture's alpha
+    // multiplies it where a ray meets the surface).
+    void alpha(const tinygltf::Material &gm, material &mat, const std::string &label) {
+        const std::vector<double> &f = gm.pbrMetallicRoughness.baseColorFactor;
+        if (f.size() >= 4) mat.base_alpha = factor(f[3], label, "baseColorFactor's alpha");
+        if (mat.base_alpha > 1.0f) {
+            mat.base_alpha = 1.0f;
+            scene_warn(s, "%s: %s: baseColorFactor's alpha is above 1, clamped to 1", name.c_str(), label.c_str());
+        }
+        mat.alpha_cutoff = factor(gm.alphaCutoff, label, "alphaCutoff");
+        if (gm.alphaMode == "MASK")
+            mat.alpha = ALPHA_MASK;
+        else if (gm.alphaMode == "BLEND")
+            mat.alpha = ALPHA_BLEND;
+        else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE")
+            scene_warn(s, "%s: %s: unknown alphaMode '%s', drawn opaque", name.c_str(), label.c_str(),
+                       gm.alphaMode.c_str());
+    }
+
     void materials() {
         material_map.assign(m.materials.size(), -1);
         for (size_t i = 0; i < m.materials.size(); i++) {
@@ -442,9 +461,7 @@ struct importer {
                 }
             }
             clamp_unit(mat, label);
-            if (gm.alphaMode == "BLEND" || gm.alphaMode == "MASK")
-                scene_warn(s, "%s: alphaMode %s is not supported; surfaces are opaque", name.c_str(),
-                           gm.alphaMode.c_str());
+            alpha(gm, mat, label);
             normal_map(gm, mat, label, what);
             material_map[i] = scene_add_material(s, &mat);
             if (material_map[i] < 0) fail("out of memory");

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene_parts.h"
+
 /* ---- environment map ----------------------------------------------------------------------- */
 
 vec3 env_eval(const scene *s, vec3 d) {
@@ -88,7 +90,7 @@ int scene_build_lights(scene *s, char *err, size_t errlen) {
     for (int t = 0; t < s->num_triangles; t++) {
         s->tri_light[t] = -1;
         const material *m = &s->materials[s->tri_material[t]];
-        if (!(max_comp3(m->emission) > 0.0f)) continue;
+        if (!(max_comp3(m->emission) > 0.0f) || scene_triangle_invisible(s, t)) continue;
         light l;
         memset(&l, 0, sizeof l);
         l.type = LIGHT_TRIANGLE;
@@ -213,7 +215,7 @@ static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light
         vec3 wi = scale3(d, 1.0f / dist);
         float cos_l = dot3(n, wi); /* > 0: we see the back (winding) side */
         h.backface = cos_l > 0.0f;
-        vec3 le = material_emission(s, &h);
+        vec3 le = scale3(material_emission(s, &h), material_coverage(s, &h)); /* none from a cut-out */
         float abs_cos = fabsf(cos_l);
         if (is_black3(le) || !(abs_cos > 0.0f)) return 0;
         out->wi = wi;
@@ -350,7 +352,7 @@ int light_sample_emission(const scene *s, float u_select, vec2 u_pos, vec2 u_dir
                 h.backface = 1;
             }
         }
-        vec3 le = material_emission(s, &h);
+        vec3 le = scale3(material_emission(s, &h), material_coverage(s, &h));
         if (is_black3(le) || !(area2 > 0.0f)) return 0;
         /* Cosine-weighted: Le cos / (pdf_area pdf_dir) = Le pi area. */
         out->o = q;

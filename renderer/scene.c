@@ -63,7 +63,7 @@ done:
 
 void scene_destroy(scene *s) {
     if (!s) return;
-    if (s->rtc) rtcReleaseScene(s->rtc);
+    scene_bvh_free(s);
     if (s->device) rtcReleaseDevice(s->device);
     free(s->positions);
     free(s->normals);
@@ -165,6 +165,8 @@ material material_default(void) {
     snprintf(m.name, sizeof m.name, "default");
     m.normal_tex = (texture_slot){.texture = -1};
     m.normal_scale = 1.0f;
+    m.alpha_cutoff = 0.5f;
+    m.base_alpha = 1.0f;
     m.model = MATERIAL_GLTF;
     m.base_color = v3s(1.0f);
     m.metallic = 1.0f;
@@ -333,11 +335,6 @@ oom:
 
 /* ---- finalize ------------------------------------------------------------------------------ */
 
-/* Embree's own errors go where the scene's warnings go: the library does not print. */
-static void embree_error(void *user, enum RTCError code, const char *str) {
-    scene_warn(user, "embree: %s (code %d)", str ? str : "unknown error", (int)code);
-}
-
 /* The scene's size from its triangles: bounds, diagonal, and the ray offset that scales with it.
  * Returns 0, or -1 when the scene has no (finite) extent. */
 static int update_extent(scene *s) {
@@ -359,13 +356,6 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
     /* Pad the vertex array for Embree (the slot exists: positions has one spare element). */
     s->positions[s->num_vertices] = v3(0, 0, 0);
 
-    if (scene_build_lights(s, err, errlen) != 0) return -1;
-    if (s->num_lights == 0)
-        scene_warn(s,
-                   "%s: no light (no punctual light, no emissive material): the image is black without an "
-                   "environment map",
-                   s->path);
-
     /* Hits need the geometric normal, which moving a light (a translation) never changes. */
     free(s->tri_normal);
     if (!(s->tri_normal = malloc((size_t)s->num_triangles * sizeof(vec3))))
@@ -376,22 +366,13 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
         s->tri_normal[t] = normalize3(cross3(sub3(s->positions[v[1]], p0), sub3(s->positions[v[2]], p0)));
     }
 
-    s->device = rtcNewDevice(NULL);
-    if (!s->device) return snprintf(err, errlen, "%s: cannot create an Embree device", s->path), -1;
-    rtcSetDeviceErrorFunction(s->device, embree_error, s);
-    s->rtc = rtcNewScene(s->device);
-    rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry geom = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->positions, 0, sizeof(vec3),
-                               (size_t)s->num_vertices);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->indices, 0, 3 * sizeof(uint32_t),
-                               (size_t)s->num_triangles);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometryByID(s->rtc, geom, 0);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(s->rtc);
-    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE)
-        return snprintf(err, errlen, "%s: building the BVH failed", s->path), -1;
+    /* The BVH first: it decides which triangles no ray can see (alpha), and those emit nothing. */
+    if (scene_build_bvh(s, err, errlen) != 0 || scene_build_lights(s, err, errlen) != 0) return -1;
+    if (s->num_lights == 0)
+        scene_warn(s,
+                   "%s: no light (no punctual light, no emissive material): the image is black without an "
+                   "environment map",
+                   s->path);
     return 0;
 }
 
@@ -504,11 +485,7 @@ int scene_move_light(scene *s, int g, vec3 delta, char *err, size_t errlen) {
     free(moved);
     update_extent(s); /* cannot fail: the moved triangles keep their (non-zero) areas */
     /* The vertex buffer is shared with Embree: mark it changed and rebuild the BVH. */
-    RTCGeometry geom = rtcGetGeometry(s->rtc, 0);
-    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
-    rtcCommitGeometry(geom);
-    rtcCommitScene(s->rtc);
-    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) return snprintf(err, errlen, "rebuilding the BVH failed"), -1;
+    if (scene_bvh_vertices_moved(s) != 0) return snprintf(err, errlen, "rebuilding the BVH failed"), -1;
     /* Bounds feed the directional and environment powers: the selection distribution follows. */
     return scene_build_lights(s, err, errlen);
 }
@@ -647,7 +624,7 @@ int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) 
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(s->rtc, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
-    complete_hit(s, d, (int)rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, h);
+    complete_hit(s, d, scene_hit_triangle(s, rh.hit.geomID, rh.hit.primID), rh.hit.u, rh.hit.v, rh.ray.tfar, h);
     return 1;
 }
 
@@ -683,7 +660,8 @@ unsigned scene_intersect_packet(const scene *s, vec3 o, const vec3 *d, int n, su
     unsigned hits = 0;
     for (int i = 0; i < n; i++) {
         if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-        complete_hit(s, d[i], (int)rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], rh.ray.tfar[i], &h[i]);
+        complete_hit(s, d[i], scene_hit_triangle(s, rh.hit.geomID[i], rh.hit.primID[i]), rh.hit.u[i], rh.hit.v[i],
+                     rh.ray.tfar[i], &h[i]);
         hits |= 1u << i;
     }
     return hits;

@@ -54,12 +54,18 @@ typedef enum {
     MATERIAL_WARD,     /* extras.glint.model = "ward" */
 } material_model;
 
+/* glTF alphaMode. */
+typedef enum { ALPHA_OPAQUE = 0, ALPHA_MASK, ALPHA_BLEND } alpha_mode;
+
 typedef struct {
     char name[64];
     material_model model;
     /* Geometry and texturing (docs/design.md, "Surfaces as glTF draws them") */
     texture_slot normal_tex; /* linear: tangent-space normal, glTF's convention */
     float normal_scale;      /* normalTexture.scale: multiplies the map's x and y */
+    alpha_mode alpha;        /* MASK: cut out below alpha_cutoff; BLEND: stochastic transparency */
+    float alpha_cutoff;      /* MASK */
+    float base_alpha;        /* baseColorFactor's alpha; the base colour texture's alpha multiplies it */
     /* glTF metallic-roughness */
     vec3 base_color;
     float metallic, roughness;
@@ -151,6 +157,15 @@ typedef struct scene {
 
     RTCDevice device;
     RTCScene rtc;
+
+    /* The ray-traced geometry (alpha.c): Embree geometry 0 holds the triangles every ray stops
+     * at, geometry 1 those whose alpha a filter tests; each maps its primitives to scene
+     * triangles (bvh_tri[0] NULL: geometry 0 is every triangle, in order). Per material its
+     * alpha class. */
+    uint32_t *bvh_indices[2];
+    int32_t *bvh_tri[2];
+    int bvh_count[2];
+    unsigned char *alpha_class;
 } scene;
 
 /* ---- loading ------------------------------------------------------------------------------- */

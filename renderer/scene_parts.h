@@ -33,4 +33,28 @@ void tangent_mesh_free(tangent_mesh *t);
  * anisotropic or normal-mapped. h->ng, h->uv0, h->uv1 and h->material must be set. */
 void shading_frame_at_hit(const scene *s, surface_hit *h, float b1, float b2, vec3 d);
 
+/* ---- alpha.c ------------------------------------------------------------------------------- */
+
+/* Builds (or rebuilds, after materials changed) the Embree scene: the device on first use, the
+ * opaque geometry, the alpha-tested one with its filters. Returns 0, or -1 with err set. */
+int scene_build_bvh(scene *s, char *err, size_t errlen);
+/* After vertices moved (a light edit): Embree refits. Returns 0 or -1. */
+int scene_bvh_vertices_moved(scene *s);
+/* Releases the Embree scene and the alpha tables (not the device). */
+void scene_bvh_free(scene *s);
+/* The scene triangle Embree's hit (geometry, primitive) stands for. */
+static inline int scene_hit_triangle(const scene *s, unsigned geom, unsigned prim) {
+    return s->bvh_tri[geom] ? s->bvh_tri[geom][prim] : (int)prim;
+}
+/* 1 when no ray can see triangle t (its material's alpha is zero, or below its cutoff,
+ * everywhere): it is not in the BVH and emits nothing. */
+int scene_triangle_invisible(const scene *s, int t);
+/* Alpha of material m at uv: baseColorFactor's alpha times the base colour texture's. */
+float material_alpha(const scene *s, const material *m, vec2 uv0, vec2 uv1);
+/* How much of a hit's surface is there, for what samples points on it (emission): 1 for opaque
+ * materials, MASK 1 or 0, BLEND its alpha. */
+float material_coverage(const scene *s, const surface_hit *h);
+/* BLEND's number in [0, 1) for the ray (o, d) meeting triangle tri (tests compare against it). */
+float alpha_ray_hash(vec3 o, vec3 d, int tri);
+
 #endif
