@@ -74,6 +74,7 @@ void scene_destroy(scene *s) {
     free(s->tri_material);
     free(s->tri_normal);
     free(s->tri_light);
+    free(s->tri_emit_tex);
     free(s->materials);
     for (int i = 0; i < s->num_images; i++) free(s->images[i].rgba);
     free(s->images);
@@ -367,7 +368,9 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
     }
 
     /* The BVH first: it decides which triangles no ray can see (alpha), and those emit nothing. */
-    if (scene_build_bvh(s, err, errlen) != 0 || scene_build_lights(s, err, errlen) != 0) return -1;
+    if (scene_build_bvh(s, err, errlen) != 0 || scene_emissive_analyse(s, err, errlen) != 0 ||
+        scene_build_lights(s, err, errlen) != 0)
+        return -1;
     if (s->num_lights == 0)
         scene_warn(s,
                    "%s: no light (no punctual light, no emissive material): the image is black without an "

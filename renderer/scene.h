@@ -166,6 +166,9 @@ typedef struct scene {
     int32_t *bvh_tri[2];
     int bvh_count[2];
     unsigned char *alpha_class;
+    /* Per triangle, for emissive triangles with an emissive texture (emissive.c): the texture's
+     * mean over the triangle, 0 in the channels where it is black all over; NULL without such. */
+    vec3 *tri_emit_tex;
 } scene;
 
 /* ---- loading ------------------------------------------------------------------------------- */

@@ -33,6 +33,22 @@ void tangent_mesh_free(tangent_mesh *t);
  * anisotropic or normal-mapped. h->ng, h->uv0, h->uv1 and h->material must be set. */
 void shading_frame_at_hit(const scene *s, surface_hit *h, float b1, float b2, vec3 d);
 
+/* ---- texture.c ----------------------------------------------------------------------------- */
+
+/* Texel index i in a row or column of n texels under a wrap mode. */
+int texture_wrap(int i, int n, wrap_mode mode);
+/* sRGB-encoded 8-bit value -> linear, as texture_lookup decodes colour (256 entries). */
+const float *texture_srgb_table(void);
+
+/* ---- emissive.c ---------------------------------------------------------------------------- */
+
+/* For every emissive triangle with an emissive texture, the texture's mean over the triangle
+ * (s->tri_emit_tex): zero in exactly the channels where the texture is black all over the
+ * triangle (then it emits nothing there and is no light), never below a thousandth of the
+ * channel's maximum elsewhere. Bounded work per triangle (pyramids of the textures). Call after
+ * materials change; scene_build_lights reads it. Returns 0, or -1 with err set. */
+int scene_emissive_analyse(scene *s, char *err, size_t errlen);
+
 /* ---- alpha.c ------------------------------------------------------------------------------- */
 
 /* Builds (or rebuilds, after materials changed) the Embree scene: the device on first use, the
