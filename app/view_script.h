@@ -9,7 +9,7 @@
  *   reference FILE.exr        spin DEG_PER_S SECONDS stats
  *   frame                     reference-camera       sky
  *   quit                      pause                  resume
- *   sleep SECONDS
+ *   sleep SECONDS             variant NAME|default
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -19,7 +19,8 @@
  * the whole scene, `reference-camera` goes back to the reference's. `sleep` lets time pass, changing
  * nothing (while a test sends real input events). `move-light` moves light INDEX (as the panel lists them)
  * by a world-space offset and selects it; `spin` orbits continuously, a little every drawn
- * frame, as a held mouse drag would. */
+ * frame, as a held mouse drag would. `variant` shows the scene's material variant NAME (`default`:
+ * the file's materials), as the panel's choice does, and waits until the scene is reloaded. */
 #ifndef GLINT_VIEW_SCRIPT_H
 #define GLINT_VIEW_SCRIPT_H
 
@@ -50,6 +51,7 @@ typedef enum {
     ACT_PAUSE,  /* refinement stops... */
     ACT_RESUME, /* ...and goes on */
     ACT_SLEEP,  /* the script waits SECONDS, the viewer runs on */
+    ACT_VARIANT,
 } script_action_kind;
 
 typedef struct {

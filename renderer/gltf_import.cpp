@@ -16,6 +16,7 @@
 
 #include <tiny_gltf.h>
 
+#include "gltf_extensions.h"
 #include "gltf_input.h"
 
 namespace {
@@ -51,18 +52,13 @@ std::string printable(std::string t) {
     return t;
 }
 
-std::string num(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", v);
-    return b;
-}
+using gltf_ext::num;
 
 // Limits on what a scene may hold (README states them).
 constexpr int MAX_NODE_DEPTH = 4096;                       // nesting of the node hierarchy
 constexpr long MAX_NODE_INSTANCES = 1000000;               // node visits, counting each instance of a shared node
 constexpr double MAX_INTENSITY = 1e20;                     // light intensities, emission, material factors
 constexpr size_t MAX_INSTANCED_ELEMENTS = (size_t)1 << 27; // vertices + indices over all mesh instances
-constexpr double MAX_UV_TRANSFORM = 1e6;                   // KHR_texture_transform offsets, scales, rotation
 
 // ---- accessors ----------------------------------------------------------------------------
 
@@ -311,36 +307,13 @@ struct importer {
         if (index < 0) return texture_slot{-1, 0};
         float xf[6] = {1, 0, 0, 0, 1, 0};
         if (transform) {
-            std::string label = what + ": KHR_texture_transform";
-            double offset[2] = {0.0, 0.0}, scale[2] = {1.0, 1.0};
-            pair_or(*transform, "offset", offset, label);
-            pair_or(*transform, "scale", scale, label);
-            double rotation = number_or(*transform, "rotation", 0.0);
-            if (!(std::fabs(rotation) <= MAX_UV_TRANSFORM))
-                fail(label + ": rotation " + num(rotation) + " is not a finite number up to " + num(MAX_UV_TRANSFORM));
-            texcoord = index_or(*transform, "texCoord", texcoord, label);
-            double c = std::cos(rotation), sn = std::sin(rotation);
-            const double m[6] = {c * scale[0], sn * scale[1], offset[0], -sn * scale[0], c * scale[1], offset[1]};
-            for (int k = 0; k < 6; k++) xf[k] = (float)m[k];
+            std::string why = gltf_ext::texture_transform(*transform, xf, &texcoord);
+            if (!why.empty()) fail(what + ": KHR_texture_transform: " + why);
         }
         texture_slot slot = texture(index, texcoord, what);
         slot.transformed = transform != nullptr;
         std::memcpy(slot.uv_xf, xf, sizeof xf);
         return slot;
-    }
-
-    // Two numbers under key (fallback untouched when absent), each finite and at most
-    // MAX_UV_TRANSFORM in magnitude; anything else is an error.
-    static void pair_or(const Value &obj, const char *key, double out[2], const std::string &what) {
-        if (!obj.IsObject() || !obj.Has(key)) return;
-        const Value &v = obj.Get(key);
-        if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber())
-            fail(what + ": " + key + " is not two numbers");
-        for (int i = 0; i < 2; i++) {
-            out[i] = v.Get(i).GetNumberAsDouble();
-            if (!(std::fabs(out[i]) <= MAX_UV_TRANSFORM))
-                fail(what + ": " + key + " " + num(out[i]) + " is not a finite number up to " + num(MAX_UV_TRANSFORM));
-        }
     }
 
     static const Value *transform_of(const tinygltf::ExtensionMap &ext) {
@@ -468,6 +441,17 @@ struct importer {
         }
     }
 
+    // KHR_materials_variants: per primitive its mappings as one table, made at its first
+    // instance and shared by the others (gltf_extensions.cpp reads them).
+    std::vector<std::vector<int>> variant_tables; // [mesh][primitive]: table, -1 none, -2 not read yet
+
+    int variant_table(int mesh, size_t prim, const tinygltf::Primitive &p, const std::string &what) {
+        int &table = variant_tables[(size_t)mesh][prim];
+        std::string why = table == -2 ? gltf_ext::variant_table(s, p, material_map, &table) : "";
+        if (!why.empty()) fail(what + ": " + why);
+        return table;
+    }
+
     // ---- nodes, meshes, lights, cameras ----------------------------------------------------
 
     static mat4 node_local(const tinygltf::Node &n) {
@@ -590,7 +574,9 @@ struct importer {
             if (idx.empty() && nv % 3 != 0) md.num_vertices = (int)(nv - nv % 3);
             md.material = material;
             char err[256];
+            int table = variant_table(index, pi, p, what), first = s->num_triangles;
             if (scene_add_mesh(s, &md, &xf, err, sizeof err) != 0) fail(what + ": " + err);
+            if (table >= 0 && scene_map_variants(s, first, table) != 0) fail("out of memory");
         }
     }
 
@@ -711,7 +697,8 @@ struct importer {
 
     void run() {
         static const char *supported[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                          "KHR_materials_anisotropy", "KHR_texture_transform"};
+                                          "KHR_materials_anisotropy", "KHR_texture_transform",
+                                          "KHR_materials_variants"};
         for (const std::string &e : m.extensionsUsed) {
             bool ok = false;
             for (const char *sup : supported) ok = ok || e == sup;
@@ -720,7 +707,11 @@ struct importer {
         texture_map.assign(m.textures.size(), -1);
         image_map.assign(m.images.size(), -1);
         on_stack.assign(m.nodes.size(), 0);
+        variant_tables.resize(m.meshes.size());
+        for (size_t i = 0; i < m.meshes.size(); i++) variant_tables[i].assign(m.meshes[i].primitives.size(), -2);
         materials();
+        std::string why = gltf_ext::read_variants(s, m);
+        if (!why.empty()) fail(why);
         if (!m.scenes.empty()) {
             int si = m.defaultScene >= 0 && (size_t)m.defaultScene < m.scenes.size() ? m.defaultScene : 0;
             for (int r : m.scenes[(size_t)si].nodes) node(r);

@@ -75,6 +75,7 @@ void scene_destroy(scene *s) {
     free(s->tri_normal);
     free(s->tri_light);
     free(s->tri_emit_tex);
+    scene_variants_free(s);
     free(s->materials);
     for (int i = 0; i < s->num_images; i++) free(s->images[i].rgba);
     free(s->images);
@@ -350,6 +351,14 @@ static int update_extent(scene *s) {
     return 0;
 }
 
+static void warn_if_unlit(scene *s) {
+    if (s->num_lights == 0)
+        scene_warn(s,
+                   "%s: no light (no punctual light, no emissive material): the image is black without an "
+                   "environment map",
+                   s->path);
+}
+
 int scene_finalize(scene *s, char *err, size_t errlen) {
     if (s->num_triangles == 0) return snprintf(err, errlen, "%s: no triangles to render", s->path), -1;
     if (update_extent(s) != 0) return snprintf(err, errlen, "%s: scene has no extent", s->path), -1;
@@ -371,11 +380,8 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
     if (scene_build_bvh(s, err, errlen) != 0 || scene_emissive_analyse(s, err, errlen) != 0 ||
         scene_build_lights(s, err, errlen) != 0)
         return -1;
-    if (s->num_lights == 0)
-        scene_warn(s,
-                   "%s: no light (no punctual light, no emissive material): the image is black without an "
-                   "environment map",
-                   s->path);
+    /* A material variant may bring its own: scene_set_variant warns then. */
+    if (!scene_variants_emit(s)) warn_if_unlit(s);
     return 0;
 }
 
@@ -529,6 +535,29 @@ int scene_set_light_gain(scene *s, int g, float gain, char *err, size_t errlen) 
     box->gains[g] = gain;
     /* Powers and the selection distribution follow the new intensity. */
     return scene_build_lights(s, err, errlen);
+}
+
+int scene_set_variant(scene *s, int v, char *err, size_t errlen) {
+    if (v < -1 || v >= scene_num_variants(s))
+        return snprintf(err, errlen, "%s: no material variant %d (the scene has %d)", s->path, v,
+                        scene_num_variants(s)),
+               -1;
+    /* Light groups follow the materials: intensities go back to the file's before they change. */
+    scene_box *box = (scene_box *)s;
+    for (int g = 0; g < box->num_gains; g++)
+        if (box->gains[g] != 1.0f && scene_set_light_gain(s, g, 1.0f, err, errlen) != 0) return -1;
+    scene_apply_variant(s, v);
+    free(box->gains);
+    free(box->gain_bases);
+    box->gains = NULL;
+    box->gain_bases = NULL;
+    box->num_gains = 0;
+    if (!s->rtc) return 0; /* not finalized yet: scene_finalize builds the rest */
+    if (scene_build_bvh(s, err, errlen) != 0 || scene_emissive_analyse(s, err, errlen) != 0 ||
+        scene_build_lights(s, err, errlen) != 0)
+        return -1;
+    warn_if_unlit(s);
+    return 0;
 }
 
 /* ---- loading ------------------------------------------------------------------------------- */

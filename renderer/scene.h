@@ -169,6 +169,8 @@ typedef struct scene {
     /* Per triangle, for emissive triangles with an emissive texture (emissive.c): the texture's
      * mean over the triangle, 0 in the channels where it is black all over; NULL without such. */
     vec3 *tri_emit_tex;
+    /* KHR_materials_variants (variants.c; the accessors below): NULL without variants. */
+    struct scene_variants *variants;
 } scene;
 
 /* ---- loading ------------------------------------------------------------------------------- */
@@ -240,6 +242,30 @@ int scene_add_camera(scene *s, const camera *c);
 material material_default(void);
 /* Builds what rendering needs: light list and selection, scale, the BVH. Returns 0 or -1. */
 int scene_finalize(scene *s, char *err, size_t errlen);
+
+/* Material variants (KHR_materials_variants): their number (0 without), names, and the one in
+ * use (-1: the file's default materials). */
+#define SCENE_MAX_VARIANTS 1024
+#define SCENE_MAX_VARIANT_PAIRS (1 << 22) /* (variant, material) mappings over all primitives */
+int scene_num_variants(const scene *s);
+const char *scene_variant_name(const scene *s, int i);
+int scene_variant(const scene *s);
+/* The variant called name, or -1. */
+int scene_variant_find(const scene *s, const char *name);
+/* Gives every primitive its material for variant v (-1: the default ones) and rebuilds what
+ * follows from materials (alpha, emitters, the light list); intensity edits start over (light
+ * groups follow materials), moved lights stay moved. Between frames. Returns 0, or -1 with err
+ * set (no such variant, out of memory). */
+int scene_set_variant(scene *s, int v, char *err, size_t errlen);
+/* scene_set_variant for the variant called name; an unknown name is an error listing the scene's. */
+int scene_select_variant(scene *s, const char *name, char *err, size_t errlen);
+/* Building them (the importer): the names, once; a primitive's mappings as a table of (variant,
+ * material) pairs, returning its index; then, after each scene_add_mesh of an instance of it,
+ * that the triangles added since first_triangle follow table. Each returns -1 on bad input (an
+ * index out of range, over the limits above) or out of memory. */
+int scene_add_variants(scene *s, const char *const *names, int n);
+int scene_add_variant_table(scene *s, const int *variants, const int *materials, int n);
+int scene_map_variants(scene *s, int first_triangle, int table);
 
 /* ---- editing lights (between frames: nothing may be rendering the scene) ------------------ */
 

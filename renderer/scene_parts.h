@@ -73,4 +73,13 @@ float material_coverage(const scene *s, const surface_hit *h);
 /* BLEND's number in [0, 1) for the ray (o, d) meeting triangle tri (tests compare against it). */
 float alpha_ray_hash(vec3 o, vec3 d, int tri);
 
+/* ---- variants.c ---------------------------------------------------------------------------- */
+
+/* Rewrites the triangles' materials for variant v (-1: the defaults) and nothing else (the caller
+ * rebuilds). Returns 0, or -1 for a variant the scene does not have. */
+int scene_apply_variant(scene *s, int v);
+void scene_variants_free(scene *s);
+/* 1 when some variant gives a primitive an emissive material. */
+int scene_variants_emit(const scene *s);
+
 #endif

@@ -42,12 +42,24 @@ static inline void gt_cat(char **s, size_t *n, const char *text) {
     *n += k;
 }
 
+/* gt_gltf with the nodes array and the scene's root nodes given (JSON text). */
+static inline char *gt_gltf_nodes(const char *nodes, const char *roots, const char *materials, const char *textures,
+                                  const char *samplers, const gt_image *images, int num_images, const char *prim_extra,
+                                  const char *top_extra);
+
 /* The glTF's JSON (malloc'd): the square as mesh 0 in node 0, its primitive using material 0
  * plus prim_extra (members added verbatim, e.g. "\"extensions\":{...}", or ""), the materials,
  * textures and samplers arrays as given (NULL: none), the images, and top_extra (more top-level
  * members, or ""). */
 static inline char *gt_gltf(const char *materials, const char *textures, const char *samplers, const gt_image *images,
                             int num_images, const char *prim_extra, const char *top_extra) {
+    return gt_gltf_nodes("[{\"mesh\":0}]", "[0]", materials, textures, samplers, images, num_images, prim_extra,
+                         top_extra);
+}
+
+static inline char *gt_gltf_nodes(const char *nodes, const char *roots, const char *materials, const char *textures,
+                                  const char *samplers, const gt_image *images, int num_images, const char *prim_extra,
+                                  const char *top_extra) {
     float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12], uv0[8], uv1[8];
     for (int i = 0; i < 4; i++) {
         nrm[3 * i] = 0, nrm[3 * i + 1] = 0, nrm[3 * i + 2] = 1;
@@ -65,10 +77,12 @@ static inline char *gt_gltf(const char *materials, const char *textures, const c
     base64(bin, sizeof bin, b64);
     char *s = NULL;
     size_t n = 0;
+    gt_cat(&s, &n, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":");
+    gt_cat(&s, &n, roots);
+    gt_cat(&s, &n, "}],\"nodes\":");
+    gt_cat(&s, &n, nodes);
     snprintf(line, sizeof line,
-             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
-             "\"buffers\":[{\"byteLength\":172,\"uri\":\"data:application/octet-stream;base64,%s\"}],",
-             b64);
+             ",\"buffers\":[{\"byteLength\":172,\"uri\":\"data:application/octet-stream;base64,%s\"}],", b64);
     gt_cat(&s, &n, line);
     gt_cat(&s, &n,
            "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
