@@ -369,7 +369,8 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
                EXIT_USAGE;
 
     scene *s =
-        load_scene_or_default(o->scene_path, o->env_path, (float)(o->env_rotation_deg * 3.14159265358979 / 180.0));
+        load_scene_or_default(o->scene_path, o->env_path, (float)(o->env_rotation_deg * 3.14159265358979 / 180.0),
+                              have && have->variant[0] ? have->variant : NULL);
     if (!s) return EXIT_FAILURE_;
     if (cam_index >= s->num_cameras && !(cam_index == -1)) {
         cli_error("%s: --camera %d: the scene has %d camera%s", s->path, cam_index, s->num_cameras,

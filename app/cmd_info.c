@@ -10,10 +10,11 @@
 #include "image_io.h"
 
 static void print_info_help(void) {
-    printf("usage: glint info [SCENE] [--env FILE] [--method NAME] [--max-depth D] [--plan auto|full]\n"
-           "                  [--obj FILE.obj]\n"
+    printf("usage: glint info [SCENE] [--env FILE] [--variant NAME] [--method NAME] [--max-depth D]\n"
+           "                  [--plan auto|full] [--obj FILE.obj]\n"
            "\n"
-           "Prints a summary of SCENE: geometry, materials, lights, cameras, size; then what the\n"
+           "Prints a summary of SCENE: geometry, materials, lights, material variants, cameras, size\n"
+           "(with --variant NAME, of that variant); then what the\n"
            "scene calls for (material classes, emitters, whether indirect and glossy-to-glossy\n"
            "transport exist) and the passes method NAME would run (default %s, as the viewer's;\n"
            "vsl+hl has every pass), each with its reason.\n"
@@ -73,7 +74,7 @@ static int write_obj(const scene *s, const char *obj_path) {
 }
 
 int cmd_info(int argc, char **argv) {
-    const char *path = NULL, *env = NULL, *obj = NULL;
+    const char *path = NULL, *env = NULL, *obj = NULL, *variant = NULL;
     int method = DEFAULT_METHOD, max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
@@ -81,6 +82,8 @@ int cmd_info(int argc, char **argv) {
             return EXIT_OK;
         } else if (strcmp(argv[i], "--env") == 0) {
             if (!(env = cli_value(argc, argv, &i))) return EXIT_USAGE;
+        } else if (strcmp(argv[i], "--variant") == 0) {
+            if (!(variant = cli_value(argc, argv, &i))) return EXIT_USAGE;
         } else if (strcmp(argv[i], "--method") == 0) {
             const char *v = cli_value(argc, argv, &i);
             if (!v) return EXIT_USAGE;
@@ -106,7 +109,7 @@ int cmd_info(int argc, char **argv) {
     if (cli_check_roles(outputs, 1, inputs, 2) != 0) return EXIT_USAGE;
     if (obj && cli_check_output_dir("--obj", obj)) return EXIT_FAILURE_;
     double t0 = cli_now();
-    scene *s = load_scene_or_default(path, env, 0.0f);
+    scene *s = load_scene_or_default(path, env, 0.0f, variant);
     if (!s) return EXIT_FAILURE_;
     double load_seconds = cli_now() - t0;
     struct rusage ru;
@@ -129,6 +132,13 @@ int cmd_info(int argc, char **argv) {
     printf("lights:     %d point, %d spot, %d directional, %d emissive triangles, %s\n", by_type[LIGHT_POINT],
            by_type[LIGHT_SPOT], by_type[LIGHT_DIRECTIONAL], by_type[LIGHT_TRIANGLE],
            s->env ? "an environment map" : "no environment map");
+    if (scene_num_variants(s) > 0) {
+        printf("variants:   %d (", scene_num_variants(s));
+        for (int i = 0; i < scene_num_variants(s); i++) printf("%s'%s'", i ? ", " : "", scene_variant_name(s, i));
+        int v = scene_variant(s);
+        printf("); shown: %s%s%s\n", v < 0 ? "the default materials" : "'", v < 0 ? "" : scene_variant_name(s, v),
+               v < 0 ? "" : "'");
+    }
     printf("cameras:    %d", s->num_cameras);
     for (int i = 0; i < s->num_cameras; i++) printf("%s%d '%s'", i ? ", " : " (", i, s->cameras[i].name);
     printf("%s\n", s->num_cameras ? ")" : " (a framing view is used)");

@@ -22,6 +22,7 @@ typedef struct {
     double seconds;
     const char *env_path;
     double env_rotation_deg;
+    const char *variant; /* NULL: the file's default materials */
     long long camera_index;
     const char *out_exr, *out_png, *out_stats;
     double exposure;
@@ -48,6 +49,8 @@ static void print_render_help(void) {
            "                       them); full: every pass, for comparison [auto]\n"
            "  --env FILE           environment map, equirectangular .exr or .hdr [none]\n"
            "  --env-rotation DEG   rotate the environment about +Y [0]\n"
+           "  --variant NAME       the scene's material variant NAME (KHR_materials_variants;\n"
+           "                       glint info lists them) [the file's default materials]\n"
            "  --camera INDEX       glTF camera to render from [0; a framing view without cameras]\n"
            "  --seed S             random seed; runs with the same seed reproduce [0]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
@@ -86,6 +89,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--max-depth", .kind = CLI_INT, .out = &p->max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
         {.name = "--plan", .kind = CLI_PLAN, .out = &p->plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
+        {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
         {.name = "--env-rotation", .kind = CLI_FLOAT, .out = &o->env_rotation_deg, .lo = -36000.0, .hi = 36000.0},
         {.name = "--camera", .kind = CLI_LONG, .out = &o->camera_index, .lo = 0, .hi = CLI_CAMERA_MAX},
         {.name = "--seed", .kind = CLI_U64, .out = &p->seed},
@@ -282,7 +286,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
     return 0;
 }
 
-scene *load_scene_or_default(const char *path, const char *env_path, float env_rotation) {
+scene *load_scene_or_default(const char *path, const char *env_path, float env_rotation, const char *variant) {
     char err[1024];
     scene *s = path ? scene_load(path, cli_print_warning, NULL, err, sizeof err)
                     : scene_load_default(cli_print_warning, NULL, err, sizeof err);
@@ -290,7 +294,8 @@ scene *load_scene_or_default(const char *path, const char *env_path, float env_r
         cli_error("%s", err);
         return NULL;
     }
-    if (env_path && scene_set_env(s, env_path, env_rotation, err, sizeof err) != 0) {
+    if ((env_path && scene_set_env(s, env_path, env_rotation, err, sizeof err) != 0) ||
+        (variant && scene_select_variant(s, variant, err, sizeof err) != 0)) {
         cli_error("%s", err);
         scene_destroy(s);
         return NULL;
@@ -310,7 +315,8 @@ int cmd_render(int argc, char **argv) {
         (o.out_stats && cli_check_output_dir("--stats", o.out_stats)))
         return EXIT_FAILURE_;
 
-    scene *s = load_scene_or_default(o.scene_path, o.env_path, (float)(o.env_rotation_deg * 3.14159265358979 / 180.0));
+    scene *s = load_scene_or_default(o.scene_path, o.env_path, (float)(o.env_rotation_deg * 3.14159265358979 / 180.0),
+                                     o.variant);
     if (!s) return EXIT_FAILURE_;
     if (o.camera_index >= 0 && o.camera_index >= s->num_cameras) {
         cli_error("%s: --camera %lld: the scene has %d camera%s", s->path, o.camera_index, s->num_cameras,

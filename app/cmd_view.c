@@ -13,6 +13,7 @@
 
 typedef struct {
     const char *scene_path, *env_path, *script_path;
+    const char *variant; /* NULL: the file's default materials */
     int width, height;
     render_params params;
     int camera;
@@ -35,6 +36,7 @@ static void print_view_help(void) {
            "  --max-depth D        scattering events per path [%d]\n"
            "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
+           "  --variant NAME       the scene's material variant NAME (the panel switches them)\n"
            "  --camera INDEX       start from the scene's camera INDEX\n"
            "  --seed S             random seed [0]\n"
            "  --exposure STOPS     display exposure [0]\n"
@@ -64,6 +66,7 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         {.name = "--max-depth", .kind = CLI_INT, .out = &o->params.max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
         {.name = "--plan", .kind = CLI_PLAN, .out = &o->params.plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
+        {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
         {.name = "--camera", .kind = CLI_INT, .out = &o->camera, .lo = 0, .hi = CLI_CAMERA_MAX},
         {.name = "--seed", .kind = CLI_U64, .out = &o->params.seed},
         {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -30.0, .hi = 30.0},
@@ -114,7 +117,7 @@ int cmd_view(int argc, char **argv) {
         u.script_path_for_errors = o.script_path;
     }
 
-    scene *s = load_scene_or_default(o.scene_path, o.env_path, 0.0f);
+    scene *s = load_scene_or_default(o.scene_path, o.env_path, 0.0f, o.variant);
     if (!s) {
         view_script_free(&u.script);
         return EXIT_FAILURE_;
@@ -177,7 +180,8 @@ int cmd_view(int argc, char **argv) {
                           .show = UI_SHOW_ALL,
                           .show_panel = 1,
                           .spp_limit = o.spp,
-                          .time_limit = o.seconds};
+                          .time_limit = o.seconds,
+                          .variant = u.info.variant};
     u.ctl.params.vl = vl_params_resolve(&o.params.vl);
     u.applied_ctl = u.ctl;
     reset_lights(&u);

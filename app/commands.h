@@ -12,8 +12,8 @@ int cmd_bench(int argc, char **argv);
 /* The interactive viewer. */
 int cmd_view(int argc, char **argv);
 
-/* Loads SCENE (a file or builtin:NAME; NULL: the default built-in) and attaches --env when given.
- * Prints the error and returns NULL on failure. */
-scene *load_scene_or_default(const char *path, const char *env_path, float env_rotation);
+/* Loads SCENE (a file or builtin:NAME; NULL: the default built-in), attaches --env and picks the
+ * material variant (--variant) when given. Prints the error and returns NULL on failure. */
+scene *load_scene_or_default(const char *path, const char *env_path, float env_rotation, const char *variant);
 
 #endif

@@ -89,6 +89,7 @@ int reference_describe(reference_info *r, const char *scene_path, const char *en
         if (reference_hash_file(env_path, r->env_hash, err, errlen)) return -1;
         r->env_rotation = env_rotation_deg;
     }
+    if (scene_variant(s) >= 0) snprintf(r->variant, sizeof r->variant, "%s", scene_variant_name(s, scene_variant(s)));
     /* -1 renders the first camera when there is one: record that, so both spellings match. */
     r->camera_index = camera_index < 0 && s->num_cameras > 0 ? 0 : camera_index;
     r->cam = scene_camera(s, camera_index, (float)p->width / (float)p->height);
@@ -152,6 +153,11 @@ char *reference_json(const reference_info *r) {
     snprintf(rot, sizeof rot, "%.15g", r->env_rotation);
     if (strtod(rot, NULL) != r->env_rotation) snprintf(rot, sizeof rot, "%.17g", r->env_rotation);
     fprintf(f, ",\n  \"env_rotation\": %s,\n", rot);
+    if (r->variant[0]) { /* older references have none: the default materials */
+        fputs("  \"variant\": ", f);
+        reference_json_string(f, r->variant);
+        fputs(",\n", f);
+    }
     fprintf(f, "  \"camera\": {\"index\": %d, ", r->camera_index);
     json_vec3(f, "position", r->cam.position);
     fputs(", ", f);
@@ -293,6 +299,9 @@ int reference_parse(const char *text, size_t n, const char *label, reference_inf
     NEED(json_str(root, "env", r->env, sizeof r->env) == 0, "env");
     NEED(json_str(root, "env_hash", r->env_hash, sizeof r->env_hash) == 0, "env_hash");
     NEED(json_number(root, "env_rotation", &r->env_rotation) == 0, "env_rotation");
+    NEED(!cJSON_GetObjectItemCaseSensitive(root, "variant") ||
+             json_str(root, "variant", r->variant, sizeof r->variant) == 0,
+         "variant");
     NEED(json_int(cam, "index", -1, 1000000, &ll) == 0, "camera index");
     r->camera_index = (int)ll;
     NEED(json_vec(cam, "position", &r->cam.position) == 0, "camera position");
@@ -434,6 +443,12 @@ int reference_check(const char *ref, const reference_info *have, const reference
     if (fabs(have->env_rotation - want->env_rotation) > 1e-6)
         return fail(err, errlen, "%s: rendered with --env-rotation %g, not %g", ref, have->env_rotation,
                     want->env_rotation);
+    if (strcmp(have->variant, want->variant) != 0)
+        return fail(err, errlen, "%s: rendered with %s%s%s, not %s%s%s", ref,
+                    have->variant[0] ? "material variant '" : "",
+                    have->variant[0] ? have->variant : "the default materials", have->variant[0] ? "'" : "",
+                    want->variant[0] ? "material variant '" : "",
+                    want->variant[0] ? want->variant : "the default materials", want->variant[0] ? "'" : "");
     if (have->width != want->width || have->height != want->height)
         return fail(err, errlen, "%s: rendered at %dx%d, not %dx%d", ref, have->width, have->height, want->width,
                     want->height);

@@ -18,6 +18,7 @@ typedef struct {
     char env[1024];      /* "" without an environment map */
     char env_hash[64];
     double env_rotation; /* degrees */
+    char variant[64];    /* the material variant rendered, "" for the file's default materials */
     int camera_index;    /* -1: the scene's first camera or the framing view */
     camera cam;          /* the camera actually rendered from */
     int width, height;
@@ -83,7 +84,7 @@ void reference_noise_deinit(reference_noise *rn);
 
 /* Compares what a bench renders (want) with a reference's description (have), field by field: the
  * material model (a reference of another is stale: re-render it), scene and environment hashes,
- * camera index and parameters, size. Returns 0 when they match, else -1
+ * material variant, camera index and parameters, size. Returns 0 when they match, else -1
  * with err naming the first difference ("REF.exr: ..."). */
 int reference_check(const char *ref_path, const reference_info *have, const reference_info *want, char *err,
                     size_t errlen);

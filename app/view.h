@@ -36,6 +36,7 @@
 #define MAX_VIEW_CAMERAS 32
 #define MAX_LIGHT_GROUPS 64  /* lights the viewer lists and edits; more are rendered, not listed */
 #define MAX_CURVES 6         /* error curves kept for comparison */
+#define MAX_VIEW_VARIANTS 64 /* material variants the panel lists */
 #define MAX_CURVE_POINTS 512 /* per curve; halved (every other point) when full */
 
 static inline double seconds_since(double t) { return cli_now() - t; }
@@ -59,6 +60,10 @@ typedef struct {
     int num_lights;
     light_group lights[MAX_LIGHT_GROUPS]; /* as loaded */
     int unlit;                            /* no light of its own (punctual or emissive): black without an environment */
+    /* material variants (KHR_materials_variants): names, the one shown (-1: the defaults) */
+    int num_variants, variant;
+    char variant_names[MAX_VIEW_VARIANTS][64];
+    int kept_view; /* it replaced the last scene to show another variant: the view stays */
 } scene_info;
 
 /* Light edits: the offset and intensity multiplier of every light, against the scene as loaded. */
@@ -102,7 +107,9 @@ typedef struct {
     char export_path[1024];
     int export_pending;
     char load_path[1024];
-    int load_kind; /* 0 none, 1 scene, 2 environment map */
+    int load_kind;         /* 0 none, 1 scene, 2 environment map */
+    char load_variant[64]; /* a scene load: the material variant to show ("": the defaults)... */
+    int load_keep_view;    /* ...from where the view is (a variant switch) */
     int quit;
     uint64_t lights_scene;   /* the scene (info_serial) the light requests below refer to */
     light_edits lights;      /* wanted */
@@ -254,6 +261,8 @@ typedef struct {
     int pending_w, pending_h; /* a new size of the place beside the panel, not yet rendered at... */
     double pending_since;     /* ...since this time */
     int panel_dragging;       /* the panel's edge was being dragged at the last frame */
+    const char *variant_labels[MAX_VIEW_VARIANTS + 1]; /* the panel's: the defaults, then info's names */
+    uint64_t variant_target;                           /* the load of a variant switch under way, or 0 */
 } ui_thread;
 
 /* view_camera.c: the free camera, the scene's cameras and the bookmarks file */
@@ -278,6 +287,8 @@ long long frames_of_current_state(const ui_thread *u);
 void request_export(ui_thread *u, const char *name);
 /* kind: LOAD_SCENE, LOAD_ENV (path), LOAD_SKY, LOAD_NO_ENV. */
 void request_load(ui_thread *u, int kind, const char *path);
+/* The scene again with material variant v (-1: the defaults), the view kept. */
+void request_variant(ui_thread *u, int v);
 vec3 light_position(const ui_thread *u, int g);
 int light_movable(const ui_thread *u, int g);
 void update_light_screen(ui_thread *u);
@@ -346,6 +357,8 @@ int refinement_held(const shared_state *sh, long long frames);
 void refinement_hold(shared_state *sh);
 /* The pause and limits of the controls, to the render thread. */
 void push_refinement(ui_thread *u);
+/* A script's `variant NAME` (or `default`): the switch asked for; 0, or -1 with a message. */
+int panel_variant(ui_thread *u, const char *name, char *err, size_t errlen);
 /* `set spp N`, `set time S`: 0, -1 with a message, or 1 for a name not theirs. */
 int panel_set(ui_thread *u, const char *name, const char *value, char *err, size_t errlen);
 /* pause, resume, sleep. Returns 0 while the script has to wait. */

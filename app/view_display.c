@@ -157,10 +157,13 @@ int fetch_published(ui_thread *u) {
     pthread_mutex_unlock(&sh->lock);
     if (new_error && u->reference.rgb)
         add_error_point(u, u->stats.rel_error_at, u->stats.rel_error, u->stats.rel_error_resets);
-    if (new_info) { /* a new scene: its own view, lights and bookmarks */
-        u->ctl.camera = -1;
-        u->applied_ctl.camera = -1;
-        u->ctl.reset_view = 1;
+    if (new_info) { /* a new scene: its own view (not for another variant of it), lights and bookmarks */
+        if (!u->info.kept_view) {
+            u->ctl.camera = -1;
+            u->applied_ctl.camera = -1;
+            u->ctl.reset_view = 1;
+        }
+        u->ctl.variant = u->info.variant;
         reset_lights(u);
         bookmarks_load(u);
     }

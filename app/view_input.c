@@ -87,16 +87,25 @@ void request_export(ui_thread *u, const char *name) {
     pthread_mutex_unlock(&sh->lock);
 }
 
-void request_load(ui_thread *u, int kind, const char *path) {
+static void request(ui_thread *u, int kind, const char *path, const char *variant, int keep_view) {
     shared_state *sh = u->sh;
     pthread_mutex_lock(&sh->lock);
     snprintf(sh->load_path, sizeof sh->load_path, "%s", path);
+    snprintf(sh->load_variant, sizeof sh->load_variant, "%s", variant);
+    sh->load_keep_view = keep_view;
     sh->load_kind = kind;
     /* Not a change yet: the frame in flight goes on, and the accumulation too, unless the load
      * succeeds (a new scene then arrives, and with it a new view). */
     u->script_load_target = ++sh->load_requests;
     pthread_cond_signal(&sh->load_cond);
     pthread_mutex_unlock(&sh->lock);
+}
+
+void request_load(ui_thread *u, int kind, const char *path) { request(u, kind, path, "", 0); }
+
+void request_variant(ui_thread *u, int v) {
+    request(u, LOAD_SCENE, u->info.name, v >= 0 && v < u->info.num_variants ? u->info.variant_names[v] : "", 1);
+    u->variant_target = u->script_load_target;
 }
 
 /* ---- lights ---------------------------------------------------------------------------------- */

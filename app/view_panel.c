@@ -193,6 +193,7 @@ void print_panel_stats(ui_thread *u) {
     printf(" paused=%d spp_limit=%lld time_limit=%g held=%d help=%d window=%dx%d image=%dx%d dock=%d content_scale=%g",
            u->ctl.paused, u->ctl.spp_limit, u->ctl.time_limit, held(u), u->ctl.show_help, ww, wh, iw, ih, ww - iw,
            (double)ui_content_scale());
+    printf(" variant=%s", u->info.variant >= 0 ? u->info.variant_names[u->info.variant] : "-");
 }
 
 double view_cost_ms(const ui_thread *u) {
@@ -228,6 +229,43 @@ void panel_frame(ui_thread *u, ui_stats *st) {
     st->shortcut_keys = keys;
     st->shortcut_actions = actions;
     st->num_shortcuts = num_view_shortcuts < 64 ? num_view_shortcuts : 64;
+    u->variant_labels[0] = "default materials";
+    for (int i = 0; i < u->info.num_variants; i++) u->variant_labels[i + 1] = u->info.variant_names[i];
+    st->variant_labels = u->variant_labels;
+    st->num_variants = u->info.num_variants;
+}
+
+/* ---- material variants ------------------------------------------------------------------------- */
+
+/* Whether the variant switch asked for has been tried and its outcome taken in. */
+static int variant_settled(ui_thread *u) {
+    pthread_mutex_lock(&u->sh->lock);
+    int done = u->sh->loads_done >= u->variant_target && u->sh->info_serial == u->info_serial;
+    pthread_mutex_unlock(&u->sh->lock);
+    return done;
+}
+
+/* The panel's choice against the scene shown: a switch reloads the scene with that variant (every
+ * part of it follows the materials); one that failed puts the choice back. */
+static void follow_variant(ui_thread *u) {
+    if (u->variant_target) {
+        if (!variant_settled(u)) return;
+        u->variant_target = 0;
+        u->ctl.variant = u->info.variant;
+        return;
+    }
+    if (u->ctl.variant != u->info.variant) request_variant(u, u->ctl.variant);
+}
+
+int panel_variant(ui_thread *u, const char *name, char *err, size_t errlen) {
+    int v = -2;
+    if (strcmp(name, "default") == 0) v = -1;
+    for (int i = 0; i < u->info.num_variants && v == -2; i++)
+        if (strcmp(u->info.variant_names[i], name) == 0) v = i;
+    if (v == -2) return snprintf(err, errlen, "no material variant '%s'", name), -1;
+    u->ctl.variant = v;
+    follow_variant(u);
+    return 0;
 }
 
 void panel_after(ui_thread *u) {
@@ -235,4 +273,5 @@ void panel_after(ui_thread *u) {
     if (u->ctl.bookmark_restore) bookmark_restore(u, u->ctl.bookmark_restore);
     u->ctl.bookmark_save = u->ctl.bookmark_restore = 0;
     push_refinement(u);
+    follow_variant(u);
 }

@@ -27,8 +27,10 @@ typedef struct {
     int ok;
     int kind;
     char path[1024], env[1024];
-    scene *scene;    /* LOAD_SCENE's result, with the environment env */
-    image_rgb image; /* LOAD_ENV's */
+    char variant[64]; /* LOAD_SCENE: the material variant to show ("": the defaults)... */
+    int keep_view;    /* ...in place of the last scene, from the same view */
+    scene *scene;     /* LOAD_SCENE's result, with the environment env */
+    image_rgb image;  /* LOAD_ENV's */
     char err[1200];
 } load_job;
 
@@ -79,6 +81,11 @@ void fill_scene_info(scene_info *info, const scene *s) {
     int n = scene_light_groups(s, info->lights, MAX_LIGHT_GROUPS); /* -1 (out of memory): none listed */
     info->num_lights = n < 0 ? 0 : n < MAX_LIGHT_GROUPS ? n : MAX_LIGHT_GROUPS;
     info->unlit = s->num_lights - (s->env_light >= 0 ? 1 : 0) == 0;
+    info->num_variants = scene_num_variants(s) < MAX_VIEW_VARIANTS ? scene_num_variants(s) : MAX_VIEW_VARIANTS;
+    for (int i = 0; i < info->num_variants; i++)
+        snprintf(info->variant_names[i], sizeof info->variant_names[i], "%s", scene_variant_name(s, i));
+    info->variant = scene_variant(s) < info->num_variants ? scene_variant(s) : -1;
+    info->kept_view = 0;
 }
 
 void clear_light_edits(light_edits *e) {
@@ -204,6 +211,7 @@ static void load_failed(render_thread *rt, const char *err) {
 static int load_files(load_job *j) {
     if (j->kind == LOAD_SCENE) {
         if (!(j->scene = scene_load(j->path, cli_print_warning, NULL, j->err, sizeof j->err))) return 0;
+        if (j->variant[0] && scene_select_variant(j->scene, j->variant, j->err, sizeof j->err) != 0) return 0;
         /* The environment stays with the viewer, not with the scene. */
         if (j->env[0] && set_environment(j->scene, j->env, j->err, sizeof j->err) != 0) {
             cli_warning("%s; %s opens without it", j->err, j->path);
@@ -226,6 +234,8 @@ static void *loader_main(void *arg) {
         *j = (load_job){.active = 1, .kind = sh->load_kind};
         snprintf(j->path, sizeof j->path, "%s", sh->load_path);
         snprintf(j->env, sizeof j->env, "%s", sh->env_now);
+        snprintf(j->variant, sizeof j->variant, "%s", sh->load_variant);
+        j->keep_view = sh->load_keep_view;
         sh->load_kind = LOAD_NONE;
         pthread_mutex_unlock(&sh->lock);
         int ok = load_files(j);
@@ -244,8 +254,10 @@ static void load_job_free(load_job *j) {
     memset(j, 0, sizeof *j);
 }
 
-/* Puts scene s (its environment env) in place of the current one. */
-static void replace_scene(render_thread *rt, scene *s, const char *env, const char *path, const render_params *params) {
+/* Puts scene s (its environment env) in place of the current one, seen from keep when given
+ * (another variant of the same scene), else from its own default view. */
+static void replace_scene(render_thread *rt, scene *s, const char *env, const char *path, const render_params *params,
+                          const camera *keep) {
     shared_state *sh = rt->sh;
     /* The sessions read the old scene: replace them with it. */
     int w = session_params(rt->full)->width, h = session_params(rt->full)->height;
@@ -258,10 +270,11 @@ static void replace_scene(render_thread *rt, scene *s, const char *env, const ch
     sh->scene_now = s;
     pthread_rwlock_unlock(&sh->scene_lock);
     clear_light_edits(&rt->lights_applied);
-    camera c = scene_camera(s, -1, (float)w / (float)h);
+    camera c = keep ? *keep : scene_camera(s, -1, (float)w / (float)h);
     make_sessions(rt, w, h, &c, params);
     pthread_mutex_lock(&sh->lock);
     fill_scene_info(&sh->info, s);
+    sh->info.kept_view = keep != NULL;
     sh->info_serial++;
     snprintf(sh->env_now, sizeof sh->env_now, "%s", env);
     pthread_mutex_unlock(&sh->lock);
@@ -276,7 +289,7 @@ static int finish_load(render_thread *rt, load_job *j, const camera *cam, const 
     int kind = j->kind;
     if (!j->ok) return load_failed(rt, j->err), 0;
     if (kind == LOAD_SCENE) {
-        replace_scene(rt, j->scene, j->env, j->path, params);
+        replace_scene(rt, j->scene, j->env, j->path, params, j->keep_view ? cam : NULL);
         j->scene = NULL; /* the render thread's now */
         return 1;
     }

@@ -10,7 +10,7 @@
  *   frame                     reference-camera       sky
  *   quit                      pause                  resume
  *   sleep SECONDS             wait-file FILE         buttons
- *   wheel X Y STEPS
+ *   wheel X Y STEPS           variant NAME|default
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -24,7 +24,9 @@
  * puts the cursor at X Y (window units) and turns the wheel there by STEPS (up positive) in the
  * same frame, as a wheel event arriving with the cursor's move does.
  * `move-light` moves light INDEX (as the panel lists them) by a world-space offset and selects it;
- * `spin` orbits continuously, a little every drawn frame, as a held mouse drag would. */
+ * `spin` orbits continuously, a little every drawn frame, as a held mouse drag would. `variant`
+ * shows the scene's material variant NAME (`default`: the file's materials), as the panel's choice
+ * does, and waits until the scene is reloaded. */
 #ifndef GLINT_VIEW_SCRIPT_H
 #define GLINT_VIEW_SCRIPT_H
 
@@ -58,6 +60,7 @@ typedef enum {
     ACT_WAIT_FILE, /* the script waits until a file exists */
     ACT_BUTTONS,   /* where the panel's buttons are */
     ACT_WHEEL,     /* the cursor moved and the wheel turned at once */
+    ACT_VARIANT,
 } script_action_kind;
 
 typedef struct {

@@ -259,6 +259,18 @@ void run_script(ui_thread *u) {
             if (!load_settled(u)) return;
             u->script_waiting = 0;
             break;
+        case ACT_VARIANT:
+            if (!u->script_waiting) {
+                if (panel_variant(u, a->text, err, sizeof err) != 0) {
+                    cli_error("%s:%d: %s", u->script_path_for_errors, a->line, err);
+                    u->script_errors++;
+                    break;
+                }
+                u->script_waiting = 1;
+            }
+            if (!load_settled(u)) return;
+            u->script_waiting = 0;
+            break;
         case ACT_WINDOW_SHOT: /* taken after this frame's draw: later actions wait for it */
             snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text);
             u->script_pos++;

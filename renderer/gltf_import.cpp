@@ -16,6 +16,7 @@
 
 #include <tiny_gltf.h>
 
+#include "gltf_extensions.h"
 #include "gltf_input.h"
 
 namespace {
@@ -51,11 +52,7 @@ std::string printable(std::string t) {
     return t;
 }
 
-std::string num(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", v);
-    return b;
-}
+using gltf_ext::num;
 
 // Limits on what a scene may hold (README states them).
 constexpr int MAX_NODE_DEPTH = 4096;                       // nesting of the node hierarchy
@@ -303,12 +300,45 @@ struct importer {
         return texture_slot{mapped, texcoord};
     }
 
-    // A textureInfo inside an extension's JSON ({index, texCoord}), or no texture.
-    texture_slot ext_texture(const Value &e, const char *key, const std::string &label, const std::string &what) {
+    // A texture reference (index, texCoord, the reference's extensions) with its
+    // KHR_texture_transform: offset, rotation and scale as the extension's matrix T R S, and a
+    // texCoord that overrides the reference's. Every texture slot comes through here.
+    texture_slot texture_ref(int index, int texcoord, const Value *transform, const std::string &what) {
+        if (index < 0) return texture_slot{-1, 0};
+        float xf[6] = {1, 0, 0, 0, 1, 0};
+        if (transform) {
+            std::string why = gltf_ext::texture_transform(*transform, xf, &texcoord);
+            if (!why.empty()) fail(what + ": KHR_texture_transform: " + why);
+        }
+        texture_slot slot = texture(index, texcoord, what);
+        slot.transformed = transform != nullptr;
+        std::memcpy(slot.uv_xf, xf, sizeof xf);
+        return slot;
+    }
+
+    static const Value *transform_of(const tinygltf::ExtensionMap &ext) {
+        auto it = ext.find("KHR_texture_transform");
+        return it == ext.end() ? nullptr : &it->second;
+    }
+    texture_slot texture(const tinygltf::TextureInfo &t, const std::string &what) {
+        return texture_ref(t.index, t.texCoord, transform_of(t.extensions), what);
+    }
+    texture_slot texture(const tinygltf::NormalTextureInfo &t, const std::string &what) {
+        return texture_ref(t.index, t.texCoord, transform_of(t.extensions), what);
+    }
+    // A textureInfo object inside a material extension (JSON as tinygltf keeps it).
+    texture_slot texture(const Value &t, const std::string &what) {
+        const Value *transform = nullptr;
+        if (t.IsObject() && t.Has("extensions") && t.Get("extensions").Has("KHR_texture_transform"))
+            transform = &t.Get("extensions").Get("KHR_texture_transform");
+        return texture_ref(index_or(t, "index", -1, what), std::min(index_or(t, "texCoord", 0, what), 2), transform,
+                           what);
+    }
+
+    // A textureInfo inside an extension's JSON ({index, texCoord, KHR_texture_transform}), or no texture.
+    texture_slot ext_texture(const Value &e, const char *key, const std::string &label) {
         if (!e.Has(key)) return texture_slot{-1, 0};
-        const Value &t = e.Get(key);
-        return texture(index_or(t, "index", -1, label + ": " + key), std::min(index_or(t, "texCoord", 0, label), 2),
-                       what);
+        return texture(e.Get(key), label + ": " + key);
     }
 
     // ---- the material model's extensions (docs/design.md, "The glTF material") ----
@@ -317,26 +347,26 @@ struct importer {
         mat.ext.ior = factor(number_or(e, "ior", 1.5), label, "ior");
     }
 
-    void ext_specular(material &mat, const Value &e, const std::string &label, const std::string &what) {
+    void ext_specular(material &mat, const Value &e, const std::string &label) {
         mat.ext.specular = factor(number_or(e, "specularFactor", 1.0), label, "specularFactor");
         mat.ext.specular_color = color_or(e, "specularColorFactor", v3s(1.0f), label);
-        mat.ext.specular_tex = ext_texture(e, "specularTexture", label, what);
-        mat.ext.specular_color_tex = ext_texture(e, "specularColorTexture", label, what);
+        mat.ext.specular_tex = ext_texture(e, "specularTexture", label);
+        mat.ext.specular_color_tex = ext_texture(e, "specularColorTexture", label);
     }
 
-    void ext_sheen(material &mat, const Value &e, const std::string &label, const std::string &what) {
+    void ext_sheen(material &mat, const Value &e, const std::string &label) {
         mat.ext.sheen_color = color_or(e, "sheenColorFactor", v3s(0.0f), label);
         mat.ext.sheen_roughness = factor(number_or(e, "sheenRoughnessFactor", 0.0), label, "sheenRoughnessFactor");
-        mat.ext.sheen_color_tex = ext_texture(e, "sheenColorTexture", label, what);
-        mat.ext.sheen_roughness_tex = ext_texture(e, "sheenRoughnessTexture", label, what);
+        mat.ext.sheen_color_tex = ext_texture(e, "sheenColorTexture", label);
+        mat.ext.sheen_roughness_tex = ext_texture(e, "sheenRoughnessTexture", label);
     }
 
-    void ext_clearcoat(material &mat, const Value &e, const std::string &label, const std::string &what) {
+    void ext_clearcoat(material &mat, const Value &e, const std::string &label) {
         mat.ext.clearcoat = factor(number_or(e, "clearcoatFactor", 0.0), label, "clearcoatFactor");
         mat.ext.clearcoat_roughness =
             factor(number_or(e, "clearcoatRoughnessFactor", 0.0), label, "clearcoatRoughnessFactor");
-        mat.ext.clearcoat_tex = ext_texture(e, "clearcoatTexture", label, what);
-        mat.ext.clearcoat_roughness_tex = ext_texture(e, "clearcoatRoughnessTexture", label, what);
+        mat.ext.clearcoat_tex = ext_texture(e, "clearcoatTexture", label);
+        mat.ext.clearcoat_roughness_tex = ext_texture(e, "clearcoatRoughnessTexture", label);
         if (e.Has("clearcoatNormalTexture"))
             scene_warn(s, "%s: %s: clearcoatNormalTexture is not supported; the coat uses the surface's normal",
                        name.c_str(), label.c_str());
@@ -358,6 +388,37 @@ struct importer {
                        label.c_str());
     }
 
+    // normalTexture: tangent-space normals in glTF's convention, x and y scaled. The
+    // occlusionTexture is ignored on purpose: a path tracer computes occlusion (docs/design.md).
+    void normal_map(const tinygltf::Material &gm, material &mat, const std::string &label, const std::string &what) {
+        const tinygltf::NormalTextureInfo &nt = gm.normalTexture;
+        if (nt.index < 0) return;
+        mat.normal_tex = texture(nt, what);
+        if (!(std::fabs(nt.scale) <= MAX_INTENSITY))
+            fail(label + ": normalTexture.scale " + num(nt.scale) + " is not a finite number up to " +
+                 num(MAX_INTENSITY));
+        mat.normal_scale = (float)nt.scale;
+    }
+
+    // alphaMode with its cutoff, and baseColorFactor's alpha (the base colour texture's alpha
+    // multiplies it where a ray meets the surface).
+    void alpha(const tinygltf::Material &gm, material &mat, const std::string &label) {
+        const std::vector<double> &f = gm.pbrMetallicRoughness.baseColorFactor;
+        if (f.size() >= 4) mat.base_alpha = factor(f[3], label, "baseColorFactor's alpha");
+        if (mat.base_alpha > 1.0f) {
+            mat.base_alpha = 1.0f;
+            scene_warn(s, "%s: %s: baseColorFactor's alpha is above 1, clamped to 1", name.c_str(), label.c_str());
+        }
+        mat.alpha_cutoff = factor(gm.alphaCutoff, label, "alphaCutoff");
+        if (gm.alphaMode == "MASK")
+            mat.alpha = ALPHA_MASK;
+        else if (gm.alphaMode == "BLEND")
+            mat.alpha = ALPHA_BLEND;
+        else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE")
+            scene_warn(s, "%s: %s: unknown alphaMode '%s', drawn opaque", name.c_str(), label.c_str(),
+                       gm.alphaMode.c_str());
+    }
+
     void materials() {
         material_map.assign(m.materials.size(), -1);
         for (size_t i = 0; i < m.materials.size(); i++) {
@@ -370,11 +431,10 @@ struct importer {
             mat.base_color = factor3_or(pbr.baseColorFactor, v3s(1.0f), label, "baseColorFactor");
             mat.metallic = factor(pbr.metallicFactor, label, "metallicFactor");
             mat.roughness = factor(pbr.roughnessFactor, label, "roughnessFactor");
-            mat.base_color_tex = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what);
-            mat.metal_rough_tex =
-                texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what);
+            mat.base_color_tex = texture(pbr.baseColorTexture, what);
+            mat.metal_rough_tex = texture(pbr.metallicRoughnessTexture, what);
             mat.emission = factor3_or(gm.emissiveFactor, v3s(0.0f), label, "emissiveFactor");
-            mat.emissive_tex = texture(gm.emissiveTexture.index, gm.emissiveTexture.texCoord, what);
+            mat.emissive_tex = texture(gm.emissiveTexture, what);
             mat.double_sided = gm.doubleSided;
             for (const auto &ext : gm.extensions) {
                 const Value &e = ext.second;
@@ -389,15 +449,16 @@ struct importer {
                     double rot = number_or(e, "anisotropyRotation", 0.0);
                     if (!(std::fabs(rot) <= 1e6)) fail(label + ": anisotropyRotation " + num(rot) + " is not an angle");
                     mat.anisotropy_rotation = (float)rot;
-                    mat.anisotropy_tex = ext_texture(e, "anisotropyTexture", label, what);
+                    if (e.Has("anisotropyTexture"))
+                        mat.anisotropy_tex = texture(e.Get("anisotropyTexture"), label + ": anisotropyTexture");
                 } else if (ext.first == "KHR_materials_ior") {
                     ext_ior(mat, e, label);
                 } else if (ext.first == "KHR_materials_specular") {
-                    ext_specular(mat, e, label, what);
+                    ext_specular(mat, e, label);
                 } else if (ext.first == "KHR_materials_sheen") {
-                    ext_sheen(mat, e, label, what);
+                    ext_sheen(mat, e, label);
                 } else if (ext.first == "KHR_materials_clearcoat") {
-                    ext_clearcoat(mat, e, label, what);
+                    ext_clearcoat(mat, e, label);
                 }
             }
             // The papers' lobes: extras.glint = {model: "phong"|"ward", kd, ks, exponent, alpha_x, alpha_y, rotation}
@@ -422,14 +483,22 @@ struct importer {
                 }
             }
             clamp_unit(mat, label);
-            if (gm.alphaMode == "BLEND" || gm.alphaMode == "MASK")
-                scene_warn(s, "%s: alphaMode %s is not supported; surfaces are opaque", name.c_str(),
-                           gm.alphaMode.c_str());
-            if (gm.normalTexture.index >= 0)
-                scene_warn(s, "%s: normal maps are not supported yet; using interpolated normals", name.c_str());
+            alpha(gm, mat, label);
+            normal_map(gm, mat, label, what);
             material_map[i] = scene_add_material(s, &mat);
             if (material_map[i] < 0) fail("out of memory");
         }
+    }
+
+    // KHR_materials_variants: per primitive its mappings as one table, made at its first
+    // instance and shared by the others (gltf_extensions.cpp reads them).
+    std::vector<std::vector<int>> variant_tables; // [mesh][primitive]: table, -1 none, -2 not read yet
+
+    int variant_table(int mesh, size_t prim, const tinygltf::Primitive &p, const std::string &what) {
+        int &table = variant_tables[(size_t)mesh][prim];
+        std::string why = table == -2 ? gltf_ext::variant_table(s, p, material_map, &table) : "";
+        if (!why.empty()) fail(what + ": " + why);
+        return table;
     }
 
     // ---- nodes, meshes, lights, cameras ----------------------------------------------------
@@ -554,7 +623,9 @@ struct importer {
             if (idx.empty() && nv % 3 != 0) md.num_vertices = (int)(nv - nv % 3);
             md.material = material;
             char err[256];
+            int table = variant_table(index, pi, p, what), first = s->num_triangles;
             if (scene_add_mesh(s, &md, &xf, err, sizeof err) != 0) fail(what + ": " + err);
+            if (table >= 0 && scene_map_variants(s, first, table) != 0) fail("out of memory");
         }
     }
 
@@ -674,10 +745,10 @@ struct importer {
     }
 
     void run() {
-        static const char *supported[] = {"KHR_lights_punctual",      "KHR_materials_emissive_strength",
-                                          "KHR_materials_anisotropy", "KHR_materials_ior",
-                                          "KHR_materials_specular",   "KHR_materials_sheen",
-                                          "KHR_materials_clearcoat"};
+        static const char *supported[] = {
+            "KHR_lights_punctual",     "KHR_materials_emissive_strength", "KHR_materials_anisotropy",
+            "KHR_materials_ior",       "KHR_materials_specular",          "KHR_materials_sheen",
+            "KHR_materials_clearcoat", "KHR_texture_transform",           "KHR_materials_variants"};
         for (const std::string &e : m.extensionsUsed) {
             bool ok = false;
             for (const char *sup : supported) ok = ok || e == sup;
@@ -686,7 +757,11 @@ struct importer {
         texture_map.assign(m.textures.size(), -1);
         image_map.assign(m.images.size(), -1);
         on_stack.assign(m.nodes.size(), 0);
+        variant_tables.resize(m.meshes.size());
+        for (size_t i = 0; i < m.meshes.size(); i++) variant_tables[i].assign(m.meshes[i].primitives.size(), -2);
         materials();
+        std::string why = gltf_ext::read_variants(s, m);
+        if (!why.empty()) fail(why);
         if (!m.scenes.empty()) {
             int si = m.defaultScene >= 0 && (size_t)m.defaultScene < m.scenes.size() ? m.defaultScene : 0;
             for (int r : m.scenes[(size_t)si].nodes) node(r);

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene_parts.h"
+
 /* ---- environment map ----------------------------------------------------------------------- */
 
 vec3 env_eval(const scene *s, vec3 d) {
@@ -45,28 +47,6 @@ static float triangle_area(const scene *s, int t) {
     return 0.5f * length3(cross3(sub3(p1, p0), sub3(p2, p0)));
 }
 
-/* Mean emitted luminance over a triangle, estimated from a 4x4 stratified set of points. Never
- * zero for an emissive material: a triangle whose texture looks black at these points may still
- * emit elsewhere, and a zero selection probability would make that light unreachable. */
-static float triangle_mean_luminance(const scene *s, int t) {
-    const material *m = &s->materials[s->tri_material[t]];
-    float upper = luminance3(m->emission);
-    if (m->emissive_tex.texture < 0) return upper;
-    const uint32_t *v = &s->indices[3 * t];
-    float sum = 0.0f;
-    for (int i = 0; i < 16; i++) {
-        vec2 b = sample_uniform_triangle(v2(((float)(i & 3) + 0.5f) / 4.0f, ((float)(i >> 2) + 0.5f) / 4.0f));
-        float b0 = 1.0f - b.x - b.y;
-        vec2 uv0 = v2(b0 * s->uv0[v[0]].x + b.x * s->uv0[v[1]].x + b.y * s->uv0[v[2]].x,
-                      b0 * s->uv0[v[0]].y + b.x * s->uv0[v[1]].y + b.y * s->uv0[v[2]].y);
-        vec2 uv1 = v2(b0 * s->uv1[v[0]].x + b.x * s->uv1[v[1]].x + b.y * s->uv1[v[2]].x,
-                      b0 * s->uv1[v[0]].y + b.x * s->uv1[v[1]].y + b.y * s->uv1[v[2]].y);
-        vec4 c = texture_lookup(s, m->emissive_tex, uv0, uv1, 1);
-        sum += luminance3(mul3(m->emission, v3(c.x, c.y, c.z)));
-    }
-    return fmaxf(sum / 16.0f, 0.01f * upper);
-}
-
 int scene_build_lights(scene *s, char *err, size_t errlen) {
     /* Keep the punctual lights (the importer added them), drop derived ones. */
     int kept = 0;
@@ -88,14 +68,18 @@ int scene_build_lights(scene *s, char *err, size_t errlen) {
     for (int t = 0; t < s->num_triangles; t++) {
         s->tri_light[t] = -1;
         const material *m = &s->materials[s->tri_material[t]];
-        if (!(max_comp3(m->emission) > 0.0f)) continue;
+        /* What it emits on average: an emissive texture black all over the triangle makes it no
+         * light (emissive.c). */
+        vec3 mean = m->emission;
+        if (m->emissive_tex.texture >= 0 && s->tri_emit_tex) mean = mul3(mean, s->tri_emit_tex[t]);
+        if (!(max_comp3(mean) > 0.0f) || scene_triangle_invisible(s, t)) continue;
         light l;
         memset(&l, 0, sizeof l);
         l.type = LIGHT_TRIANGLE;
         l.triangle = t;
         l.color = m->emission;
         snprintf(l.name, sizeof l.name, "%s", m->name);
-        l.power = triangle_area(s, t) * PI_F * (m->double_sided ? 2.0f : 1.0f) * triangle_mean_luminance(s, t);
+        l.power = triangle_area(s, t) * PI_F * (m->double_sided ? 2.0f : 1.0f) * luminance3(mean);
         int idx = scene_add_light(s, &l);
         if (idx < 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
         s->tri_light[t] = idx;
@@ -213,7 +197,7 @@ static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light
         vec3 wi = scale3(d, 1.0f / dist);
         float cos_l = dot3(n, wi); /* > 0: we see the back (winding) side */
         h.backface = cos_l > 0.0f;
-        vec3 le = material_emission(s, &h);
+        vec3 le = scale3(material_emission(s, &h), material_coverage(s, &h)); /* none from a cut-out */
         float abs_cos = fabsf(cos_l);
         if (is_black3(le) || !(abs_cos > 0.0f)) return 0;
         out->wi = wi;
@@ -350,7 +334,7 @@ int light_sample_emission(const scene *s, float u_select, vec2 u_pos, vec2 u_dir
                 h.backface = 1;
             }
         }
-        vec3 le = material_emission(s, &h);
+        vec3 le = scale3(material_emission(s, &h), material_coverage(s, &h));
         if (is_black3(le) || !(area2 > 0.0f)) return 0;
         /* Cosine-weighted: Le cos / (pdf_area pdf_dir) = Le pi area. */
         out->o = q;

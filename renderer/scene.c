@@ -10,6 +10,7 @@
 
 #include "gltf_import.h"
 #include "lights.h"
+#include "scene_parts.h"
 
 typedef struct {
     scene_warn_fn fn;
@@ -62,7 +63,7 @@ done:
 
 void scene_destroy(scene *s) {
     if (!s) return;
-    if (s->rtc) rtcReleaseScene(s->rtc);
+    scene_bvh_free(s);
     if (s->device) rtcReleaseDevice(s->device);
     free(s->positions);
     free(s->normals);
@@ -73,6 +74,8 @@ void scene_destroy(scene *s) {
     free(s->tri_material);
     free(s->tri_normal);
     free(s->tri_light);
+    free(s->tri_emit_tex);
+    scene_variants_free(s);
     free(s->materials);
     for (int i = 0; i < s->num_images; i++) free(s->images[i].rgba);
     free(s->images);
@@ -162,11 +165,15 @@ material material_default(void) {
     material m;
     memset(&m, 0, sizeof m);
     snprintf(m.name, sizeof m.name, "default");
+    m.normal_tex = (texture_slot){.texture = -1};
+    m.normal_scale = 1.0f;
+    m.alpha_cutoff = 0.5f;
+    m.base_alpha = 1.0f;
     m.model = MATERIAL_GLTF;
     m.base_color = v3s(1.0f);
     m.metallic = 1.0f;
     m.roughness = 1.0f;
-    m.base_color_tex = m.metal_rough_tex = m.anisotropy_tex = m.emissive_tex = (texture_slot){-1, 0};
+    m.base_color_tex = m.metal_rough_tex = m.anisotropy_tex = m.emissive_tex = (texture_slot){.texture = -1};
     m.ext = material_ext_default();
     return m;
 }
@@ -215,6 +222,19 @@ int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err
             if (found < 0) return snprintf(err, errlen, "out of memory"), -1;
         }
         mat_index = found;
+    }
+
+    /* Tangents (normal maps, anisotropy) from the file, else as MikkTSpace makes them from the
+     * normal map's uv set; glTF ignores the file's when it has no normals. */
+    const material *mat = &s->materials[mat_index];
+    int tangent_uv = mat->normal_tex.texture >= 0 ? mat->normal_tex.texcoord : 0;
+    if ((mesh->uv0 || mesh->uv1) && (!mesh->tangents || !mesh->normals)) {
+        tangent_mesh tm;
+        if (tangents_generate(mesh, tangent_uv, &tm) != 0) goto oom;
+        tm.mesh.material = mat_index;
+        int status = scene_add_mesh(s, &tm.mesh, xform, err, errlen);
+        tangent_mesh_free(&tm);
+        return status;
     }
 
     /* Without normals, glTF asks for flat shading: every triangle gets its own vertices. */
@@ -300,54 +320,13 @@ int scene_add_mesh(scene *s, const mesh_desc *mesh, const mat4 *xform, char *err
         scene_warn(s, "skipped %d triangle%s with no area, or too large for float's squares (edges beyond ~1e9)",
                    skipped, skipped > 1 ? "s" : "");
 
-    /* Tangents from uv0 where the mesh has none (Lengyel): area-weighted per vertex, then
-     * orthogonalised against the normal; a fallback frame where the uvs are degenerate. */
-    if (!mesh->tangents || flat) {
-        vec3 *tan = calloc((size_t)out_vertices, sizeof(vec3));
-        vec3 *bit = calloc((size_t)out_vertices, sizeof(vec3));
-        if (!tan || !bit) {
-            free(tan);
-            free(bit);
-            goto oom;
-        }
-        if (mesh->uv0) {
-            for (int t = tri_base; t < tri_base + kept; t++) {
-                uint32_t *v = &s->indices[3 * t];
-                vec3 e1 = sub3(s->positions[v[1]], s->positions[v[0]]);
-                vec3 e2 = sub3(s->positions[v[2]], s->positions[v[0]]);
-                vec2 a = s->uv0[v[0]], b = s->uv0[v[1]], c = s->uv0[v[2]];
-                float du1 = b.x - a.x, dv1 = b.y - a.y, du2 = c.x - a.x, dv2 = c.y - a.y;
-                float d = du1 * dv2 - du2 * dv1;
-                if (!(fabsf(d) > 1e-20f)) continue;
-                float r = 1.0f / d;
-                /* Weighting by |d| turns r into sign(d): area-weighted in uv space. */
-                float w = fabsf(d);
-                vec3 sdir = scale3(sub3(scale3(e1, dv2), scale3(e2, dv1)), r * w);
-                vec3 tdir = scale3(sub3(scale3(e2, du1), scale3(e1, du2)), r * w);
-                for (int c2 = 0; c2 < 3; c2++) {
-                    tan[v[c2] - (uint32_t)base] = add3(tan[v[c2] - (uint32_t)base], sdir);
-                    bit[v[c2] - (uint32_t)base] = add3(bit[v[c2] - (uint32_t)base], tdir);
-                }
-            }
-        }
+    /* No uvs to derive tangents from (tangents_generate had them otherwise): any frame. */
+    if (!mesh->tangents || flat)
         for (int k = 0; k < out_vertices; k++) {
             vec3 n = s->normals[base + k];
-            vec3 t = tan[k];
-            vec3 to = sub3(t, scale3(n, dot3(n, t)));
-            float l2 = length_sq3(to);
-            vec3 tt;
-            float w = 1.0f;
-            if (l2 > 1e-30f && isfinite(l2)) {
-                tt = scale3(to, 1.0f / sqrtf(l2));
-                w = dot3(cross3(n, tt), bit[k]) < 0.0f ? -1.0f : 1.0f;
-            } else {
-                tt = length_sq3(n) > 0.0f ? any_tangent(n) : v3(1, 0, 0);
-            }
-            s->tangents[base + k] = (vec4){tt.x, tt.y, tt.z, w};
+            vec3 t = length_sq3(n) > 0.0f ? any_tangent(n) : v3(1, 0, 0);
+            s->tangents[base + k] = (vec4){t.x, t.y, t.z, 1.0f};
         }
-        free(tan);
-        free(bit);
-    }
 
     s->num_vertices += out_vertices;
     s->num_triangles += kept;
@@ -358,11 +337,6 @@ oom:
 }
 
 /* ---- finalize ------------------------------------------------------------------------------ */
-
-/* Embree's own errors go where the scene's warnings go: the library does not print. */
-static void embree_error(void *user, enum RTCError code, const char *str) {
-    scene_warn(user, "embree: %s (code %d)", str ? str : "unknown error", (int)code);
-}
 
 /* The scene's size from its triangles: bounds, diagonal, and the ray offset that scales with it.
  * Returns 0, or -1 when the scene has no (finite) extent. */
@@ -378,19 +352,20 @@ static int update_extent(scene *s) {
     return 0;
 }
 
+static void warn_if_unlit(scene *s) {
+    if (s->num_lights == 0)
+        scene_warn(s,
+                   "%s: no light (no punctual light, no emissive material): the image is black without an "
+                   "environment map",
+                   s->path);
+}
+
 int scene_finalize(scene *s, char *err, size_t errlen) {
     if (s->num_triangles == 0) return snprintf(err, errlen, "%s: no triangles to render", s->path), -1;
     if (update_extent(s) != 0) return snprintf(err, errlen, "%s: scene has no extent", s->path), -1;
 
     /* Pad the vertex array for Embree (the slot exists: positions has one spare element). */
     s->positions[s->num_vertices] = v3(0, 0, 0);
-
-    if (scene_build_lights(s, err, errlen) != 0) return -1;
-    if (s->num_lights == 0)
-        scene_warn(s,
-                   "%s: no light (no punctual light, no emissive material): the image is black without an "
-                   "environment map",
-                   s->path);
 
     /* Hits need the geometric normal, which moving a light (a translation) never changes. */
     free(s->tri_normal);
@@ -402,22 +377,12 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
         s->tri_normal[t] = normalize3(cross3(sub3(s->positions[v[1]], p0), sub3(s->positions[v[2]], p0)));
     }
 
-    s->device = rtcNewDevice(NULL);
-    if (!s->device) return snprintf(err, errlen, "%s: cannot create an Embree device", s->path), -1;
-    rtcSetDeviceErrorFunction(s->device, embree_error, s);
-    s->rtc = rtcNewScene(s->device);
-    rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry geom = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->positions, 0, sizeof(vec3),
-                               (size_t)s->num_vertices);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->indices, 0, 3 * sizeof(uint32_t),
-                               (size_t)s->num_triangles);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometryByID(s->rtc, geom, 0);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(s->rtc);
-    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE)
-        return snprintf(err, errlen, "%s: building the BVH failed", s->path), -1;
+    /* The BVH first: it decides which triangles no ray can see (alpha), and those emit nothing. */
+    if (scene_build_bvh(s, err, errlen) != 0 || scene_emissive_analyse(s, err, errlen) != 0 ||
+        scene_build_lights(s, err, errlen) != 0)
+        return -1;
+    /* A material variant may bring its own: scene_set_variant warns then. */
+    if (!scene_variants_emit(s)) warn_if_unlit(s);
     return 0;
 }
 
@@ -530,11 +495,7 @@ int scene_move_light(scene *s, int g, vec3 delta, char *err, size_t errlen) {
     free(moved);
     update_extent(s); /* cannot fail: the moved triangles keep their (non-zero) areas */
     /* The vertex buffer is shared with Embree: mark it changed and rebuild the BVH. */
-    RTCGeometry geom = rtcGetGeometry(s->rtc, 0);
-    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
-    rtcCommitGeometry(geom);
-    rtcCommitScene(s->rtc);
-    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) return snprintf(err, errlen, "rebuilding the BVH failed"), -1;
+    if (scene_bvh_vertices_moved(s) != 0) return snprintf(err, errlen, "rebuilding the BVH failed"), -1;
     /* Bounds feed the directional and environment powers: the selection distribution follows. */
     return scene_build_lights(s, err, errlen);
 }
@@ -575,6 +536,29 @@ int scene_set_light_gain(scene *s, int g, float gain, char *err, size_t errlen) 
     box->gains[g] = gain;
     /* Powers and the selection distribution follow the new intensity. */
     return scene_build_lights(s, err, errlen);
+}
+
+int scene_set_variant(scene *s, int v, char *err, size_t errlen) {
+    if (v < -1 || v >= scene_num_variants(s))
+        return snprintf(err, errlen, "%s: no material variant %d (the scene has %d)", s->path, v,
+                        scene_num_variants(s)),
+               -1;
+    /* Light groups follow the materials: intensities go back to the file's before they change. */
+    scene_box *box = (scene_box *)s;
+    for (int g = 0; g < box->num_gains; g++)
+        if (box->gains[g] != 1.0f && scene_set_light_gain(s, g, 1.0f, err, errlen) != 0) return -1;
+    scene_apply_variant(s, v);
+    free(box->gains);
+    free(box->gain_bases);
+    box->gains = NULL;
+    box->gain_bases = NULL;
+    box->num_gains = 0;
+    if (!s->rtc) return 0; /* not finalized yet: scene_finalize builds the rest */
+    if (scene_build_bvh(s, err, errlen) != 0 || scene_emissive_analyse(s, err, errlen) != 0 ||
+        scene_build_lights(s, err, errlen) != 0)
+        return -1;
+    warn_if_unlit(s);
+    return 0;
 }
 
 /* ---- loading ------------------------------------------------------------------------------- */
@@ -661,32 +645,7 @@ static void complete_hit(const scene *s, vec3 d, int t, float b1, float b2, floa
     h->uv1 = v2(b0 * s->uv1[v[0]].x + b1 * s->uv1[v[1]].x + b2 * s->uv1[v[2]].x,
                 b0 * s->uv1[v[0]].y + b1 * s->uv1[v[1]].y + b2 * s->uv1[v[2]].y);
 
-    vec3 ns = add3(add3(scale3(s->normals[v[0]], b0), scale3(s->normals[v[1]], b1)), scale3(s->normals[v[2]], b2));
-    float l2 = length_sq3(ns);
-    ns = (l2 > 1e-12f && isfinite(l2)) ? scale3(ns, 1.0f / sqrtf(l2)) : ng;
-    /* The shading normal lives on the same side as the geometric one... */
-    if (dot3(ns, ng) < 0.0f) ns = neg3(ns);
-    /* ...and must see the viewer: bend it toward wo when interpolation tilts it away. */
-    vec3 wo = neg3(d);
-    float cos_o = dot3(ns, wo);
-    const float min_cos = 1e-3f;
-    if (cos_o < min_cos) ns = normalize3(madd3(ns, wo, min_cos - cos_o));
-
-    /* Only anisotropic lobes care which way the tangent points; the rest take any frame. */
-    const material *m = &s->materials[h->material];
-    int anisotropic = (m->model == MATERIAL_WARD && m->alpha_x != m->alpha_y) ||
-                      (m->model == MATERIAL_GLTF && m->anisotropy_strength > 0.0f);
-    if (!anisotropic) {
-        h->shading = frame_from_normal(ns);
-        return;
-    }
-    const vec4 *tg = s->tangents;
-    vec3 tan = add3(
-        add3(scale3(v3(tg[v[0]].x, tg[v[0]].y, tg[v[0]].z), b0), scale3(v3(tg[v[1]].x, tg[v[1]].y, tg[v[1]].z), b1)),
-        scale3(v3(tg[v[2]].x, tg[v[2]].y, tg[v[2]].z), b2));
-    h->shading = frame_from_normal_tangent(ns, tan);
-    /* glTF bitangent = cross(n, t) * w; keep the handedness so anisotropy rotations turn the right way. */
-    if (tg[v[0]].w < 0.0f) h->shading.b = neg3(h->shading.b);
+    shading_frame_at_hit(s, h, b1, b2, d);
 }
 
 int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) {
@@ -698,7 +657,7 @@ int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h) 
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(s->rtc, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
-    complete_hit(s, d, (int)rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, h);
+    complete_hit(s, d, scene_hit_triangle(s, rh.hit.geomID, rh.hit.primID), rh.hit.u, rh.hit.v, rh.ray.tfar, h);
     return 1;
 }
 
@@ -734,7 +693,8 @@ unsigned scene_intersect_packet(const scene *s, vec3 o, const vec3 *d, int n, su
     unsigned hits = 0;
     for (int i = 0; i < n; i++) {
         if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-        complete_hit(s, d[i], (int)rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], rh.ray.tfar[i], &h[i]);
+        complete_hit(s, d[i], scene_hit_triangle(s, rh.hit.geomID[i], rh.hit.primID[i]), rh.hit.u[i], rh.hit.v[i],
+                     rh.ray.tfar[i], &h[i]);
         hits |= 1u << i;
     }
     return hits;

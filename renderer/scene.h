@@ -40,6 +40,10 @@ typedef struct {
 typedef struct {
     int texture;
     int texcoord; /* 0 or 1 */
+    /* KHR_texture_transform, applied where uv is looked up (texture_lookup): when transformed,
+     * u' = uv_xf[0] u + uv_xf[1] v + uv_xf[2], v' = uv_xf[3] u + uv_xf[4] v + uv_xf[5]. */
+    int transformed;
+    float uv_xf[6];
 } texture_slot;
 
 /* ---- materials ----------------------------------------------------------------------------- */
@@ -68,9 +72,18 @@ typedef struct {
     texture_slot clearcoat_roughness_tex; /* linear: G */
 } material_ext;
 
+/* glTF alphaMode. */
+typedef enum { ALPHA_OPAQUE = 0, ALPHA_MASK, ALPHA_BLEND } alpha_mode;
+
 typedef struct {
     char name[64];
     material_model model;
+    /* Geometry and texturing (docs/design.md, "Surfaces as glTF draws them") */
+    texture_slot normal_tex; /* linear: tangent-space normal, glTF's convention */
+    float normal_scale;      /* normalTexture.scale: multiplies the map's x and y */
+    alpha_mode alpha;        /* MASK: cut out below alpha_cutoff; BLEND: stochastic transparency */
+    float alpha_cutoff;      /* MASK */
+    float base_alpha;        /* baseColorFactor's alpha; the base colour texture's alpha multiplies it */
     /* glTF metallic-roughness */
     vec3 base_color;
     float metallic, roughness;
@@ -163,6 +176,20 @@ typedef struct scene {
 
     RTCDevice device;
     RTCScene rtc;
+
+    /* The ray-traced geometry (alpha.c): Embree geometry 0 holds the triangles every ray stops
+     * at, geometry 1 those whose alpha a filter tests; each maps its primitives to scene
+     * triangles (bvh_tri[0] NULL: geometry 0 is every triangle, in order). Per material its
+     * alpha class. */
+    uint32_t *bvh_indices[2];
+    int32_t *bvh_tri[2];
+    int bvh_count[2];
+    unsigned char *alpha_class;
+    /* Per triangle, for emissive triangles with an emissive texture (emissive.c): the texture's
+     * mean over the triangle, 0 in the channels where it is black all over; NULL without such. */
+    vec3 *tri_emit_tex;
+    /* KHR_materials_variants (variants.c; the accessors below): NULL without variants. */
+    struct scene_variants *variants;
 } scene;
 
 /* ---- loading ------------------------------------------------------------------------------- */
@@ -234,6 +261,30 @@ int scene_add_camera(scene *s, const camera *c);
 material material_default(void);
 /* Builds what rendering needs: light list and selection, scale, the BVH. Returns 0 or -1. */
 int scene_finalize(scene *s, char *err, size_t errlen);
+
+/* Material variants (KHR_materials_variants): their number (0 without), names, and the one in
+ * use (-1: the file's default materials). */
+#define SCENE_MAX_VARIANTS 1024
+#define SCENE_MAX_VARIANT_PAIRS (1 << 22) /* (variant, material) mappings over all primitives */
+int scene_num_variants(const scene *s);
+const char *scene_variant_name(const scene *s, int i);
+int scene_variant(const scene *s);
+/* The variant called name, or -1. */
+int scene_variant_find(const scene *s, const char *name);
+/* Gives every primitive its material for variant v (-1: the default ones) and rebuilds what
+ * follows from materials (alpha, emitters, the light list); intensity edits start over (light
+ * groups follow materials), moved lights stay moved. Between frames. Returns 0, or -1 with err
+ * set (no such variant, out of memory). */
+int scene_set_variant(scene *s, int v, char *err, size_t errlen);
+/* scene_set_variant for the variant called name; an unknown name is an error listing the scene's. */
+int scene_select_variant(scene *s, const char *name, char *err, size_t errlen);
+/* Building them (the importer): the names, once; a primitive's mappings as a table of (variant,
+ * material) pairs, returning its index; then, after each scene_add_mesh of an instance of it,
+ * that the triangles added since first_triangle follow table. Each returns -1 on bad input (an
+ * index out of range, over the limits above) or out of memory. */
+int scene_add_variants(scene *s, const char *const *names, int n);
+int scene_add_variant_table(scene *s, const int *variants, const int *materials, int n);
+int scene_map_variants(scene *s, int first_triangle, int table);
 
 /* ---- editing lights (between frames: nothing may be rendering the scene) ------------------ */
 

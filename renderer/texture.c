@@ -51,7 +51,12 @@ int scene_add_image(scene *s, int width, int height, int channels, int bits, con
     return s->num_images++;
 }
 
-static int wrap_coord(int i, int n, wrap_mode mode) {
+const float *texture_srgb_table(void) {
+    pthread_once(&tables_once, build_tables);
+    return srgb_table;
+}
+
+int texture_wrap(int i, int n, wrap_mode mode) {
     switch (mode) {
     case WRAP_CLAMP: return i < 0 ? 0 : (i >= n ? n - 1 : i);
     case WRAP_MIRROR: {
@@ -72,14 +77,18 @@ vec4 texture_lookup(const scene *s, texture_slot slot, vec2 uv0, vec2 uv1, int s
     const scene_texture *t = &s->textures[slot.texture];
     const scene_image *img = &s->images[t->image];
     vec2 uv = slot.texcoord == 1 ? uv1 : uv0;
+    if (slot.transformed) { /* KHR_texture_transform */
+        const float *m = slot.uv_xf;
+        uv = v2(m[0] * uv.x + m[1] * uv.y + m[2], m[3] * uv.x + m[4] * uv.y + m[5]);
+    }
     /* Texel centres at half-integers; floor via a large positive shift keeps negative uv exact. */
     float x = uv.x * (float)img->width - 0.5f, y = uv.y * (float)img->height - 0.5f;
     if (!isfinite(x) || !isfinite(y) || fabsf(x) > 1e8f || fabsf(y) > 1e8f) x = y = 0.0f;
     float fx = floorf(x), fy = floorf(y);
     float ax = x - fx, ay = y - fy;
     int x0 = (int)fx, y0 = (int)fy;
-    int xs[2] = {wrap_coord(x0, img->width, t->wrap_s), wrap_coord(x0 + 1, img->width, t->wrap_s)};
-    int ys[2] = {wrap_coord(y0, img->height, t->wrap_t), wrap_coord(y0 + 1, img->height, t->wrap_t)};
+    int xs[2] = {texture_wrap(x0, img->width, t->wrap_s), texture_wrap(x0 + 1, img->width, t->wrap_s)};
+    int ys[2] = {texture_wrap(y0, img->height, t->wrap_t), texture_wrap(y0 + 1, img->height, t->wrap_t)};
     float w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
     const float *colour = srgb ? srgb_table : linear_table;
     float acc[4] = {0, 0, 0, 0};

@@ -53,7 +53,12 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
             vl.p = h.p;
             vl.ng = h.ng;
             vl.wi = to_local(vl.frame, neg3(d));
-            vl.power = beta;
+            /* Shading normals are not symmetric (Veach 1997, sec. 5.3): the light arrives through
+             * the geometric surface but the BSDF weighs it by the shading normal's cosine, so the
+             * light here carries |wi.ns| / |wi.ng| and leaves by the geometric cosine (below, and
+             * at the gather in vsl.c): the path tracer's answer with any normal map. */
+            vec3 beta_in = scale3(beta, fmaxf(vl.wi.z, 0.0f) / dot3(neg3(d), h.ng));
+            vl.power = beta_in;
             vl.depth = depth;
             if (vl.wi.z > 0.0f && push(set, &vl) != 0) return -1;
             if (depth + 1 >= max_depth) break;
@@ -64,11 +69,11 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
             if (!bsdf_sample(&vl.b, vl.wi, BSDF_ALL, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) break;
             vec3 wi = to_world(vl.frame, bs.wi);
             if (dot3(wi, h.ng) <= 0.0f) break;
-            vec3 gain = scale3(bs.f, bs.wi.z / bs.pdf);
+            vec3 gain = scale3(bs.f, dot3(wi, h.ng) / bs.pdf);
             /* By the bounce's gain (the path's weight is the light's power), after a couple of
              * bounces. */
             if (depth >= 2 && !russian_roulette(&gain, rng_float(&rng))) break;
-            beta = mul3(beta, gain);
+            beta = mul3(beta_in, gain);
             if (is_black3(beta) || !is_finite3(beta)) break;
             o = offset_origin(s, h.p, h.ng, wi);
             d = wi;

@@ -40,7 +40,8 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
     if (lx.z <= 0.0f || lj.z <= 0.0f) return v3(0, 0, 0);
     vec3 f = bsdf_pair(vl, x, lx, lj, glossy_at_light ? BSDF_ALL : BSDF_DIFFUSE, terms);
     if (is_black3(f)) return f;
-    return saturate(vl->power, f, (double)lx.z * (double)lj.z / (double)d2);
+    /* The light leaves by its geometric cosine (vlights.c: shading normals' adjoint). */
+    return saturate(vl->power, f, (double)lx.z * -(double)dot3(l, vl->ng) / (double)d2);
 }
 
 /* Omega_j: the cone from x around the sphere (p_j, r_j), or x's hemisphere when x is inside. */
@@ -78,8 +79,9 @@ static int in_omega(const solid_angle *o, const shading_point *x, vec3 l) {
 static vec3 integrand(const virtual_light *vl, const shading_point *x, vl_terms terms, vec3 l, vec3 *lx, vec3 *lj) {
     *lx = to_local(x->frame, l);
     *lj = to_local(vl->frame, neg3(l));
-    if (lx->z <= 0.0f || lj->z <= 0.0f) return v3(0, 0, 0);
-    return scale3(bsdf_pair(vl, x, *lx, *lj, BSDF_ALL, terms), lx->z * lj->z);
+    float cos_j = -dot3(l, vl->ng); /* geometric: shading normals' adjoint (vlights.c) */
+    if (lx->z <= 0.0f || lj->z <= 0.0f || !(cos_j > 0.0f)) return v3(0, 0, 0);
+    return scale3(bsdf_pair(vl, x, *lx, *lj, BSDF_ALL, terms), lx->z * cos_j);
 }
 
 vec3 vsl_integrand(const virtual_light *vl, const shading_point *x, vl_terms terms, vec3 l) {

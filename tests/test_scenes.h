@@ -64,6 +64,42 @@ static inline void ts_quad(scene *s, vec3 p0, vec3 p1, vec3 p2, vec3 p3, int mat
     }
 }
 
+/* Quad p[0..3] (counter-clockwise seen from its front) with the given uvs (8 floats) and normals
+ * along its winding normal; tangents generated. */
+static inline void ts_quad_uv(scene *s, const vec3 p[4], const float uv[8], int mat) {
+    float pos[12], nrm[12];
+    vec3 n = normalize3(cross3(sub3(p[1], p[0]), sub3(p[2], p[0])));
+    for (int i = 0; i < 4; i++) {
+        pos[3 * i] = p[i].x, pos[3 * i + 1] = p[i].y, pos[3 * i + 2] = p[i].z;
+        nrm[3 * i] = n.x, nrm[3 * i + 1] = n.y, nrm[3 * i + 2] = n.z;
+    }
+    uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    mesh_desc md = {.num_vertices = 4,
+                    .positions = pos,
+                    .normals = nrm,
+                    .uv0 = uv,
+                    .num_indices = 6,
+                    .indices = idx,
+                    .material = mat};
+    mat4 id = mat4_identity();
+    char err[256];
+    if (scene_add_mesh(s, &md, &id, err, sizeof err) != 0) {
+        fprintf(stderr, "ts_quad_uv: %s\n", err);
+        abort();
+    }
+}
+
+/* A texture of w x h 8-bit RGBA texels (repeat wrapping); returns its index. */
+static inline int ts_texture(scene *s, int w, int h, const unsigned char *rgba) {
+    int img = scene_add_image(s, w, h, 4, 8, rgba);
+    int t = img < 0 ? -1 : scene_add_texture(s, (scene_texture){img, WRAP_REPEAT, WRAP_REPEAT});
+    if (t < 0) {
+        fprintf(stderr, "ts_texture: out of memory\n");
+        abort();
+    }
+    return t;
+}
+
 /* Axis-aligned box [lo, hi]; faces point inward (a closed room) or outward (a solid). */
 static inline void ts_box(scene *s, vec3 lo, vec3 hi, int inward, int mat) {
     vec3 c[8];

@@ -403,6 +403,10 @@ static void panel(ui_controls *c, const ui_stats *s) {
     g_image_dock = w;
     ImGui::TextUnformatted(s->scene_name ? s->scene_name : "");
     ImGui::PushItemWidth(-ImGui::GetFontSize() * 11.0f); // room for the longest label
+    if (s->num_variants > 0) { // KHR_materials_variants: switching reloads the scene, the view stays
+        int v = c->variant + 1;
+        if (ImGui::Combo("material variant", &v, s->variant_labels, s->num_variants + 1)) c->variant = v - 1;
+    }
 
     if (ImGui::CollapsingHeader("Progress", ImGuiTreeNodeFlags_DefaultOpen)) progress_section(c, s);
 

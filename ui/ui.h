@@ -43,6 +43,7 @@ typedef struct {
     double time_limit;                   /* seconds since the last reset */
     int show_help;                       /* the shortcut overlay */
     int bookmark_save, bookmark_restore; /* one-shot: a slot 1-9, 0 none */
+    int variant;                         /* the scene's material variant, -1 for the default materials */
 } ui_controls;
 
 /* One curve of the error plot: relative L2 error against seconds since a reset. */
@@ -93,6 +94,8 @@ typedef struct {
     unsigned bookmarks_set; /* bit N: bookmark N is set */
     const char *const *shortcut_keys, *const *shortcut_actions; /* the help overlay's lines */
     int num_shortcuts;
+    const char *const *variant_labels; /* "default materials", then the scene's variants */
+    int num_variants;                  /* variants (labels: one more); 0 hides the choice */
 } ui_stats;
 
 /* Sets up Dear ImGui for a window with a current OpenGL 3.3 context. Returns 0 or -1. */

@@ -1,0 +1,223 @@
+/* The ray-traced geometry and glTF's alpha (docs/design.md, "Alpha"): triangles whose material
+ * can never let a ray through sit in an Embree geometry without filters (Embree's fast path);
+ * those whose alpha varies sit in a second one whose intersection and occlusion filters test it,
+ * so camera rays, bounces, shadow rays and light paths all see the same cut-outs; triangles no
+ * ray can see are left out. MASK cuts out below its cutoff; BLEND lets a ray through with
+ * probability 1 - alpha, decided by a hash of the ray and the triangle: threads and runs agree,
+ * and over random rays the transmission is 1 - alpha on average. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rng.h"
+#include "scene_parts.h"
+
+enum { ALPHA_CLASS_OPAQUE = 0, ALPHA_CLASS_TESTED, ALPHA_CLASS_INVISIBLE };
+
+float material_alpha(const scene *s, const material *m, vec2 uv0, vec2 uv1) {
+    float a = m->base_alpha;
+    if (m->base_color_tex.texture >= 0) a *= texture_lookup(s, m->base_color_tex, uv0, uv1, 0).w;
+    return a;
+}
+
+/* Whether a surface of alpha a is there for a ray whose hash is u in [0, 1). */
+static int alpha_keeps(const material *m, float a, float u) {
+    return m->alpha == ALPHA_MASK ? a >= m->alpha_cutoff : u < a;
+}
+
+float material_coverage(const scene *s, const surface_hit *h) {
+    const material *m = &s->materials[h->material];
+    if (m->alpha == ALPHA_OPAQUE) return 1.0f;
+    float a = material_alpha(s, m, h->uv0, h->uv1);
+    return m->alpha == ALPHA_MASK ? (a >= m->alpha_cutoff ? 1.0f : 0.0f) : clampf(a, 0.0f, 1.0f);
+}
+
+/* The range of alpha a material's texture can give (bilinear lookups stay between its texels). */
+static void alpha_range(const scene *s, const material *m, float *lo, float *hi) {
+    *lo = *hi = m->base_alpha;
+    if (m->base_color_tex.texture < 0) return;
+    const scene_image *img = &s->images[s->textures[m->base_color_tex.texture].image];
+    int amin = 255, amax = 0;
+    size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n && (amin > 0 || amax < 255); i++) {
+        int a = img->rgba[4 * i + 3];
+        amin = a < amin ? a : amin;
+        amax = a > amax ? a : amax;
+    }
+    *lo = m->base_alpha * (float)amin / 255.0f;
+    *hi = m->base_alpha * (float)amax / 255.0f;
+}
+
+/* Opaque: every ray stops; invisible: none does; tested: the filter decides per hit. */
+static int alpha_class(const scene *s, const material *m) {
+    if (m->alpha == ALPHA_OPAQUE) return ALPHA_CLASS_OPAQUE;
+    float lo, hi;
+    alpha_range(s, m, &lo, &hi);
+    float threshold = m->alpha == ALPHA_MASK ? m->alpha_cutoff : 1.0f;
+    if (lo >= threshold) return ALPHA_CLASS_OPAQUE;
+    if (m->alpha == ALPHA_MASK ? hi < threshold : !(hi > 0.0f)) return ALPHA_CLASS_INVISIBLE;
+    return ALPHA_CLASS_TESTED;
+}
+
+/* Embree's ray and hit packets in C: structure-of-arrays of N lanes (rtcore_ray.h's RTCRayN_*
+ * and RTCHitN_* accessors, which are C++ only). */
+static float ray_f(const struct RTCRayN *r, unsigned n, unsigned k, unsigned i) {
+    return ((const float *)r)[k * n + i];
+}
+static float hit_f(const struct RTCHitN *h, unsigned n, unsigned k, unsigned i) {
+    return ((const float *)h)[k * n + i];
+}
+static unsigned hit_u(const struct RTCHitN *h, unsigned n, unsigned k, unsigned i) {
+    return ((const unsigned *)h)[k * n + i];
+}
+
+/* A number in [0, 1) from a ray (origin, direction) and a triangle: the same ray meets the same
+ * decision wherever and however often it is traced. */
+static float ray_hash(const float org_dir[6], unsigned tri) {
+    uint64_t h = 0x616c706861ULL + tri;
+    for (int k = 0; k < 6; k++) {
+        uint32_t b;
+        memcpy(&b, &org_dir[k], 4);
+        h = rng_hash64(h ^ b);
+    }
+    return (float)(h >> 40) * 0x1p-24f;
+}
+
+float alpha_ray_hash(vec3 o, vec3 d, int tri) {
+    const float od[6] = {o.x, o.y, o.z, d.x, d.y, d.z};
+    return ray_hash(od, (unsigned)tri);
+}
+
+static void alpha_filter(const struct RTCFilterFunctionNArguments *args) {
+    const scene *s = args->geometryUserPtr;
+    unsigned n = args->N;
+    for (unsigned i = 0; i < n; i++) {
+        if (args->valid[i] == 0) continue;
+        int t = s->bvh_tri[1][hit_u(args->hit, n, 5, i)]; /* primID */
+        const material *m = &s->materials[s->tri_material[t]];
+        float b1 = hit_f(args->hit, n, 3, i), b2 = hit_f(args->hit, n, 4, i);
+        if (!isfinite(b1) || !isfinite(b2)) b1 = b2 = 0.0f;
+        float b0 = 1.0f - b1 - b2;
+        const uint32_t *v = &s->indices[3 * t];
+        vec2 uv0 = v2(b0 * s->uv0[v[0]].x + b1 * s->uv0[v[1]].x + b2 * s->uv0[v[2]].x,
+                      b0 * s->uv0[v[0]].y + b1 * s->uv0[v[1]].y + b2 * s->uv0[v[2]].y);
+        vec2 uv1 = v2(b0 * s->uv1[v[0]].x + b1 * s->uv1[v[1]].x + b2 * s->uv1[v[2]].x,
+                      b0 * s->uv1[v[0]].y + b1 * s->uv1[v[1]].y + b2 * s->uv1[v[2]].y);
+        float a = material_alpha(s, m, uv0, uv1);
+        float u = 0.0f;
+        if (m->alpha == ALPHA_BLEND) {
+            float od[6]; /* org_x, org_y, org_z, then dir_x, dir_y, dir_z after tnear */
+            for (unsigned k = 0; k < 3; k++)
+                od[k] = ray_f(args->ray, n, k, i), od[3 + k] = ray_f(args->ray, n, 4 + k, i);
+            u = ray_hash(od, (unsigned)t);
+        }
+        if (!alpha_keeps(m, a, u)) args->valid[i] = 0;
+    }
+}
+
+static void free_bvh(scene *s) {
+    if (s->rtc) rtcReleaseScene(s->rtc);
+    s->rtc = NULL;
+    for (int g = 0; g < 2; g++) {
+        free(s->bvh_indices[g]);
+        free(s->bvh_tri[g]);
+        s->bvh_indices[g] = NULL;
+        s->bvh_tri[g] = NULL;
+        s->bvh_count[g] = 0;
+    }
+}
+
+void scene_bvh_free(scene *s) {
+    free_bvh(s);
+    free(s->alpha_class);
+    s->alpha_class = NULL;
+}
+
+/* Embree's own errors go where the scene's warnings go: the library does not print. */
+static void embree_error(void *user, enum RTCError code, const char *str) {
+    scene_warn(user, "embree: %s (code %d)", str ? str : "unknown error", (int)code);
+}
+
+static RTCGeometry add_geometry(scene *s, const uint32_t *indices, int count) {
+    RTCGeometry geom = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->positions, 0, sizeof(vec3),
+                               (size_t)s->num_vertices);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices, 0, 3 * sizeof(uint32_t),
+                               (size_t)count);
+    return geom;
+}
+
+int scene_build_bvh(scene *s, char *err, size_t errlen) {
+    if (!s->device) {
+        s->device = rtcNewDevice(NULL);
+        if (!s->device) return snprintf(err, errlen, "%s: cannot create an Embree device", s->path), -1;
+        rtcSetDeviceErrorFunction(s->device, embree_error, s);
+    }
+    free_bvh(s);
+    unsigned char *cls = realloc(s->alpha_class, (size_t)s->num_materials + 1);
+    if (!cls) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    s->alpha_class = cls;
+    int filters = (int)rtcGetDeviceProperty(s->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED);
+    int counts[3] = {0, 0, 0};
+    for (int m = 0; m < s->num_materials; m++) cls[m] = (unsigned char)alpha_class(s, &s->materials[m]);
+    for (int t = 0; t < s->num_triangles; t++) counts[cls[s->tri_material[t]]]++;
+    if (counts[ALPHA_CLASS_TESTED] && !filters) {
+        scene_warn(s, "%s: this Embree has no filter functions: alpha modes are drawn opaque", s->path);
+        for (int m = 0; m < s->num_materials; m++) cls[m] = ALPHA_CLASS_OPAQUE;
+        counts[0] = s->num_triangles, counts[1] = counts[2] = 0;
+    }
+
+    s->rtc = rtcNewScene(s->device);
+    rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
+    if (counts[ALPHA_CLASS_OPAQUE] == s->num_triangles) {
+        /* The common case: one geometry over the scene's own index buffer, triangles in order. */
+        RTCGeometry geom = add_geometry(s, s->indices, s->num_triangles);
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(s->rtc, geom, 0);
+        rtcReleaseGeometry(geom);
+        s->bvh_count[0] = s->num_triangles;
+    } else {
+        for (int g = 0; g < 2; g++) {
+            s->bvh_indices[g] = malloc(3 * sizeof(uint32_t) * (size_t)(counts[g] + 1));
+            s->bvh_tri[g] = malloc(sizeof(int32_t) * (size_t)(counts[g] + 1));
+            if (!s->bvh_indices[g] || !s->bvh_tri[g]) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+        }
+        for (int t = 0; t < s->num_triangles; t++) {
+            int g = cls[s->tri_material[t]];
+            if (g == ALPHA_CLASS_INVISIBLE) continue;
+            memcpy(&s->bvh_indices[g][3 * s->bvh_count[g]], &s->indices[3 * t], 3 * sizeof(uint32_t));
+            s->bvh_tri[g][s->bvh_count[g]++] = t;
+        }
+        for (unsigned g = 0; g < 2; g++) {
+            if (s->bvh_count[g] == 0) continue;
+            RTCGeometry geom = add_geometry(s, s->bvh_indices[g], s->bvh_count[g]);
+            if (g == 1) {
+                rtcSetGeometryUserData(geom, s);
+                rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+                rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+            }
+            rtcCommitGeometry(geom);
+            rtcAttachGeometryByID(s->rtc, geom, g);
+            rtcReleaseGeometry(geom);
+        }
+    }
+    rtcCommitScene(s->rtc);
+    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE)
+        return snprintf(err, errlen, "%s: building the BVH failed", s->path), -1;
+    return 0;
+}
+
+int scene_bvh_vertices_moved(scene *s) {
+    for (unsigned g = 0; g < 2; g++) {
+        if (s->bvh_count[g] == 0) continue;
+        RTCGeometry geom = rtcGetGeometry(s->rtc, g);
+        rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+        rtcCommitGeometry(geom);
+    }
+    rtcCommitScene(s->rtc);
+    return rtcGetDeviceError(s->device) == RTC_ERROR_NONE ? 0 : -1;
+}
+
+int scene_triangle_invisible(const scene *s, int t) {
+    return s->alpha_class && s->alpha_class[s->tri_material[t]] == ALPHA_CLASS_INVISIBLE;
+}
