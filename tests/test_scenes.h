@@ -41,29 +41,6 @@ static inline material ts_phong(vec3 kd, vec3 ks, float n) {
     return m;
 }
 
-/* Quad p0 p1 p2 p3 (counter-clockwise seen from its front), flat-shaded. */
-static inline void ts_quad(scene *s, vec3 p0, vec3 p1, vec3 p2, vec3 p3, int mat) {
-    float pos[12] = {p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y, p2.z, p3.x, p3.y, p3.z};
-    float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
-    uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    vec3 n = normalize3(cross3(sub3(p1, p0), sub3(p2, p0)));
-    float nrm[12];
-    for (int i = 0; i < 4; i++) nrm[3 * i] = n.x, nrm[3 * i + 1] = n.y, nrm[3 * i + 2] = n.z;
-    mesh_desc md = {.num_vertices = 4,
-                    .positions = pos,
-                    .normals = nrm,
-                    .uv0 = uv,
-                    .num_indices = 6,
-                    .indices = idx,
-                    .material = mat};
-    mat4 id = mat4_identity();
-    char err[256];
-    if (scene_add_mesh(s, &md, &id, err, sizeof err) != 0) {
-        fprintf(stderr, "ts_quad: %s\n", err);
-        abort();
-    }
-}
-
 /* Quad p[0..3] (counter-clockwise seen from its front) with the given uvs (8 floats) and normals
  * along its winding normal; tangents generated. */
 static inline void ts_quad_uv(scene *s, const vec3 p[4], const float uv[8], int mat) {
@@ -84,9 +61,16 @@ static inline void ts_quad_uv(scene *s, const vec3 p[4], const float uv[8], int 
     mat4 id = mat4_identity();
     char err[256];
     if (scene_add_mesh(s, &md, &id, err, sizeof err) != 0) {
-        fprintf(stderr, "ts_quad_uv: %s\n", err);
+        fprintf(stderr, "ts_quad: %s\n", err);
         abort();
     }
+}
+
+/* Quad p0 p1 p2 p3 (counter-clockwise seen from its front), flat-shaded, uvs 0..1. */
+static inline void ts_quad(scene *s, vec3 p0, vec3 p1, vec3 p2, vec3 p3, int mat) {
+    const vec3 p[4] = {p0, p1, p2, p3};
+    const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    ts_quad_uv(s, p, uv, mat);
 }
 
 /* A texture of w x h 8-bit RGBA texels (repeat wrapping); returns its index. */
