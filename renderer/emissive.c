@@ -178,7 +178,7 @@ static vec3 triangle_integral(const pyramid *p, const scene_texture *tex, int l,
 /* The texture's mean over triangle t, and (in *mx) its maximum over every texel a lookup on the
  * triangle can read; both zero when nothing on the triangle can emit. */
 static vec3 triangle_mean(const scene *s, const pyramid *p, const scene_texture *tex, texture_slot slot, int t,
-                          vec3 *mx) {
+                          int mean_span, vec3 *mx) {
     const uint32_t *v = &s->indices[3 * t];
     float xs[3], ys[3];
     int whole = 0;
@@ -209,9 +209,13 @@ static vec3 triangle_mean(const scene *s, const pyramid *p, const scene_texture 
     if (is_black3(*mx)) return *mx;
 
     /* The mean: the exact integral of the interpolant, on the level where the footprint spans at
-     * most MEAN_SPAN texels (a box-filtered copy beyond: the cost stays bounded). */
+     * most mean_span texels (a box-filtered copy beyond: the cost stays bounded). */
     int l = 0;
-    while (l < top && fmaxf(x_hi - x_lo, y_hi - y_lo) > (float)(MEAN_SPAN << l)) l++;
+    float width = fmaxf(x_hi - x_lo, y_hi - y_lo);
+    while (l < top && width > (float)(mean_span << l)) l++;
+    /* Wider than that even on the coarsest level: the footprint covers the image many times over
+     * (or clamps far past it); the image's mean stands for it. */
+    if (width > (float)(mean_span << l)) return texel(p, top, 0, 0, 0);
     float k = 1.0f / (float)(1 << l), lx[3], ly[3];
     for (int c = 0; c < 3; c++) lx[c] = (xs[c] + 0.5f) * k - 0.5f, ly[c] = (ys[c] + 0.5f) * k - 0.5f;
     float area = 0.5f * fabsf((lx[1] - lx[0]) * (ly[2] - ly[0]) - (lx[2] - lx[0]) * (ly[1] - ly[0]));
@@ -234,34 +238,48 @@ static int textured_emitter(const material *m) { return max_comp3(m->emission) >
 int scene_emissive_analyse(scene *s, char *err, size_t errlen) {
     free(s->tri_emit_tex);
     s->tri_emit_tex = NULL;
-    int any = 0;
-    for (int m = 0; m < s->num_materials && !any; m++) any = textured_emitter(&s->materials[m]);
-    if (!any) return 0;
+    /* The emissive textured triangles, grouped by the image they show (a counting sort): each
+     * image's pyramid is built once, however many textures and materials share it. */
+    int *start = calloc((size_t)s->num_images + 2, sizeof(int)), n = 0;
+    if (!start) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    for (int t = 0; t < s->num_triangles; t++) {
+        const material *m = &s->materials[s->tri_material[t]];
+        if (textured_emitter(m)) start[s->textures[m->emissive_tex.texture].image + 1]++, n++;
+    }
+    if (n == 0) return free(start), 0;
+    for (int i = 0; i < s->num_images; i++) start[i + 1] += start[i];
+    int *order = malloc(sizeof(int) * (size_t)n), *fill = calloc((size_t)s->num_images + 1, sizeof(int));
     s->tri_emit_tex = calloc((size_t)s->num_triangles + 1, sizeof(vec3));
-    if (!s->tri_emit_tex) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
-    /* One emissive texture at a time: its pyramid, then every triangle that shows it. */
-    for (int tx = 0; tx < s->num_textures; tx++) {
-        int used = 0;
-        for (int m = 0; m < s->num_materials && !used; m++)
-            used = textured_emitter(&s->materials[m]) && s->materials[m].emissive_tex.texture == tx;
-        if (!used) continue;
-        const scene_texture *tex = &s->textures[tx];
+    int status = order && fill && s->tri_emit_tex ? 0 : -1;
+    for (int t = 0; status == 0 && t < s->num_triangles; t++) {
+        const material *m = &s->materials[s->tri_material[t]];
+        if (!textured_emitter(m)) continue;
+        int img = s->textures[m->emissive_tex.texture].image;
+        order[start[img] + fill[img]++] = t;
+    }
+    /* The integral's cells per triangle shrink with their number: a few hundred each for a
+     * model's emitters, a handful each for millions (the whole stays below about 2^26). */
+    int mean_span = (int)sqrtf((float)(1 << 26) / (float)n);
+    mean_span = mean_span < 2 ? 2 : (mean_span > MEAN_SPAN ? MEAN_SPAN : mean_span);
+    for (int img = 0; status == 0 && img < s->num_images; img++) {
+        if (start[img] == start[img + 1]) continue;
         pyramid p;
-        if (pyramid_build(&s->images[tex->image], &p) != 0) {
-            pyramid_free(&p);
-            return snprintf(err, errlen, "%s: out of memory", s->path), -1;
-        }
-        for (int t = 0; t < s->num_triangles; t++) {
-            const material *m = &s->materials[s->tri_material[t]];
-            if (!textured_emitter(m) || m->emissive_tex.texture != tx) continue;
-            vec3 mx, mean = triangle_mean(s, &p, tex, m->emissive_tex, t, &mx);
-            /* Zero exactly where nothing emits; elsewhere never zero (a coarse level's integral is
-             * an estimate, and a light the texture lights somewhere must stay reachable). */
-            s->tri_emit_tex[t] = v3(mx.x > 0.0f ? fmaxf(mean.x, MEAN_FLOOR * mx.x) : 0.0f,
-                                    mx.y > 0.0f ? fmaxf(mean.y, MEAN_FLOOR * mx.y) : 0.0f,
-                                    mx.z > 0.0f ? fmaxf(mean.z, MEAN_FLOOR * mx.z) : 0.0f);
-        }
+        if ((status = pyramid_build(&s->images[img], &p)) == 0)
+            for (int k = start[img]; k < start[img + 1]; k++) {
+                int t = order[k];
+                const material *m = &s->materials[s->tri_material[t]];
+                vec3 mx, mean = triangle_mean(s, &p, &s->textures[m->emissive_tex.texture], m->emissive_tex, t,
+                                              mean_span, &mx);
+                /* Zero exactly where nothing emits; elsewhere never zero (a coarse level's integral
+                 * is an estimate, and a light the texture lights somewhere must stay reachable). */
+                s->tri_emit_tex[t] = v3(mx.x > 0.0f ? fmaxf(mean.x, MEAN_FLOOR * mx.x) : 0.0f,
+                                        mx.y > 0.0f ? fmaxf(mean.y, MEAN_FLOOR * mx.y) : 0.0f,
+                                        mx.z > 0.0f ? fmaxf(mean.z, MEAN_FLOOR * mx.z) : 0.0f);
+            }
         pyramid_free(&p);
     }
-    return 0;
+    free(start);
+    free(order);
+    free(fill);
+    return status == 0 ? 0 : (snprintf(err, errlen, "%s: out of memory", s->path), -1);
 }

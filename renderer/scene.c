@@ -546,7 +546,7 @@ int scene_set_variant(scene *s, int v, char *err, size_t errlen) {
     scene_box *box = (scene_box *)s;
     for (int g = 0; g < box->num_gains; g++)
         if (box->gains[g] != 1.0f && scene_set_light_gain(s, g, 1.0f, err, errlen) != 0) return -1;
-    scene_apply_variant(s, v);
+    if (scene_apply_variant(s, v) != 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
     free(box->gains);
     free(box->gain_bases);
     box->gains = NULL;

@@ -76,7 +76,7 @@ float alpha_ray_hash(vec3 o, vec3 d, int tri);
 /* ---- variants.c ---------------------------------------------------------------------------- */
 
 /* Rewrites the triangles' materials for variant v (-1: the defaults) and nothing else (the caller
- * rebuilds). Returns 0, or -1 for a variant the scene does not have. */
+ * rebuilds). Returns 0, or -1 for a variant the scene does not have, or out of memory. */
 int scene_apply_variant(scene *s, int v);
 void scene_variants_free(scene *s);
 /* 1 when some variant gives a primitive an emissive material. */
