@@ -15,25 +15,27 @@
 #define MEAN_FLOOR 1e-6f /* the mean never drops below this share of the maximum where it is not 0 */
 #define HUGE_COORD 1e8f  /* texel coordinates beyond: the whole texture (texture_lookup reads 0, 0) */
 
-/* Level 0 is the image itself (decoded on reading); levels 1.. halve it, keeping per texel the
- * mean and the maximum of the texels below. */
+/* Level 0 is the image itself (decoded on reading); levels 1.. halve it, keeping per texel and
+ * channel the mean (linear, 16-bit fixed point) and the maximum (the encoded 8-bit value: sRGB
+ * decoding keeps the order). 9 bytes a level-1 texel: the whole pyramid takes 3/4 of the image's
+ * own memory, and only while the image's triangles are measured. */
 typedef struct {
     const scene_image *img;
     int levels;
     int w[MAX_LEVELS], h[MAX_LEVELS];
-    vec3 *mean[MAX_LEVELS], *max[MAX_LEVELS];
+    uint16_t *mean[MAX_LEVELS];
+    uint8_t *max[MAX_LEVELS];
 } pyramid;
 
-static vec3 texel0(const pyramid *p, int x, int y) {
-    const float *srgb = texture_srgb_table();
-    const uint8_t *c = p->img->rgba + 4 * ((size_t)y * (size_t)p->img->width + (size_t)x);
-    return v3(srgb[c[0]], srgb[c[1]], srgb[c[2]]);
-}
-
 static vec3 texel(const pyramid *p, int level, int x, int y, int want_max) {
-    if (level == 0) return texel0(p, x, y);
-    size_t i = (size_t)y * (size_t)p->w[level] + (size_t)x;
-    return want_max ? p->max[level][i] : p->mean[level][i];
+    const float *srgb = texture_srgb_table();
+    size_t i = 3 * ((size_t)y * (size_t)p->w[level] + (size_t)x);
+    if (level == 0 || want_max) {
+        const uint8_t *c = level == 0 ? p->img->rgba + 4 * (i / 3) : p->max[level] + i;
+        return v3(srgb[c[0]], srgb[c[1]], srgb[c[2]]);
+    }
+    const uint16_t *m = p->mean[level] + i;
+    return scale3(v3((float)m[0], (float)m[1], (float)m[2]), 1.0f / 65535.0f);
 }
 
 static void pyramid_free(pyramid *p) {
@@ -55,23 +57,30 @@ static int pyramid_build(const scene_image *img, pyramid *p) {
         int w = (pw + 1) / 2, h = (ph + 1) / 2;
         p->w[l] = w;
         p->h[l] = h;
-        p->mean[l] = malloc(sizeof(vec3) * (size_t)w * (size_t)h);
-        p->max[l] = malloc(sizeof(vec3) * (size_t)w * (size_t)h);
+        p->mean[l] = malloc(3 * sizeof(uint16_t) * (size_t)w * (size_t)h);
+        p->max[l] = malloc(3 * (size_t)w * (size_t)h);
         p->levels++;
         if (!p->mean[l] || !p->max[l]) return -1;
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++) {
-                vec3 sum = v3(0, 0, 0), mx = v3(0, 0, 0);
+                vec3 sum = v3(0, 0, 0);
+                uint8_t mx[3] = {0, 0, 0};
                 int n = 0;
                 for (int k = 0; k < 4; k++) {
                     int cx = 2 * x + (k & 1), cy = 2 * y + (k >> 1);
                     if (cx >= pw || cy >= ph) continue;
                     sum = add3(sum, texel(p, l - 1, cx, cy, 0));
-                    mx = max3(mx, texel(p, l - 1, cx, cy, 1));
+                    size_t j = (size_t)cy * (size_t)pw + (size_t)cx;
+                    const uint8_t *c = l == 1 ? img->rgba + 4 * j : p->max[l - 1] + 3 * j;
+                    for (int ch = 0; ch < 3; ch++) mx[ch] = c[ch] > mx[ch] ? c[ch] : mx[ch];
                     n++;
                 }
-                p->mean[l][(size_t)y * (size_t)w + (size_t)x] = scale3(sum, 1.0f / (float)n);
-                p->max[l][(size_t)y * (size_t)w + (size_t)x] = mx;
+                size_t i = 3 * ((size_t)y * (size_t)w + (size_t)x);
+                vec3 mean = scale3(sum, 65535.0f / (float)n);
+                p->mean[l][i] = (uint16_t)(mean.x + 0.5f);
+                p->mean[l][i + 1] = (uint16_t)(mean.y + 0.5f);
+                p->mean[l][i + 2] = (uint16_t)(mean.z + 0.5f);
+                memcpy(p->max[l] + i, mx, 3);
             }
     }
     return 0;
