@@ -101,13 +101,7 @@ static void alpha_filter(const struct RTCFilterFunctionNArguments *args) {
         const material *m = &s->materials[s->tri_material[t]];
         float b1 = hit_f(args->hit, n, 3, i), b2 = hit_f(args->hit, n, 4, i);
         if (!isfinite(b1) || !isfinite(b2)) b1 = b2 = 0.0f;
-        float b0 = 1.0f - b1 - b2;
-        const uint32_t *v = &s->indices[3 * t];
-        vec2 uv0 = v2(b0 * s->uv0[v[0]].x + b1 * s->uv0[v[1]].x + b2 * s->uv0[v[2]].x,
-                      b0 * s->uv0[v[0]].y + b1 * s->uv0[v[1]].y + b2 * s->uv0[v[2]].y);
-        vec2 uv1 = v2(b0 * s->uv1[v[0]].x + b1 * s->uv1[v[1]].x + b2 * s->uv1[v[2]].x,
-                      b0 * s->uv1[v[0]].y + b1 * s->uv1[v[1]].y + b2 * s->uv1[v[2]].y);
-        float a = material_alpha(s, m, uv0, uv1);
+        float a = material_alpha(s, m, triangle_uv(s, s->uv0, t, b1, b2), triangle_uv(s, s->uv1, t, b1, b2));
         float u = 0.0f;
         if (m->alpha == ALPHA_BLEND) {
             float od[6]; /* org_x, org_y, org_z, then dir_x, dir_y, dir_z after tnear */
