@@ -187,6 +187,8 @@ int cmd_view(int argc, char **argv) {
     reset_lights(&u);
     bookmarks_load(&u);
     u.rel_error = -1.0;
+    u.step_ms = -1.0; /* the first image's time is measured from here */
+    u.sent_at = cli_now();
     u.current_curve = -1;
     u.started_at = cli_now();
     view_fit_window(&u, o.width, o.height); /* the image at --size beside the panel */
@@ -214,8 +216,6 @@ int cmd_view(int argc, char **argv) {
 
     glfwGetCursorPos(win, &u.mouse_x, &u.mouse_y);
     u.last_time = cli_now();
-    double resized_at = 0.0;
-    int pending_w = 0, pending_h = 0;
     while (!u.quit && !glfwWindowShouldClose(win)) {
         glfwWaitEventsTimeout(1.0 / 60.0);
         double now = cli_now(), dt = now - u.last_time;
@@ -229,25 +229,9 @@ int cmd_view(int argc, char **argv) {
 
         apply_controls(&u, handle_input(&u, dt));
 
-        /* A new size of the image beside the panel becomes the render size once it has stopped changing. */
-        int iw, ih;
-        view_image_size(&u, &iw, &ih);
-        glfwGetFramebufferSize(win, &fw, &fh);
-        if (iw > 0 && ih > 0 && (iw != sh.render_w || ih != sh.render_h)) {
-            if (iw != pending_w || ih != pending_h) {
-                pending_w = iw;
-                pending_h = ih;
-                resized_at = now;
-            } else if (now - resized_at > 0.2) {
-                pthread_mutex_lock(&sh.lock);
-                sh.render_w = iw;
-                sh.render_h = ih;
-                pthread_mutex_unlock(&sh.lock);
-                /* the aspect ratio changed: recompute the camera */
-                send_change(&u);
-            }
-        }
+        view_follow_size(&u, now);
 
+        glfwGetFramebufferSize(win, &fw, &fh);
         if (u.need_tonemap) {
             tonemap_and_upload(&u);
             u.need_tonemap = 0;

@@ -28,7 +28,7 @@ int main(int argc, char **argv) {
         return EXIT_OK;
     }
     if (strcmp(argv[1], "--version") == 0) {
-        printf("glint %s\n", GLINT_VERSION);
+        printf("glint %s (material model %s)\n", GLINT_VERSION, BSDF_MODEL_STAMP);
         return EXIT_OK;
     }
     if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 2, argv + 2);

@@ -80,6 +80,7 @@ int reference_hash_file(const char *path, char out[64], char *err, size_t errlen
 int reference_describe(reference_info *r, const char *scene_path, const char *env_path, double env_rotation_deg,
                        const scene *s, int camera_index, const render_params *p, char *err, size_t errlen) {
     memset(r, 0, sizeof *r);
+    snprintf(r->model, sizeof r->model, "%s", BSDF_MODEL_STAMP);
     /* Without a path, the scene is the default built-in, which knows its name. */
     snprintf(r->scene, sizeof r->scene, "%s", scene_path ? scene_path : s->path);
     if (reference_hash_file(r->scene, r->scene_hash, err, errlen)) return -1;
@@ -136,7 +137,9 @@ char *reference_json(const reference_info *r) {
     size_t size = 0;
     FILE *f = open_memstream(&buf, &size);
     if (!f) return NULL;
-    fprintf(f, "{\n  \"glint_reference\": 1,\n  \"scene\": ");
+    fprintf(f, "{\n  \"glint_reference\": 1,\n  \"model\": ");
+    reference_json_string(f, r->model);
+    fputs(",\n  \"scene\": ", f);
     reference_json_string(f, r->scene);
     /* Every string escaped, the hashes too: a description read from a file holds what it held. */
     fputs(",\n  \"scene_hash\": ", f);
@@ -281,6 +284,9 @@ int reference_parse(const char *text, size_t n, const char *label, reference_inf
 #define NEED(ok, key)                                                                                                  \
     if (!missing && !(ok)) missing = key
     NEED(cJSON_GetObjectItemCaseSensitive(root, "glint_reference") != NULL, "glint_reference");
+    /* Older references have no model: read as "", which reference_check refuses as stale. */
+    NEED(!cJSON_GetObjectItemCaseSensitive(root, "model") || json_str(root, "model", r->model, sizeof r->model) == 0,
+         "model");
     NEED(json_str(root, "scene", r->scene, sizeof r->scene) == 0, "scene");
     NEED(json_str(root, "scene_hash", r->scene_hash, sizeof r->scene_hash) == 0, "scene_hash");
     /* Before there were several, the built-in scene showcase was spelt builtin:default. */
@@ -421,6 +427,12 @@ static int near(float a, float b) { return fabsf(a - b) <= 1e-5f * (1.0f + fmaxf
 static int near3(vec3 a, vec3 b) { return near(a.x, b.x) && near(a.y, b.y) && near(a.z, b.z); }
 
 int reference_check(const char *ref, const reference_info *have, const reference_info *want, char *err, size_t errlen) {
+    if (strcmp(have->model, want->model) != 0)
+        return fail(err, errlen,
+                    "%s: rendered by %s%s%s, not this glint's material model '%s': its values are stale; "
+                    "re-render the reference",
+                    ref, have->model[0] ? "material model '" : "an older glint (no material model recorded)",
+                    have->model, have->model[0] ? "'" : "", want->model);
     if (strcmp(have->scene_hash, want->scene_hash) != 0)
         return fail(err, errlen, "%s: rendered from another scene ('%s', %s), not '%s' (%s)", ref, have->scene,
                     have->scene_hash, want->scene, want->scene_hash);

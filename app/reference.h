@@ -12,6 +12,7 @@
 #include "session.h"
 
 typedef struct {
+    char model[64];      /* BSDF_MODEL_STAMP of the glint that rendered it; "" in older references */
     char scene[1024];    /* as given on the command line, "builtin:NAME" for a built-in scene */
     char scene_hash[64]; /* "fnv1a64:..." of the file's bytes, "builtin:NAME:fnv1a64:..." */
     char env[1024];      /* "" without an environment map */
@@ -81,9 +82,9 @@ void reference_noise_frame(reference_noise *rn, const render_session *rs);
 void reference_noise_finish(reference_noise *rn, const render_session *rs, reference_info *info);
 void reference_noise_deinit(reference_noise *rn);
 
-/* Compares what a bench renders (want) with a reference's description (have), field by field: scene
- * and environment hashes, material variant, camera index and parameters, size. Returns 0 when they
- * match, else -1
+/* Compares what a bench renders (want) with a reference's description (have), field by field: the
+ * material model (a reference of another is stale: re-render it), scene and environment hashes,
+ * material variant, camera index and parameters, size. Returns 0 when they match, else -1
  * with err naming the first difference ("REF.exr: ..."). */
 int reference_check(const char *ref_path, const reference_info *have, const reference_info *want, char *err,
                     size_t errlen);

@@ -47,6 +47,8 @@ typedef struct {
     float *rgb;
     int width, height;
     int preview;
+    int full_w, full_h;  /* the render size it belongs to (a preview's is larger than its own) */
+    uint64_t generation; /* the request generation it shows */
 } image_buf;
 
 typedef struct {
@@ -78,6 +80,7 @@ typedef struct {
     uint64_t frames_total;      /* full-resolution frames ever */
     uint64_t resets;
     double reset_at, frame_ms, rays_per_second;
+    double full_frame_ms; /* the last full-resolution frame's time */
     unsigned long long rejected;
     unsigned long long virtual_lights;
     char plan[1200]; /* the full-resolution session's effect plan, one pass a line */
@@ -203,6 +206,12 @@ typedef struct {
     char message[1200];
     view_stats stats; /* copied from the render thread */
     uint64_t sent_generation;
+    double sent_at; /* when it was sent */
+    /* The cost of the estimator settings: a full frame's time before their last change (0:
+     * unknown), and the generation of that change (full frames from it on measure the new ones). */
+    double cost_before_ms;
+    uint64_t cost_generation;
+    double step_ms;           /* from the last change sent to its first image taken here; < 0: none yet */
     int preview_w, preview_h; /* the last preview frame's size */
     double started_at;
     light_edits lights; /* the wanted offset and intensity of each, sent with every change */
@@ -245,12 +254,15 @@ typedef struct {
     long long script_wait_target;
     uint64_t script_wait_generation;
     int quit;
-    double reference_noise; /* the reference's own relative L2 noise, from its description; < 0 unknown */
-    double sleep_until;     /* a script's sleep */
+    double reference_noise;   /* the reference's own relative L2 noise, from its description; < 0 unknown */
+    double sleep_until;       /* a script's sleep */
+    int was_held;             /* refinement stood still at the last frame drawn... */
+    double held_seconds;      /* ...since this time */
+    int pending_w, pending_h; /* a new size of the place beside the panel, not yet rendered at... */
+    double pending_since;     /* ...since this time */
+    int panel_dragging;       /* the panel's edge was being dragged at the last frame */
     const char *variant_labels[MAX_VIEW_VARIANTS + 1]; /* the panel's: the defaults, then info's names */
     uint64_t variant_target;                           /* the load of a variant switch under way, or 0 */
-    int was_held;                                      /* refinement stood still at the last frame drawn... */
-    double held_seconds;                               /* ...since this time */
 } ui_thread;
 
 /* view_camera.c: the free camera, the scene's cameras and the bookmarks file */
@@ -331,8 +343,14 @@ void print_shortcuts(FILE *f);
 /* The image's size beside the panel: in framebuffer pixels (the render size), in window units. */
 void view_image_size(ui_thread *u, int *w, int *h);
 void view_image_window_size(ui_thread *u, int *w, int *h);
+/* Where the image is drawn (x0, y0, x1, y1, window units): the place beside the panel, or, while
+ * the image shown was rendered for another size, the largest part of it of the image's shape. */
+void view_image_rect(ui_thread *u, float rect[4]);
 /* Makes the window hold an image of image_w x image_h beside the panel. */
 void view_fit_window(ui_thread *u, int image_w, int image_h);
+/* Takes a new size of the place beside the panel as the render size (a new accumulation) once the
+ * window has stopped changing size and the panel's edge is no longer dragged. */
+void view_follow_size(ui_thread *u, double now);
 /* Render thread, under the lock: whether the full-resolution image of frames frames stops here. */
 int refinement_held(const shared_state *sh, long long frames);
 /* Render thread, without the lock: waits a little, and returns with the lock taken. */
@@ -345,6 +363,8 @@ int panel_variant(ui_thread *u, const char *name, char *err, size_t errlen);
 int panel_set(ui_thread *u, const char *name, const char *value, char *err, size_t errlen);
 /* pause, resume, sleep. Returns 0 while the script has to wait. */
 int panel_script_action(ui_thread *u, const script_action *a);
+/* A full frame's time with the current estimator settings; 0 before one is measured. */
+double view_cost_ms(const ui_thread *u);
 /* More of a stats line: pause, limits, window, image and panel sizes. */
 void print_panel_stats(ui_thread *u);
 /* Before the panel: its keys, and the overlay's and help's part of st. After: its buttons. */

@@ -48,7 +48,7 @@ void ctl_zoom(cam_ctl *c, float factor) {
 
 void reset_view(ui_thread *u) {
     int w, h;
-    glfwGetFramebufferSize(u->win, &w, &h);
+    view_image_size(u, &w, &h); /* the image's shape, beside the panel */
     float aspect = h > 0 ? (float)w / (float)h : 16.0f / 9.0f;
     camera c = u->ctl.camera >= 0 && u->ctl.camera < u->info.num_cameras
                    ? u->info.cameras[u->ctl.camera]

@@ -139,6 +139,8 @@ int fetch_published(ui_thread *u) {
         sh->image = t;
         u->image_serial = sh->image_serial;
         fresh = 1;
+        if (u->step_ms < 0.0 && u->front.generation == u->sent_generation) /* the change's first image */
+            u->step_ms = 1e3 * seconds_since(u->sent_at);
         if (u->front.preview) u->preview_w = u->front.width, u->preview_h = u->front.height;
     }
     int new_error = sh->stats.rel_error_serial != u->stats.rel_error_serial;
@@ -170,6 +172,20 @@ int fetch_published(ui_thread *u) {
 
 /* ---- the image and the panel ----------------------------------------------------------------- */
 
+/* The texture the image is drawn from; black until the first image (it has no storage yet).
+ * Linear filtering: a preview is magnified smoothly, not in blocks. */
+static void make_texture(ui_thread *u) {
+    if (u->texture) return;
+    GLuint t;
+    glGenTextures(1, &t);
+    u->texture = t;
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
 /* The image shown, tone-mapped (or its error in false colour), into the texture drawn. */
 void tonemap_and_upload(ui_thread *u) {
     int w = u->front.width, h = u->front.height;
@@ -187,16 +203,7 @@ void tonemap_and_upload(ui_thread *u) {
         tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f, (tonemap_op)u->ctl.tonemap};
         tonemap_apply(u->front.rgb, w * h, &tp, u->pixels);
     }
-    if (!u->texture) {
-        GLuint t;
-        glGenTextures(1, &t);
-        u->texture = t;
-        glBindTexture(GL_TEXTURE_2D, t);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
+    make_texture(u);
     glBindTexture(GL_TEXTURE_2D, u->texture);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     if (w != u->tex_w || h != u->tex_h) {
@@ -270,6 +277,8 @@ void draw_image_and_panel(ui_thread *u) {
                    .spp = (double)u->stats.frames,
                    .seconds = seconds_since(u->stats.reset_at),
                    .frame_ms = u->stats.frame_ms,
+                   .cost_ms = view_cost_ms(u),
+                   .cost_before_ms = u->cost_before_ms,
                    .rays_per_second = u->stats.rays_per_second,
                    .rejected_samples = u->stats.rejected,
                    .many_light = u->ctl.params.method != METHOD_PT,
@@ -301,7 +310,10 @@ void draw_image_and_panel(ui_thread *u) {
     st.num_methods = METHOD_COUNT;
     panel_frame(u, &st);
     ui_panel(&u->ctl, &st); /* first: the image goes beside the panel as it is drawn now */
-    ui_draw_image(u->texture);
+    float rect[4];
+    view_image_rect(u, rect);
+    make_texture(u); /* before the first image, too: the draw list takes its name now */
+    ui_draw_image(u->texture, rect);
     if (u->ctl.show_panel) {
         update_light_screen(u);
         ui_draw_lights(u->light_xy, u->info.num_lights, u->ctl.light);

@@ -33,7 +33,8 @@ void send_change(ui_thread *u) {
     sh->lights = u->lights;
     sh->lights_scene = u->info_serial;
     u->sent_generation = ++sh->generation;
-    sh->changed_at = cli_now();
+    sh->changed_at = u->sent_at = cli_now();
+    u->step_ms = -1.0;
     if (!sh->export_pending) atomic_store(&sh->abort_frame, 1); /* an export takes the frame as asked */
     pthread_mutex_unlock(&sh->lock);
 }
@@ -47,8 +48,12 @@ long long frames_of_current_state(const ui_thread *u) {
  * accumulation; display settings only change how the image is shown. */
 void apply_controls(ui_thread *u, int camera_changed) {
     const render_params *p = &u->ctl.params, *was = &u->applied_ctl.params;
-    if (p->method != was->method || p->max_depth != was->max_depth || memcmp(&p->vl, &was->vl, sizeof p->vl) != 0)
-        camera_changed = 1;
+    int estimator_changed =
+        p->method != was->method || p->max_depth != was->max_depth || memcmp(&p->vl, &was->vl, sizeof p->vl) != 0;
+    /* the panel compares the new settings' cost with the last ones' (once a full frame measured it) */
+    if (estimator_changed && u->stats.frames_generation >= u->cost_generation)
+        u->cost_before_ms = u->stats.full_frame_ms;
+    camera_changed |= estimator_changed;
     /* Picking another light shows its intensity; changing the intensity changes the light. */
     if (u->ctl.light < 0 || u->ctl.light >= u->info.num_lights) u->ctl.light = -1;
     if (u->ctl.light != u->applied_ctl.light) {
@@ -58,6 +63,7 @@ void apply_controls(ui_thread *u, int camera_changed) {
         camera_changed = 1;
     }
     if (camera_changed) send_change(u);
+    if (estimator_changed) u->cost_generation = u->sent_generation;
     if (u->ctl.exposure != u->applied_ctl.exposure || u->ctl.tonemap != u->applied_ctl.tonemap) u->need_tonemap = 1;
     if (u->ctl.show != u->applied_ctl.show) {
         pthread_mutex_lock(&u->sh->lock);
@@ -110,35 +116,37 @@ int light_movable(const ui_thread *u, int g) {
     return g >= 0 && g < u->info.num_lights && u->info.lights[g].type != LIGHT_DIRECTIONAL;
 }
 
-/* World units per window pixel at distance z in front of the camera. */
-static float pixel_footprint(const ui_thread *u, float z) {
-    int wh;
-    glfwGetWindowSize(u->win, NULL, &wh);
-    return 2.0f * z * tanf(0.5f * u->cam.yfov) / (float)(wh > 0 ? wh : 1);
+/* World units per window unit at distance z in front of the camera. */
+static float pixel_footprint(ui_thread *u, float z) {
+    float r[4];
+    view_image_rect(u, r);
+    return 2.0f * z * tanf(0.5f * u->cam.yfov) / fmaxf(r[3] - r[1], 1.0f);
 }
 
-/* Where each light appears in the window (for markers and picking). */
+/* Where each light appears in the window (for markers and picking): on the image as drawn. */
 void update_light_screen(ui_thread *u) {
-    int ww, wh;
-    view_image_window_size(u, &ww, &wh);
+    float r[4];
+    view_image_rect(u, r);
+    float ww = fmaxf(r[2] - r[0], 1.0f), wh = fmaxf(r[3] - r[1], 1.0f);
     camera c = ctl_camera(&u->cam);
-    float t = tanf(0.5f * c.yfov), aspect = wh > 0 ? (float)ww / (float)wh : 1.0f;
+    float t = tanf(0.5f * c.yfov), aspect = ww / wh;
     for (int g = 0; g < u->info.num_lights; g++) {
         vec3 d = sub3(light_position(u, g), c.position);
         float z = dot3(d, c.forward);
         u->light_xy[2 * g] = u->light_xy[2 * g + 1] = NAN;
         if (!light_movable(u, g) || !(z > 1e-6f)) continue;
         float x = dot3(d, c.right) / (z * t * aspect), y = dot3(d, c.up) / (z * t);
-        u->light_xy[2 * g] = 0.5f * (x + 1.0f) * (float)ww;
-        u->light_xy[2 * g + 1] = 0.5f * (1.0f - y) * (float)wh;
+        u->light_xy[2 * g] = r[0] + 0.5f * (x + 1.0f) * ww;
+        u->light_xy[2 * g + 1] = r[1] + 0.5f * (1.0f - y) * wh;
     }
 }
 
-/* The light drawn nearest to window position (x, y), within a few pixels; -1 for none. */
+/* The light drawn nearest to window position (x, y), within a few pixels (scaled as the markers
+ * are, for HiDPI); -1 for none. */
 static int pick_light(ui_thread *u, double x, double y) {
     update_light_screen(u);
     int best = -1;
-    double best_d2 = 24.0 * 24.0;
+    double reach = 24.0 * (double)ui_scale(), best_d2 = reach * reach;
     for (int g = 0; g < u->info.num_lights; g++) {
         double dx = (double)u->light_xy[2 * g] - x, dy = (double)u->light_xy[2 * g + 1] - y;
         double d2 = dx * dx + dy * dy;
@@ -190,7 +198,14 @@ void on_key(GLFWwindow *win, int key, int scancode, int action, int mods) {
 void on_scroll(GLFWwindow *win, double dx, double dy) {
     (void)dx;
     ui_thread *u = glfwGetWindowUserPointer(win);
-    if (!ui_wants_mouse()) u->scroll += dy;
+    /* Over the image only: the panel's hover state is the last frame's, and a cursor that has
+     * just moved onto the panel would zoom instead of scrolling it. */
+    double x, y;
+    float r[4];
+    glfwGetCursorPos(win, &x, &y);
+    view_image_rect(u, r);
+    int over_image = x >= (double)r[0] && x < (double)r[2] && y >= (double)r[1] && y < (double)r[3];
+    if (!ui_wants_mouse() && over_image) u->scroll += dy;
 }
 
 void on_drop(GLFWwindow *win, int count, const char **paths) {

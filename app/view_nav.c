@@ -94,7 +94,7 @@ static int walled_off(ui_thread *u, const camera *cam, vec3 centre) {
 
 void frame_scene(ui_thread *u) {
     int w, h;
-    glfwGetFramebufferSize(u->win, &w, &h);
+    view_image_size(u, &w, &h);
     float aspect = h > 0 ? (float)w / (float)h : 16.0f / 9.0f;
     bounds3 b = u->info.bounds;
     vec3 centre = bounds_center(b);
@@ -129,6 +129,7 @@ int open_reference(ui_thread *u, const char *path) {
         shared_state *sh = u->sh;
         char env[1024];
         memset(&want, 0, sizeof want);
+        snprintf(want.model, sizeof want.model, "%s", BSDF_MODEL_STAMP);
         pthread_mutex_lock(&sh->lock);
         snprintf(env, sizeof env, "%s", sh->env_now);
         want.width = sh->render_w;

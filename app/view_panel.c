@@ -2,6 +2,8 @@
  * the list of shortcuts the help overlay and --help share, the image's place beside the docked
  * panel, pausing and the spp and time limits, and the panel's own keys and buttons. */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -63,9 +65,57 @@ void view_image_size(ui_thread *u, int *w, int *h) {
     *h = fh > 1 ? fh : 1;
 }
 
+void view_image_rect(ui_thread *u, float rect[4]) {
+    int w, h;
+    view_image_window_size(u, &w, &h);
+    float rw = (float)w, rh = (float)h, fit_w = rw, fit_h = rh;
+    if (u->front.full_w > 0 && u->front.full_h > 0) {
+        float aspect = (float)u->front.full_w / (float)u->front.full_h;
+        fit_w = fminf(rw, rh * aspect);
+        fit_h = fminf(rh, rw / aspect);
+    }
+    if (rw - fit_w < 1.0f && rh - fit_h < 1.0f) fit_w = rw, fit_h = rh; /* rounding: pixel for pixel */
+    rect[0] = 0.5f * (rw - fit_w);
+    rect[1] = 0.5f * (rh - fit_h);
+    rect[2] = rect[0] + fit_w;
+    rect[3] = rect[1] + fit_h;
+}
+
 void view_fit_window(ui_thread *u, int image_w, int image_h) {
     float dock = ui_dock_width_beside(&u->ctl, (float)image_w);
     if (dock > 0.0f) glfwSetWindowSize(u->win, image_w + (int)(dock + 0.5f), image_h);
+}
+
+/* A window being resized sends a stream of sizes: the last one is taken once they stop for this
+ * long. A drag of the panel's edge ends with the button's release: its size is taken then. Until
+ * then the image keeps its size and is shown scaled (view_image_rect), its accumulation kept. */
+#define SIZE_SETTLE_SECONDS 0.2
+
+void view_follow_size(ui_thread *u, double now) {
+    int w, h, dragging = ui_panel_resizing();
+    int dropped = u->panel_dragging && !dragging;
+    u->panel_dragging = dragging;
+    view_image_size(u, &w, &h);
+    shared_state *sh = u->sh;
+    pthread_mutex_lock(&sh->lock);
+    int same = w == sh->render_w && h == sh->render_h;
+    pthread_mutex_unlock(&sh->lock);
+    if (w <= 0 || h <= 0 || same) { /* minimised, or rendered at that size already */
+        u->pending_w = u->pending_h = 0;
+        return;
+    }
+    if (w != u->pending_w || h != u->pending_h || dragging) {
+        u->pending_w = w;
+        u->pending_h = h;
+        u->pending_since = now;
+    }
+    if (dragging || (!dropped && now - u->pending_since < SIZE_SETTLE_SECONDS)) return;
+    pthread_mutex_lock(&sh->lock);
+    sh->render_w = w;
+    sh->render_h = h;
+    pthread_mutex_unlock(&sh->lock);
+    u->pending_w = u->pending_h = 0;
+    send_change(u); /* a new aspect ratio: the camera too */
 }
 
 /* ---- pause and limits ------------------------------------------------------------------------ */
@@ -140,9 +190,15 @@ void print_panel_stats(ui_thread *u) {
     int ww, wh, iw, ih;
     glfwGetWindowSize(u->win, &ww, &wh);
     view_image_window_size(u, &iw, &ih);
-    printf(" paused=%d spp_limit=%lld time_limit=%g held=%d help=%d window=%dx%d image=%dx%d dock=%d", u->ctl.paused,
-           u->ctl.spp_limit, u->ctl.time_limit, held(u), u->ctl.show_help, ww, wh, iw, ih, ww - iw);
+    printf(" paused=%d spp_limit=%lld time_limit=%g held=%d help=%d window=%dx%d image=%dx%d dock=%d content_scale=%g",
+           u->ctl.paused, u->ctl.spp_limit, u->ctl.time_limit, held(u), u->ctl.show_help, ww, wh, iw, ih, ww - iw,
+           (double)ui_content_scale());
     printf(" variant=%s", u->info.variant >= 0 ? u->info.variant_names[u->info.variant] : "-");
+}
+
+double view_cost_ms(const ui_thread *u) {
+    return u->stats.frames_generation >= u->cost_generation && u->stats.full_frame_ms > 0.0 ? u->stats.full_frame_ms
+                                                                                            : 0.0;
 }
 
 /* ---- the panel's keys and buttons ------------------------------------------------------------ */

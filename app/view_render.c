@@ -13,9 +13,9 @@
 #include "metrics.h"
 #include "view.h"
 
-#define PREVIEW_DIVISOR 3 /* preview resolution = full / 3 on each axis, or coarser... */
-#define PREVIEW_MAX_DIVISOR 8
-#define PREVIEW_TARGET_MS 70.0 /* ...so that a preview frame takes about this long */
+#define PREVIEW_DIVISOR 3      /* preview resolution = full / 3 on each axis, or coarser... */
+#define PREVIEW_TARGET_MS 70.0 /* ...so that a preview frame takes about this long... */
+#define PREVIEW_MAX_DIVISOR 12 /* ...down to 80x45 at 960x540: blurred, but 10 a second on a busy machine */
 #define PREVIEW_HOLD_SECONDS 0.3
 
 /* Loads go to a thread of their own, which reads files while frames go on: only a load that
@@ -149,26 +149,34 @@ static void set_preview_divisor(render_thread *rt, int d, const camera *cam, con
     rt->preview_divisor = d;
 }
 
+/* The divisor whose preview frames take about PREVIEW_TARGET_MS, from a frame of frame_ms at
+ * divisor d (a frame's time goes about as its pixels, 1 / d^2), within the divisors' limits. */
+static int divisor_for(int d, double frame_ms) {
+    int fit = (int)ceil((double)d * sqrt(frame_ms / PREVIEW_TARGET_MS));
+    return fit < PREVIEW_DIVISOR ? PREVIEW_DIVISOR : fit > PREVIEW_MAX_DIVISOR ? PREVIEW_MAX_DIVISOR : fit;
+}
+
 /* Coarser previews when their frames are slow (a large window, a costly method, a busy
- * machine), finer again when they are quick, so the image follows motion at about 10 frames a
- * second or more. The thresholds leave room: one step changes the time by a factor of 0.56 to
- * 0.77, less than their ratio. */
+ * machine), at once to the size that should be quick enough; finer again, a step at a time,
+ * when they are quick, so the image follows motion at about 10 frames a second or more. A step
+ * finer makes a frame at most 1.78 times slower (from divisor 4 to 3): 0.45 of the target
+ * becomes 0.8, still under the 1.3 that coarsens. */
 static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam, const render_params *params) {
     int d = rt->preview_divisor;
-    if (frame_ms > 1.3 * PREVIEW_TARGET_MS && d < PREVIEW_MAX_DIVISOR)
-        d++;
+    if (frame_ms > 1.3 * PREVIEW_TARGET_MS)
+        d = divisor_for(d, frame_ms);
     else if (frame_ms < 0.45 * PREVIEW_TARGET_MS && d > PREVIEW_DIVISOR)
         d--;
     set_preview_divisor(rt, d, cam, params);
 }
 
-/* After a full frame of frame_ms: the preview size whose frames take about PREVIEW_TARGET_MS (a
- * preview at divisor d costs about a full frame / d^2), so that the first preview after a change
- * comes quickly instead of after adapt_preview's steps from the finest size. */
+/* After the first full frame of a state: a preview size fitted to that frame's time, so that
+ * the first preview after a change comes quickly instead of after adapt_preview's steps. Only
+ * coarser: previews measured at the size there is know the costs a frame has whatever its size
+ * (the virtual lights' pass) better than the full frame does. */
 static void fit_preview(render_thread *rt, double frame_ms, const camera *cam, const render_params *params) {
-    int d = (int)ceil(sqrt(frame_ms / PREVIEW_TARGET_MS));
-    d = d < PREVIEW_DIVISOR ? PREVIEW_DIVISOR : d > PREVIEW_MAX_DIVISOR ? PREVIEW_MAX_DIVISOR : d;
-    set_preview_divisor(rt, d, cam, params);
+    int d = divisor_for(1, frame_ms);
+    if (d > rt->preview_divisor) set_preview_divisor(rt, d, cam, params);
 }
 
 /* Gives s the environment named by source (a map's path, ENV_SKY, or "" for none). The scene
@@ -376,6 +384,9 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
     pthread_mutex_unlock(&sh->lock);
     film_resolve(f, mask, rt->back.rgb);
     rt->back.preview = preview;
+    rt->back.full_w = session_film(rt->full)->width;
+    rt->back.full_h = session_film(rt->full)->height;
+    rt->back.generation = gen;
     double rel_error = preview || !measure ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
@@ -405,6 +416,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
             sh->stats.rel_error_serial++;
         }
         if (!preview) {
+            sh->stats.full_frame_ms = frame_ms;
             plan_summary(session_plan(rs), sh->stats.plan, sizeof sh->stats.plan);
             sh->stats.plan_highlights = session_plan(rs)->highlights;
             sh->stats.virtual_lights = st.virtual_lights;
@@ -415,6 +427,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
         }
     }
     pthread_mutex_unlock(&sh->lock);
+    glfwPostEmptyEvent(); /* the UI thread, waiting for events, takes the image now */
 }
 
 static void *render_main(void *arg) {
@@ -541,6 +554,9 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
     sh->scene_now = s;
     clear_light_edits(&rt->lights_applied);
     sh->stats.reset_at = cli_now(); /* the first accumulation starts now, not at the clock's origin */
+    /* Previews first, as after a change: the window shows the scene at once (a full frame can take
+     * seconds), and their times size the previews before the first move. */
+    sh->changed_at = sh->stats.reset_at;
     if (make_sessions(rt, sh->render_w, sh->render_h, &sh->cam, &sh->params) != 0) {
         session_destroy(rt->full); /* before the scene they read, which stays the caller's */
         session_destroy(rt->preview);

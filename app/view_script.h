@@ -9,7 +9,8 @@
  *   reference FILE.exr        spin DEG_PER_S SECONDS stats
  *   frame                     reference-camera       sky
  *   quit                      pause                  resume
- *   sleep SECONDS             variant NAME|default
+ *   sleep SECONDS             wait-file FILE         buttons
+ *   wheel X Y STEPS           variant NAME|default
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -17,10 +18,15 @@
  * tab, escape, f, c, k, 1-9, ctrl+N, shift+N). `load`, `env` and `sky` wait until the render thread
  * has tried them (a failed one changes nothing); `env none` clears the environment. `frame` views
  * the whole scene, `reference-camera` goes back to the reference's. `sleep` lets time pass, changing
- * nothing (while a test sends real input events). `move-light` moves light INDEX (as the panel lists them)
- * by a world-space offset and selects it; `spin` orbits continuously, a little every drawn
- * frame, as a held mouse drag would. `variant` shows the scene's material variant NAME (`default`:
- * the file's materials), as the panel's choice does, and waits until the scene is reloaded. */
+ * nothing (while a test sends real input events); `wait-file` waits until FILE exists (a test
+ * makes it once its input events are sent); `buttons` prints where the panel's visible buttons
+ * are, one line each ("button X0 Y0 X1 Y1 LABEL", window units), for a test to click; `wheel`
+ * puts the cursor at X Y (window units) and turns the wheel there by STEPS (up positive) in the
+ * same frame, as a wheel event arriving with the cursor's move does.
+ * `move-light` moves light INDEX (as the panel lists them) by a world-space offset and selects it;
+ * `spin` orbits continuously, a little every drawn frame, as a held mouse drag would. `variant`
+ * shows the scene's material variant NAME (`default`: the file's materials), as the panel's choice
+ * does, and waits until the scene is reloaded. */
 #ifndef GLINT_VIEW_SCRIPT_H
 #define GLINT_VIEW_SCRIPT_H
 
@@ -48,9 +54,12 @@ typedef enum {
     ACT_FRAME,
     ACT_REFERENCE_CAMERA,
     ACT_SKY,
-    ACT_PAUSE,  /* refinement stops... */
-    ACT_RESUME, /* ...and goes on */
-    ACT_SLEEP,  /* the script waits SECONDS, the viewer runs on */
+    ACT_PAUSE,     /* refinement stops... */
+    ACT_RESUME,    /* ...and goes on */
+    ACT_SLEEP,     /* the script waits SECONDS, the viewer runs on */
+    ACT_WAIT_FILE, /* the script waits until a file exists */
+    ACT_BUTTONS,   /* where the panel's buttons are */
+    ACT_WHEEL,     /* the cursor moved and the wheel turned at once */
     ACT_VARIANT,
 } script_action_kind;
 
@@ -59,7 +68,7 @@ typedef struct {
     int line;
     double a, b, c, d; /* numbers: frames, degrees, offsets, factor, light index and offset */
     char name[64];     /* set: parameter; key: key name */
-    char text[1024];   /* set: value; screenshot, export, load, env, window-shot, reference: path */
+    char text[1024];   /* set: value; screenshot, export, load, env, window-shot, reference, wait-file: path */
 } script_action;
 
 typedef struct {

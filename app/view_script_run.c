@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "view.h"
 
@@ -44,9 +45,11 @@ static void print_stats(ui_thread *u) {
     pthread_mutex_lock(&u->sh->lock);
     snprintf(env, sizeof env, "%s", u->sh->env_now[0] ? u->sh->env_now : "-");
     pthread_mutex_unlock(&u->sh->lock);
-    printf("env=%s unlit_note=%d paused_note=%d error_paused=%d errors_measured=%llu", env,
-           strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->stats.error_paused,
-           (unsigned long long)u->stats.rel_error_serial);
+    printf("env=%s unlit_note=%d paused_note=%d error_paused=%d errors_measured=%llu step_ms=%.1f frame_ms=%.1f "
+           "cost_ms=%.1f cost_before_ms=%.1f",
+           env, strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->stats.error_paused,
+           (unsigned long long)u->stats.rel_error_serial, u->step_ms, u->stats.frame_ms, view_cost_ms(u),
+           u->cost_before_ms);
     print_panel_stats(u);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
@@ -272,7 +275,23 @@ void run_script(ui_thread *u) {
             snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text);
             u->script_pos++;
             return;
+        case ACT_WHEEL: /* through the wheel's own handler, before this frame updates the panel's hover */
+            glfwSetCursorPos(u->win, a->a, a->b);
+            on_scroll(u->win, 0.0, a->c);
+            break;
+        case ACT_WAIT_FILE: /* a test's input events are sent */
+            if (access(a->text, F_OK) != 0) return;
+            break;
         case ACT_STATS: print_stats(u); break;
+        case ACT_BUTTONS: {
+            const char *label;
+            float r[4];
+            for (int i = 0; ui_drawn_button(i, &label, r); i++)
+                printf("button %.0f %.0f %.0f %.0f %s\n", (double)r[0], (double)r[1], (double)r[2], (double)r[3],
+                       label);
+            fflush(stdout);
+            break;
+        }
         case ACT_QUIT: u->quit = 1; break;
         case ACT_PAUSE:
         case ACT_RESUME:

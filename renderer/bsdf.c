@@ -1,5 +1,6 @@
-/* glint — the one BSDF. Lambert plus one glossy lobe (GGX, modified Phong or Ward), evaluated,
- * sampled and given pdfs here and nowhere else. Everything is in the local shading frame.
+/* glint — the one BSDF. Lambert plus one glossy lobe (GGX, modified Phong or Ward), and glTF's
+ * layers over them (sheen, clear coat), evaluated, sampled and given pdfs here and nowhere
+ * else. Everything is in the local shading frame.
  *
  * The glossy formulas are written in forms that stay finite at the traps docs/design.md lists: grazing
  * wo (Smith's Lambda is never formed as a ratio by wo.z), razor-sharp lobes (roughness floored at
@@ -16,9 +17,10 @@ static float schlick_weight(float cos_theta) {
     return m2 * m2 * m;
 }
 
-static vec3 schlick_fresnel(vec3 f0, float cos_theta) {
+/* Schlick's Fresnel from F0 at normal incidence to F90 at grazing. */
+static vec3 schlick_fresnel(vec3 f0, float f90, float cos_theta) {
     float w = schlick_weight(cos_theta);
-    return add3(f0, scale3(sub3(v3s(1.0f), f0), w));
+    return add3(f0, scale3(sub3(v3s(f90), f0), w));
 }
 
 /* ---- constructors -------------------------------------------------------------------------- */
@@ -30,15 +32,42 @@ bsdf make_bsdf_gltf(vec3 base_color, float metallic, float roughness, float anis
     anisotropy = clampf(anisotropy, 0.0f, 1.0f);
     /* glTF appendix B: mix(dielectric, conductor, metallic). Schlick is linear in F0, so both
      * specular terms merge into one GGX lobe with F0 = mix(0.04, base, metallic); the dielectric's
-     * diffuse keeps its (1 - F) weight through diffuse_f0. */
+     * diffuse is coupled to its own specular lobe (F0 0.04), not to the mixed one. */
     b.diffuse = scale3(base_color, 1.0f - metallic);
-    b.diffuse_f0 = 0.04f;
+    b.couple_f0 = 0.04f;
+    b.couple_f90 = 1.0f;
     b.model = GLOSSY_GGX;
     b.specular = lerp3(v3s(0.04f), base_color, metallic);
     float alpha = fmaxf(roughness * roughness, BSDF_MIN_ALPHA);
     /* KHR_materials_anisotropy: alpha along the tangent = mix(alpha, 1, anisotropy^2). */
     b.alpha_x = lerpf(alpha, 1.0f, anisotropy * anisotropy);
     b.alpha_y = alpha;
+    return b;
+}
+
+gltf_layers gltf_layers_default(void) {
+    gltf_layers x = {0};
+    x.dielectric_f0 = v3s(0.04f);
+    x.specular = 1.0f;
+    return x;
+}
+
+bsdf make_bsdf_gltf_layered(vec3 base_color, float metallic, float roughness, float anisotropy, const gltf_layers *x) {
+    bsdf b = make_bsdf_gltf(base_color, metallic, roughness, anisotropy);
+    metallic = clampf(metallic, 0.0f, 1.0f);
+    /* KHR_materials_specular: the dielectric's F0 min(f0_ior specularColor, 1) specular, its F90
+     * specular; the metal's stay base colour and 1. The diffuse takes what the dielectric lobe
+     * leaves of its strongest channel (the spec's max_value). */
+    float s = clampf(x->specular, 0.0f, 1.0f);
+    vec3 f0 = scale3(min3(max3(x->dielectric_f0, v3s(0.0f)), v3s(1.0f)), s);
+    b.specular = lerp3(f0, base_color, metallic);
+    b.f90_loss = (1.0f - s) * (1.0f - metallic);
+    b.couple_f0 = max_comp3(f0);
+    b.couple_f90 = s;
+    b.sheen = min3(max3(x->sheen_color, v3s(0.0f)), v3s(1.0f));
+    b.sheen_rough = clampf(x->sheen_roughness, BSDF_MIN_SHEEN_ROUGHNESS, 1.0f);
+    b.coat = clampf(x->clearcoat, 0.0f, 1.0f);
+    b.coat_alpha = fmaxf(sqr(clampf(x->clearcoat_roughness, 0.0f, 1.0f)), BSDF_MIN_ALPHA);
     return b;
 }
 
@@ -82,6 +111,10 @@ float bsdf_glossy_aspect(const bsdf *b) {
 #define ALBEDO_STRATA 16 /* per axis: 256 samples an entry */
 enum { ALBEDO_GGX_SCALE, ALBEDO_GGX_BIAS, ALBEDO_PHONG, ALBEDO_WARD, ALBEDO_TABLES };
 static float albedo_table[ALBEDO_TABLES][ALBEDO_N][ALBEDO_N]; /* [table][alpha][cos theta_o] */
+/* GGX's cosine-weighted mean albedo 2 int E(mu) mu dmu per alpha, scale and bias, integrated
+ * exactly over the table's linear interpolation so that the coupled diffuse lobe's integral
+ * over wi, (1 - E_avg), is the one the lookups make. */
+static float albedo_avg[2][ALBEDO_N];
 static pthread_once_t albedo_once = PTHREAD_ONCE_INIT;
 
 static float lobe_albedo_sampled(const bsdf *b, float cos_o) {
@@ -114,35 +147,60 @@ static void build_albedo_tables(void) {
             bsdf ward = make_bsdf_ward(v3s(0.0f), v3s(1.0f), alpha, alpha);
             albedo_table[ALBEDO_WARD][a][c] = lobe_albedo_sampled(&ward, cos_o);
         }
+        for (int t = 0; t < 2; t++) {
+            /* int over [m0, m1] of mu times the linear interpolant: h/6 (E0 (2 m0 + m1) + E1 (m0 + 2 m1)) */
+            const float *e = albedo_table[t == 0 ? ALBEDO_GGX_SCALE : ALBEDO_GGX_BIAS][a];
+            double sum = 0.0, h = 1.0 / (ALBEDO_N - 1);
+            for (int c = 0; c + 1 < ALBEDO_N; c++) {
+                double m0 = c * h, m1 = (c + 1) * h;
+                sum += h / 6.0 * ((double)e[c] * (2.0 * m0 + m1) + (double)e[c + 1] * (m0 + 2.0 * m1));
+            }
+            albedo_avg[t][a] = (float)(2.0 * sum);
+        }
     }
 }
 
-static float albedo_lookup(int table, float alpha, float cos_o) {
-    float x = clampf(cos_o, 0.0f, 1.0f) * (ALBEDO_N - 1), y = clampf(alpha, 0.0f, 1.0f) * (ALBEDO_N - 1);
+/* Bilinear lookup in a table over [0, 1]^2: t[width][cos theta_o]. */
+static float table_lookup(const float (*t)[ALBEDO_N], float width, float cos_o) {
+    float x = clampf(cos_o, 0.0f, 1.0f) * (ALBEDO_N - 1), y = clampf(width, 0.0f, 1.0f) * (ALBEDO_N - 1);
     int i = x < ALBEDO_N - 2 ? (int)x : ALBEDO_N - 2, j = y < ALBEDO_N - 2 ? (int)y : ALBEDO_N - 2;
     float fx = x - (float)i, fy = y - (float)j;
-    const float(*t)[ALBEDO_N] = albedo_table[table];
     return lerpf(lerpf(t[j][i], t[j][i + 1], fx), lerpf(t[j + 1][i], t[j + 1][i + 1], fx), fy);
 }
 
-vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo) {
-    if (!(bsdf_lobes(b) & BSDF_GLOSSY) || wo.z <= 0.0f) return v3s(0.0f);
-    pthread_once(&albedo_once, build_albedo_tables);
-    float alpha = bsdf_glossy_alpha(b);
-    if (b->model == GLOSSY_GGX) {
-        float scale = albedo_lookup(ALBEDO_GGX_SCALE, alpha, wo.z), bias = albedo_lookup(ALBEDO_GGX_BIAS, alpha, wo.z);
-        return add3(scale3(b->specular, scale), v3s(bias));
-    }
-    return scale3(b->specular, albedo_lookup(b->model == GLOSSY_PHONG ? ALBEDO_PHONG : ALBEDO_WARD, alpha, wo.z));
+static float albedo_lookup(int table, float alpha, float cos_o) {
+    return table_lookup(albedo_table[table], alpha, cos_o);
 }
 
-float bsdf_glossy_alpha(const bsdf *b) {
-    if (!(bsdf_lobes(b) & BSDF_GLOSSY)) return 0.0f;
+/* Directional albedo of a GGX lobe of width alpha with Schlick's F0 and F90 (scalars). */
+static float ggx_albedo(float alpha, float f0, float f90, float cos_o) {
+    pthread_once(&albedo_once, build_albedo_tables);
+    return f0 * albedo_lookup(ALBEDO_GGX_SCALE, alpha, cos_o) + f90 * albedo_lookup(ALBEDO_GGX_BIAS, alpha, cos_o);
+}
+
+/* Its cosine-weighted mean over the hemisphere. */
+static float ggx_albedo_avg(float alpha, float f0, float f90) {
+    pthread_once(&albedo_once, build_albedo_tables);
+    float y = clampf(alpha, 0.0f, 1.0f) * (ALBEDO_N - 1);
+    int j = y < ALBEDO_N - 2 ? (int)y : ALBEDO_N - 2;
+    float fy = y - (float)j;
+    return f0 * lerpf(albedo_avg[0][j], albedo_avg[0][j + 1], fy) +
+           f90 * lerpf(albedo_avg[1][j], albedo_avg[1][j + 1], fy);
+}
+
+/* The base's glossy lobe's width as a microfacet alpha. */
+static float base_glossy_alpha(const bsdf *b) {
     /* Blinn's cos^m of the half-vector angle matches a microfacet lobe of roughness alpha for
      * m = 2 / alpha^2 - 2 (Walter et al. 2007); Phong's cos^n of the angle to the mirror direction,
      * twice the half-vector angle near the peak, is Blinn's with m = 4n. */
     if (b->model == GLOSSY_PHONG) return sqrtf(1.0f / (2.0f * b->exponent + 1.0f));
     return sqrtf(b->alpha_x * b->alpha_y);
+}
+
+float bsdf_glossy_alpha(const bsdf *b) {
+    if (!(bsdf_lobes(b) & BSDF_GLOSSY)) return 0.0f;
+    float coat = b->coat > 0.0f ? b->coat_alpha : INFINITY;
+    return bsdf_has_base_glossy(b) ? fminf(base_glossy_alpha(b), coat) : coat;
 }
 
 /* ---- GGX ------------------------------------------------------------------------------------ */
@@ -212,6 +270,140 @@ static float phong_one_minus_cos(vec3 wo, vec3 wi) {
     return 0.5f * length_sq3(sub3(wi, r));
 }
 
+/* ---- sheen (KHR_materials_sheen: Conty and Kulla 2017's Charlie lobe) ------------------------- */
+
+/* Charlie's D(h) and V = G / (4 zo zi) with their fitted Lambda, as the extension writes them. */
+static float charlie_d(float alpha, float cos_h) {
+    float inv = 1.0f / alpha, sin2 = fmaxf(1.0f - cos_h * cos_h, 0.0f);
+    return (2.0f + inv) * powf(sin2, 0.5f * inv) * INV_2PI_F;
+}
+
+static float charlie_l(float x, float alpha) {
+    float t = sqr(1.0f - alpha);
+    float a = lerpf(21.5473f, 25.3245f, t), b = lerpf(3.82987f, 3.32435f, t), c = lerpf(0.19823f, 0.16801f, t);
+    float d = lerpf(-1.97760f, -1.27393f, t), e = lerpf(-4.32054f, -4.85967f, t);
+    return a / (1.0f + b * powf(x, c)) + d * x + e;
+}
+
+static float charlie_lambda(float cos_t, float alpha) {
+    return cos_t < 0.5f ? expf(charlie_l(cos_t, alpha))
+                        : expf(2.0f * charlie_l(0.5f, alpha) - charlie_l(1.0f - cos_t, alpha));
+}
+
+/* The sheen lobe without its colour: D V, reciprocal (symmetric in zo, zi). */
+static float sheen_lobe(float rough, vec3 wo, vec3 wi) {
+    float alpha = rough * rough;
+    vec3 h = normalize3(add3(wo, wi));
+    float denom = (1.0f + charlie_lambda(wo.z, alpha) + charlie_lambda(wi.z, alpha)) * 4.0f * wo.z * wi.z;
+    return denom > 0.0f ? charlie_d(alpha, h.z) / denom : 0.0f;
+}
+
+/* Its directional albedo over cos theta_o and the perceptual roughness, both on [0, 1] (the
+ * floor BSDF_MIN_SHEEN_ROUGHNESS at node 0), by the midpoint rule in (sqrt(cos theta_i), phi):
+ * the lobe's peak lies near the horizon, where that grid is densest. Half the azimuths: the
+ * lobe is symmetric about the plane of incidence. */
+#define SHEEN_NT 96
+#define SHEEN_NPHI 48
+static float sheen_table[ALBEDO_N][ALBEDO_N]; /* [roughness][cos theta_o] */
+static pthread_once_t sheen_once = PTHREAD_ONCE_INIT;
+
+static void build_sheen_table(void) {
+    for (int r = 0; r < ALBEDO_N; r++) {
+        float rough = fmaxf((float)r / (ALBEDO_N - 1), BSDF_MIN_SHEEN_ROUGHNESS);
+        for (int c = 0; c < ALBEDO_N; c++) {
+            float cos_o = fmaxf((float)c / (ALBEDO_N - 1), 1e-3f);
+            vec3 wo = v3(safe_sqrtf(1.0f - cos_o * cos_o), 0.0f, cos_o);
+            double sum = 0.0;
+            for (int i = 0; i < SHEEN_NT; i++) {
+                float t = ((float)i + 0.5f) / SHEEN_NT, z = t * t, sz = safe_sqrtf(1.0f - z * z);
+                for (int j = 0; j < SHEEN_NPHI; j++) {
+                    float phi = PI_F * ((float)j + 0.5f) / SHEEN_NPHI;
+                    vec3 wi = v3(sz * cosf(phi), sz * sinf(phi), z);
+                    sum += (double)(sheen_lobe(rough, wo, wi) * z * 2.0f * t); /* f cos dz, dz = 2 t dt */
+                }
+            }
+            sum *= 2.0 * (double)PI_F / (SHEEN_NT * SHEEN_NPHI); /* both halves of the azimuths */
+            sheen_table[r][c] = fminf((float)sum, 1.0f);
+        }
+    }
+}
+
+static float sheen_albedo(float rough, float cos_o) {
+    pthread_once(&sheen_once, build_sheen_table);
+    return table_lookup(sheen_table, rough, cos_o);
+}
+
+/* ---- the layers ------------------------------------------------------------------------------ */
+
+/* The clear coat as a GGX lobe of its own: F0 0.04, F90 1, isotropic. */
+static bsdf coat_lobe(const bsdf *b) {
+    bsdf c = {0};
+    c.model = GLOSSY_GGX;
+    c.specular = v3s(0.04f);
+    c.alpha_x = c.alpha_y = b->coat_alpha;
+    return c;
+}
+
+/* What a layer of weight w and albedo E leaves to what lies under it for the pair (wo, wi):
+ * 1 - w max(E(wo), E(wi)), the sheen extension's reciprocal albedo scaling (docs/design.md). */
+static float coat_scale(const bsdf *b, float cos_o, float cos_i) {
+    if (!(b->coat > 0.0f)) return 1.0f;
+    float e = fmaxf(ggx_albedo(b->coat_alpha, 0.04f, 1.0f, cos_o), ggx_albedo(b->coat_alpha, 0.04f, 1.0f, cos_i));
+    return 1.0f - b->coat * fminf(e, 1.0f);
+}
+
+static float sheen_scale(const bsdf *b, float cos_o, float cos_i) {
+    if (is_black3(b->sheen)) return 1.0f;
+    float e = fmaxf(sheen_albedo(b->sheen_rough, cos_o), sheen_albedo(b->sheen_rough, cos_i));
+    return 1.0f - max_comp3(b->sheen) * e;
+}
+
+/* The probability that a glossy sample comes from the coat rather than the base's lobe. */
+static float coat_select_prob(const bsdf *b, float cos_o) {
+    if (!(b->coat > 0.0f)) return 0.0f;
+    if (!bsdf_has_base_glossy(b)) return 1.0f;
+    float wc = b->coat * (0.04f + 0.96f * schlick_weight(cos_o));
+    float wb = avg3(schlick_fresnel(b->specular, 1.0f - b->f90_loss, cos_o)) * coat_scale(b, cos_o, cos_o) *
+               sheen_scale(b, cos_o, cos_o);
+    return clampf(wc / fmaxf(wc + wb, 1e-20f), 0.1f, 0.9f);
+}
+
+/* The width of the dielectric specular lobe the diffuse is coupled to: the glossy lobe's. */
+static float coupled_alpha(const bsdf *b) { return sqrtf(b->alpha_x * b->alpha_y); }
+
+/* The coupled diffuse lobe's weight for one direction: 1 - E(w) of the dielectric's specular lobe. */
+static float coupled_transmittance(const bsdf *b, float cos_w) {
+    return 1.0f - fminf(ggx_albedo(coupled_alpha(b), b->couple_f0, b->couple_f90, cos_w), 1.0f);
+}
+
+/* ---- the lobes' albedos ----------------------------------------------------------------------- */
+
+vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo) {
+    if (!(bsdf_lobes(b) & BSDF_GLOSSY) || wo.z <= 0.0f) return v3s(0.0f);
+    pthread_once(&albedo_once, build_albedo_tables);
+    float alpha = base_glossy_alpha(b);
+    vec3 base = v3s(0.0f);
+    if (b->model == GLOSSY_GGX && bsdf_has_base_glossy(b)) {
+        float scale = albedo_lookup(ALBEDO_GGX_SCALE, alpha, wo.z), bias = albedo_lookup(ALBEDO_GGX_BIAS, alpha, wo.z);
+        base = add3(scale3(b->specular, scale), v3s((1.0f - b->f90_loss) * bias));
+    } else if (bsdf_has_base_glossy(b)) {
+        base = scale3(b->specular, albedo_lookup(b->model == GLOSSY_PHONG ? ALBEDO_PHONG : ALBEDO_WARD, alpha, wo.z));
+    }
+    if (b->coat > 0.0f || !is_black3(b->sheen))
+        base = scale3(base, coat_scale(b, wo.z, wo.z) * sheen_scale(b, wo.z, wo.z));
+    if (b->coat > 0.0f) base = add3(base, v3s(b->coat * ggx_albedo(b->coat_alpha, 0.04f, 1.0f, wo.z)));
+    return base;
+}
+
+vec3 bsdf_diffuse_albedo(const bsdf *b, vec3 wo) {
+    if (!(bsdf_lobes(b) & BSDF_DIFFUSE) || wo.z <= 0.0f) return v3s(0.0f);
+    vec3 d = b->diffuse;
+    if (b->couple_f0 > 0.0f || b->couple_f90 > 0.0f) d = scale3(d, coupled_transmittance(b, wo.z));
+    d = scale3(d, sheen_scale(b, wo.z, wo.z));
+    if (!is_black3(b->sheen)) d = add3(d, scale3(b->sheen, sheen_albedo(b->sheen_rough, wo.z)));
+    return scale3(d, coat_scale(b, wo.z, wo.z));
+}
+
 /* ---- dispatch ------------------------------------------------------------------------------- */
 
 static vec3 eval_glossy(const bsdf *b, vec3 wo, vec3 wi) {
@@ -219,7 +411,7 @@ static vec3 eval_glossy(const bsdf *b, vec3 wo, vec3 wi) {
     case GLOSSY_GGX: {
         vec3 h = normalize3(add3(wo, wi));
         float dv = ggx_d(b, h) * ggx_visibility(b, wo, wi);
-        return scale3(schlick_fresnel(b->specular, dot3(wo, h)), dv);
+        return scale3(schlick_fresnel(b->specular, 1.0f - b->f90_loss, dot3(wo, h)), dv);
     }
     case GLOSSY_PHONG: {
         float lobe = power_cosine(phong_one_minus_cos(wo, wi), b->exponent);
@@ -276,17 +468,81 @@ static int sample_glossy(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
 
 static vec3 eval_diffuse(const bsdf *b, vec3 wo, vec3 wi) {
     vec3 f = scale3(b->diffuse, INV_PI_F);
-    if (b->diffuse_f0 > 0.0f) {
-        /* glTF dielectric: light the specular layer reflects never reaches the diffuse base. The
-         * spec weighs by 1 - F(wo.h), which lets the sum exceed 1 at grazing angles; weighing by
-         * the Fresnel transmittance on the way in and on the way out conserves energy and stays
-         * reciprocal. */
-        float f0 = b->diffuse_f0;
-        float t_o = 1.0f - (f0 + (1.0f - f0) * schlick_weight(wo.z));
-        float t_i = 1.0f - (f0 + (1.0f - f0) * schlick_weight(wi.z));
-        f = scale3(f, t_o * t_i);
+    if (b->couple_f0 > 0.0f || b->couple_f90 > 0.0f) {
+        /* glTF dielectric (docs/design.md): the diffuse base gets what the specular layer does
+         * not reflect, on the way in and on the way out, and 1 / (1 - E_avg) restores the energy
+         * the cosine-weighted mean of (1 - E(wi)) takes: its albedo is exactly base (1 - E(wo)),
+         * the spec's model where that conserves energy, and it stays reciprocal. */
+        float rest = 1.0f - fminf(ggx_albedo_avg(coupled_alpha(b), b->couple_f0, b->couple_f90), 1.0f);
+        float k = rest > 1e-4f ? coupled_transmittance(b, wo.z) * coupled_transmittance(b, wi.z) / rest : 0.0f;
+        f = scale3(f, k);
     }
     return f;
+}
+
+/* The diffuse lobe: Lambert (coupled) under the sheen, the sheen, both under the coat. */
+static vec3 eval_diffuse_part(const bsdf *b, vec3 wo, vec3 wi) {
+    vec3 f = eval_diffuse(b, wo, wi);
+    if (!is_black3(b->sheen))
+        f = add3(scale3(f, sheen_scale(b, wo.z, wi.z)), scale3(b->sheen, sheen_lobe(b->sheen_rough, wo, wi)));
+    return b->coat > 0.0f ? scale3(f, coat_scale(b, wo.z, wi.z)) : f;
+}
+
+/* A sheen lobe peaks near the horizon, where cosine sampling rarely goes: with a sheen, half the
+ * diffuse lobe's samples are uniform over the hemisphere. */
+static float sheen_uniform_prob(const bsdf *b) { return is_black3(b->sheen) ? 0.0f : 0.5f; }
+
+static float pdf_diffuse_part(const bsdf *b, vec3 wi) {
+    float q = sheen_uniform_prob(b);
+    return (1.0f - q) * pdf_cosine_hemisphere(wi) + (wi.z > 0.0f ? q * INV_2PI_F : 0.0f);
+}
+
+static vec3 sample_diffuse_part(const bsdf *b, vec2 u) {
+    float q = sheen_uniform_prob(b);
+    if (u.x < q) {
+        float z = fminf(u.x / q, 0x1.fffffep-1f), r = safe_sqrtf(1.0f - z * z), phi = 2.0f * PI_F * u.y;
+        return v3(r * cosf(phi), r * sinf(phi), z);
+    }
+    if (q > 0.0f) u.x = fminf((u.x - q) / (1.0f - q), 0x1.fffffep-1f);
+    return sample_cosine_hemisphere(u);
+}
+
+/* The glossy lobe: the base's own under the sheen and the coat, and the coat's. */
+static vec3 eval_glossy_part(const bsdf *b, vec3 wo, vec3 wi) {
+    vec3 f = v3s(0.0f);
+    if (bsdf_has_base_glossy(b)) {
+        f = eval_glossy(b, wo, wi);
+        if (b->coat > 0.0f || !is_black3(b->sheen))
+            f = scale3(f, coat_scale(b, wo.z, wi.z) * sheen_scale(b, wo.z, wi.z));
+    }
+    if (b->coat > 0.0f) {
+        bsdf c = coat_lobe(b);
+        f = add3(f, scale3(eval_glossy(&c, wo, wi), b->coat));
+    }
+    return f;
+}
+
+static float pdf_glossy_part(const bsdf *b, vec3 wo, vec3 wi) {
+    float pc = coat_select_prob(b, wo.z), p = 0.0f;
+    if (pc < 1.0f) p += (1.0f - pc) * pdf_glossy(b, wo, wi);
+    if (pc > 0.0f) {
+        bsdf c = coat_lobe(b);
+        p += pc * pdf_glossy(&c, wo, wi);
+    }
+    return p;
+}
+
+/* The coat or the base's lobe, chosen by u.x, which is then stretched back over [0, 1): the
+ * callers' stratification of u carries over, and a u_lobe of 0 (one glossy lobe asked for) still
+ * samples both. */
+static int sample_glossy_part(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
+    float pc = coat_select_prob(b, wo.z);
+    if (u.x < pc) {
+        bsdf c = coat_lobe(b);
+        return sample_glossy(&c, wo, v2(fminf(u.x / pc, 0x1.fffffep-1f), u.y), wi);
+    }
+    if (pc > 0.0f) u.x = fminf((u.x - pc) / (1.0f - pc), 0x1.fffffep-1f);
+    return sample_glossy(b, wo, u, wi);
 }
 
 float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes) {
@@ -296,10 +552,10 @@ float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes) {
     /* Proportional to the lobes' rough albedos, kept away from 0 and 1 so that neither lobe's
      * samples ever become rare enough to make fireflies. */
     float c = fmaxf(wo.z, 0.0f);
-    float wd = avg3(b->diffuse), wg;
+    float wd = avg3(bsdf_diffuse_albedo(b, wo)), wg;
     if (b->model == GLOSSY_GGX) {
-        wg = avg3(schlick_fresnel(b->specular, c));
-        if (b->diffuse_f0 > 0.0f) wd *= 1.0f - (b->diffuse_f0 + (1.0f - b->diffuse_f0) * schlick_weight(c));
+        wg = avg3(schlick_fresnel(b->specular, 1.0f - b->f90_loss, c)) * coat_scale(b, c, c) * sheen_scale(b, c, c);
+        if (b->coat > 0.0f) wg += b->coat * (0.04f + 0.96f * schlick_weight(c));
     } else {
         wg = avg3(b->specular);
     }
@@ -311,8 +567,8 @@ vec3 bsdf_eval(const bsdf *b, vec3 wo, vec3 wi, int lobes) {
     if (wo.z <= 0.0f || wi.z <= 0.0f) return v3s(0.0f);
     lobes &= bsdf_lobes(b);
     vec3 f = v3s(0.0f);
-    if (lobes & BSDF_DIFFUSE) f = eval_diffuse(b, wo, wi);
-    if (lobes & BSDF_GLOSSY) f = add3(f, eval_glossy(b, wo, wi));
+    if (lobes & BSDF_DIFFUSE) f = eval_diffuse_part(b, wo, wi);
+    if (lobes & BSDF_GLOSSY) f = add3(f, eval_glossy_part(b, wo, wi));
     return f;
 }
 
@@ -321,8 +577,8 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi, int lobes) {
     lobes &= bsdf_lobes(b);
     float pg = bsdf_glossy_select_prob(b, wo, lobes);
     float pdf = 0.0f;
-    if (pg < 1.0f && (lobes & BSDF_DIFFUSE)) pdf += (1.0f - pg) * pdf_cosine_hemisphere(wi);
-    if (pg > 0.0f) pdf += pg * pdf_glossy(b, wo, wi);
+    if (pg < 1.0f && (lobes & BSDF_DIFFUSE)) pdf += (1.0f - pg) * pdf_diffuse_part(b, wi);
+    if (pg > 0.0f) pdf += pg * pdf_glossy_part(b, wo, wi);
     return pdf;
 }
 
@@ -334,10 +590,10 @@ int bsdf_sample(const bsdf *b, vec3 wo, int lobes, float u_lobe, vec2 u, bsdf_sa
     vec3 wi;
     int lobe;
     if (u_lobe < pg) {
-        if (!sample_glossy(b, wo, u, &wi)) return 0;
+        if (!sample_glossy_part(b, wo, u, &wi)) return 0;
         lobe = BSDF_GLOSSY;
     } else {
-        wi = sample_cosine_hemisphere(u);
+        wi = sample_diffuse_part(b, u);
         if (wi.z <= 0.0f) return 0;
         lobe = BSDF_DIFFUSE;
     }

@@ -2,9 +2,12 @@
  * evaluates, samples and asks pdfs through these three functions. Adding a lobe is one edit in
  * bsdf.c.
  *
- * A bsdf is a diffuse (Lambert) lobe plus at most one glossy lobe, in the local shading frame:
+ * A bsdf is a diffuse lobe (Lambert, and glTF's sheen) plus a glossy lobe (one GGX, Phong or Ward
+ * lobe, and glTF's clear coat, a second GGX lobe over everything), in the local shading frame:
  * +z is the shading normal, +x the tangent (the anisotropy direction). Reflection only: any
- * direction with z <= 0 gets f = 0 and pdf = 0. f excludes the cosine factor. */
+ * direction with z <= 0 gets f = 0 and pdf = 0. f excludes the cosine factor. The glTF model
+ * couples its diffuse lobe to the dielectric's specular lobe (docs/design.md, "The glTF
+ * material"). */
 #ifndef GLINT_BSDF_H
 #define GLINT_BSDF_H
 
@@ -13,6 +16,12 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* What the materials render as, for references (their descriptions record it; glint bench
+ * refuses one rendered by another): bump it whenever any BSDF's values change. Version 1, never
+ * written, was the glTF diffuse weighted by (1 - F(wo)) (1 - F(wi)); 2 is the spec's model with
+ * the coupled diffuse and the ior, specular, sheen and clear coat extensions. */
+#define BSDF_MODEL_STAMP "glint-bsdf-2"
 
 /* Lobe masks: estimators that split path space ask for one lobe or both. BSDF_NOT_HIGHLIGHT,
  * for estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe. */
@@ -37,14 +46,38 @@ typedef enum {
 #define BSDF_MAX_PHONG_EXPONENT 1e6f
 
 typedef struct {
-    vec3 diffuse;     /* Lambert albedo (already multiplied by 1 - metallic for glTF) */
-    float diffuse_f0; /* > 0: diffuse scaled by (1 - F(wo.z)) (1 - F(wi.z)), Schlick with this F0 (glTF dielectric) */
+    vec3 diffuse; /* Lambert albedo (already multiplied by 1 - metallic for glTF) */
+    /* glTF dielectric: the diffuse lobe takes what a GGX lobe of the glossy lobe's roughness with
+     * this Schlick F0 and F90 (scalars) does not reflect, reciprocally: f_d = diffuse / pi
+     * (1 - E(wo)) (1 - E(wi)) / (1 - E_avg), E that lobe's directional albedo. 0, 0: plain Lambert. */
+    float couple_f0, couple_f90;
     glossy_model model;
     vec3 specular;  /* GGX: F0 of Schlick's Fresnel; Phong and Ward: ks (no Fresnel) */
+    float f90_loss; /* GGX: 1 - Schlick's F90 (KHR_materials_specular's factor below 1), 0 by default */
     float alpha_x;  /* GGX, Ward: roughness along +x */
     float alpha_y;  /* GGX, Ward: roughness along +y */
     float exponent; /* Phong exponent */
+    /* Layers over the rest (glTF extensions), each scaling what lies under it by
+     * 1 - weight max(E(wo), E(wi)), E its own directional albedo: reciprocal, energy-conserving. */
+    vec3 sheen;        /* KHR_materials_sheen's colour (Charlie lobe), part of BSDF_DIFFUSE; 0: none */
+    float sheen_rough; /* its perceptual roughness (alpha = rough^2), floored at BSDF_MIN_SHEEN_ROUGHNESS */
+    float coat;        /* KHR_materials_clearcoat's weight: a GGX lobe, F0 0.04, part of BSDF_GLOSSY */
+    float coat_alpha;  /* its roughness (alpha) */
+    int dropped;       /* lobes left out by bsdf_only: the layers' attenuation of the rest stays */
 } bsdf;
+
+/* Sheen below this perceptual roughness is a spike at grazing angles no sampler resolves. */
+#define BSDF_MIN_SHEEN_ROUGHNESS 0.07f
+
+/* The glTF material extensions, already looked up in their textures. */
+typedef struct {
+    vec3 dielectric_f0; /* min(((ior - 1) / (ior + 1))^2 specularColor, 1): KHR_materials_ior, _specular */
+    float specular;     /* KHR_materials_specular's strength: scales the dielectric's F0 and F90 */
+    vec3 sheen_color;   /* KHR_materials_sheen */
+    float sheen_roughness;
+    float clearcoat; /* KHR_materials_clearcoat */
+    float clearcoat_roughness;
+} gltf_layers;
 
 typedef struct {
     vec3 wi;   /* sampled direction (local frame) */
@@ -53,10 +86,17 @@ typedef struct {
     int lobe;  /* BSDF_DIFFUSE or BSDF_GLOSSY: which lobe produced wi */
 } bsdf_sample_result;
 
-/* glTF 2.0 metallic-roughness (Lambert + GGX, Fresnel-weighted as the glTF spec's appendix B):
- * roughness is perceptual (alpha = roughness^2); anisotropy in [0,1] stretches alpha along +x as
- * KHR_materials_anisotropy does. */
+/* glTF 2.0 metallic-roughness, the spec's appendix B: mix(dielectric, metal, metallic), the
+ * dielectric a Fresnel mix of Lambert and GGX (F0 0.04), the diffuse coupled to the specular lobe
+ * by its directional albedo; roughness is perceptual (alpha = roughness^2); anisotropy in [0,1]
+ * stretches alpha along +x as KHR_materials_anisotropy does. */
 bsdf make_bsdf_gltf(vec3 base_color, float metallic, float roughness, float anisotropy);
+/* The same with the extensions: the dielectric's Fresnel from KHR_materials_ior and _specular
+ * (its diffuse coupled to the strongest channel, as the spec's max_value), sheen over that,
+ * clear coat over everything. */
+bsdf make_bsdf_gltf_layered(vec3 base_color, float metallic, float roughness, float anisotropy, const gltf_layers *x);
+/* The glTF defaults: F0 0.04, specular 1, no sheen, no coat. */
+gltf_layers gltf_layers_default(void);
 /* Diffuse kd plus modified Phong with ks and exponent n (kd + ks <= 1 conserves energy). */
 bsdf make_bsdf_phong(vec3 kd, vec3 ks, float exponent);
 /* Diffuse kd plus anisotropic Ward with ks and roughness alpha_x, alpha_y. */
@@ -75,15 +115,28 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi, int lobes);
  * be produced (wo below the surface, a sample below the horizon, an empty mask). */
 int bsdf_sample(const bsdf *b, vec3 wo, int lobes, float u_lobe, vec2 u, bsdf_sample_result *out);
 
+/* Whether the base's own glossy lobe is there: GGX reflects F90 at grazing even with F0 0. */
+static inline int bsdf_has_base_glossy(const bsdf *b) {
+    return b->model != GLOSSY_NONE && (!is_black3(b->specular) || (b->model == GLOSSY_GGX && b->f90_loss < 1.0f));
+}
 /* Which lobes are present (non-zero). Inline: every estimator asks at every vertex. */
 static inline int bsdf_lobes(const bsdf *b) {
     int lobes = 0;
-    if (!is_black3(b->diffuse)) lobes |= BSDF_DIFFUSE;
-    if (b->model != GLOSSY_NONE && !is_black3(b->specular)) lobes |= BSDF_GLOSSY;
-    return lobes;
+    if (!is_black3(b->diffuse) || !is_black3(b->sheen)) lobes |= BSDF_DIFFUSE;
+    if (bsdf_has_base_glossy(b) || b->coat > 0.0f) lobes |= BSDF_GLOSSY;
+    return lobes & ~b->dropped;
 }
+/* b with only the lobes in the mask; the layers over them still attenuate them as in b. */
+static inline bsdf bsdf_only(const bsdf *b, int lobes) {
+    bsdf r = *b;
+    r.dropped |= BSDF_ALL & ~lobes;
+    return r;
+}
+/* 1 when the glossy lobe is one lobe of the base (no clear coat over it): one width, one vMF. */
+static inline int bsdf_glossy_is_single(const bsdf *b) { return !(b->coat > 0.0f); }
 /* The glossy lobe's width as a microfacet roughness alpha (geometric mean of the two axes;
- * Phong through its equivalent exponent); 0 without a glossy lobe. */
+ * Phong through its equivalent exponent); the sharper of the base's and the coat's; 0 without a
+ * glossy lobe. */
 float bsdf_glossy_alpha(const bsdf *b);
 /* BSDF_GLOSSY when b's glossy lobe is sharper than BSDF_HIGHLIGHT_ALPHA, else 0. */
 int bsdf_highlight_lobe(const bsdf *b);
@@ -92,8 +145,11 @@ int bsdf_highlight_lobe(const bsdf *b);
 float bsdf_glossy_aspect(const bsdf *b);
 /* The glossy lobe's directional albedo for wo, from tables built on first use: within 2% for
  * isotropic lobes; anisotropic ones are looked up at their mean width (within 2% off grazing,
- * 10% at grazing for aspect 1.4). 0 without a glossy lobe or with wo below. */
+ * 10% at grazing for aspect 1.4); the layers over the base glossy lobe taken at wi = wo. 0
+ * without a glossy lobe or with wo below. */
 vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo);
+/* The same for the diffuse lobe (Lambert as coupled and layered, and the sheen): for estimates. */
+vec3 bsdf_diffuse_albedo(const bsdf *b, vec3 wo);
 /* Probability that bsdf_sample picks the glossy lobe for this wo (0 or 1 with one lobe). */
 float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes);
 

@@ -335,10 +335,51 @@ struct importer {
                            what);
     }
 
-    // glTF's [0, 1] factors: a value above 1 is clamped, with one warning per material.
+    // A textureInfo inside an extension's JSON ({index, texCoord, KHR_texture_transform}), or no texture.
+    texture_slot ext_texture(const Value &e, const char *key, const std::string &label) {
+        if (!e.Has(key)) return texture_slot{-1, 0};
+        return texture(e.Get(key), label + ": " + key);
+    }
+
+    // ---- the material model's extensions (docs/design.md, "The glTF material") ----
+
+    void ext_ior(material &mat, const Value &e, const std::string &label) {
+        mat.ext.ior = factor(number_or(e, "ior", 1.5), label, "ior");
+    }
+
+    void ext_specular(material &mat, const Value &e, const std::string &label) {
+        mat.ext.specular = factor(number_or(e, "specularFactor", 1.0), label, "specularFactor");
+        mat.ext.specular_color = color_or(e, "specularColorFactor", v3s(1.0f), label);
+        mat.ext.specular_tex = ext_texture(e, "specularTexture", label);
+        mat.ext.specular_color_tex = ext_texture(e, "specularColorTexture", label);
+    }
+
+    void ext_sheen(material &mat, const Value &e, const std::string &label) {
+        mat.ext.sheen_color = color_or(e, "sheenColorFactor", v3s(0.0f), label);
+        mat.ext.sheen_roughness = factor(number_or(e, "sheenRoughnessFactor", 0.0), label, "sheenRoughnessFactor");
+        mat.ext.sheen_color_tex = ext_texture(e, "sheenColorTexture", label);
+        mat.ext.sheen_roughness_tex = ext_texture(e, "sheenRoughnessTexture", label);
+    }
+
+    void ext_clearcoat(material &mat, const Value &e, const std::string &label) {
+        mat.ext.clearcoat = factor(number_or(e, "clearcoatFactor", 0.0), label, "clearcoatFactor");
+        mat.ext.clearcoat_roughness =
+            factor(number_or(e, "clearcoatRoughnessFactor", 0.0), label, "clearcoatRoughnessFactor");
+        mat.ext.clearcoat_tex = ext_texture(e, "clearcoatTexture", label);
+        mat.ext.clearcoat_roughness_tex = ext_texture(e, "clearcoatRoughnessTexture", label);
+        if (e.Has("clearcoatNormalTexture"))
+            scene_warn(s, "%s: %s: clearcoatNormalTexture is not supported; the coat uses the surface's normal",
+                       name.c_str(), label.c_str());
+    }
+
+    // glTF's [0, 1] factors: a value above 1 is clamped, with one warning per material
+    // (specularColorFactor may exceed 1).
     void clamp_unit(material &mat, const std::string &label) {
-        float *f[] = {&mat.base_color.x, &mat.base_color.y, &mat.base_color.z,
-                      &mat.metallic,     &mat.roughness,    &mat.anisotropy_strength};
+        material_ext &x = mat.ext;
+        float *f[] = {&mat.base_color.x,     &mat.base_color.y,        &mat.base_color.z,  &mat.metallic,
+                      &mat.roughness,        &mat.anisotropy_strength, &x.specular,        &x.sheen_color.x,
+                      &x.sheen_color.y,      &x.sheen_color.z,         &x.sheen_roughness, &x.clearcoat,
+                      &x.clearcoat_roughness};
         bool clamped = false;
         for (float *v : f)
             if (*v > 1.0f) *v = 1.0f, clamped = true;
@@ -410,6 +451,14 @@ struct importer {
                     mat.anisotropy_rotation = (float)rot;
                     if (e.Has("anisotropyTexture"))
                         mat.anisotropy_tex = texture(e.Get("anisotropyTexture"), label + ": anisotropyTexture");
+                } else if (ext.first == "KHR_materials_ior") {
+                    ext_ior(mat, e, label);
+                } else if (ext.first == "KHR_materials_specular") {
+                    ext_specular(mat, e, label);
+                } else if (ext.first == "KHR_materials_sheen") {
+                    ext_sheen(mat, e, label);
+                } else if (ext.first == "KHR_materials_clearcoat") {
+                    ext_clearcoat(mat, e, label);
                 }
             }
             // The papers' lobes: extras.glint = {model: "phong"|"ward", kd, ks, exponent, alpha_x, alpha_y, rotation}
@@ -696,9 +745,10 @@ struct importer {
     }
 
     void run() {
-        static const char *supported[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                          "KHR_materials_anisotropy", "KHR_texture_transform",
-                                          "KHR_materials_variants"};
+        static const char *supported[] = {
+            "KHR_lights_punctual",     "KHR_materials_emissive_strength", "KHR_materials_anisotropy",
+            "KHR_materials_ior",       "KHR_materials_specular",          "KHR_materials_sheen",
+            "KHR_materials_clearcoat", "KHR_texture_transform",           "KHR_materials_variants"};
         for (const std::string &e : m.extensionsUsed) {
             bool ok = false;
             for (const char *sup : supported) ok = ok || e == sup;

@@ -366,7 +366,7 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
 
 /* Lobes more anisotropic than this (larger roughness over smaller) are not fitted by a vMF: no
  * isotropic vMF follows their streak (the default scene's brushed metals: over half the vMF
- * modes' error). */
+ * modes' error). Nor are two lobes of two widths (a clear coat over a glossy base). */
 #define HL_MAX_VMF_ASPECT 1.5f
 /* Nor are lobes whose broadest band has less of its mass above the surface than this: a broad lobe
  * seen at a grazing angle, cut by the horizon and bent toward the normal by the cosine, is no
@@ -383,7 +383,7 @@ enum { HIT_NONE = 0, HIT_VMF, HIT_TRACE };
 static int hit_record(hl_hit *hit, const shading_point *q, vec3 weight, const float *x_share) {
     vmf_lobe lobe;
     vec3 albedo;
-    if (bsdf_glossy_aspect(&q->b) > HL_MAX_VMF_ASPECT) return HIT_TRACE;
+    if (!bsdf_glossy_is_single(&q->b) || bsdf_glossy_aspect(&q->b) > HL_MAX_VMF_ASPECT) return HIT_TRACE;
     if (!vmf_fit_glossy_bands(&q->b, q->wo, &lobe, &albedo)) return HIT_NONE;
     /* The normal lies in the plane of incidence: what the horizon cuts is the spread along it. */
     double sq = fmax((double)lobe.squeeze, 1e-3), broadest = (double)lobe.band[0].kappa;

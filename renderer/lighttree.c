@@ -193,7 +193,7 @@ lt_receiver lighttree_receiver(const shading_point *x, float eps) {
     r.eps = eps;
     r.p = x->p;
     r.ng = x->ng;
-    r.diffuse = luminance3(x->b.diffuse) * INV_PI_F;
+    r.diffuse = luminance3(bsdf_diffuse_albedo(&x->b, x->wo)) * INV_PI_F; /* the sheen's too: no false zero */
     vmf lobe;
     vec3 albedo;
     if (vmf_fit_glossy(&x->b, x->wo, &lobe, &albedo)) {
@@ -257,7 +257,7 @@ static lt_node leaf_of_light(const virtual_light *vl, int index) {
     memset(&n, 0, sizeof n);
     set_box(&n, vl->p, vl->p);
     n.radius = vl->radius;
-    n.phi_diffuse = luminance3(mul3(vl->power, vl->b.diffuse));
+    n.phi_diffuse = luminance3(mul3(vl->power, bsdf_diffuse_albedo(&vl->b, vl->wi)));
     set_cone(&n.n_axis, &n.n_cos, &n.n_sin, (cone){vl->ng, 0.0f});
     set_cone(&n.g_axis, &n.g_cos, &n.g_sin, (cone){vl->ng, -1.0f});
     vmf lobe;

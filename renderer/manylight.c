@@ -235,8 +235,28 @@ static int cluster_lights(manylight *m, const scene *s, const camera *cam, const
     return status;
 }
 
-vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, int max_depth, rng_state *rng,
-                        render_stats *st) {
+/* One direction u through x's glossy lobe (x is scattering event k, reached with weight beta): the
+ * direct light at the next hit, weighted (*t), and what carrying the path on needs (*b, *h, *wi).
+ * Returns 0 when the direction ends there (sampled below the surface, Russian roulette, a miss). */
+static int glossy_direction(const scene *s, const shading_point *x, vec3 beta, int k, int lobes, vec2 u, rng_state *rng,
+                            render_stats *st, vec3 *t, vec3 *b, surface_hit *h, vec3 *wi) {
+    bsdf_sample_result bs;
+    if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, u, &bs) || !(bs.pdf > 0.0f)) return 0;
+    *wi = to_world(x->frame, bs.wi);
+    if (dot3(*wi, x->ng) <= 0.0f) return 0;
+    *b = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
+    if (k - 1 >= RR_FIRST_VERTEX && !russian_roulette(b, rng_float(rng))) return 0;
+    if (is_black3(*b) || !is_finite3(*b)) return 0;
+    st->glossy_bounces++;
+    /* Emission at the next hit is the direct light at x, which the shared estimator has. */
+    vec3 direct;
+    if (!pt_reflected_direct(s, offset_origin(s, x->p, x->ng, *wi), *wi, lobes, rng, &direct, h, st->rays)) return 0;
+    *t = mul3(*b, direct);
+    return 1;
+}
+
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, int max_depth, int split_first,
+                        pixel_record *rec, rng_state *rng, render_stats *st) {
     vec3 sum = v3(0, 0, 0), beta = v3s(1.0f);
     shading_point x = *x0;
     /* x is scattering event k: gathering there makes paths of k + 1 events or more. */
@@ -246,14 +266,14 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         int sharp = (bsdf_lobes(&x.b) & BSDF_GLOSSY) && bsdf_glossy_alpha(&x.b) < m->trace_alpha;
         if (!sharp) return add3(sum, mul3(beta, manylight_shade(m, s, &x, terms, rng, st)));
         shading_point diffuse_only = x;
-        diffuse_only.b.model = GLOSSY_NONE;
+        diffuse_only.b = bsdf_only(&x.b, BSDF_DIFFUSE);
         sum = add3(sum, mul3(beta, manylight_shade(m, s, &diffuse_only, terms, rng, st)));
 
         /* At the camera hit the lobe is split: `split` stratified directions each take the direct
          * light at their next hit (the reflection of lit surfaces, where a single direction is
          * the noisiest part of the image), and one of them, chosen at random, carries the rest of
          * the path (with weight 1: it stands for the mean of the split's continuations). */
-        int split = k == 1 ? m->glossy_split : 1;
+        int split = k == 1 ? split_first : 1;
         vec2 shift = rng_vec2(rng);
         int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
         /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (docs/design.md) when both
@@ -264,22 +284,14 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         surface_hit next;
         int have_next = 0;
         for (int j = 0; j < split; j++) {
-            bsdf_sample_result bs;
-            if (!bsdf_sample(&x.b, x.wo, BSDF_GLOSSY, 0.0f, split > 1 ? sample_r2(j, shift) : shift, &bs) ||
-                !(bs.pdf > 0.0f))
-                continue;
-            vec3 wi = to_world(x.frame, bs.wi);
-            if (dot3(wi, x.ng) <= 0.0f) continue;
-            vec3 b = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
-            if (k - 1 >= RR_FIRST_VERTEX && !russian_roulette(&b, rng_float(rng))) continue;
-            if (is_black3(b) || !is_finite3(b)) continue;
-            st->glossy_bounces++;
-            /* Emission at the next hit is the direct light at x, which the shared estimator has. */
+            vec3 t = v3(0, 0, 0), b;
             surface_hit h;
-            vec3 direct;
-            if (!pt_reflected_direct(s, offset_origin(s, x.p, x.ng, wi), wi, lobes, rng, &direct, &h, st->rays))
-                continue;
-            sum = madd3(sum, mul3(b, direct), 1.0f / (float)split);
+            vec3 wi;
+            int ok = glossy_direction(s, &x, beta, k, lobes, split > 1 ? sample_r2(j, shift) : shift, rng, st, &t, &b,
+                                      &h, &wi);
+            if (k == 1 && rec) pixel_record_add(rec, avg3(t));
+            if (!ok) continue;
+            sum = madd3(sum, t, 1.0f / (float)split);
             if (j == chosen) next_beta = b, next = h, next_wi = wi, have_next = 1;
         }
         if (!have_next) break;

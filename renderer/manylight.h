@@ -7,6 +7,7 @@
 #include "camera.h"
 #include "lighttree.h"
 #include "params.h"
+#include "pixel_alloc.h"
 #include "plan.h"
 #include "threadpool.h"
 #include "vsl.h"
@@ -28,7 +29,7 @@ typedef struct {
     int per_pixel;      /* 0: every entry */
     int candidates;     /* resampling candidates per pixel (1: the draws are shaded as they come) */
     float trace_alpha;  /* glossy lobes sharper than this are traced through, not gathered */
-    int glossy_split;   /* directions traced through such a lobe at the camera hit */
+    int glossy_split;   /* directions traced through such a lobe at the camera hit (the mean with adapt) */
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;
@@ -55,9 +56,10 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
 /* Indirect light at the camera hit x (scattering event 1 of at most max_depth): gathered from
  * the virtual lights, except through a glossy lobe sharper than trace_alpha, where a handful of
  * lights cannot represent the incoming light: that lobe is sampled, and the path picks up the
- * direct light at the next hit and gathers there (the same rule again). */
-vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, int max_depth, rng_state *rng,
-                        render_stats *st);
+ * direct light at the next hit and gathers there (the same rule again). At the camera hit the
+ * lobe is sampled in `split` directions; rec, when not NULL, records each one's light. */
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, int max_depth, int split,
+                        pixel_record *rec, rng_state *rng, render_stats *st);
 
 /* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
 shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);

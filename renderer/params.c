@@ -37,6 +37,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     if (vp->select == VL_SELECT_DEFAULT) r.select = VL_SELECT_POWER;
     r.trace_glossy = float_or(vp->trace_glossy, VL_DEFAULT_TRACE_GLOSSY);
     r.glossy_rays = int_or(vp->glossy_rays, VL_DEFAULT_GLOSSY_RAYS, VL_MAX_GLOSSY_RAYS);
+    if (vp->adapt == VL_ADAPT_DEFAULT) r.adapt = VL_ADAPT_ON;
     r.secondary_rays = int_or(vp->secondary_rays, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_SECONDARY_RAYS);
     r.clusters = int_or(vp->clusters, HL_DEFAULT_CLUSTERS, HL_MAX_CLUSTERS);
     if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_ON;
@@ -75,6 +76,7 @@ static const param_choice on_off[] = {{"on", 1, "on"}, {"off", 0, "off"}};
 static const param_choice clamps[] = {{NULL, VL_CLAMP_DEFAULT, "method default"}, {"on", VL_CLAMP_ON, "on"},
                                       {"off", VL_CLAMP_OFF, "off"}};
 static const param_choice selects[] = {{"power", VL_SELECT_POWER, "by power"}, {"tree", VL_SELECT_TREE, "light tree"}};
+static const param_choice adapts[] = {{"on", VL_ADAPT_ON, "on"}, {"off", VL_ADAPT_OFF, "off"}};
 static const param_choice merges[] = {{"on", HL_MERGE_ON, "on"}, {"off", HL_MERGE_OFF, "off"},
                                       {"trace", HL_MERGE_TRACE, "trace"}};
 
@@ -148,6 +150,12 @@ static const param_desc table[] = {
      .help = "directions traced through such a lobe at the camera hit, 1.." STR(VL_MAX_GLOSSY_RAYS),
      .label = "glossy rays", .unit = "rays per camera hit", .panel_lo = 1, .panel_hi = VL_MAX_GLOSSY_RAYS,
      .panel_format = "%d"},
+    {.name = "adapt", .type = PARAM_CHOICE, .offset = F(adapt), .choices = adapts, .num_choices = 2,
+     .def = VL_ADAPT_ON,
+     .help = "on: each pixel's glossy rays (N on average) and direct-light\n"
+             "samples (4) follow how much one sample's light varied there in\n"
+             "earlier frames; off: the same at every pixel",
+     .label = "adapt samples"},
     {.name = "secondary-rays", .type = PARAM_INT, .group = PARAM_HIGHLIGHTS, .offset = F(secondary_rays), .lo = 1,
      .hi = HL_MAX_SECONDARY_RAYS, .def = HL_DEFAULT_SECONDARY_RAYS, .value_name = "N",
      .help = "rays sampled from a camera hit's glossy lobe, 1.." STR(HL_MAX_SECONDARY_RAYS),

@@ -60,8 +60,10 @@ typedef struct {
                           * sampling, direct light at the next hit, gathering there); < 0: never
                           * [VL_DEFAULT_TRACE_GLOSSY] */
     int glossy_rays;     /* directions traced through such a lobe at the camera hit, each taking the
-                          * direct light at its next hit, one carrying the path on
-                          * [VL_DEFAULT_GLOSSY_RAYS] */
+                          * direct light at its next hit, one carrying the path on; with
+                          * adapt, their mean over the pixels [VL_DEFAULT_GLOSSY_RAYS] */
+    int adapt;           /* VL_ADAPT_*: each pixel's number of those directions follows how much one
+                          * direction's light varied there in earlier frames [on] */
     /* vsl+hl: the highlight estimator (which owns the camera - glossy - glossy - light paths) */
     int secondary_rays; /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
     int clusters;       /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
@@ -72,6 +74,7 @@ enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
 /* Where a pixel's light draws come from: VL_SELECT_POWER by power (or cluster norm); VL_SELECT_TREE
  * through the light tree (lighttree.h), by an estimate of each group's contribution there. */
 enum { VL_SELECT_DEFAULT = 0, VL_SELECT_TREE, VL_SELECT_POWER };
+enum { VL_ADAPT_DEFAULT = 0, VL_ADAPT_ON, VL_ADAPT_OFF };
 #define VL_DEFAULT_COUNT 1024
 #define VL_DEFAULT_CLAMP 1.0f
 /* The paper's multipliers (4-12) go with 10^5 lights in one set; radii scale as mult/sqrt(count),

@@ -134,7 +134,7 @@ void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, ve
     trace_path(s, max_depth, o, d, first, rng, out, rays, 0, split_highlights, BSDF_ALL);
 }
 
-vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, rng_state *rng,
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
                uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT], sum = v3(0, 0, 0);
     uint64_t camera_rays = rays[RAY_CAMERA];
@@ -142,6 +142,7 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     for (int k = 0; k < n; k++) {
         trace_path(s, 1, o, d, first, rng, out, rays, 0, 0, BSDF_ALL);
         sum = add3(sum, out[COMP_DIRECT]);
+        if (rec && first) pixel_record_add(rec, avg3(out[COMP_DIRECT]));
     }
     rays[RAY_CAMERA] = camera_rays + 1; /* the samples share one camera ray */
     return scale3(sum, 1.0f / (float)n);

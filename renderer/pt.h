@@ -6,6 +6,7 @@
 
 #include "film.h"
 #include "params.h"
+#include "pixel_alloc.h"
 #include "rng.h"
 #include "scene.h"
 
@@ -20,8 +21,8 @@ void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, ve
 
 /* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
  * max depth 1, so every method shares one direct estimator), the mean of `samples` estimates at
- * that hit; first as for pt_radiance. */
-vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, rng_state *rng,
+ * that hit; first as for pt_radiance. rec, when not NULL and there is a hit, records each one. */
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
                uint64_t rays[RAY_KIND_COUNT]);
 
 /* The same without the emission at the hit (nor the environment when the ray escapes): only

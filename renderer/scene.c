@@ -174,6 +174,7 @@ material material_default(void) {
     m.metallic = 1.0f;
     m.roughness = 1.0f;
     m.base_color_tex = m.metal_rough_tex = m.anisotropy_tex = m.emissive_tex = (texture_slot){.texture = -1};
+    m.ext = material_ext_default();
     return m;
 }
 
@@ -752,7 +753,8 @@ bsdf material_bsdf(const scene *s, const surface_hit *h, frame3 *frame) {
             float len = sqrtf(rx * rx + ry * ry);
             if (len > 1e-6f) rotate_tangent(frame, rx / len, ry / len);
         }
-        return make_bsdf_gltf(mul3(m->base_color, tint), metallic, roughness, aniso);
+        gltf_layers layers = material_layers(s, m, h);
+        return make_bsdf_gltf_layered(mul3(m->base_color, tint), metallic, roughness, aniso, &layers);
     }
     }
 }

@@ -54,6 +54,24 @@ typedef enum {
     MATERIAL_WARD,     /* extras.glint.model = "ward" */
 } material_model;
 
+/* The glTF material extensions of the material model (KHR_materials_ior, _specular, _sheen,
+ * _clearcoat): factors with their textures, combined at a hit by material_layers. */
+typedef struct {
+    float ior;                            /* KHR_materials_ior: 1.5; 0 means F0 = 1 (spec-gloss conversions) */
+    float specular;                       /* KHR_materials_specular: specularFactor, 1 */
+    vec3 specular_color;                  /* specularColorFactor, 1 (may exceed 1; F0 is clamped) */
+    texture_slot specular_tex;            /* linear: A strength */
+    texture_slot specular_color_tex;      /* sRGB: RGB */
+    vec3 sheen_color;                     /* KHR_materials_sheen: 0, no sheen */
+    float sheen_roughness;                /* perceptual */
+    texture_slot sheen_color_tex;         /* sRGB: RGB */
+    texture_slot sheen_roughness_tex;     /* linear: A */
+    float clearcoat;                      /* KHR_materials_clearcoat: 0, no coat */
+    float clearcoat_roughness;            /* perceptual */
+    texture_slot clearcoat_tex;           /* linear: R */
+    texture_slot clearcoat_roughness_tex; /* linear: G */
+} material_ext;
+
 /* glTF alphaMode. */
 typedef enum { ALPHA_OPAQUE = 0, ALPHA_MASK, ALPHA_BLEND } alpha_mode;
 
@@ -82,6 +100,7 @@ typedef struct {
     vec3 emission;             /* emissiveFactor * KHR_materials_emissive_strength */
     texture_slot emissive_tex; /* sRGB */
     int double_sided;          /* emits from both faces */
+    material_ext ext;          /* glTF material extensions (metallic-roughness only) */
 } material;
 
 /* ---- lights and cameras -------------------------------------------------------------------- */
@@ -329,6 +348,10 @@ static inline vec3 offset_origin(const scene *s, vec3 p, vec3 ng, vec3 dir) {
 /* The BSDF at a hit (textures looked up), in the hit's shading frame; *frame may be rotated for
  * anisotropy. */
 bsdf material_bsdf(const scene *s, const surface_hit *h, frame3 *frame);
+/* The glTF extensions' defaults (no extension: the core material). */
+material_ext material_ext_default(void);
+/* A glTF material's extensions at a hit, their textures looked up (material_layers.c). */
+gltf_layers material_layers(const scene *s, const material *m, const surface_hit *h);
 /* Emitted radiance leaving the hit toward the side the ray came from (0 for the back of a
  * single-sided emitter). */
 vec3 material_emission(const scene *s, const surface_hit *h);

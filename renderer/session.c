@@ -31,6 +31,7 @@ typedef struct {
  * 2.4x on showcase at 14% more time a frame; 8 did better there but cost atelier (whose direct
  * light is easy) a third of its frames for little (docs/benchmarks.md). */
 #define MANYLIGHT_DIRECT_SAMPLES 4
+#define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
 
 struct render_session {
     const scene *scene;
@@ -42,7 +43,11 @@ struct render_session {
     worker_stats *workers;
     render_stats totals;
     int tiles_x, tiles_y;
-    manylight ml;            /* vpl, vsl, vsl+hl: this frame's virtual lights */
+    manylight ml; /* vpl, vsl, vsl+hl: this frame's virtual lights */
+    /* Many-light frames with --adapt: each pixel's directions through sharp lobes and direct-light
+     * samples, from the spread of one sample's light in earlier frames */
+    int adapt;
+    pixel_alloc glossy, direct;
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
@@ -87,6 +92,11 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         session_destroy(rs);
         return NULL;
     }
+    if (pixel_alloc_init(&rs->glossy, p->width * p->height) != 0 ||
+        pixel_alloc_init(&rs->direct, p->width * p->height) != 0) {
+        session_destroy(rs);
+        return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
+    }
     rs->plan = session_make_plan(rs);
     rs->tiles_x = (p->width + TILE - 1) / TILE;
     rs->tiles_y = (p->height + TILE - 1) / TILE;
@@ -97,6 +107,8 @@ void session_destroy(render_session *rs) {
     if (!rs) return;
     threadpool_destroy(rs->pool);
     manylight_deinit(&rs->ml);
+    pixel_alloc_free(&rs->glossy);
+    pixel_alloc_free(&rs->direct);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -123,7 +135,9 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
         for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
         uint64_t t0 = clock_ns();
         if (!p->only || p->only & (1u << COMP_DIRECT))
-            L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first, MANYLIGHT_DIRECT_SAMPLES, rng, st->rays);
+            L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first,
+                                       rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES,
+                                       rs->adapt ? &rs->direct.rec[pixel] : NULL, rng, st->rays);
         else
             st->rays[RAY_CAMERA]++;
         uint64_t t1 = clock_ns();
@@ -132,7 +146,9 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
             shading_point sp = shading_point_at(s, first, d);
             rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
             if (rs->plan.virtual_lights) {
-                L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, rng, st);
+                L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth,
+                                                      rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
+                                                      rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
                 uint64_t t2 = clock_ns();
                 st->pass_ns[PASS_GATHER] += t2 - t1;
                 t1 = t2;
@@ -203,6 +219,15 @@ static void render_tile(void *ctx, int tile, int worker) {
 }
 
 int session_render_frame(render_session *rs) {
+    const render_params *p = &rs->params;
+    rs->adapt = p->method != METHOD_PT && vl_params_resolve(&p->vl).adapt == VL_ADAPT_ON;
+    if (rs->adapt) {
+        pixel_alloc_plan(&rs->direct, MANYLIGHT_DIRECT_SAMPLES, MANYLIGHT_MAX_DIRECT_SAMPLES, (uint64_t)rs->frames,
+                         p->seed ^ 0x646972656374ULL);
+        if (rs->plan.virtual_lights)
+            pixel_alloc_plan(&rs->glossy, vl_params_resolve(&p->vl).glossy_rays, VL_MAX_GLOSSY_RAYS,
+                             (uint64_t)rs->frames, p->seed);
+    }
     if (rs->plan.highlights) {
         if (rs->plan.env_prefilter && (!rs->envf || rs->envf_map != rs->scene->env)) {
             env_vmf_filter_destroy(rs->envf);
@@ -251,6 +276,8 @@ const char *session_error(const render_session *rs) { return rs->error; }
 
 void session_reset(render_session *rs) {
     film_clear(&rs->film);
+    pixel_alloc_reset(&rs->glossy);
+    pixel_alloc_reset(&rs->direct);
     rs->frames = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }

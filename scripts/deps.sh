@@ -4,9 +4,12 @@ GLINT_PACKAGES=(
   build-essential cmake pkg-config
   libglfw3-dev libembree-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev
   libimgui-dev libstb-dev libgl-dev libcjson-dev libcairo2-dev fonts-dejavu-core
-  xvfb xauth xdotool embree-tools openexr clang-format
+  xvfb xauth xdotool x11-xserver-utils embree-tools openexr clang-format
   clang libclang-rt-14-dev
 )
+# Opt-in, large: Blender (with the numpy its glTF importer needs) for the comparison against
+# Cycles (tests/bench/blender_twin.py, the blender ctest).
+if [ "${GLINT_BLENDER:-}" = 1 ]; then GLINT_PACKAGES+=(blender python3-numpy); fi
 
 glint_install_deps() {
   local missing=()

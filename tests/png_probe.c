@@ -3,6 +3,8 @@
  *   png_probe A.png size                      prints "W H"
  *   png_probe A.png ink X0 Y0 X1 Y1           sharp horizontal steps (|luma difference| > 96) per
  *                                             thousand pixels of the box: text is full of them
+ *   png_probe A.png inkrows X0 Y0 X1 Y1       rows of the box holding at least one such step: the
+ *                                             height of the text in it
  *   png_probe A.png blocky X0 Y0 X1 Y1        per thousand steps between horizontal neighbours
  *                                             in the box: those between two runs of 3 identical
  *                                             pixels (a magnification to nearest neighbours
@@ -38,6 +40,9 @@ static int luma(const img *m, int x, int y) {
     return (299 * p[0] + 587 * p[1] + 114 * p[2]) / 1000;
 }
 
+/* A sharp horizontal step: the edge of a glyph. */
+static int step(const img *m, int x, int y) { return abs(luma(m, x, y) - luma(m, x + 1, y)) > 96; }
+
 static int same(const img *m, int x0, int y0, int x1, int y1) { return memcmp(at(m, x0, y0), at(m, x1, y1), 3) == 0; }
 
 static void clip(const img *m, int *b) {
@@ -67,7 +72,16 @@ int main(int argc, char **argv) {
     long count = 0, total = 0;
     if (strcmp(cmd, "ink") == 0) {
         for (int y = box[1]; y < box[3]; y++)
-            for (int x = box[0]; x + 1 < box[2]; x++, total++) count += abs(luma(&a, x, y) - luma(&a, x + 1, y)) > 96;
+            for (int x = box[0]; x + 1 < box[2]; x++, total++) count += step(&a, x, y);
+    } else if (strcmp(cmd, "inkrows") == 0) {
+        for (int y = box[1]; y < box[3]; y++) {
+            int ink = 0;
+            for (int x = box[0]; x + 1 < box[2] && !ink; x++) ink = step(&a, x, y);
+            count += ink;
+        }
+        printf("%ld\n", count);
+        stbi_image_free(a.px);
+        return 0;
     } else if (strcmp(cmd, "blocky") == 0) {
         for (int y = box[1]; y < box[3]; y++)
             for (int x = box[0] + 2; x + 3 < box[2]; x++) {

@@ -3,8 +3,8 @@
  * CSV parses (header, monotone time, pt's error falling), whose SVG and PNG plots and report
  * appear, sweeps, the highlights component; several seeds per run, their summary and its split
  * into noise and bias; mismatched references (size, camera, scene, no or broken description,
- * one of unexpected shape, in the header or a sidecar) and impossible seed counts refused with
- * one error line; nothing ever overwritten; the plots' words, and the SVG drawn as the PNG is (the
+ * one of unexpected shape, in the header or a sidecar, one rendered by another material model)
+ * and impossible seed counts refused with one error line; nothing ever overwritten; the plots' words, and the SVG drawn as the PNG is (the
  * curves and legend in the PNG legend's colours, the legend's names as glyphs).
  * Usage: test_bench PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
@@ -422,6 +422,32 @@ static void test_reference_files(void) {
     expect_refusal("bench --reference old.exr --size 32x16 --times 0.05 --out f3", "24x16");
     expect_refusal("bench other.gltf --reference old.exr --times 0.05 --out f4", "another scene");
 
+    /* A reference rendered by another material model is stale, in the header or a sidecar:
+     * refused, saying so and what to do; without a model recorded it predates the stamp. */
+    CHECK(strstr(json, "\"model\": \"glint-bsdf-") != NULL, "the description has no material model: %s", json);
+    static char edited[8192];
+    const char *at = strstr(json, "\"model\": ");
+    const char *eol = at ? strchr(at, '\n') : NULL;
+    if (at && eol) {
+        for (int sidecar = 0; sidecar < 2; sidecar++) {
+            char name[32], args[128];
+            snprintf(edited, sizeof edited, "%.*s%s", (int)(at - json), json, eol + 1);
+            snprintf(name, sizeof name, "stale%d.exr", sidecar);
+            CHECK(write_reference("ref.exr", name, edited, sidecar) == 0, "writing %s", name);
+            snprintf(args, sizeof args, "bench --reference %s --times 0.05 --out stale-out%d", name, sidecar);
+            expect_refusal(args, "rendered by an older glint (no material model recorded), not this glint's material "
+                                 "model 'glint-bsdf-");
+            expect_refusal(args, "re-render the reference");
+            snprintf(edited, sizeof edited, "%.*s\"model\": \"glint-bsdf-1\",%s", (int)(at - json), json, eol);
+            snprintf(name, sizeof name, "older%d.exr", sidecar);
+            CHECK(write_reference("ref.exr", name, edited, sidecar) == 0, "writing %s", name);
+            snprintf(args, sizeof args, "bench --reference %s --times 0.05 --out older-out%d", name, sidecar);
+            expect_refusal(args, "rendered by material model 'glint-bsdf-1', not this glint's material model");
+        }
+    }
+    CHECK(!exists("stale-out0") && !exists("stale-out1") && !exists("older-out0") && !exists("older-out1"),
+          "a refused bench created its directory");
+
     write_text("copy.exr.json", "{\"glint_reference\": 1, \"scene\": \"x\"");
     CHECK(run("bench --reference copy.exr --methods pt --times 0.05 --quiet --out f5") == 0,
           "a stale sidecar beside a reference: %s", err_text);
@@ -477,6 +503,7 @@ static void test_description_shapes(void) {
         {"\"highlights_layer\": false", "\"highlights_layer\": 0", "missing or bad \"highlights_layer\""},
         {"\"method\": \"pt\"", "\"method\": \"a method name longer than any\"", "missing or bad \"method\""},
         {"\"glint_reference\": 1,", "", "missing or bad \"glint_reference\""},
+        {"\"model\": \"", "\"model\": 2, \"m\": \"", "missing or bad \"model\""},
         {"{", "[", "not JSON, line 2)"},
     };
     enum { N = sizeof edits / sizeof edits[0], EXTRA = 5 };

@@ -83,6 +83,11 @@ static double pdf_integrand(const void *c, vec3 wi) {
 
 static vec3 mirror(vec3 wo) { return v3(-wo.x, -wo.y, wo.z); }
 
+/* A random direction above the surface, not quite grazing. */
+static vec3 random_above(rng_state *rng) {
+    return normalize3(v3(2 * rng_float(rng) - 1, 2 * rng_float(rng) - 1, rng_float(rng) + 0.02f));
+}
+
 /* ---- an independent GGX --------------------------------------------------------------------- */
 
 /* Walter et al. (2007) with the anisotropic D of Heitz (2014) and height-correlated Smith G2 =
@@ -123,8 +128,8 @@ static void test_ggx_reference(void) {
         bsdf b = make_bsdf_gltf(v3s(1.0f), 1.0f, cases[c].metal_rough, cases[c].aniso);
         int bad = 0;
         for (int k = 0; k < 2000; k++) {
-            vec3 wo = normalize3(v3(2 * rng_float(&rng) - 1, 2 * rng_float(&rng) - 1, rng_float(&rng) + 0.02f));
-            vec3 wi = normalize3(v3(2 * rng_float(&rng) - 1, 2 * rng_float(&rng) - 1, rng_float(&rng) + 0.02f));
+            vec3 wo = random_above(&rng);
+            vec3 wi = random_above(&rng);
             double want = ggx_reference(1.0, b.alpha_x, b.alpha_y, wo, wi);
             double got = avg3(bsdf_eval(&b, wo, wi, BSDF_GLOSSY));
             if (!(fabs(got - want) <= 1e-3 * want + 1e-7)) {
@@ -154,6 +159,253 @@ static void test_ggx_reference(void) {
                   "GGX case %d, wo %d: sampled albedo %.5f vs quadrature %.5f (sigma %.2g)", c, a, mean, quad, sigma);
             CHECK(quad <= 1.0 + 1e-3 && quad > 0.3, "GGX case %d, wo %d: albedo %.5f", c, a, quad);
         }
+    }
+}
+
+/* ---- the glTF model (spec appendix B, diffuse coupled) ---------------------------------------- */
+
+/* Schlick's Fresnel with F90, in double. */
+static double schlick_d(double f0, double f90, double c) { return f0 + (f90 - f0) * pow(1.0 - c, 5.0); }
+
+typedef struct {
+    double alpha, f0;
+    vec3 wo;
+} spec_ctx;
+
+/* The dielectric's specular lobe (F0 0.04, F90 1) times the cosine: its integral is E(wo). */
+static double dielectric_integrand(const void *c, vec3 wi) {
+    const spec_ctx *x = c;
+    double f = ggx_reference(1.0, x->alpha, x->alpha, x->wo, wi); /* D G / (4 zo zi) with F = 1 */
+    vec3 h = normalize3(add3(x->wo, wi));
+    double fr = schlick_d(x->f0, 1.0, (double)dot3(x->wo, h));
+    return f * fr * wi.z;
+}
+
+/* E(mu) of the dielectric lobe by quadrature, independent of the renderer's tables. */
+static double dielectric_albedo(double alpha, double mu) {
+    vec3 wo = v3((float)sqrt(fmax(0.0, 1.0 - mu * mu)), 0.0f, (float)mu);
+    spec_ctx c = {alpha, 0.04, wo};
+    return hemisphere_integral(dielectric_integrand, &c, mirror(wo), 400, 128);
+}
+
+typedef struct {
+    vec3 wo;
+    double base; /* the diffuse albedo */
+} spec_diffuse_ctx;
+
+/* The spec's own diffuse term, (1 - F(v.h)) base / pi, times the cosine. */
+static double spec_diffuse_integrand(const void *c, vec3 wi) {
+    const spec_diffuse_ctx *x = c;
+    vec3 h = normalize3(add3(x->wo, wi));
+    return (1.0 - schlick_d(0.04, 1.0, (double)dot3(x->wo, h))) * x->base / PI_D * wi.z;
+}
+
+static void test_gltf_model(void) {
+    const float roughness[] = {0.3f, 0.55f, 0.8f, 1.0f};
+    const double angles[] = {0.0, 35.0, 60.0, 80.0, 88.0};
+    rng_state rng = rng_make(57, 5);
+    for (int r = 0; r < 4; r++) {
+        double alpha = (double)roughness[r] * (double)roughness[r];
+        /* E(mu) and its cosine-weighted mean 2 int E mu dmu, by quadrature (midpoints in mu). */
+        enum { NMU = 32 };
+        double e_mu[NMU], e_avg = 0.0;
+        for (int k = 0; k < NMU; k++) {
+            double mu = (k + 0.5) / NMU;
+            e_mu[k] = dielectric_albedo(alpha, mu);
+            e_avg += 2.0 * e_mu[k] * mu / NMU;
+        }
+        bsdf white = make_bsdf_gltf(v3s(1.0f), 0.0f, roughness[r], 0.0f);
+        bsdf grey = make_bsdf_gltf(v3(0.5f, 0.3f, 0.1f), 0.0f, roughness[r], 0.0f);
+        bsdf half = make_bsdf_gltf(v3(0.9f, 0.6f, 0.2f), 0.5f, roughness[r], 0.0f);
+        /* Pointwise against the formulas: specular = F(v.h) D V with F0 mix(0.04, base,
+         * metallic); diffuse = (1 - metallic) base / pi (1 - E(wo)) (1 - E(wi)) / (1 - E_avg). */
+        int bad_spec = 0, bad_diff = 0;
+        for (int k = 0; k < 200; k++) {
+            double mo = rng_float(&rng) * 0.98 + 0.01, mi = rng_float(&rng) * 0.98 + 0.01;
+            float phi = 2.0f * (float)PI_D * rng_float(&rng);
+            vec3 wo = v3((float)sqrt(1.0 - mo * mo), 0.0f, (float)mo);
+            vec3 wi = v3((float)sqrt(1.0 - mi * mi) * cosf(phi), (float)sqrt(1.0 - mi * mi) * sinf(phi), (float)mi);
+            vec3 h = normalize3(add3(wo, wi));
+            double vh = dot3(wo, h), dv = ggx_reference(1.0, alpha, alpha, wo, wi);
+            double f0 = 0.5 * 0.04 + 0.5 * 0.9; /* half: red channel */
+            double want_spec = schlick_d(f0, 1.0, vh) * dv;
+            double got_spec = bsdf_eval(&half, wo, wi, BSDF_GLOSSY).x;
+            if (!(fabs(got_spec - want_spec) <= 2e-3 * want_spec + 1e-7)) {
+                if (bad_spec++ < 3)
+                    fprintf(stderr, "gltf spec r %g: %.6g, formula %.6g\n", (double)roughness[r], got_spec, want_spec);
+            }
+            /* E at mo and mi from the quadrature table, interpolated linearly */
+            double e[2], m[2] = {mo, mi};
+            for (int j = 0; j < 2; j++) {
+                double t = m[j] * NMU - 0.5;
+                int i0 = t < 0 ? 0 : (t >= NMU - 1 ? NMU - 2 : (int)t);
+                double f = fmin(fmax(t - i0, 0.0), 1.0);
+                e[j] = e_mu[i0] + (e_mu[i0 + 1] - e_mu[i0]) * f;
+            }
+            double want_diff = 0.5 * 0.6 / PI_D * (1.0 - e[0]) * (1.0 - e[1]) / (1.0 - e_avg); /* half, green */
+            double got_diff = bsdf_eval(&half, wo, wi, BSDF_DIFFUSE).y;
+            /* the renderer's tables (256 samples an entry, linear interpolation) within 2.5% */
+            if (!(fabs(got_diff - want_diff) <= 0.025 * want_diff + 1e-6)) {
+                if (bad_diff++ < 3)
+                    fprintf(stderr, "gltf diffuse r %g mo %.3f mi %.3f: %.6g, formula %.6g\n", (double)roughness[r], mo,
+                            mi, got_diff, want_diff);
+            }
+        }
+        CHECK(bad_spec == 0, "glTF r %g: %d of 200 specular values differ from F(v.h) D V", (double)roughness[r],
+              bad_spec);
+        CHECK(bad_diff == 0, "glTF r %g: %d of 200 diffuse values differ from the coupled form", (double)roughness[r],
+              bad_diff);
+        for (int a = 0; a < 5; a++) {
+            vec3 wo = dir_from_angles(angles[a], 30.0);
+            /* White furnace: a white dielectric reflects everything, at every angle and roughness
+             * (the diffuse takes exactly what the specular lobe leaves). */
+            eval_ctx ec = {&white, wo, BSDF_ALL};
+            double albedo = hemisphere_integral(albedo_integrand, &ec, mirror(wo), 800, 256);
+            CHECK_NEAR(albedo, 1.0, 0.015, "white dielectric r %g at %g deg: albedo %.4f", (double)roughness[r],
+                       angles[a], albedo);
+            /* Where the spec's (1 - F(v.h)) weight conserves energy (off grazing) the coupled
+             * diffuse reflects what it does, within 3%; at grazing the spec's sum passes 1. */
+            eval_ctx dc = {&grey, wo, BSDF_DIFFUSE};
+            spec_diffuse_ctx sc = {wo, 0.3};
+            double ours = 3.0 * hemisphere_integral(albedo_integrand, &dc, v3(0, 0, 1), 400, 128) / (0.5 + 0.3 + 0.1);
+            double spec = hemisphere_integral(spec_diffuse_integrand, &sc, v3(0, 0, 1), 400, 128) / 0.3;
+            if (angles[a] <= 60.0)
+                CHECK(fabs(ours - spec) <= 0.03 * spec, "r %g at %g deg: diffuse albedo %.4f, the spec's %.4f",
+                      (double)roughness[r], angles[a], ours, spec);
+            else if (angles[a] >= 88.0 && r == 0) {
+                eval_ctx gc = {&white, wo, BSDF_GLOSSY};
+                double gloss = hemisphere_integral(albedo_integrand, &gc, mirror(wo), 800, 256);
+                CHECK(gloss + spec > 1.05 && gloss + ours <= 1.0 + 0.015,
+                      "at %g deg the spec's sum %.4f should gain energy, ours %.4f not", angles[a], gloss + spec,
+                      gloss + ours);
+            }
+        }
+    }
+}
+
+/* ---- the glTF extensions ------------------------------------------------------------------------ */
+
+/* A glTF bsdf with extensions: base colour, metallic, roughness, then the layers. */
+static bsdf layered(vec3 base, float metallic, float rough, gltf_layers x) {
+    return make_bsdf_gltf_layered(base, metallic, rough, 0.0f, &x);
+}
+
+/* The sheen extension's Charlie lobe D V, written from its formulas in double. */
+static double charlie_reference(double rough, vec3 wo, vec3 wi) {
+    double a = rough * rough, t = (1.0 - a) * (1.0 - a);
+    double ca = 21.5473 + (25.3245 - 21.5473) * t, cb = 3.82987 + (3.32435 - 3.82987) * t,
+           cc = 0.19823 + (0.16801 - 0.19823) * t, cd = -1.97760 + (-1.27393 + 1.97760) * t,
+           ce = -4.32054 + (-4.85967 + 4.32054) * t;
+#define CHARLIE_L(x) (ca / (1.0 + cb * pow((x), cc)) + cd * (x) + ce)
+    double lam[2], z[2] = {wo.z, wi.z};
+    for (int k = 0; k < 2; k++)
+        lam[k] = z[k] < 0.5 ? exp(CHARLIE_L(z[k])) : exp(2.0 * CHARLIE_L(0.5) - CHARLIE_L(1.0 - z[k]));
+#undef CHARLIE_L
+    double hx = wo.x + wi.x, hy = wo.y + wi.y, hz = wo.z + wi.z, hl = sqrt(hx * hx + hy * hy + hz * hz);
+    double sin2 = 1.0 - (hz / hl) * (hz / hl);
+    double d = (2.0 + 1.0 / a) * pow(sin2, 0.5 / a) / (2.0 * PI_D);
+    return d / ((1.0 + lam[0] + lam[1]) * 4.0 * z[0] * z[1]);
+}
+
+static void test_gltf_extensions(void) {
+    rng_state rng = rng_make(91, 6);
+    gltf_layers none = gltf_layers_default();
+    none.specular = 0.0f; /* no specular lobe: what is left is the layer under test */
+
+    /* KHR_materials_specular and _ior: F0 = min(f0_ior specularColor, 1) specular, F90 =
+     * specular, against the formula; a white base with any of them still reflects everything
+     * (the diffuse takes the strongest channel's complement). */
+    gltf_layers spec = gltf_layers_default();
+    double ior = 1.33, f0_ior = ((ior - 1.0) / (ior + 1.0)) * ((ior - 1.0) / (ior + 1.0));
+    spec.dielectric_f0 = v3((float)f0_ior * 1.0f, (float)f0_ior * 0.5f, 0.0f);
+    spec.specular = 0.6f;
+    bsdf bs = layered(v3s(1.0f), 0.0f, 0.5f, spec);
+    int bad = 0;
+    for (int k = 0; k < 300; k++) {
+        vec3 wo = random_above(&rng);
+        vec3 wi = random_above(&rng);
+        vec3 h = normalize3(add3(wo, wi));
+        double dv = ggx_reference(1.0, 0.25, 0.25, wo, wi), vh = dot3(wo, h);
+        vec3 got = bsdf_eval(&bs, wo, wi, BSDF_GLOSSY);
+        double want[3] = {schlick_d(f0_ior * 0.6, 0.6, vh) * dv, schlick_d(f0_ior * 0.5 * 0.6, 0.6, vh) * dv,
+                          schlick_d(0.0, 0.6, vh) * dv};
+        for (int c = 0; c < 3; c++) bad += !(fabs(comp3(got, c) - want[c]) <= 2e-3 * want[c] + 1e-7);
+    }
+    CHECK(bad == 0, "KHR_materials_specular/_ior: %d of 900 values differ from F0 min(f0 c, 1) s, F90 s", bad);
+    for (int a = 0; a < 3; a++) {
+        vec3 wo = dir_from_angles(a * 38.0, 10.0);
+        eval_ctx ec = {&bs, wo, BSDF_ALL};
+        CHECK_NEAR(hemisphere_integral(albedo_integrand, &ec, mirror(wo), 800, 256) * 3.0 / (1.0 + 1.0 + 1.0),
+                   1.0 - (1.0 / 3.0) * 0.0, 0.03, "white base under KHR_materials_specular at %d deg", a * 38);
+        /* specular 0: a plain Lambert base, exactly */
+        bsdf lam = layered(v3s(0.7f), 0.0f, 0.5f, none);
+        eval_ctx lc = {&lam, wo, BSDF_ALL};
+        CHECK_NEAR(hemisphere_integral(albedo_integrand, &lc, v3(0, 0, 1), 400, 64), 0.7, 1e-3,
+                   "specular 0 leaves Lambert at %d deg", a * 38);
+    }
+
+    /* KHR_materials_sheen: the lobe is the extension's D V (against the formulas in double); its
+     * albedo over a black base is the table's (quadrature); over a white base the scaling keeps
+     * the sum at or below 1, and it loses at most what the sheen lobe misses. */
+    const float sheen_rough[] = {0.2f, 0.5f, 1.0f};
+    for (int r = 0; r < 3; r++) {
+        gltf_layers sh = none;
+        sh.sheen_color = v3s(1.0f);
+        sh.sheen_roughness = sheen_rough[r];
+        bsdf black = layered(v3s(0.0f), 0.0f, 0.5f, sh), white = layered(v3s(1.0f), 0.0f, 0.5f, sh);
+        int off = 0;
+        for (int k = 0; k < 300; k++) {
+            vec3 wo = random_above(&rng);
+            vec3 wi = random_above(&rng);
+            double want = charlie_reference(sheen_rough[r], wo, wi), got = bsdf_eval(&black, wo, wi, BSDF_ALL).x;
+            off += !(fabs(got - want) <= 2e-3 * want + 1e-7);
+        }
+        CHECK(off == 0, "sheen r %g: %d of 300 values differ from Charlie's D V", (double)sheen_rough[r], off);
+        for (int a = 0; a < 4; a++) {
+            vec3 wo = dir_from_angles(a * 27.0, 0.0);
+            eval_ctx bc = {&black, wo, BSDF_ALL}, wc = {&white, wo, BSDF_ALL};
+            double e = hemisphere_integral(albedo_integrand, &bc, v3(0, 0, 1), 600, 128);
+            double table = bsdf_diffuse_albedo(&black, wo).x;
+            CHECK(fabs(table - e) <= 0.03 * e + 2e-3, "sheen r %g at %d deg: table albedo %.4f, quadrature %.4f",
+                  (double)sheen_rough[r], a * 27, table, e);
+            double w = hemisphere_integral(albedo_integrand, &wc, v3(0, 0, 1), 600, 128);
+            CHECK(w <= 1.0 + 0.01 && w >= 0.8, "sheen r %g over white at %d deg: albedo %.4f (sheen %.4f)",
+                  (double)sheen_rough[r], a * 27, w, e);
+        }
+    }
+
+    /* KHR_materials_clearcoat: the coat lobe is F(v.h) D V with F0 0.04; at normal incidence a
+     * smooth coat leaves the base 1 - 0.04 clearcoat, the spec's fresnel_coat; over a white base
+     * nothing is gained at any angle. */
+    gltf_layers cc = none;
+    cc.clearcoat = 0.8f;
+    cc.clearcoat_roughness = 0.4f;
+    bsdf coat_black = layered(v3s(0.0f), 0.0f, 0.5f, cc);
+    int off = 0;
+    for (int k = 0; k < 300; k++) {
+        vec3 wo = random_above(&rng);
+        vec3 wi = random_above(&rng);
+        vec3 h = normalize3(add3(wo, wi));
+        double want = 0.8 * schlick_d(0.04, 1.0, dot3(wo, h)) * ggx_reference(1.0, 0.16, 0.16, wo, wi);
+        double got = bsdf_eval(&coat_black, wo, wi, BSDF_GLOSSY).y;
+        off += !(fabs(got - want) <= 2e-3 * want + 1e-7);
+    }
+    CHECK(off == 0, "clearcoat: %d of 300 values differ from 0.8 F(v.h) D V", off);
+    gltf_layers smooth = none;
+    smooth.clearcoat = 1.0f;
+    bsdf coated = layered(v3s(0.6f), 0.0f, 0.5f, smooth);
+    double base_normal = bsdf_eval(&coated, v3(0, 0, 1), v3(0, 0, 1), BSDF_DIFFUSE).x * PI_D;
+    CHECK_NEAR(base_normal, 0.6 * (1.0 - 0.04), 0.006, "a smooth coat at normal incidence leaves %.4f of the base",
+               base_normal);
+    for (int a = 0; a < 4; a++) {
+        vec3 wo = dir_from_angles(a * 28.0, 50.0);
+        gltf_layers cw = gltf_layers_default();
+        cw.clearcoat = 1.0f;
+        cw.clearcoat_roughness = 0.3f;
+        bsdf white = layered(v3s(1.0f), 0.0f, 0.7f, cw);
+        eval_ctx ec = {&white, wo, BSDF_ALL};
+        double w = hemisphere_integral(albedo_integrand, &ec, mirror(wo), 1200, 256);
+        CHECK(w <= 1.0 + 0.015 && w > 0.85, "coat over a white dielectric at %d deg: albedo %.4f", a * 28, w);
     }
 }
 
@@ -253,6 +505,8 @@ static void test_traps(void) {
         make_bsdf_gltf(v3(0.9f, 0.8f, 0.7f), 1.0f, 0.0f, 0.0f), /* alpha floored at BSDF_MIN_ALPHA */
         make_bsdf_gltf(v3(0.9f, 0.8f, 0.7f), 1.0f, 0.0f, 1.0f), /* fully anisotropic, razor-thin across */
         make_bsdf_gltf(v3s(0.5f), 0.0f, 0.0f, 0.0f),
+        make_bsdf_gltf_layered(v3s(0.5f), 0.0f, 0.6f, 0.0f, /* a razor-sharp clear coat */
+                               &(gltf_layers){v3s(0.04f), 1.0f, v3s(0.0f), 0.0f, 1.0f, 0.0f}),
         make_bsdf_phong(v3s(0.1f), v3s(0.8f), 1e6f),
         make_bsdf_ward(v3s(0.1f), v3s(0.8f), 1e-4f, 1e-4f),
         make_bsdf_ward(v3s(0.0f), v3s(0.9f), 1e-3f, 0.8f),
@@ -290,6 +544,26 @@ static void test_traps(void) {
             below += bsdf_sample(&sharp[m], under, BSDF_ALL, 0.5f, v2(0.3f, 0.3f), &r) != 0;
         }
     CHECK(bad == 0, "razor-sharp lobes and grazing angles: %d non-finite or unbounded values", bad);
+
+    /* A white sheen at its floor roughness peaks at the horizon, which neither cosine nor uniform
+     * sampling follows: at grazing wo its weights reach tens (docs/design.md), but stay finite. */
+    bsdf sheen = make_bsdf_gltf_layered(v3s(0.5f), 0.0f, 0.6f, 0.0f,
+                                        &(gltf_layers){v3s(0.04f), 1.0f, v3s(1.0f), 0.0f, 0.0f, 0.0f});
+    float sheen_max = 0.0f;
+    int sheen_bad = 0;
+    for (int z = 0; z < 5; z++) {
+        float sz = sqrtf(1.0f - zs[z] * zs[z]);
+        vec3 wo = v3(sz * 0.6f, sz * 0.8f, zs[z]);
+        for (int k = 0; k < 4000; k++) {
+            bsdf_sample_result r;
+            if (!bsdf_sample(&sheen, wo, BSDF_ALL, rng_float(&rng), rng_vec2(&rng), &r)) continue;
+            float w = max_comp3(r.f) * r.wi.z / r.pdf;
+            sheen_bad += !isfinite(w) || !(r.pdf > 0.0f);
+            sheen_max = fmaxf(sheen_max, w);
+        }
+    }
+    CHECK(sheen_bad == 0 && sheen_max < 150.0f, "sheen at its floor: %d non-finite, weights up to %g", sheen_bad,
+          (double)sheen_max);
     CHECK(below == 0, "below the horizon: %d non-zero values", below);
 
     /* A razor-sharp Phong lobe (n = 1e6) still integrates to 1 at normal incidence: its peak is
@@ -397,15 +671,44 @@ static void test_glossy_albedo_table(void) {
     CHECK(is_black3(bsdf_glossy_albedo(&lambert, v3(0, 0, 1))), "a Lambert BSDF has a glossy albedo");
 }
 
+static gltf_layers sheen_of(vec3 color, float rough) {
+    gltf_layers x = gltf_layers_default();
+    x.sheen_color = color;
+    x.sheen_roughness = rough;
+    return x;
+}
+
+static gltf_layers coat_of(float weight, float rough) {
+    gltf_layers x = gltf_layers_default();
+    x.clearcoat = weight;
+    x.clearcoat_roughness = rough;
+    return x;
+}
+
+static gltf_layers all_layers(void) {
+    gltf_layers x = sheen_of(v3(0.9f, 0.5f, 0.2f), 0.4f);
+    x.clearcoat = 0.5f;
+    x.clearcoat_roughness = 0.25f;
+    x.dielectric_f0 = v3(0.08f, 0.05f, 0.02f);
+    x.specular = 0.7f;
+    return x;
+}
+
 int main(void) {
     test_glossy_albedo_table();
     const material mats[] = {
         {"lambert", make_bsdf_lambert(v3(0.8f, 0.6f, 0.4f)), 1},
         {"gltf dielectric r0.5", make_bsdf_gltf(v3s(1.0f), 0.0f, 0.5f, 0.0f), 1},
+        {"gltf dielectric r1.0", make_bsdf_gltf(v3(0.7f, 0.5f, 0.9f), 0.0f, 1.0f, 0.0f), 1},
         {"gltf dielectric r0.2", make_bsdf_gltf(v3(0.9f, 0.2f, 0.2f), 0.0f, 0.2f, 0.0f), 1},
         {"gltf metal r0.4", make_bsdf_gltf(v3s(1.0f), 1.0f, 0.4f, 0.0f), 1},
         {"gltf metal r0.5 aniso 0.8", make_bsdf_gltf(v3(1.0f, 0.8f, 0.6f), 1.0f, 0.5f, 0.8f), 1},
         {"gltf half-metal r0.6", make_bsdf_gltf(v3s(1.0f), 0.5f, 0.6f, 0.3f), 1},
+        {"gltf velvet (sheen 0.5)", layered(v3s(0.01f), 0.0f, 0.8f, sheen_of(v3(0.1f, 0.2f, 0.9f), 0.5f)), 1},
+        {"gltf sheen 0.1", layered(v3(0.5f, 0.2f, 0.2f), 0.0f, 0.5f, sheen_of(v3s(1.0f), 0.1f)), 1},
+        {"gltf coat r0.3 over r0.7", layered(v3(0.8f, 0.1f, 0.1f), 0.0f, 0.7f, coat_of(1.0f, 0.3f)), 1},
+        {"gltf coat r0 over metal", layered(v3(0.9f, 0.6f, 0.3f), 1.0f, 0.5f, coat_of(0.7f, 0.1f)), 0},
+        {"gltf coat, sheen, specular", layered(v3s(0.3f), 0.2f, 0.6f, all_layers()), 1},
         {"phong n20", make_bsdf_phong(v3s(0.3f), v3s(0.7f), 20.0f), 1},
         {"phong n1", make_bsdf_phong(v3s(0.0f), v3s(1.0f), 1.0f), 1},
         {"phong n1000", make_bsdf_phong(v3s(0.2f), v3s(0.8f), 1000.0f), 0},
@@ -424,6 +727,8 @@ int main(void) {
         for (int a = 0; a < 4; a++)
             test_material(&mats[m], dir_from_angles(angles[a][0], angles[a][1]), (uint64_t)(m * 10 + a));
     test_ggx_reference();
+    test_gltf_model();
+    test_gltf_extensions();
     test_furnace();
     test_traps();
     test_glossy_alpha_scale();

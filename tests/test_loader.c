@@ -124,15 +124,20 @@ static size_t make_glb(const char *json, unsigned char *buf, size_t cap) {
 static int num_warnings;
 static char last_warning[512];
 
+static char all_warnings[4096];
+
 static void on_warn(void *user, const char *msg) {
     (void)user;
     num_warnings++;
     snprintf(last_warning, sizeof last_warning, "%s", msg);
+    size_t n = strlen(all_warnings);
+    snprintf(all_warnings + n, sizeof all_warnings - n, "%s\n", msg);
 }
 
 static scene *load(const char *path, char *err, size_t errlen) {
     num_warnings = 0;
     last_warning[0] = 0;
+    all_warnings[0] = 0;
     err[0] = 0;
     return scene_load(path, on_warn, NULL, err, errlen);
 }
@@ -274,7 +279,8 @@ static void test_materials(void) {
                          "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":4,\"material\":2},"
                          "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"material\":3}]}]";
     const char *extra =
-        "\"extensionsUsed\":[\"KHR_materials_emissive_strength\",\"KHR_materials_clearcoat\",\"EXT_made_up\"],"
+        "\"extensionsUsed\":[\"KHR_materials_emissive_strength\",\"KHR_materials_clearcoat\",\"EXT_made_up\","
+        "\"KHR_materials_sheen\",\"KHR_materials_specular\",\"KHR_materials_ior\"],"
         "\"materials\":["
         "{\"name\":\"phong\",\"extras\":{\"glint\":{\"model\":\"phong\",\"kd\":[0.1,0.2,0.3],\"ks\":[0.5,0.5,0.5],"
         "\"exponent\":250}}},"
@@ -283,7 +289,11 @@ static void test_materials(void) {
         "{\"name\":\"lamp\",\"emissiveFactor\":[1,0.5,0.5],"
         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":40}}},"
         "{\"name\":\"coated\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":1,"
-        "\"roughnessFactor\":0.2},\"extensions\":{\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1}}}]";
+        "\"roughnessFactor\":0.2},\"extensions\":{\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1,"
+        "\"clearcoatRoughnessFactor\":0.3,\"clearcoatNormalTexture\":{\"index\":0}},"
+        "\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.1,0.2,1.5],\"sheenRoughnessFactor\":0.4},"
+        "\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[2,1,0.5]},"
+        "\"KHR_materials_ior\":{\"ior\":1.33}}}]";
     scene *s = load(write_gltf("materials.gltf", gltf_json(NULL, meshes, extra, NULL)), err, sizeof err);
     CHECK(s != NULL, "materials: %s", err);
     if (!s) return;
@@ -306,6 +316,15 @@ static void test_materials(void) {
         } else if (!strcmp(m->name, "coated")) {
             seen |= 8;
             CHECK(m->metallic == 1.0f && fabsf(m->roughness - 0.2f) < 1e-6f, "metallic-roughness factors");
+            const material_ext *x = &m->ext;
+            CHECK(x->clearcoat == 1.0f && fabsf(x->clearcoat_roughness - 0.3f) < 1e-6f, "clearcoat %g %g",
+                  (double)x->clearcoat, (double)x->clearcoat_roughness);
+            /* sheen colour is a 0-1 factor (clamped); specular colour may exceed 1 */
+            CHECK(fabsf(x->sheen_color.z - 1.0f) < 1e-6f && fabsf(x->sheen_roughness - 0.4f) < 1e-6f, "sheen");
+            CHECK(x->specular == 0.5f && x->specular_color.x == 2.0f && fabsf(x->ior - 1.33f) < 1e-6f,
+                  "specular %g (%g), ior %g", (double)x->specular, (double)x->specular_color.x, (double)x->ior);
+        } else if (m->ext.ior != 1.5f) {
+            CHECK(0, "material %s: ior %g without KHR_materials_ior", m->name, (double)m->ext.ior);
         }
     }
     CHECK(seen == 15, "materials seen: %d of 15", seen);
@@ -315,6 +334,9 @@ static void test_materials(void) {
     CHECK(tri_lights == 2, "emissive triangles as lights: %d", tri_lights);
     CHECK(num_warnings >= 1 && strstr(last_warning, "materials.gltf"),
           "unsupported extension: no warning naming the file");
+    CHECK(strstr(all_warnings, "EXT_made_up") && !strstr(all_warnings, "extension KHR_"),
+          "only the unsupported extension warns by name: %s", all_warnings);
+    CHECK(strstr(all_warnings, "clearcoatNormalTexture"), "no warning for the coat's normal map: %s", all_warnings);
     scene_destroy(s);
 }
 

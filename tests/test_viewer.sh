@@ -126,6 +126,9 @@ grep '^stats ' out.txt >stats.txt
 [ "$(field 2 radius_mult)" = "4" ] && [ "$(field 2 candidates)" = "8" ] && [ "$(field 2 trace_glossy)" = "0.4" ] ||
   fail "radius, candidates or trace-glossy not applied"
 [ "$(field 2 resets)" -gt "$(field 1 resets)" ] || fail "a many-light change did not reset the accumulation"
+# the panel states the new settings' cost beside the last ones'
+below 0 "$(field 2 cost_ms)" && below 0 "$(field 2 cost_before_ms)" ||
+  fail "no cost of the settings before and after the change: $(sed -n 2p stats.txt)"
 [ "$(field 3 radius_mult)" = "4" ] || fail "a bad radius multiplier replaced the last good one"
 # stats lines 4 on: vsl+hl (with fewer secondary rays than the default 8, to save time), then shown
 # as highlights only, then N, K and merge changed
@@ -207,7 +210,6 @@ grep '^stats ' out.txt >stats.txt
 [ "$(wc -l <stats.txt)" -eq 7 ] || fail "light session: expected 7 stats lines, got: $(cat out.txt)"
 [ "$(field 1 lights)" -ge 1 ] || fail "the default scene lists no light: $(sed -n 1p stats.txt)"
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.4f", a / b }'; }
-below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; } # below A B: A < B
 [ "$(field 2 light)" = "0" ] && [ "$(field 2 light_intensity)" = "0.25" ] || fail "light intensity not applied: $(sed -n 2p stats.txt)"
 [ "$(field 2 resets)" -gt "$(field 1 resets)" ] || fail "a light intensity change did not reset the accumulation"
 below "$(ratio "$(field 2 mean)" "$(field 1 mean)")" 0.6 || fail "dimming the light did not darken the image: $(field 1 mean) -> $(field 2 mean)"

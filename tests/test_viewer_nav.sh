@@ -4,8 +4,8 @@
 # room, F / frame views the whole scene from outside it; a reference of another scene or size is refused, the
 # error plot pauses away from the reference's camera and resumes back there; a failed load keeps
 # the accumulation; quitting stops the frame in flight; an unlit scene is reported and a uniform
-# sky lights it, and the environment is kept across loads; the viewer and glint info start with
-# the same method.
+# sky lights it, and the environment is kept across loads; the wheel and W keep their steps a share
+# of the distance in a 2 mm and a 2 km scene; the viewer and glint info start with the same method.
 # Usage: test_viewer_nav.sh GLINT TMPDIR [KEEP_MODULES_LIB]
 set -u
 glint=$1
@@ -19,17 +19,7 @@ screen=1280x800x24
 view_timed() {
   timeout 300 env LD_PRELOAD="$preload" ASAN_OPTIONS="${ASAN_OPTIONS:-}:detect_leaks=0" "$glint" "$@" >out.txt 2>err.txt
 }
-below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; } # below A B: A < B
 now() { date +%s.%N; }
-# stats_lines N [TRIES]: waits (0.1 s steps) until out.txt holds N stats lines
-stats_lines() {
-  n=0
-  while [ "$(grep -c '^stats ' out.txt 2>/dev/null)" -lt "$1" ]; do
-    n=$((n + 1))
-    [ $n -le "${2:-1500}" ] || return 1
-    sleep 0.1
-  done
-}
 
 # ---- navigation through the script: the default view, one wheel step back (zoom by 1/0.85),
 # far out, an orbit and a pan as far as they go, then a bookmark outside the room (black: its
@@ -268,6 +258,47 @@ grep -q 'uniform sky' err.txt || fail "the warning does not offer the uniform sk
 [ "$(field 3 env)" = "-" ] && [ "$(field 3 unlit_note)" = "1" ] || fail "the K key did not take the sky away: $(sed -n 3p stats.txt)"
 [ "$(field 4 scene)" = "builtin:doorway" ] && [ "$(field 4 env)" = "sky" ] || fail "the sky did not stay across a load: $(sed -n 4p stats.txt)"
 [ "$(field 5 env)" = "-" ] || fail "env none did not clear the environment"
+
+# ---- zoom and fly at any scale, through real X events: the wheel (three steps in) and W held for
+# a second move the camera by a share of its distance to what it looks at, never to it or through
+# it, whether the scene spans 2 mm or 2 km (the quad above, scaled; lit by the uniform sky).
+cat >scaled.txt <<'EOF'
+set panel 0
+sky
+wait 1
+stats
+screenshot ready.png
+wait-file wheeled
+sleep 0.5
+wait 1
+stats
+wait-file flown
+sleep 0.5
+wait 1
+stats
+quit
+EOF
+for s in 0.001 1000; do
+  sed "s/\"nodes\": \[{\"mesh\": 0}\]/\"nodes\": [{\"mesh\": 0, \"scale\": [$s, $s, $s]}]/" unlit.gltf >scaled.gltf
+  rm -f wheeled flown
+  view_bg ready.png scaled.gltf --size 160x90 --script scaled.txt
+  if [ -n "$win" ]; then
+    xdotool mousemove --window "$win" 80 45 click 4 sleep 0.3 click 4 sleep 0.3 click 4
+    touch wheeled
+    stats_lines 2
+    xdotool windowfocus --sync "$win" 2>/dev/null
+    xdotool keydown w sleep 1 keyup w
+  fi
+  view_end "scale $s" wheeled flown
+  # distances from the camera to the quad's centre (the origin), over the scale
+  d=$(for i in 1 2 3; do field $i cam; done | awk -F, -v s="$s" '{ printf "%g ", sqrt($1 * $1 + $2 * $2 + $3 * $3) / s }')
+  set -- $d
+  awk -v a="${1:-0}" -v b="${2:-0}" 'BEGIN { exit !(a > 0 && b > 0.4 * a && b < 0.9 * a) }' ||
+    fail "scale $s: three wheel steps in took the camera from $1 to $2 (scene units)"
+  awk -v b="${2:-0}" -v c="${3:-0}" 'BEGIN { exit !(b > 0 && c > 0.1 * b && c < 0.95 * b) }' ||
+    fail "scale $s: a second of W took the camera from $2 to $3 (scene units)"
+  for i in 1 2 3; do below 0.01 "$(field $i mean)" || fail "scale $s: view $i is black: $(sed -n ${i}p stats.txt)"; done
+done
 
 # ---- one default method: the viewer's and glint info's
 [ "$(field 1 method)" = "vsl" ] || fail "the viewer does not start with vsl: $(field 1 method)"

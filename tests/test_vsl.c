@@ -468,6 +468,42 @@ static void test_glossy_box_energy(void) {
     scene_destroy(s);
 }
 
+/* The glTF layers as the many-light methods treat them: the sheen gathered with the diffuse lobe,
+ * a sharp clear coat traced (with the base's glossy lobe under it), a coated secondary hit lit
+ * through its own BSDF by the highlights. In a closed box of velvet under a clear coat, vsl and
+ * vsl+hl reach the path tracer's indirect light (for vsl+hl with its highlights). */
+static void test_layered_box_against_pt(void) {
+    material m = material_default();
+    m.base_color = v3(0.5f, 0.3f, 0.2f);
+    m.metallic = 0.0f;
+    m.roughness = 0.7f;
+    m.ext.sheen_color = v3(0.3f, 0.5f, 0.9f);
+    m.ext.sheen_roughness = 0.4f;
+    m.ext.clearcoat = 1.0f;
+    m.ext.clearcoat_roughness = 0.2f; /* alpha 0.04: sharp, traced and a highlight lobe */
+    scene *s = closed_box(m, v3(0.3f, 0.5f, 0.2f));
+    camera cam = box_camera();
+    const unsigned hl = 1u << COMP_HIGHLIGHTS;
+    float *ref = ts_render(s, &cam, W, H, 2048, 8, 3, INDIRECT);
+    for (int method = METHOD_VSL; method <= METHOD_VSL_HL; method++) {
+        render_params p = vl_params_for((render_method)method, 1024);
+        p.vl.radius_mult = 1.0f;
+        p.vl.per_pixel = 32; /* resampled: the layered lobes cost more than Phong's to shade */
+        float *img = ts_render_with(s, &cam, &p, 64, INDIRECT | hl);
+        double ratio = image_mean(img, NPIX) / image_mean(ref, NPIX), err = rel_l2(img, ref, NPIX);
+        printf("layered box, %s: indirect mean ratio to PT %.4f, relative L2 %.4f\n", method_name(p.method), ratio,
+               err);
+        /* the diffuse box's tolerances: the VSLs' radius costs a few percent near the corners */
+        CHECK(fabs(ratio - 1.0) < 0.06, "layered box, %s: indirect mean off by %+.4f", method_name(p.method),
+              ratio - 1.0);
+        CHECK(err < 0.12, "layered box, %s: relative L2 %.4f", method_name(p.method), err);
+        CHECK(all_finite(img, NPIX), "layered box, %s: non-finite pixels", method_name(p.method));
+        free(img);
+    }
+    free(ref);
+    scene_destroy(s);
+}
+
 /* Per-pixel light selection is unbiased: with the same light sets (same seed, so every frame
  * traces the same lights), sampling a few lights per pixel, by power or through the light tree,
  * shaded as drawn or resampled from candidates, averages to the sum over every light; for VSLs
@@ -689,6 +725,47 @@ static void test_counts_beyond_the_frame(void) {
     scene_destroy(s);
 }
 
+/* The traced directions' allocation: a pixel whose record is too short keeps the budget; the others
+ * get the budget in proportion to the spread of one direction's light there (stochastic rounding
+ * keeps fractional shares on average), clamped to [1, max]. */
+static void test_pixel_alloc_plan(void) {
+    pixel_alloc a;
+    CHECK(pixel_alloc_init(&a, 5) == 0, "allocation");
+    /* pixel 0: constant light (spread 0); 1: spread 1; 2: spread 3; 3: unrecorded; 4: two samples */
+    for (int k = 0; k < 40; k++) {
+        pixel_record_add(&a.rec[0], 2.0f);
+        pixel_record_add(&a.rec[1], k % 2 ? 1.0f : -1.0f);
+        pixel_record_add(&a.rec[2], k % 2 ? 5.0f : -1.0f);
+    }
+    pixel_record_add(&a.rec[4], 0.0f);
+    pixel_record_add(&a.rec[4], 100.0f);
+    /* The sample spreads of +-1 and 2 +- 3 over 40 values: sqrt(40/39) and 3 sqrt(40/39); the mean
+     * over the three recorded pixels is 4/3 sqrt(40/39), so budget 4 wants 0, 3 and 9 directions. */
+    double sum[5] = {0};
+    int frames = 4000, over = 0;
+    for (int f = 0; f < frames; f++) {
+        pixel_alloc_plan(&a, 4, 8, (uint64_t)f, 7);
+        for (int i = 0; i < 5; i++) sum[i] += a.samples[i];
+        over |= a.samples[2] > 8;
+    }
+    CHECK(sum[0] == frames, "constant light: %.3f directions, expected 1 (the floor)", sum[0] / frames);
+    CHECK_NEAR(sum[1] / frames, 3.0, 0.05, "spread 1");
+    CHECK(sum[2] == 8.0 * frames && !over, "spread 3: %.3f directions, expected the cap 8", sum[2] / frames);
+    CHECK(sum[3] == 4.0 * frames && sum[4] == 4.0 * frames, "unknown spreads: %.3f and %.3f, expected the budget",
+          sum[3] / frames, sum[4] / frames);
+    /* A fractional share: budget 3 wants 2.25 directions at pixel 1, on average. */
+    sum[1] = 0.0;
+    for (int f = 0; f < frames; f++) {
+        pixel_alloc_plan(&a, 3, 8, (uint64_t)f, 7);
+        sum[1] += a.samples[1];
+    }
+    CHECK_NEAR(sum[1] / frames, 2.25, 0.03, "stochastic rounding");
+    pixel_alloc_reset(&a);
+    pixel_alloc_plan(&a, 4, 8, 0, 7);
+    CHECK(a.samples[1] == 4 && a.samples[2] == 4, "after a reset every pixel takes the budget");
+    pixel_alloc_free(&a);
+}
+
 int main(void) {
     test_integral_against_brute_force();
     test_diffuse_kernel();
@@ -698,7 +775,9 @@ int main(void) {
     test_energy_by_a_wall();
     test_diffuse_box_against_pt();
     test_glossy_box_energy();
+    test_layered_box_against_pt();
     test_light_selection_unbiased();
+    test_pixel_alloc_plan();
     test_trace_glossy_matches_pt();
     test_no_leak_through_thin_walls();
     test_lights_touching_surfaces();

@@ -20,7 +20,15 @@ float g_content_scale = 0.0f; // the window's content scale the fonts and sizes 
 float g_scale = 1.0f;         // sizes in window units: the content scale over the framebuffer's pixels per unit
 float g_dock_w = 0.0f;        // the panel's width as the user left it (window units); 0: the default
 bool g_collapsed = false;
+bool g_resizing = false;   // its edge is dragged: its width changed since the left button went down
 float g_image_dock = 0.0f; // this frame's: the image is drawn beside it
+// The panel's buttons where they were drawn (the visible ones), for scripts that click them
+struct drawn_button {
+    char label[48];
+    float rect[4];
+};
+drawn_button g_buttons[48];
+int g_num_buttons;
 } // namespace
 
 // Fonts and sizes for the window's content scale (HiDPI): glyphs rasterised at the framebuffer's
@@ -91,24 +99,35 @@ static float dock_width(float window_w) {
     return std::fmax(std::fmin(w, hi), lo);
 }
 
+// Collapsed, the panel keeps a narrow column at the window's edge for its title bar's arrow: the
+// image stays beside it, never under it.
+static float collapsed_width(void) { return ImGui::GetStyle().WindowMinSize.x; }
+
 extern "C" float ui_dock_width(const ui_controls *c) {
-    if (!c->show_panel || g_collapsed) return 0.0f;
+    if (!c->show_panel) return 0.0f;
+    if (g_collapsed) return collapsed_width();
     int ww = 0;
     glfwGetWindowSize(g_window, &ww, nullptr);
     return dock_width((float)ww);
 }
 
 extern "C" float ui_dock_width_beside(const ui_controls *c, float image_w) {
-    if (!c->show_panel || g_collapsed) return 0.0f;
+    if (!c->show_panel) return 0.0f;
+    if (g_collapsed) return collapsed_width();
     // dock_width(image_w + d) == d: the default, unless that is over 60% of the window
     return std::fmin(g_dock_w > 0.0f ? g_dock_w : 360.0f * g_scale, 1.5f * image_w);
 }
 
-extern "C" void ui_draw_image(unsigned texture) {
+extern "C" int ui_panel_resizing(void) { return g_resizing; }
+
+extern "C" float ui_scale(void) { return g_scale; }
+
+extern "C" float ui_content_scale(void) { return g_content_scale; }
+
+extern "C" void ui_draw_image(unsigned texture, const float rect[4]) {
     if (!texture) return;
-    ImVec2 size = ImGui::GetIO().DisplaySize;
-    ImGui::GetBackgroundDrawList()->AddImage((ImTextureID)(intptr_t)texture, ImVec2(0, 0),
-                                             ImVec2(size.x - g_image_dock, size.y));
+    ImGui::GetBackgroundDrawList()->AddImage((ImTextureID)(intptr_t)texture, ImVec2(rect[0], rect[1]),
+                                             ImVec2(rect[2], rect[3]));
 }
 
 extern "C" void ui_draw_lights(const float *xy, int n, int selected) {
@@ -117,8 +136,9 @@ extern "C" void ui_draw_lights(const float *xy, int n, int selected) {
         float x = xy[2 * i], y = xy[2 * i + 1];
         if (!std::isfinite(x) || !std::isfinite(y)) continue;
         ImU32 col = i == selected ? IM_COL32(255, 210, 60, 255) : IM_COL32(255, 255, 255, 140);
-        dl->AddCircle(ImVec2(x, y), i == selected ? 9.0f : 6.0f, IM_COL32(0, 0, 0, 160), 0, 3.5f);
-        dl->AddCircle(ImVec2(x, y), i == selected ? 9.0f : 6.0f, col, 0, 1.5f);
+        float r = (i == selected ? 9.0f : 6.0f) * g_scale;
+        dl->AddCircle(ImVec2(x, y), r, IM_COL32(0, 0, 0, 160), 0, 3.5f * g_scale);
+        dl->AddCircle(ImVec2(x, y), r, col, 0, 1.5f * g_scale);
     }
 }
 
@@ -146,15 +166,20 @@ static void error_plot(const ui_stats *s) {
         emin = std::fmin(emin, noise);
         emax = std::fmax(emax, noise);
     }
-    float lo = std::floor(std::log10(emin)), hi = std::ceil(std::log10(emax));
-    if (hi <= lo) hi = lo + 1.0f;
     if (!(tmax > 0.0f)) tmax = 1.0f;
     ImVec2 p0 = ImGui::GetCursorScreenPos();
     float w = std::fmax(ImGui::GetContentRegionAvail().x, 50.0f), h = 110.0f * g_scale;
+    // Log scale with a label's height of room above and below: neither a curve nor the noise floor
+    // runs under the axis labels
+    float line = ImGui::GetTextLineHeight(), room = line + 4.0f;
+    float lo = std::log10(emin), hi = std::log10(emax);
+    float pad = std::fmax(room * (hi - lo) / std::fmax(h - 2.0f * room, 1.0f), 0.1f);
+    lo -= pad;
+    hi += pad;
     ImGui::Dummy(ImVec2(w, h));
     ImDrawList *dl = ImGui::GetWindowDrawList();
     dl->AddRectFilled(p0, ImVec2(p0.x + w, p0.y + h), IM_COL32(15, 15, 20, 255));
-    for (float d = lo + 1.0f; d < hi; d += 1.0f) { // decade lines
+    for (float d = std::ceil(lo); d < hi; d += 1.0f) { // decade lines
         float y = p0.y + h * (1.0f - (d - lo) / (hi - lo));
         dl->AddLine(ImVec2(p0.x, y), ImVec2(p0.x + w, y), IM_COL32(60, 60, 70, 255));
     }
@@ -179,10 +204,9 @@ static void error_plot(const ui_stats *s) {
             dl->AddPolyline(pts.Data, pts.Size, curve_colours[c % 6], 0, 1.5f);
     }
     char label[32];
-    std::snprintf(label, sizeof label, "1e%+.0f", (double)hi);
+    std::snprintf(label, sizeof label, "%.2g", std::pow(10.0, (double)hi));
     dl->AddText(ImVec2(p0.x + 2, p0.y + 1), IM_COL32(200, 200, 200, 255), label);
-    std::snprintf(label, sizeof label, "1e%+.0f", (double)lo);
-    float line = ImGui::GetTextLineHeight();
+    std::snprintf(label, sizeof label, "%.2g", std::pow(10.0, (double)lo));
     dl->AddText(ImVec2(p0.x + 2, p0.y + h - line - 1), IM_COL32(200, 200, 200, 255), label);
     std::snprintf(label, sizeof label, "%.1f s", (double)tmax);
     dl->AddText(ImVec2(p0.x + w - ImGui::CalcTextSize(label).x - 2, p0.y + h - line - 1), IM_COL32(200, 200, 200, 255),
@@ -190,8 +214,14 @@ static void error_plot(const ui_stats *s) {
     for (int c = 0; c < s->num_curves; c++) ImGui::TextColored(ImColor(curve_colours[c % 6]), "%s", s->curves[c].label);
 }
 
+// What a setting does and trades (its --help text), while the mouse rests on it.
+static void help_tooltip(const char *help) {
+    if (help && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", help);
+}
+
 // One widget per many-light parameter of the group, from the table (params.h): choices as combo
-// boxes, numbers as sliders whose lowest position stands for "off" where the parameter has one.
+// boxes, numbers as sliders whose lowest position stands for "off" where the parameter has one;
+// each explains itself on hover.
 static void param_widgets(param_group group, vl_params *vl) {
     int n;
     const param_desc *table = params_table(&n);
@@ -207,6 +237,7 @@ static void param_widgets(param_group group, vl_params *vl) {
                 if (d->choices[k].value == (int)v) cur = k;
             }
             if (ImGui::Combo(d->label, &cur, labels, k)) param_put(d, vl, d->choices[cur].value);
+            help_tooltip(d->help);
             continue;
         }
         int has_off = d->off_word || d->zero_is_off;
@@ -214,15 +245,18 @@ static void param_widgets(param_group group, vl_params *vl) {
         double shown = has_off && v < 0.0 ? d->panel_lo : v;
         const char *format = d->panel_lo_text && shown <= d->panel_lo ? d->panel_lo_text : d->panel_format;
         double edited;
+        bool changed;
         if (d->type == PARAM_INT) {
             int x = (int)shown;
-            if (!ImGui::SliderInt(d->label, &x, (int)d->panel_lo, (int)d->panel_hi, format, flags)) continue;
+            changed = ImGui::SliderInt(d->label, &x, (int)d->panel_lo, (int)d->panel_hi, format, flags);
             edited = x;
         } else {
             float x = (float)shown;
-            if (!ImGui::SliderFloat(d->label, &x, (float)d->panel_lo, (float)d->panel_hi, format, flags)) continue;
+            changed = ImGui::SliderFloat(d->label, &x, (float)d->panel_lo, (float)d->panel_hi, format, flags);
             edited = x;
         }
+        help_tooltip(d->help);
+        if (!changed) continue;
         // The lowest position is "off" where there is one; anything else stays in the accepted range.
         if (has_off && edited <= d->panel_lo)
             edited = -1.0;
@@ -230,6 +264,25 @@ static void param_widgets(param_group group, vl_params *vl) {
             edited = std::fmin(std::fmax(edited, d->lo), d->below_hi ? std::nextafter(d->hi, 0.0) : d->hi);
         param_put(d, vl, edited);
     }
+}
+
+// A button of the panel, its place kept while visible (ui_drawn_button).
+static bool button(const char *label) {
+    bool pressed = ImGui::Button(label);
+    if (ImGui::IsItemVisible() && g_num_buttons < (int)(sizeof g_buttons / sizeof g_buttons[0])) {
+        drawn_button *b = &g_buttons[g_num_buttons++];
+        std::snprintf(b->label, sizeof b->label, "%s", label);
+        ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+        b->rect[0] = lo.x, b->rect[1] = lo.y, b->rect[2] = hi.x, b->rect[3] = hi.y;
+    }
+    return pressed;
+}
+
+extern "C" int ui_drawn_button(int i, const char **label, float rect[4]) {
+    if (i < 0 || i >= g_num_buttons) return 0;
+    *label = g_buttons[i].label;
+    for (int k = 0; k < 4; k++) rect[k] = g_buttons[i].rect[k];
+    return 1;
 }
 
 // Grey text for notes.
@@ -279,9 +332,9 @@ static void progress_section(ui_controls *c, const ui_stats *s) {
         ImGui::TextUnformatted(s->previewing ? "moving: a reduced-resolution preview" : "refining");
     /* Standing notes: the error plot paused away from the reference's camera, no light. */
     if (s->status && s->status[0]) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", s->status);
-    if (ImGui::Button(c->paused ? "resume (Space)" : "pause (Space)")) c->paused = !c->paused;
+    if (button(c->paused ? "resume (Space)" : "pause (Space)")) c->paused = !c->paused;
     ImGui::SameLine();
-    if (ImGui::Button("help (F1)")) c->show_help = !c->show_help;
+    if (button("help (F1)")) c->show_help = !c->show_help;
     int spp = (int)std::fmin((double)c->spp_limit, 1e8);
     if (ImGui::InputInt("stop at spp", &spp, 16, 256)) c->spp_limit = spp < 0 ? 0 : spp;
     float t = (float)c->time_limit;
@@ -306,7 +359,7 @@ static void bookmark_buttons(ui_controls *c, const ui_stats *s) {
         bool set = (s->bookmarks_set >> k) & 1u;
         if (k > 1) ImGui::SameLine();
         if (!set) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, 0.35f);
-        if (ImGui::Button(label) && set) c->bookmark_restore = k;
+        if (button(label) && set) c->bookmark_restore = k;
         if (!set) ImGui::PopStyleVar();
     }
     ImGui::TextUnformatted("save the view as");
@@ -314,7 +367,7 @@ static void bookmark_buttons(ui_controls *c, const ui_stats *s) {
         char label[16];
         std::snprintf(label, sizeof label, "%d##save", k);
         ImGui::SameLine();
-        if (ImGui::Button(label)) c->bookmark_save = k;
+        if (button(label)) c->bookmark_save = k;
     }
     if (s->bookmarks) note("%s", s->bookmarks);
 }
@@ -323,15 +376,27 @@ static void bookmark_buttons(ui_controls *c, const ui_stats *s) {
 // (dragging its left edge), kept between limits so that it and the image stay on-screen.
 static void panel(ui_controls *c, const ui_stats *s) {
     ImVec2 display = ImGui::GetIO().DisplaySize;
-    float w = dock_width(display.x);
+    float w = g_collapsed ? collapsed_width() : dock_width(display.x);
     ImGui::SetNextWindowPos(ImVec2(display.x, 0.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
     ImGui::SetNextWindowSize(ImVec2(w, display.y), ImGuiCond_Always);
     ImGui::SetNextWindowBgAlpha(0.94f);
-    g_collapsed = !ImGui::Begin("glint: settings and progress", nullptr, ImGuiWindowFlags_NoMove);
+    // Collapsed, its column shows the arrow alone on the panel's colour (the title, one ID
+    // with "###", would not fit).
+    if (g_collapsed)
+        ImGui::GetBackgroundDrawList()->AddRectFilled(ImVec2(display.x - w, 0.0f), display,
+                                                      ImGui::GetColorU32(ImGuiCol_WindowBg));
+    bool open = ImGui::Begin(g_collapsed ? "###panel" : "glint: settings and progress###panel", nullptr,
+                             ImGuiWindowFlags_NoMove);
     // A drag of the left edge resized it this frame: keep the width asked for.
     float now_w = ImGui::GetWindowWidth();
-    if (!g_collapsed && std::fabs(now_w - w) > 0.5f) g_dock_w = now_w;
-    if (g_collapsed) {
+    if (open && !g_collapsed && std::fabs(now_w - w) > 0.5f) {
+        g_dock_w = now_w;
+        g_resizing = true;
+    }
+    if (!ImGui::IsMouseDown(ImGuiMouseButton_Left)) g_resizing = false;
+    g_collapsed = !open;
+    if (!open) {
+        g_image_dock = collapsed_width();
         ImGui::End();
         return;
     }
@@ -353,7 +418,13 @@ static void panel(ui_controls *c, const ui_stats *s) {
         ImGui::SliderInt("max depth", &c->params.max_depth, 1, 64);
         if (s->many_light) param_widgets(PARAM_MANY_LIGHT, &c->params.vl);
         // Cost and bias where known: the last full frame's time and the plan's reasons.
-        note("cost: %.0f ms a frame at %d x %d", s->frame_ms, s->width, s->height);
+        if (s->cost_ms <= 0.0)
+            note("cost: measuring (the first full frame of these settings)");
+        else if (s->cost_before_ms > 0.0)
+            note("cost: %.0f ms a full frame, %.2gx the %.0f ms before the last change", s->cost_ms,
+                 s->cost_ms / s->cost_before_ms, s->cost_before_ms);
+        else
+            note("cost: %.0f ms a full frame", s->cost_ms);
         if (s->plan && s->plan[0] &&
             ImGui::TreeNodeEx("what runs, and why (effect plan)", ImGuiTreeNodeFlags_DefaultOpen)) {
             note("%s", s->plan);
@@ -410,27 +481,27 @@ static void panel(ui_controls *c, const ui_stats *s) {
             }
             ImGui::EndCombo();
         }
-        if (ImGui::Button("reset view (R)")) c->reset_view = 1;
+        if (button("reset view (R)")) c->reset_view = 1;
         ImGui::SameLine();
-        if (ImGui::Button("frame scene (F)")) c->frame_scene = 1;
+        if (button("frame scene (F)")) c->frame_scene = 1;
         if (s->reference) {
             ImGui::SameLine();
-            if (ImGui::Button("reference camera (C)")) c->reference_view = 1;
+            if (button("reference camera (C)")) c->reference_view = 1;
         }
         bookmark_buttons(c, s);
     }
 
     if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
-        if (ImGui::Button("screenshot (F12)")) c->screenshot = 1;
+        if (button("screenshot (F12)")) c->screenshot = 1;
         ImGui::SameLine();
-        if (ImGui::Button("export EXR (F11)")) c->export_exr = 1;
+        if (button("export EXR (F11)")) c->export_exr = 1;
         ImGui::InputText("path", c->path, sizeof c->path);
-        if (ImGui::Button("load scene")) c->load_scene = 1;
+        if (button("load scene")) c->load_scene = 1;
         ImGui::SameLine();
-        if (ImGui::Button("load environment")) c->load_env = 1;
+        if (button("load environment")) c->load_env = 1;
         ImGui::SameLine();
-        if (ImGui::Button("load reference")) c->load_reference = 1;
-        if (ImGui::Button("uniform sky on/off (K)")) c->uniform_sky = 1;
+        if (button("load reference")) c->load_reference = 1;
+        if (button("uniform sky on/off (K)")) c->uniform_sky = 1;
         if (s->message && s->message[0]) ImGui::TextWrapped("%s", s->message);
     }
 
@@ -515,6 +586,7 @@ static void help(ui_controls *c, const ui_stats *s) {
 
 extern "C" void ui_panel(ui_controls *c, const ui_stats *s) {
     g_image_dock = 0.0f;
+    g_num_buttons = 0;
     if (c->show_panel) panel(c, s);
     overlay(c, s);
     if (c->show_help) help(c, s);

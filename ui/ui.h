@@ -59,6 +59,9 @@ typedef struct {
     double spp;
     double seconds;  /* since the last reset */
     double frame_ms; /* the last frame's render time */
+    /* a full-resolution frame's time with the current settings (0: none yet) and before the last
+     * change of estimator settings (0: unknown) */
+    double cost_ms, cost_before_ms;
     double rays_per_second;
     unsigned long long rejected_samples;
     int width, height; /* of the image shown */
@@ -99,13 +102,22 @@ typedef struct {
 int ui_init(struct GLFWwindow *window);
 void ui_shutdown(void);
 void ui_begin_frame(void);
-/* The image fills the window beside the docked panel (a textured quad). texture 0 draws nothing. */
-void ui_draw_image(unsigned texture);
+/* The image as a textured quad over rect (x0, y0, x1, y1, window units). texture 0 draws nothing. */
+void ui_draw_image(unsigned texture, const float rect[4]);
 /* The width the panel docked at the window's right edge takes from the image, in window units: 0
- * while it is hidden or collapsed. Before the first frame, its default width. */
+ * while it is hidden, a narrow column for its title bar's arrow while collapsed. Before the first
+ * frame, its default width. */
 float ui_dock_width(const ui_controls *c);
 /* The panel's width in a window that leaves image_w (window units) to the image. */
 float ui_dock_width_beside(const ui_controls *c, float image_w);
+/* Whether the user is dragging the panel's edge (its width changed since the button went down). */
+int ui_panel_resizing(void);
+/* The i-th visible button of the panel as last drawn: its label and rect (x0, y0, x1, y1, window
+ * units). Returns 0 past the last one. */
+int ui_drawn_button(int i, const char **label, float rect[4]);
+/* Sizes in window units for the window's content scale (HiDPI), and that content scale. */
+float ui_scale(void);
+float ui_content_scale(void);
 /* Markers over the image at the lights' window positions (2 floats per light; NaN: off
  * screen); the selected one stands out. */
 void ui_draw_lights(const float *xy, int n, int selected);

@@ -52,13 +52,15 @@ mkdir -p "$cache" "$results"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cornell=$scenes/cornell-box/CornellBox-Original.gltf
+# References are stamped with the material model (glint bench refuses another's): it keys the cache.
+model=$("$glint" --version | sed -n 's/.*(material model \(.*\))$/\1/p')
 
 # reference NAME SCENE: the cached path-traced reference of SCENE (rendered when missing); its
 # path on stdout. The name holds the size and length, so a short smoke run never stands in for
 # a long one.
 reference() {
-  local ref=$cache/$1-$size-pt${ref_seconds}s.exr
-  if [ ! -f "$ref.json" ]; then
+  local ref=$cache/$1-$size-pt${ref_seconds}s-$model.exr
+  if [ ! -f "$ref" ]; then
     echo "rendering the path-traced reference of $1 for $ref_seconds s" >&2
     "$glint" render "$2" --method pt --time "$ref_seconds" --size "$size" --seed 777 --highlights-layer \
       --out "$ref" --quiet
@@ -89,8 +91,8 @@ fi
 if [ "$mode" = hl ]; then
   echo "## The highlight paper's comparison, default scene ($(nproc) threads, $(date +%F))"
   hl_seconds=${HL_REF_SECONDS:-600}
-  ref=$cache/atelier-$size-hl-trace${hl_seconds}s.exr
-  if [ ! -f "$ref.json" ]; then
+  ref=$cache/atelier-$size-hl-trace${hl_seconds}s-$model.exr
+  if [ ! -f "$ref" ]; then
     echo "rendering the highlights reference (--merge trace, 64 secondary rays) for $hl_seconds s"
     "$glint" render builtin:atelier --method vsl+hl --merge trace --secondary-rays 64 --time "$hl_seconds" \
       --size "$size" --seed 777 --out "$ref" --quiet

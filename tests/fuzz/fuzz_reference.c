@@ -47,7 +47,7 @@ static void check_round_trip(const reference_info *r) {
     }
     free(json);
     if (strcmp(r->scene, back.scene) || strcmp(r->scene_hash, back.scene_hash) || strcmp(r->env, back.env) ||
-        strcmp(r->env_hash, back.env_hash) || strcmp(r->method, back.method))
+        strcmp(r->env_hash, back.env_hash) || strcmp(r->method, back.method) || strcmp(r->model, back.model))
         bad("a string changed in the round trip");
     if (r->width != back.width || r->height != back.height || r->camera_index != back.camera_index ||
         r->max_depth != back.max_depth || r->spp != back.spp || r->seed != back.seed ||

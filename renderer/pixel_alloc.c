@@ -1,0 +1,51 @@
+#include "pixel_alloc.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rng.h"
+
+/* Fewer single-direction samples than this: the pixel keeps the budget (its variance is not known). */
+#define PIXEL_MIN_RECORD 16.0f
+
+int pixel_alloc_init(pixel_alloc *a, int pixels) {
+    a->pixels = pixels;
+    a->rec = calloc((size_t)pixels, sizeof *a->rec);
+    a->samples = calloc((size_t)pixels, 1);
+    return a->rec && a->samples ? 0 : -1;
+}
+
+void pixel_alloc_free(pixel_alloc *a) {
+    free(a->rec);
+    free(a->samples);
+    memset(a, 0, sizeof *a);
+}
+
+void pixel_alloc_reset(pixel_alloc *a) { memset(a->rec, 0, (size_t)a->pixels * sizeof *a->rec); }
+
+/* The spread of one direction's light at the pixel. */
+static double record_sd(const pixel_record *r) { return sqrt(fmax((double)r->m2 / ((double)r->n - 1.0), 0.0)); }
+
+void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint64_t seed) {
+    double sum = 0.0;
+    int known = 0;
+    for (int i = 0; i < a->pixels; i++) {
+        const pixel_record *r = &a->rec[i];
+        if (r->n < PIXEL_MIN_RECORD) continue;
+        sum += record_sd(r);
+        known++;
+    }
+    double mean = known ? sum / known : 0.0;
+    for (int i = 0; i < a->pixels; i++) {
+        const pixel_record *r = &a->rec[i];
+        if (r->n < PIXEL_MIN_RECORD || !(mean > 0.0)) {
+            a->samples[i] = (uint8_t)budget;
+            continue;
+        }
+        double want = budget * record_sd(r) / mean;
+        rng_state rng = rng_for((uint64_t)i, frame, seed ^ 0x676c6f7373ULL);
+        int n = (int)floor(want + (double)rng_float(&rng)); /* stochastic rounding: the mean is kept */
+        a->samples[i] = (uint8_t)(n < 1 ? 1 : n > max ? max : n);
+    }
+}

@@ -1,0 +1,34 @@
+/* glint — how many samples of one part of a many-light frame each pixel takes (directions through a
+ * sharp glossy lobe, direct-light samples). The variance sits in few pixels (a chrome sphere
+ * reflecting a lit patch, the floor under the spot's hot patch): samples go where one sample's
+ * light varied most in the pixel's earlier frames (docs/design.md, "Where the samples go"). */
+#ifndef GLINT_PIXEL_ALLOC_H
+#define GLINT_PIXEL_ALLOC_H
+#include <stdint.h>
+
+/* One pixel's record of single-direction contributions (luminance), Welford's running form. */
+typedef struct {
+    float n, mean, m2;
+} pixel_record;
+
+typedef struct {
+    int pixels;
+    pixel_record *rec;
+    uint8_t *samples; /* this frame's samples per pixel */
+} pixel_alloc;
+
+int pixel_alloc_init(pixel_alloc *a, int pixels);
+void pixel_alloc_free(pixel_alloc *a);
+void pixel_alloc_reset(pixel_alloc *a);
+/* Sets every pixel's samples for the next frame: `budget` on average over the pixels with a
+ * record, in proportion to the standard deviation of one sample's light there, within [1, max];
+ * the others take the budget. The frame's own samples never decide its allocation, so each frame
+ * stays unbiased. */
+void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint64_t seed);
+static inline void pixel_record_add(pixel_record *r, float v) {
+    r->n += 1.0f;
+    float d = v - r->mean;
+    r->mean += d / r->n;
+    r->m2 += d * (v - r->mean);
+}
+#endif
