@@ -32,11 +32,9 @@ float material_coverage(const scene *s, const surface_hit *h) {
     return m->alpha == ALPHA_MASK ? (a >= m->alpha_cutoff ? 1.0f : 0.0f) : clampf(a, 0.0f, 1.0f);
 }
 
-/* The range of alpha a material's texture can give (bilinear lookups stay between its texels). */
-static void alpha_range(const scene *s, const material *m, float *lo, float *hi) {
-    *lo = *hi = m->base_alpha;
-    if (m->base_color_tex.texture < 0) return;
-    const scene_image *img = &s->images[s->textures[m->base_color_tex.texture].image];
+/* The range of alpha an image holds, [lo, hi] in 0..255 (scanned once per image, however many
+ * materials use it). */
+static void image_alpha_range(const scene_image *img, unsigned char range[2]) {
     int amin = 255, amax = 0;
     size_t n = (size_t)img->width * (size_t)img->height;
     for (size_t i = 0; i < n && (amin > 0 || amax < 255); i++) {
@@ -44,15 +42,21 @@ static void alpha_range(const scene *s, const material *m, float *lo, float *hi)
         amin = a < amin ? a : amin;
         amax = a > amax ? a : amax;
     }
-    *lo = m->base_alpha * (float)amin / 255.0f;
-    *hi = m->base_alpha * (float)amax / 255.0f;
+    range[0] = (unsigned char)amin;
+    range[1] = (unsigned char)amax;
 }
 
-/* Opaque: every ray stops; invisible: none does; tested: the filter decides per hit. */
-static int alpha_class(const scene *s, const material *m) {
+/* Opaque: every ray stops; invisible: none does; tested: the filter decides per hit. ranges:
+ * per image its alpha range, once known (range[0] > range[1]: not scanned yet). */
+static int alpha_class(const scene *s, const material *m, unsigned char (*ranges)[2]) {
     if (m->alpha == ALPHA_OPAQUE) return ALPHA_CLASS_OPAQUE;
-    float lo, hi;
-    alpha_range(s, m, &lo, &hi);
+    float lo = m->base_alpha, hi = m->base_alpha; /* bilinear lookups stay between the texels */
+    if (m->base_color_tex.texture >= 0) {
+        int img = s->textures[m->base_color_tex.texture].image;
+        if (ranges[img][0] > ranges[img][1]) image_alpha_range(&s->images[img], ranges[img]);
+        lo *= (float)ranges[img][0] / 255.0f;
+        hi *= (float)ranges[img][1] / 255.0f;
+    }
     float threshold = m->alpha == ALPHA_MASK ? m->alpha_cutoff : 1.0f;
     if (lo >= threshold) return ALPHA_CLASS_OPAQUE;
     if (m->alpha == ALPHA_MASK ? hi < threshold : !(hi > 0.0f)) return ALPHA_CLASS_INVISIBLE;
@@ -97,13 +101,7 @@ static void alpha_filter(const struct RTCFilterFunctionNArguments *args) {
         const material *m = &s->materials[s->tri_material[t]];
         float b1 = hit_f(args->hit, n, 3, i), b2 = hit_f(args->hit, n, 4, i);
         if (!isfinite(b1) || !isfinite(b2)) b1 = b2 = 0.0f;
-        float b0 = 1.0f - b1 - b2;
-        const uint32_t *v = &s->indices[3 * t];
-        vec2 uv0 = v2(b0 * s->uv0[v[0]].x + b1 * s->uv0[v[1]].x + b2 * s->uv0[v[2]].x,
-                      b0 * s->uv0[v[0]].y + b1 * s->uv0[v[1]].y + b2 * s->uv0[v[2]].y);
-        vec2 uv1 = v2(b0 * s->uv1[v[0]].x + b1 * s->uv1[v[1]].x + b2 * s->uv1[v[2]].x,
-                      b0 * s->uv1[v[0]].y + b1 * s->uv1[v[1]].y + b2 * s->uv1[v[2]].y);
-        float a = material_alpha(s, m, uv0, uv1);
+        float a = material_alpha(s, m, triangle_uv(s, s->uv0, t, b1, b2), triangle_uv(s, s->uv1, t, b1, b2));
         float u = 0.0f;
         if (m->alpha == ALPHA_BLEND) {
             float od[6]; /* org_x, org_y, org_z, then dir_x, dir_y, dir_z after tnear */
@@ -159,7 +157,11 @@ int scene_build_bvh(scene *s, char *err, size_t errlen) {
     s->alpha_class = cls;
     int filters = (int)rtcGetDeviceProperty(s->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED);
     int counts[3] = {0, 0, 0};
-    for (int m = 0; m < s->num_materials; m++) cls[m] = (unsigned char)alpha_class(s, &s->materials[m]);
+    unsigned char(*ranges)[2] = malloc(2 * (size_t)s->num_images + 2);
+    if (!ranges) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    for (int i = 0; i < s->num_images; i++) ranges[i][0] = 255, ranges[i][1] = 0;
+    for (int m = 0; m < s->num_materials; m++) cls[m] = (unsigned char)alpha_class(s, &s->materials[m], ranges);
+    free(ranges);
     for (int t = 0; t < s->num_triangles; t++) counts[cls[s->tri_material[t]]]++;
     if (counts[ALPHA_CLASS_TESTED] && !filters) {
         scene_warn(s, "%s: this Embree has no filter functions: alpha modes are drawn opaque", s->path);

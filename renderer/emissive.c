@@ -15,25 +15,27 @@
 #define MEAN_FLOOR 1e-6f /* the mean never drops below this share of the maximum where it is not 0 */
 #define HUGE_COORD 1e8f  /* texel coordinates beyond: the whole texture (texture_lookup reads 0, 0) */
 
-/* Level 0 is the image itself (decoded on reading); levels 1.. halve it, keeping per texel the
- * mean and the maximum of the texels below. */
+/* Level 0 is the image itself (decoded on reading); levels 1.. halve it, keeping per texel and
+ * channel the mean (linear, 16-bit fixed point) and the maximum (the encoded 8-bit value: sRGB
+ * decoding keeps the order). 9 bytes a level-1 texel: the whole pyramid takes 3/4 of the image's
+ * own memory, and only while the image's triangles are measured. */
 typedef struct {
     const scene_image *img;
     int levels;
     int w[MAX_LEVELS], h[MAX_LEVELS];
-    vec3 *mean[MAX_LEVELS], *max[MAX_LEVELS];
+    uint16_t *mean[MAX_LEVELS];
+    uint8_t *max[MAX_LEVELS];
 } pyramid;
 
-static vec3 texel0(const pyramid *p, int x, int y) {
-    const float *srgb = texture_srgb_table();
-    const uint8_t *c = p->img->rgba + 4 * ((size_t)y * (size_t)p->img->width + (size_t)x);
-    return v3(srgb[c[0]], srgb[c[1]], srgb[c[2]]);
-}
-
 static vec3 texel(const pyramid *p, int level, int x, int y, int want_max) {
-    if (level == 0) return texel0(p, x, y);
-    size_t i = (size_t)y * (size_t)p->w[level] + (size_t)x;
-    return want_max ? p->max[level][i] : p->mean[level][i];
+    const float *srgb = texture_srgb_table();
+    size_t i = 3 * ((size_t)y * (size_t)p->w[level] + (size_t)x);
+    if (level == 0 || want_max) {
+        const uint8_t *c = level == 0 ? p->img->rgba + 4 * (i / 3) : p->max[level] + i;
+        return v3(srgb[c[0]], srgb[c[1]], srgb[c[2]]);
+    }
+    const uint16_t *m = p->mean[level] + i;
+    return scale3(v3((float)m[0], (float)m[1], (float)m[2]), 1.0f / 65535.0f);
 }
 
 static void pyramid_free(pyramid *p) {
@@ -55,23 +57,30 @@ static int pyramid_build(const scene_image *img, pyramid *p) {
         int w = (pw + 1) / 2, h = (ph + 1) / 2;
         p->w[l] = w;
         p->h[l] = h;
-        p->mean[l] = malloc(sizeof(vec3) * (size_t)w * (size_t)h);
-        p->max[l] = malloc(sizeof(vec3) * (size_t)w * (size_t)h);
+        p->mean[l] = malloc(3 * sizeof(uint16_t) * (size_t)w * (size_t)h);
+        p->max[l] = malloc(3 * (size_t)w * (size_t)h);
         p->levels++;
         if (!p->mean[l] || !p->max[l]) return -1;
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++) {
-                vec3 sum = v3(0, 0, 0), mx = v3(0, 0, 0);
+                vec3 sum = v3(0, 0, 0);
+                uint8_t mx[3] = {0, 0, 0};
                 int n = 0;
                 for (int k = 0; k < 4; k++) {
                     int cx = 2 * x + (k & 1), cy = 2 * y + (k >> 1);
                     if (cx >= pw || cy >= ph) continue;
                     sum = add3(sum, texel(p, l - 1, cx, cy, 0));
-                    mx = max3(mx, texel(p, l - 1, cx, cy, 1));
+                    size_t j = (size_t)cy * (size_t)pw + (size_t)cx;
+                    const uint8_t *c = l == 1 ? img->rgba + 4 * j : p->max[l - 1] + 3 * j;
+                    for (int ch = 0; ch < 3; ch++) mx[ch] = c[ch] > mx[ch] ? c[ch] : mx[ch];
                     n++;
                 }
-                p->mean[l][(size_t)y * (size_t)w + (size_t)x] = scale3(sum, 1.0f / (float)n);
-                p->max[l][(size_t)y * (size_t)w + (size_t)x] = mx;
+                size_t i = 3 * ((size_t)y * (size_t)w + (size_t)x);
+                vec3 mean = scale3(sum, 65535.0f / (float)n);
+                p->mean[l][i] = (uint16_t)(mean.x + 0.5f);
+                p->mean[l][i + 1] = (uint16_t)(mean.y + 0.5f);
+                p->mean[l][i + 2] = (uint16_t)(mean.z + 0.5f);
+                memcpy(p->max[l] + i, mx, 3);
             }
     }
     return 0;
@@ -178,7 +187,7 @@ static vec3 triangle_integral(const pyramid *p, const scene_texture *tex, int l,
 /* The texture's mean over triangle t, and (in *mx) its maximum over every texel a lookup on the
  * triangle can read; both zero when nothing on the triangle can emit. */
 static vec3 triangle_mean(const scene *s, const pyramid *p, const scene_texture *tex, texture_slot slot, int t,
-                          vec3 *mx) {
+                          int mean_span, vec3 *mx) {
     const uint32_t *v = &s->indices[3 * t];
     float xs[3], ys[3];
     int whole = 0;
@@ -209,9 +218,13 @@ static vec3 triangle_mean(const scene *s, const pyramid *p, const scene_texture 
     if (is_black3(*mx)) return *mx;
 
     /* The mean: the exact integral of the interpolant, on the level where the footprint spans at
-     * most MEAN_SPAN texels (a box-filtered copy beyond: the cost stays bounded). */
+     * most mean_span texels (a box-filtered copy beyond: the cost stays bounded). */
     int l = 0;
-    while (l < top && fmaxf(x_hi - x_lo, y_hi - y_lo) > (float)(MEAN_SPAN << l)) l++;
+    float width = fmaxf(x_hi - x_lo, y_hi - y_lo);
+    while (l < top && width > (float)(mean_span << l)) l++;
+    /* Wider than that even on the coarsest level: the footprint covers the image many times over
+     * (or clamps far past it); the image's mean stands for it. */
+    if (width > (float)(mean_span << l)) return texel(p, top, 0, 0, 0);
     float k = 1.0f / (float)(1 << l), lx[3], ly[3];
     for (int c = 0; c < 3; c++) lx[c] = (xs[c] + 0.5f) * k - 0.5f, ly[c] = (ys[c] + 0.5f) * k - 0.5f;
     float area = 0.5f * fabsf((lx[1] - lx[0]) * (ly[2] - ly[0]) - (lx[2] - lx[0]) * (ly[1] - ly[0]));
@@ -234,34 +247,48 @@ static int textured_emitter(const material *m) { return max_comp3(m->emission) >
 int scene_emissive_analyse(scene *s, char *err, size_t errlen) {
     free(s->tri_emit_tex);
     s->tri_emit_tex = NULL;
-    int any = 0;
-    for (int m = 0; m < s->num_materials && !any; m++) any = textured_emitter(&s->materials[m]);
-    if (!any) return 0;
+    /* The emissive textured triangles, grouped by the image they show (a counting sort): each
+     * image's pyramid is built once, however many textures and materials share it. */
+    int *start = calloc((size_t)s->num_images + 2, sizeof(int)), n = 0;
+    if (!start) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    for (int t = 0; t < s->num_triangles; t++) {
+        const material *m = &s->materials[s->tri_material[t]];
+        if (textured_emitter(m)) start[s->textures[m->emissive_tex.texture].image + 1]++, n++;
+    }
+    if (n == 0) return free(start), 0;
+    for (int i = 0; i < s->num_images; i++) start[i + 1] += start[i];
+    int *order = malloc(sizeof(int) * (size_t)n), *fill = calloc((size_t)s->num_images + 1, sizeof(int));
     s->tri_emit_tex = calloc((size_t)s->num_triangles + 1, sizeof(vec3));
-    if (!s->tri_emit_tex) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
-    /* One emissive texture at a time: its pyramid, then every triangle that shows it. */
-    for (int tx = 0; tx < s->num_textures; tx++) {
-        int used = 0;
-        for (int m = 0; m < s->num_materials && !used; m++)
-            used = textured_emitter(&s->materials[m]) && s->materials[m].emissive_tex.texture == tx;
-        if (!used) continue;
-        const scene_texture *tex = &s->textures[tx];
+    int status = order && fill && s->tri_emit_tex ? 0 : -1;
+    for (int t = 0; status == 0 && t < s->num_triangles; t++) {
+        const material *m = &s->materials[s->tri_material[t]];
+        if (!textured_emitter(m)) continue;
+        int img = s->textures[m->emissive_tex.texture].image;
+        order[start[img] + fill[img]++] = t;
+    }
+    /* The integral's cells per triangle shrink with their number: a few hundred each for a
+     * model's emitters, a handful each for millions (the whole stays below about 2^26). */
+    int mean_span = (int)sqrtf((float)(1 << 26) / (float)n);
+    mean_span = mean_span < 2 ? 2 : (mean_span > MEAN_SPAN ? MEAN_SPAN : mean_span);
+    for (int img = 0; status == 0 && img < s->num_images; img++) {
+        if (start[img] == start[img + 1]) continue;
         pyramid p;
-        if (pyramid_build(&s->images[tex->image], &p) != 0) {
-            pyramid_free(&p);
-            return snprintf(err, errlen, "%s: out of memory", s->path), -1;
-        }
-        for (int t = 0; t < s->num_triangles; t++) {
-            const material *m = &s->materials[s->tri_material[t]];
-            if (!textured_emitter(m) || m->emissive_tex.texture != tx) continue;
-            vec3 mx, mean = triangle_mean(s, &p, tex, m->emissive_tex, t, &mx);
-            /* Zero exactly where nothing emits; elsewhere never zero (a coarse level's integral is
-             * an estimate, and a light the texture lights somewhere must stay reachable). */
-            s->tri_emit_tex[t] = v3(mx.x > 0.0f ? fmaxf(mean.x, MEAN_FLOOR * mx.x) : 0.0f,
-                                    mx.y > 0.0f ? fmaxf(mean.y, MEAN_FLOOR * mx.y) : 0.0f,
-                                    mx.z > 0.0f ? fmaxf(mean.z, MEAN_FLOOR * mx.z) : 0.0f);
-        }
+        if ((status = pyramid_build(&s->images[img], &p)) == 0)
+            for (int k = start[img]; k < start[img + 1]; k++) {
+                int t = order[k];
+                const material *m = &s->materials[s->tri_material[t]];
+                vec3 mx, mean = triangle_mean(s, &p, &s->textures[m->emissive_tex.texture], m->emissive_tex, t,
+                                              mean_span, &mx);
+                /* Zero exactly where nothing emits; elsewhere never zero (a coarse level's integral
+                 * is an estimate, and a light the texture lights somewhere must stay reachable). */
+                s->tri_emit_tex[t] = v3(mx.x > 0.0f ? fmaxf(mean.x, MEAN_FLOOR * mx.x) : 0.0f,
+                                        mx.y > 0.0f ? fmaxf(mean.y, MEAN_FLOOR * mx.y) : 0.0f,
+                                        mx.z > 0.0f ? fmaxf(mean.z, MEAN_FLOOR * mx.z) : 0.0f);
+            }
         pyramid_free(&p);
     }
-    return 0;
+    free(start);
+    free(order);
+    free(fill);
+    return status == 0 ? 0 : (snprintf(err, errlen, "%s: out of memory", s->path), -1);
 }

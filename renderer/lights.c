@@ -132,10 +132,8 @@ static surface_hit triangle_point(const scene *s, int t, vec2 u, vec3 *q, vec3 *
     h.material = s->tri_material[t];
     h.p = *q;
     h.ng = *n;
-    h.uv0 = v2(b0 * s->uv0[v[0]].x + b.x * s->uv0[v[1]].x + b.y * s->uv0[v[2]].x,
-               b0 * s->uv0[v[0]].y + b.x * s->uv0[v[1]].y + b.y * s->uv0[v[2]].y);
-    h.uv1 = v2(b0 * s->uv1[v[0]].x + b.x * s->uv1[v[1]].x + b.y * s->uv1[v[2]].x,
-               b0 * s->uv1[v[0]].y + b.x * s->uv1[v[1]].y + b.y * s->uv1[v[2]].y);
+    h.uv0 = triangle_uv(s, s->uv0, t, b.x, b.y);
+    h.uv1 = triangle_uv(s, s->uv1, t, b.x, b.y);
     return h;
 }
 

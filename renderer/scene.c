@@ -547,7 +547,7 @@ int scene_set_variant(scene *s, int v, char *err, size_t errlen) {
     scene_box *box = (scene_box *)s;
     for (int g = 0; g < box->num_gains; g++)
         if (box->gains[g] != 1.0f && scene_set_light_gain(s, g, 1.0f, err, errlen) != 0) return -1;
-    scene_apply_variant(s, v);
+    if (scene_apply_variant(s, v) != 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
     free(box->gains);
     free(box->gain_bases);
     box->gains = NULL;
@@ -640,10 +640,8 @@ static void complete_hit(const scene *s, vec3 d, int t, float b1, float b2, floa
     h->backface = dot3(ng, d) > 0.0f;
     if (h->backface) ng = neg3(ng);
     h->ng = ng;
-    h->uv0 = v2(b0 * s->uv0[v[0]].x + b1 * s->uv0[v[1]].x + b2 * s->uv0[v[2]].x,
-                b0 * s->uv0[v[0]].y + b1 * s->uv0[v[1]].y + b2 * s->uv0[v[2]].y);
-    h->uv1 = v2(b0 * s->uv1[v[0]].x + b1 * s->uv1[v[1]].x + b2 * s->uv1[v[2]].x,
-                b0 * s->uv1[v[0]].y + b1 * s->uv1[v[1]].y + b2 * s->uv1[v[2]].y);
+    h->uv0 = triangle_uv(s, s->uv0, t, b1, b2);
+    h->uv1 = triangle_uv(s, s->uv1, t, b1, b2);
 
     shading_frame_at_hit(s, h, b1, b2, d);
 }

@@ -7,6 +7,13 @@
 
 #include "scene.h"
 
+/* The uv set uv (s->uv0 or s->uv1) of triangle t at barycentrics (b1, b2). */
+static inline vec2 triangle_uv(const scene *s, const vec2 *uv, int t, float b1, float b2) {
+    const uint32_t *v = &s->indices[3 * t];
+    float b0 = 1.0f - b1 - b2;
+    return v2(b0 * uv[v[0]].x + b1 * uv[v[1]].x + b2 * uv[v[2]].x, b0 * uv[v[0]].y + b1 * uv[v[1]].y + b2 * uv[v[2]].y);
+}
+
 /* ---- tangents.c ---------------------------------------------------------------------------- */
 
 /* A mesh rebuilt with tangents: the arrays behind mesh (positions, normals, tangents, uvs,
@@ -76,7 +83,7 @@ float alpha_ray_hash(vec3 o, vec3 d, int tri);
 /* ---- variants.c ---------------------------------------------------------------------------- */
 
 /* Rewrites the triangles' materials for variant v (-1: the defaults) and nothing else (the caller
- * rebuilds). Returns 0, or -1 for a variant the scene does not have. */
+ * rebuilds). Returns 0, or -1 for a variant the scene does not have, or out of memory. */
 int scene_apply_variant(scene *s, int v);
 void scene_variants_free(scene *s);
 /* 1 when some variant gives a primitive an emissive material. */

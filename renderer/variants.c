@@ -119,13 +119,21 @@ int scene_apply_variant(scene *s, int variant) {
     struct scene_variants *v = s->variants;
     if (variant < -1 || variant >= scene_num_variants(s)) return -1;
     if (!v) return 0;
+    /* Each table's material for this variant first (-1: the default): the work is the pairs
+     * plus the triangles, however many instances share a table. */
+    int *pick = malloc(sizeof(int) * (size_t)(v->num_tables + 1));
+    if (!pick) return -1;
+    for (int k = 0; k < v->num_tables; k++) {
+        pick[k] = -1;
+        for (int i = v->table_start[k]; i < v->table_start[k + 1]; i++)
+            if (v->pairs[i].variant == variant) pick[k] = v->pairs[i].material;
+    }
     for (int r = 0; r < v->num_ranges; r++) {
         const variant_range *g = &v->ranges[r];
-        int m = g->base_material;
-        for (int k = v->table_start[g->table]; k < v->table_start[g->table + 1]; k++)
-            if (v->pairs[k].variant == variant) m = v->pairs[k].material;
+        int m = pick[g->table] >= 0 ? pick[g->table] : g->base_material;
         for (int t = g->first; t < g->first + g->count; t++) s->tri_material[t] = m;
     }
+    free(pick);
     v->current = variant;
     return 0;
 }

@@ -45,6 +45,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         return 0;
     }
     trace_some_rays(s);
+    /* Each material variant (a few), rebuilt and traced again; then back to the defaults. */
+    for (int v = 0; v < scene_num_variants(s) && v < 4; v++) {
+        if (scene_set_variant(s, v, err, sizeof err) == 0) trace_some_rays(s);
+    }
+    if (scene_num_variants(s) > 0 && scene_set_variant(s, -1, err, sizeof err) == 0) trace_some_rays(s);
     scene_destroy(s);
     return 0;
 }

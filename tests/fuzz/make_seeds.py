@@ -125,6 +125,27 @@ d["textures"] = [{"source": 0}]
 d["images"] = [{"uri": "tex.png"}]
 d["buffers"][0]["uri"] = "quad.bin"
 seeds["papers-materials.gltf"] = d
+# Normal maps, texture transforms, alpha, emissive textures and material variants, instanced twice.
+tt = {"KHR_texture_transform": {"offset": [0.5, 0.25], "rotation": 0.7, "scale": [2, -1], "texCoord": 1}}
+d = embedded()
+d["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = 2
+d["meshes"][0]["primitives"][0]["material"] = 0
+d["meshes"][0]["primitives"][0]["extensions"] = {"KHR_materials_variants": {"mappings": [
+    {"material": 1, "variants": [0, 2]}, {"material": 2, "variants": [1]}]}}
+d["materials"] = [
+    {"normalTexture": {"index": 0, "scale": 0.5, "texCoord": 1, "extensions": tt}, "occlusionTexture": {"index": 0},
+     "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions": tt}}},
+    {"alphaMode": "MASK", "alphaCutoff": 0.3,
+     "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [1, 1, 1, 0.8]}},
+    {"alphaMode": "BLEND", "emissiveTexture": {"index": 0, "extensions": tt}, "emissiveFactor": [1, 1, 1],
+     "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.5]}}]
+d["nodes"] = [{"mesh": 0, "children": [1]}, {"mesh": 0, "translation": [2, 0, 0]}]
+d["textures"] = [{"source": 0, "sampler": 0}]
+d["samplers"] = [{"wrapS": 33648, "wrapT": 10497}]
+d["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(TEX).decode()}]
+d["extensionsUsed"] = ["KHR_texture_transform", "KHR_materials_variants"]
+d["extensions"] = {"KHR_materials_variants": {"variants": [{"name": "masked"}, {"name": "blend"}, {"name": "c"}]}}
+seeds["surfaces-variants.gltf"] = d
 
 os.makedirs(os.path.join(here, "corpus"), exist_ok=True)
 os.makedirs(os.path.join(here, "files"), exist_ok=True)
