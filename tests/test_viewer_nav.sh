@@ -96,7 +96,11 @@ window=
 if stats_lines 1; then
   window=$(xdotool search --sync --onlyvisible --name glint 2>/dev/null | head -n 1)
   # away from the panel, in the window's lower right
-  xdotool mousemove --window "$window" 300 170 click 5
+  # the cursor first, then the wheel: the viewer zooms only when the cursor was over the image in
+  # the frame before (as a user's wheel follows the pointer's motion)
+  xdotool mousemove --window "$window" 300 170
+  sleep 0.5
+  xdotool click 5
 fi
 stats_lines 3 && { xdotool windowfocus --sync "$window" 2>/dev/null; xdotool key f; }
 wait $viewer

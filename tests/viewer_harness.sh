@@ -39,7 +39,9 @@ below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; } # below A B: A < 
 # stats_lines N [TRIES]: waits (0.1 s steps) until out.txt holds N stats lines
 stats_lines() {
   n=0
-  while [ "$(grep -c '^stats ' out.txt 2>/dev/null)" -lt "$1" ]; do
+  while :; do
+    c=$(grep -c '^stats ' out.txt 2>/dev/null) || c=0 # no file yet: none
+    [ "${c:-0}" -lt "$1" ] || break
     n=$((n + 1))
     [ $n -le "${2:-1500}" ] || return 1
     sleep 0.1
