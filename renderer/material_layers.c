@@ -9,7 +9,7 @@ material_ext material_ext_default(void) {
     x.specular = 1.0f;
     x.specular_color = v3s(1.0f);
     x.specular_tex = x.specular_color_tex = x.sheen_color_tex = x.sheen_roughness_tex = x.clearcoat_tex =
-        x.clearcoat_roughness_tex = (texture_slot){-1, 0};
+        x.clearcoat_roughness_tex = (texture_slot){.texture = -1};
     return x;
 }
 
