@@ -165,7 +165,10 @@ static int accumulator_init(accumulator *a, size_t pixels, int layers) {
 /* The plane of channel "PREFIX.C" (or "C") of the layer's means (var 0) or variances (var 1). */
 static const float *layer_channel(const exr_image *ex, const char *prefix, int var, int k) {
     char layer[96], name[128];
-    snprintf(layer, sizeof layer, "%s%s%s", var ? MOMENTS_VAR_PREFIX : "", var && prefix[0] ? "." : "", prefix);
+    if (var)
+        film_moments_var_layer(prefix, layer, sizeof layer);
+    else
+        snprintf(layer, sizeof layer, "%s", prefix);
     snprintf(name, sizeof name, "%s%s%c", layer, layer[0] ? "." : "", "RGB"[k]);
     return exr_image_channel(ex, name);
 }
@@ -242,7 +245,7 @@ static int write_merged(const char *path, const accumulator *a, const layer_set 
                 var[3 * i + (size_t)k] = v > 0.0 ? (float)v : 0.0f; /* rounding takes a constant pixel's below 0 */
             }
         layers[l] = (exr_layer){ls->prefix[l], mean};
-        snprintf(names[l], sizeof names[l], "%s%s%s", MOMENTS_VAR_PREFIX, ls->prefix[l][0] ? "." : "", ls->prefix[l]);
+        film_moments_var_layer(ls->prefix[l], names[l], sizeof names[l]);
         layers[ls->n + l] = (exr_layer){names[l], var};
     }
     nl = 2 * ls->n;

@@ -38,6 +38,10 @@ void film_clear(film *f) {
     f->passes = 0;
 }
 
+void film_moments_var_layer(const char *layer, char *out, size_t n) {
+    snprintf(out, n, "%s%s%s", MOMENTS_VAR_PREFIX, layer[0] ? "." : "", layer);
+}
+
 int film_enable_moments(film *f) {
     size_t n = 3 * (size_t)f->width * (size_t)f->height;
     for (int c = 0; c <= COMP_COUNT; c++) {
@@ -210,7 +214,7 @@ int film_save_exr_attrs(const film *f, unsigned layers_mask, const char *path, c
                 layers[nl] = (exr_layer){name, planes[nl]};
             } else {
                 film_resolve_variance(f, mask, planes[nl]);
-                snprintf(names[c + 1], sizeof names[c + 1], "%s%s%s", MOMENTS_VAR_PREFIX, c < 0 ? "" : ".", name);
+                film_moments_var_layer(name, names[c + 1], sizeof names[c + 1]);
                 layers[nl] = (exr_layer){names[c + 1], planes[nl]};
             }
             nl++;

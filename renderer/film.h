@@ -79,6 +79,8 @@ void film_resolve_variance(const film *f, unsigned mask, float *var);
  * the pixel's dropped samples, so its count is the frames less them. */
 #define MOMENTS_VAR_PREFIX "moments.var"
 #define MOMENTS_REJECTED "moments.rejected"
+/* The variance layer's name of layer ("" the image, "direct", ...): "moments.var[.LAYER]". */
+void film_moments_var_layer(const char *layer, char *out, size_t n);
 
 /* Values film_save_exr would clamp: in the whole image and in the layers of layers_mask. */
 size_t film_count_clamped(const film *f, unsigned layers_mask);

@@ -63,7 +63,7 @@ int main(int argc, char **argv) {
     expect_refusal("bench --collect plan", "run-0/results.csv");
     expect_refusal(BENCH " --jobs plan", "plan/args.txt");
     expect_refusal(BENCH " --jobs p2 --out x", "--jobs: the jobs choose their own --out");
-    expect_refusal(BENCH " --job 2 --out j2", "--job 2: the plan has 2 runs (0 to 1)");
+    expect_usage(BENCH " --job 2 --out j2", "--job 2: the plan has 2 runs (0 to 1)");
     expect_refusal("bench --collect .", "args.txt");
     /* Each line as a scheduler would run it: a shell command, from anywhere. */
     char cmd[9000];
@@ -92,6 +92,13 @@ int main(int argc, char **argv) {
     columns(text, 5, a, sizeof a);
     columns(local, 5, b, sizeof b);
     CHECK(strcmp(a, b) == 0 && count_lines(a) == 1 + 2 * 2, "summary.csv rows:\n%s\nlocally:\n%s", a, b);
+    /* Each run's rows as its job measured them: the noise and bias split holds over its seeds. */
+    static row rows[16];
+    static summary_row summary[8];
+    CHECK(parse_csv("plan/results.csv", rows, 16) == 8, "plan/results.csv: not 8 rows");
+    int ns = parse_summary("plan/summary.csv", summary, 8);
+    CHECK(ns == 4, "plan/summary.csv: %d rows", ns);
+    for (int k = 0; k < ns; k++) check_identity(&summary[k], summary[k].method);
     read_file("plan/report.md", text, sizeof text);
     read_file("local/report.md", local, sizeof local);
     skeleton(text, a, sizeof a);
