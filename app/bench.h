@@ -69,6 +69,13 @@ typedef struct {
     vl_params vl;  /* the many-light options given: every run's base */
     char base_text[512];
     int force, quiet;
+    /* A sweep split into jobs: --jobs DIR writes one command line per run (bench_write_jobs);
+     * --job K renders run K alone into --out; --collect DIR (cmd_bench) builds the results from
+     * the jobs' outputs. */
+    const char *jobs_dir;
+    long long job;
+    int job_given;
+    const char *collect_dir; /* set by cmd_bench, not an option of its own */
 } bench_options;
 
 /* One checkpoint of one render. */
@@ -139,5 +146,19 @@ int bench_write_summary(const bench_options *o, const char *dir, const bench_ref
  * describes what the bench rendered. Returns 0, or -1 after reporting the error. */
 int bench_write_plots_and_report(const bench_options *o, const char *dir, const bench_ref *ref,
                                  const reference_info *want, const bench_run *runs, int num_runs);
+
+/* --jobs: the arguments argv (argc of them, --jobs DIR left out) saved in DIR/args.txt, with the
+ * working directory, for --collect; and DIR/jobs.txt, line K + 1 a shell command that renders run
+ * K of num_runs (--job K) into DIR/run-K from that directory. DIR is created; one holding a plan
+ * already is refused. Returns 0, or -1 after reporting the error. */
+int bench_write_jobs(const char *dir, int argc, char **argv, int num_runs);
+/* --collect: the saved arguments of DIR/args.txt (malloc'ed, as one block: free(*argv)) and the
+ * directory the jobs ran in, which relative paths in them are relative to. Returns 0, or -1 after
+ * reporting the error. */
+int bench_read_jobs(const char *dir, int *argc, char ***argv, char *cwd, size_t cwdlen);
+/* The figures of run r as job r wrote them in DIR/run-R (results.csv, summary.csv), into run
+ * (its points' storage allocated by the caller for o->seeds renders). Returns 0, or -1 after
+ * reporting the error. */
+int bench_read_job_run(const char *dir, const bench_options *o, int r, bench_run *run);
 
 #endif

@@ -59,6 +59,7 @@ enum { NUM_PRESETS = sizeof presets / sizeof presets[0] };
 
 static void print_bench_help(void) {
     printf("usage: glint bench [SCENE] --reference REF.exr [options]\n"
+           "       glint bench --collect DIR\n"
            "\n"
            "Renders SCENE (default: the built-in scene) with each method, progressively, and reads the\n"
            "error against REF.exr at each time budget of one run. REF.exr is a glint render --out\n"
@@ -97,6 +98,10 @@ static void print_bench_help(void) {
            "                       bias [1]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
            "  --out DIR            output directory, created; never overwritten [bench, bench-1, ...]\n"
+           "  --jobs DIR           render nothing: write DIR/jobs.txt, one command line per run, to run\n"
+           "                       anywhere (scripts/slurm/bench.sbatch); then glint bench --collect\n"
+           "                       DIR writes the results, plots and report into DIR\n"
+           "  --job K              render run K alone (a line of jobs.txt)\n"
            "  --force              accept a reference that records no scene, camera or size\n"
            "  --quiet              no progress lines\n"
            "  --help               this text\n"
@@ -282,6 +287,8 @@ static int parse_pass(int argc, char **argv, bench_options *o, int *preset_at, c
         {.name = "--seeds", .kind = CLI_INT, .out = &o->seeds, .lo = 1, .hi = MAX_SEEDS},
         {.name = "--threads", .kind = CLI_INT, .out = &o->threads, .lo = 0, .hi = CLI_THREADS_MAX},
         {.name = "--out", .kind = CLI_TEXT, .out = &o->out_dir},
+        {.name = "--jobs", .kind = CLI_TEXT, .out = &o->jobs_dir},
+        {.name = "--job", .kind = CLI_LONG, .out = &o->job, .lo = 0, .hi = MAX_RUNS - 1, .given = &o->job_given},
     };
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *v;
@@ -356,6 +363,8 @@ int bench_parse_options(int argc, char **argv, bench_options *o) {
     }
     if (r != 0) return r;
     if (!o->ref_path) return cli_error("glint bench needs --reference REF.exr (see glint bench --help)"), -1;
+    if (o->jobs_dir && (o->out_dir || o->job_given))
+        return cli_error("--jobs: the jobs choose their own --out and --job"), -1;
 
     /* --methods first, then the --run variants; all four methods when neither is given. */
     bench_variant runs[MAX_VARIANTS];

@@ -5,8 +5,9 @@
  * report.md into a directory. This file loads the reference, plans, runs and measures the
  * renders; bench_options.c parses the command line and expands presets, bench_report.c writes
  * the outputs. */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* realpath */
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -214,9 +215,10 @@ static void aggregate(const bench_options *o, const meter *m, bench_run *run) {
     run->num_points = o->num_times;
 }
 
-/* Renders and measures every seed of one run, writing the CSVs as renders complete. */
+/* Renders and measures every seed of one run, writing the CSVs as renders complete (first: the
+ * bench's first run, whose files must not exist yet). */
 static int run_seeds(const bench_options *o, const scene *s, const camera *cam, meter *m, const char *dir,
-                     bench_run *runs, int r, int num_runs) {
+                     bench_run *runs, int r, int num_runs, int first_run) {
     bench_run *run = &runs[r];
     if (m->sum) {
         memset(m->sum, 0, sizeof(double) * m->n * (size_t)o->num_times);
@@ -226,11 +228,11 @@ static int run_seeds(const bench_options *o, const scene *s, const camera *cam, 
         if (render_seed(o, s, cam, m, run, i, r, num_runs) != 0) return -1;
         run->seeds_done = i + 1;
         /* Written after every render, so an interrupted bench keeps what it measured. */
-        int first = r == 0 && i == 0;
+        int first = r == first_run && i == 0;
         if (bench_write_csv(dir, runs, r + 1, o->num_times, first ? WRITE_NO_REPLACE : WRITE_REPLACE) != 0) return -1;
     }
     aggregate(o, m, run);
-    return bench_write_summary(o, dir, m->ref, runs, r + 1, r == 0 ? WRITE_NO_REPLACE : WRITE_REPLACE);
+    return bench_write_summary(o, dir, m->ref, runs, r + 1, r == first_run ? WRITE_NO_REPLACE : WRITE_REPLACE);
 }
 
 /* ---- the output directory ------------------------------------------------------------------------ */
@@ -316,7 +318,23 @@ static int plan_runs(const bench_options *o, const render_params *base, int spli
     return n;
 }
 
-static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
+/* Renders the runs (all, or --job's alone) or, with --collect, reads them from the jobs'
+ * directories; then writes the results (a job: its CSVs only). 0, or -1 after the error. */
+static int measure_runs(const bench_options *o, const scene *s, const camera *cam, meter *m, const char *dir,
+                        bench_run *runs, int num_runs) {
+    int first = o->job_given ? (int)o->job : 0, end = o->job_given ? first + 1 : num_runs;
+    for (int r = first; r < end; r++)
+        if (o->collect_dir ? bench_read_job_run(o->collect_dir, o, r, &runs[r])
+                           : run_seeds(o, s, cam, m, dir, runs, r, num_runs, first))
+            return -1;
+    if (o->collect_dir && (bench_write_csv(dir, runs, num_runs, o->num_times, WRITE_NO_REPLACE) != 0 ||
+                           bench_write_summary(o, dir, m->ref, runs, num_runs, WRITE_NO_REPLACE) != 0))
+        return -1;
+    return 0;
+}
+
+/* argc, argv: the bench's arguments, which --jobs saves for its jobs and --collect. */
+static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs, int argc, char **argv) {
     /* What the bench renders: the reference's size, camera and depth unless given (and then they
      * must match). */
     const reference_info *have = ref->has_info ? &ref->info : NULL;
@@ -363,6 +381,10 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     int num_runs = plan_runs(o, &base, ref->layer[ERR_HIGHLIGHTS] != NULL, runs);
     if (num_runs > MAX_RUNS)
         return cli_error("more than %d runs (runs x sweep values); split the bench", MAX_RUNS), EXIT_USAGE;
+    if (o->job_given && o->job >= num_runs)
+        return cli_error("--job %lld: the plan has %d run%s (0 to %d)", o->job, num_runs, num_runs == 1 ? "" : "s",
+                         num_runs - 1),
+               EXIT_USAGE;
     if (num_runs * o->seeds > MAX_RENDERS)
         return cli_error("--seeds %d: %d runs x %d seeds = %d renders, more than %d; split the bench", o->seeds,
                          num_runs, o->seeds, num_runs * o->seeds, MAX_RENDERS),
@@ -391,6 +413,14 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
         cli_warning("%s: rendered with %s, not pt: its bias, if any, is in every error", o->ref_path, have->method);
     camera cam = scene_camera(s, cam_index, (float)width / (float)height);
 
+    if (o->jobs_dir) {
+        int st = bench_write_jobs(o->jobs_dir, argc, argv, num_runs);
+        if (st == 0 && !o->quiet)
+            printf("wrote %d job%s to %s/jobs.txt; once they have run, glint bench --collect %s\n", num_runs,
+                   num_runs == 1 ? "" : "s", o->jobs_dir, o->jobs_dir);
+        scene_destroy(s);
+        return st == 0 ? EXIT_OK : EXIT_FAILURE_;
+    }
     char dir[4096];
     if (prepare_dir(o, dir, sizeof dir) != 0) {
         scene_destroy(s);
@@ -398,7 +428,7 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     }
     int renders = num_runs * o->seeds;
     double last = o->times[o->num_times - 1];
-    if (!o->quiet)
+    if (!o->quiet && !o->collect_dir)
         fprintf(stderr, "glint: bench: %d run%s x %d seed%s of %g s, about %.0f s; writing into %s\n", num_runs,
                 num_runs == 1 ? "" : "s", o->seeds, o->seeds == 1 ? "" : "s", last, renders * last, dir);
     meter m = {.ref = ref, .component = o->component, .only = o->only, .n = values};
@@ -406,29 +436,69 @@ static int bench_main(const bench_options *o, bench_ref *ref, bench_run *runs) {
     if (o->seeds > 1) m.sum = malloc((size_t)split_bytes);
     bench_point(*points)[MAX_TIMES] = calloc((size_t)renders, sizeof *points);
     int status = m.img && (m.sum || o->seeds == 1) && points ? 0 : (cli_error("out of memory"), -1);
-    for (int r = 0; r < num_runs && status == 0; r++) {
-        runs[r].points = points + (size_t)r * (size_t)o->seeds;
-        status = run_seeds(o, s, &cam, &m, dir, runs, r, num_runs);
-    }
+    for (int r = 0; r < num_runs; r++) runs[r].points = points + (size_t)r * (size_t)o->seeds;
+    if (status == 0) status = measure_runs(o, s, &cam, &m, dir, runs, num_runs);
     free(m.img);
     free(m.sum);
-    if (status == 0) status = bench_write_plots_and_report(o, dir, ref, &want, runs, num_runs);
+    if (status == 0 && !o->job_given) status = bench_write_plots_and_report(o, dir, ref, &want, runs, num_runs);
     if (status == 0 && !o->quiet)
-        printf("wrote %s/results.csv, %s/summary.csv, %s/report.md and the plots\n", dir, dir, dir);
+        printf("wrote %s/results.csv, %s/summary.csv%s\n", dir, dir,
+               o->job_given ? " (one job's)" : ", report.md and the plots");
     free(points);
     scene_destroy(s);
     return status == 0 ? EXIT_OK : EXIT_FAILURE_;
 }
 
+/* glint bench --collect DIR: the arguments --jobs saved, parsed again in the directory the jobs
+ * ran in, writing into DIR. */
+static int collect(int argc, char **argv, bench_options *o, char ***saved) {
+    char dir[PATH_MAX], cwd[PATH_MAX];
+    int n;
+    if (argc != 2) return cli_error("--collect DIR takes no other option (the plan's are in DIR/args.txt)"), -1;
+    if (!realpath(argv[1], dir)) return cli_error("--collect: %s: %s", argv[1], strerror(errno)), -1;
+    if (bench_read_jobs(dir, &n, saved, cwd, sizeof cwd) != 0) return -1;
+    if (chdir(cwd) != 0) return cli_error("--collect: %s (where the plan was made): %s", cwd, strerror(errno)), -1;
+    int parsed = bench_parse_options(n, *saved, o);
+    if (parsed != 0) return -1;
+    o->collect_dir = o->out_dir = strdup(dir);
+    if (!o->out_dir) return cli_error("out of memory"), -1;
+    return 0;
+}
+
 int cmd_bench(int argc, char **argv) {
     bench_options o;
-    int parsed = bench_parse_options(argc, argv, &o);
-    if (parsed != 0) return parsed > 0 ? EXIT_OK : EXIT_USAGE;
+    char **saved = NULL;
+    if (argc > 0 && strcmp(argv[0], "--collect") == 0) {
+        int st = collect(argc, argv, &o, &saved);
+        if (st != 0) {
+            free(saved);
+            return EXIT_FAILURE_;
+        }
+    } else {
+        int parsed = bench_parse_options(argc, argv, &o);
+        if (parsed != 0) return parsed > 0 ? EXIT_OK : EXIT_USAGE;
+    }
+    /* What the jobs run: these arguments less --jobs DIR */
+    char **args = calloc((size_t)argc + 1, sizeof *args);
+    int num_args = 0;
+    for (int i = 0; args && i < argc; i++) {
+        if (strcmp(argv[i], "--jobs") == 0 && i + 1 < argc)
+            i++;
+        else
+            args[num_args++] = argv[i];
+    }
     bench_ref ref;
-    if (ref_load(&o, &ref) != 0) return EXIT_FAILURE_;
-    bench_run *runs = calloc(MAX_RUNS, sizeof *runs);
-    int status = runs ? bench_main(&o, &ref, runs) : (cli_error("out of memory"), EXIT_FAILURE_);
-    free(runs);
-    ref_free(&ref);
+    int status = EXIT_FAILURE_;
+    if (args && ref_load(&o, &ref) == 0) {
+        bench_run *runs = calloc(MAX_RUNS, sizeof *runs);
+        status = runs ? bench_main(&o, &ref, runs, num_args, args) : (cli_error("out of memory"), EXIT_FAILURE_);
+        free(runs);
+        ref_free(&ref);
+    } else if (!args) {
+        cli_error("out of memory");
+    }
+    if (o.collect_dir) free((void *)o.collect_dir);
+    free(args);
+    free(saved);
     return status;
 }

@@ -25,6 +25,8 @@ typedef struct {
     const char *variant; /* NULL: the file's default materials */
     long long camera_index;
     const char *out_exr, *out_png, *out_stats;
+    const char *shard;   /* --shard I/N as given; its numbers are in params */
+    long long spp_total; /* a shard's: the whole render's --spp (spp is the shard's share) */
     double exposure;
     int quiet;
 } render_options;
@@ -54,9 +56,11 @@ static void print_render_help(void) {
            "  --camera INDEX       glTF camera to render from [0; a framing view without cameras]\n"
            "  --seed S             random seed; runs with the same seed reproduce [0]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
-           "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers, and beside it\n"
-           "                       FILE.exr.json (scene hash, camera, size, spp, noise): a reference\n"
+           "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers, and in its\n"
+           "                       header the scene hash, camera, size, spp, noise: a reference\n"
            "                       for glint bench [none]\n"
+           "  --shard I/N          render shard I (from 0) of N: frames I, I+N, ... of the render\n"
+           "                       --spp asks for, with the moments glint merge needs, to --out\n"
            "  --highlights-layer   camera-glossy-glossy-light paths (the highlight estimator's share)\n"
            "                       go to their own highlights.* layer, not indirect.*: pt, vsl+hl\n"
            "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
@@ -70,6 +74,29 @@ static void print_render_help(void) {
            "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
            "new file render.png (render-1.png, ... if taken).\n",
            DEFAULT_SPP, DEFAULT_WIDTH, DEFAULT_HEIGHT, DEFAULT_MAX_DEPTH, cli_vl_help());
+}
+
+/* --shard I/N: the frames I, I + N, ... of the render --spp asks for, which is then the whole
+ * render's; the shard renders its share. 0, or -1 after a usage error. */
+static int parse_shard(render_options *o) {
+    long long i, n;
+    char first[32];
+    const char *slash = strchr(o->shard, '/');
+    if (!slash || slash - o->shard >= (long)sizeof first)
+        return cli_error("--shard: '%s' is not I/N (shard I of N, from 0)", o->shard), -1;
+    snprintf(first, sizeof first, "%.*s", (int)(slash - o->shard), o->shard);
+    if (cli_parse_int("--shard", slash + 1, 1, REFERENCE_MAX_SHARDS, &n) != 0 ||
+        cli_parse_int("--shard", first, 0, n - 1, &i) != 0)
+        return -1;
+    if (!o->out_exr) return cli_error("--shard: a shard is its EXR: name it with --out FILE.exr"), -1;
+    o->params.shard_index = (int)i;
+    o->params.shard_count = (int)n;
+    o->spp_total = o->spp;
+    if (o->spp > 0) { /* frames i + k n below spp */
+        if (o->spp <= i) return cli_error("--shard %s: --spp %lld leaves shard %lld no frame", o->shard, o->spp, i), -1;
+        o->spp = (o->spp - i + n - 1) / n;
+    }
+    return 0;
 }
 
 /* Returns 0 to render, 1 when --help was shown, -1 on a usage error (already reported). */
@@ -98,6 +125,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--png", .kind = CLI_TEXT, .out = &o->out_png},
         {.name = "--stats", .kind = CLI_TEXT, .out = &o->out_stats},
         {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -50.0, .hi = 50.0},
+        {.name = "--shard", .kind = CLI_TEXT, .out = &o->shard},
     };
     for (int i = 0; i < argc; i++) {
         int r;
@@ -117,6 +145,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
                          "as indirect)"),
                -1;
     if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
+    if (o->shard) return parse_shard(o);
     return 0;
 }
 
@@ -241,6 +270,7 @@ static char *describe_reference(const render_options *o, const render_session *r
                            sizeof err) != 0)
         return cli_error("%s", err), NULL;
     info.spp = session_frames(rs);
+    info.spp_total = o->spp_total;
     info.seconds = seconds;
     reference_noise_finish(rn, rs, &info);
     char *json = reference_json(&info);

@@ -9,6 +9,8 @@ int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 /* Error against time per method and setting, against a reference (cmd_bench.c). */
 int cmd_bench(int argc, char **argv);
+/* Shards of one render combined into one reference (cmd_merge.c). */
+int cmd_merge(int argc, char **argv);
 /* The interactive viewer. */
 int cmd_view(int argc, char **argv);
 

@@ -13,6 +13,8 @@ static void print_help(void) {
            "  glint [view] [SCENE] [options]   open the interactive viewer (see glint view --help)\n"
            "  glint render [SCENE] [options]   render headless to EXR/PNG (see glint render --help)\n"
            "  glint info [SCENE]               print a summary of the scene\n"
+           "  glint merge PART.exr... --out REF.exr\n"
+           "                                   combine the shards of a render (glint render --shard)\n"
            "  glint bench [SCENE] --reference REF.exr [options]\n"
            "                                   error against time per method (see glint bench --help)\n"
            "  glint --help | --version\n"
@@ -34,6 +36,7 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 2, argv + 2);
     if (strcmp(argv[1], "info") == 0) return cmd_info(argc - 2, argv + 2);
     if (strcmp(argv[1], "bench") == 0) return cmd_bench(argc - 2, argv + 2);
+    if (strcmp(argv[1], "merge") == 0) return cmd_merge(argc - 2, argv + 2);
     if (strcmp(argv[1], "view") == 0) return cmd_view(argc - 2, argv + 2);
     /* `glint SCENE [options]` and `glint --option ...` open the viewer too. */
     struct stat st;

@@ -100,7 +100,32 @@ int reference_describe(reference_info *r, const char *scene_path, const char *en
     r->threads = p->threads;
     snprintf(r->method, sizeof r->method, "%s", method_name(p->method));
     r->highlights_layer = p->pt_highlights || p->method == METHOD_VSL_HL;
+    reference_params_text(p, r->params, sizeof r->params);
+    if (p->shard_count > 0) {
+        r->shard_count = p->shard_count;
+        reference_add_shard(r, p->shard_index);
+    }
     return 0;
+}
+
+void reference_params_text(const render_params *p, char *out, size_t n) {
+    const render_params r = render_params_resolve(p);
+    size_t len = 0;
+    len += (size_t)snprintf(out, n, "plan=%s", r.plan == PLAN_FULL ? "full" : "auto");
+    if (r.method == METHOD_PT) return; /* whole paths: nothing else shapes them */
+    char only[64] = "";
+    for (int c = 0; c < COMP_COUNT; c++)
+        if (!r.only || r.only & (1u << c))
+            snprintf(only + strlen(only), sizeof only - strlen(only), "%s%s", only[0] ? "," : "",
+                     film_component_names[c]);
+    len += (size_t)snprintf(out + len, len < n ? n - len : 0, " only=%s", only);
+    int count = 0;
+    const param_desc *table = params_table(&count);
+    for (int k = 0; k < count; k++) {
+        char v[64];
+        param_format(&table[k], &r.vl, v, sizeof v);
+        len += (size_t)snprintf(out + len, len < n ? n - len : 0, " %s=%s", table[k].name, v);
+    }
 }
 
 /* The sidecar path of an EXR as older glint wrote it: "OUT.exr.json". */
@@ -173,11 +198,20 @@ char *reference_json(const reference_info *r) {
     fprintf(f, "  \"spp\": %lld,\n  \"frames\": %lld,\n  \"seconds\": %.6f,\n  \"max_depth\": %d,\n", r->spp, r->spp,
             r->seconds, r->max_depth);
     fprintf(f, "  \"seed\": %llu,\n  \"threads\": %d,\n", (unsigned long long)r->seed, r->threads);
+    fputs("  \"params\": ", f);
+    reference_json_string(f, r->params);
+    fputs(",\n", f);
+    if (r->shard_count > 0) {
+        fprintf(f, "  \"shards\": {\"count\": %d, \"spp_total\": %lld, \"indices\": [", r->shard_count, r->spp_total);
+        for (int i = 0, first = 1; i < r->shard_count; i++)
+            if (reference_has_shard(r, i)) fprintf(f, "%s%d", first ? "" : ", ", i), first = 0;
+        fputs("]},\n", f);
+    }
     if (r->has_noise)
         fprintf(f,
                 "  \"variance\": {\"mean_pixel_variance\": %.9g, \"rel_l2_noise\": %.9g, "
-                "\"estimate\": \"two halves of the frames\"}\n}\n",
-                r->mean_variance, r->rel_l2_noise);
+                "\"estimate\": \"%s\"}\n}\n",
+                r->mean_variance, r->rel_l2_noise, r->shard_count > 0 ? "pixel variances" : "two halves of the frames");
     else
         fprintf(f, "  \"variance\": null\n}\n");
     int bad = ferror(f);
@@ -259,6 +293,27 @@ static int json_seed(const cJSON *obj, const char *text, uint64_t *out) {
     return -1;
 }
 
+/* "shards": {"count": N, "spp_total": T, "indices": [i, ...]}: distinct indices below N. */
+static int parse_shards(const cJSON *obj, reference_info *r) {
+    long long count, total, i;
+    const cJSON *list = cJSON_GetObjectItemCaseSensitive(obj, "indices");
+    if (json_int(obj, "count", 1, REFERENCE_MAX_SHARDS, &count) ||
+        json_int(obj, "spp_total", 0, (long long)1 << 50, &total) || !cJSON_IsArray(list) ||
+        cJSON_GetArraySize(list) < 1)
+        return -1;
+    r->shard_count = (int)count;
+    r->spp_total = total;
+    const cJSON *v;
+    cJSON_ArrayForEach(v, list) {
+        double x;
+        if (finite_number(v, &x) || x != floor(x) || x < 0.0 || x >= (double)count) return -1;
+        i = (long long)x;
+        if (reference_has_shard(r, (int)i)) return -1;
+        reference_add_shard(r, (int)i);
+    }
+    return 0;
+}
+
 /* A description is small; this bounds what a damaged or hostile file can make the parser do. */
 enum { MAX_DESCRIPTION = 1 << 20 };
 
@@ -322,6 +377,11 @@ int reference_parse(const char *text, size_t n, const char *label, reference_inf
     NEED(json_int(root, "max_depth", 1, MAX_DEPTH_LIMIT, &ll) == 0, "max_depth");
     r->max_depth = (int)ll;
     NEED(json_seed(root, text, &r->seed) == 0, "seed");
+    NEED(!cJSON_GetObjectItemCaseSensitive(root, "params") ||
+             json_str(root, "params", r->params, sizeof r->params) == 0,
+         "params");
+    const cJSON *shards = cJSON_GetObjectItemCaseSensitive(root, "shards");
+    NEED(!shards || parse_shards(shards, r) == 0, "shards");
     /* "variance": null when the reference rendered a single frame. */
     const cJSON *var = cJSON_GetObjectItemCaseSensitive(root, "variance");
     r->has_noise = json_number(var, "mean_pixel_variance", &r->mean_variance) == 0 &&
@@ -403,9 +463,47 @@ void reference_noise_frame(reference_noise *rn, const render_session *rs) {
     film_resolve(session_film(rs), COMP_MASK_ALL, t);
 }
 
+void reference_noise_from_variance(const float *const mean[3], const float *const var[3], size_t stride,
+                                   const double *count, size_t pixels, reference_info *info) {
+    /* The variance of a pixel's mean is one sample's over the count (var, the squared deviations
+     * over the count, over count - 1 is its unbiased estimate): summed, it is the expected squared
+     * L2 distance of the image from the truth, as the two halves estimate it. */
+    double sum = 0.0, norm = 0.0;
+    for (size_t i = 0; i < pixels; i++)
+        for (int k = 0; k < 3; k++) {
+            double m = (double)mean[k][i * stride];
+            norm += m * m;
+            if (count[i] > 1.0) sum += (double)var[k][i * stride] / (count[i] - 1.0);
+        }
+    info->has_noise = pixels > 0;
+    info->mean_variance = pixels > 0 ? sum / (3.0 * (double)pixels) : 0.0;
+    info->rel_l2_noise = norm > 0.0 ? sqrt(sum / norm) : 0.0;
+}
+
+/* A shard's noise, from its film's moments. -1 out of memory. */
+static int noise_from_moments(const film *f, reference_info *info) {
+    size_t n = (size_t)f->width * (size_t)f->height;
+    float *mean = malloc(sizeof(float) * 3 * n), *var = malloc(sizeof(float) * 3 * n);
+    double *count = malloc(sizeof(double) * n);
+    int status = -1;
+    if (mean && var && count) {
+        film_resolve(f, COMP_MASK_ALL, mean);
+        film_resolve_variance(f, COMP_MASK_ALL, var);
+        for (size_t i = 0; i < n; i++) count[i] = (double)(f->passes - (long long)f->rejected[i]);
+        const float *const m[3] = {mean, mean + 1, mean + 2}, *const v[3] = {var, var + 1, var + 2};
+        reference_noise_from_variance(m, v, 3, count, n, info);
+        status = 0;
+    }
+    free(mean);
+    free(var);
+    free(count);
+    return status;
+}
+
 void reference_noise_finish(reference_noise *rn, const render_session *rs, reference_info *info) {
     info->has_noise = 0;
     long long total = session_frames(rs);
+    if (session_film(rs)->sumsq[0] && total >= 2 && noise_from_moments(session_film(rs), info) == 0) return;
     if (!rn->scratch || total < 2) return;
     /* Of the snapshots taken before the end, the one whose split is closest to even. */
     int best = -1;
@@ -462,5 +560,30 @@ int reference_check(const char *ref, const reference_info *have, const reference
                     "now %g %g %g)",
                     ref, have->camera_index, (double)a->position.x, (double)a->position.y, (double)a->position.z,
                     (double)b->position.x, (double)b->position.y, (double)b->position.z);
+    return 0;
+}
+
+int reference_check_shard(const char *path, const reference_info *have, const char *want_path,
+                          const reference_info *want, char *err, size_t errlen) {
+    if (reference_check(path, have, want, err, errlen) != 0) return -1;
+    if (strcmp(have->method, want->method) != 0)
+        return fail(err, errlen, "%s: rendered with --method %s, %s with %s", path, have->method, want_path,
+                    want->method);
+    if (have->max_depth != want->max_depth)
+        return fail(err, errlen, "%s: rendered with --max-depth %d, %s with %d", path, have->max_depth, want_path,
+                    want->max_depth);
+    if (have->seed != want->seed)
+        return fail(err, errlen, "%s: rendered with --seed %llu, %s with %llu: not shards of one render", path,
+                    (unsigned long long)have->seed, want_path, (unsigned long long)want->seed);
+    if (have->highlights_layer != want->highlights_layer)
+        return fail(err, errlen, "%s: %s a highlights layer, %s %s", path, have->highlights_layer ? "has" : "has no",
+                    want_path, want->highlights_layer ? "has" : "has none");
+    if (strcmp(have->params, want->params) != 0)
+        return fail(err, errlen, "%s: rendered with parameters '%s', %s with '%s'", path, have->params, want_path,
+                    want->params);
+    if (have->shard_count != want->shard_count || have->spp_total != want->spp_total)
+        return fail(err, errlen, "%s: a shard of %d of %lld spp%s, %s of %d of %lld spp%s", path, have->shard_count,
+                    have->spp_total, have->spp_total ? "" : " (--time)", want_path, want->shard_count, want->spp_total,
+                    want->spp_total ? "" : " (--time)");
     return 0;
 }

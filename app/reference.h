@@ -11,6 +11,8 @@
 
 #include "session.h"
 
+#define REFERENCE_MAX_SHARDS 4096 /* far above a cluster's job array (Slurm's default limit: 1001) */
+
 typedef struct {
     char model[64];      /* BSDF_MODEL_STAMP of the glint that rendered it; "" in older references */
     char scene[1024];    /* as given on the command line, "builtin:NAME" for a built-in scene */
@@ -29,8 +31,16 @@ typedef struct {
     int max_depth;
     uint64_t seed;
     int threads;
-    /* Noise of the reference itself, from two halves of its frames (reference_noise()); has_noise
-     * is 0 when it rendered a single frame. */
+    char params[1024]; /* every other parameter its frames read, "NAME=VALUE ..." in a fixed
+                        * order (reference_params_text); "" in older references */
+    /* A shard (glint render --shard) or a merge of shards (glint merge): it holds frames i,
+     * i + shard_count, i + 2 shard_count, ... of one render for each shard i set in shards[],
+     * and its EXR the moments merging needs. shard_count 0: a whole render. */
+    int shard_count;
+    long long spp_total; /* --spp of the whole render the shards split; 0: each rendered for --time */
+    unsigned char shards[REFERENCE_MAX_SHARDS / 8]; /* bit i: shard i is in it */
+    /* Noise of the reference itself, from two halves of its frames (reference_noise()), or in a
+     * shard or merge from its pixels' variances; has_noise is 0 when it rendered a single frame. */
     int has_noise;
     double mean_variance; /* mean over pixels and channels of the variance of the pixel mean */
     double rel_l2_noise;  /* expected relative L2 error of the reference against the truth */
@@ -47,6 +57,14 @@ int reference_hash_file(const char *path, char out[64], char *err, size_t errlen
  * (a file unreadable for hashing). */
 int reference_describe(reference_info *info, const char *scene_path, const char *env_path, double env_rotation_deg,
                        const struct scene *s, int camera_index, const render_params *p, char *err, size_t errlen);
+
+/* The parameters of p that shape its frames beyond those reference_info has fields for, as
+ * text ("plan=auto only=all count=1024 ..."; the many-light ones for those methods only): two
+ * renders with the same text draw the same samples. */
+void reference_params_text(const render_params *p, char *out, size_t n);
+
+static inline int reference_has_shard(const reference_info *r, int i) { return r->shards[i / 8] >> (i % 8) & 1; }
+static inline void reference_add_shard(reference_info *r, int i) { r->shards[i / 8] |= (unsigned char)(1u << (i % 8)); }
 
 /* Writes s as a JSON string (quotes, escapes); shared with glint render's --stats. */
 void reference_json_string(FILE *f, const char *s);
@@ -67,7 +85,8 @@ int reference_parse(const char *text, size_t n, const char *label, reference_inf
 int reference_load(const char *exr_path, reference_info *info, char *err, size_t errlen);
 
 /* Tracks two halves of a progressive render for the noise estimate: call reference_noise_frame
- * after every frame, reference_noise_finish at the end. Snapshots of the mean are taken at
+ * after every frame, reference_noise_finish at the end (which takes the film's moments instead
+ * when it keeps them: a shard's). Snapshots of the mean are taken at
  * power-of-two frame counts, so the finish uses a split of the frames between 1/2 and 3/4 (no
  * cost on the hot path: log2(frames) resolves). */
 typedef struct {
@@ -81,6 +100,11 @@ int reference_noise_init(reference_noise *rn, int width, int height); /* 0, or -
 void reference_noise_frame(reference_noise *rn, const render_session *rs);
 void reference_noise_finish(reference_noise *rn, const render_session *rs, reference_info *info);
 void reference_noise_deinit(reference_noise *rn);
+/* The noise of an image from its pixels' variances of one sample (a shard's or a merge's
+ * moments): channel k of pixel i has mean mean[k][i * stride], variance var[k][i * stride] and
+ * count[i] samples. Sets has_noise, mean_variance and rel_l2_noise as reference_noise_finish does. */
+void reference_noise_from_variance(const float *const mean[3], const float *const var[3], size_t stride,
+                                   const double *count, size_t pixels, reference_info *info);
 
 /* Compares what a bench renders (want) with a reference's description (have), field by field: the
  * material model (a reference of another is stale: re-render it), scene and environment hashes,
@@ -88,5 +112,12 @@ void reference_noise_deinit(reference_noise *rn);
  * with err naming the first difference ("REF.exr: ..."). */
 int reference_check(const char *ref_path, const reference_info *have, const reference_info *want, char *err,
                     size_t errlen);
+
+/* Whether have (a shard, at path) is of the same render as want (another shard, at want_path),
+ * so their frames may be merged: everything reference_check compares, then the method, max
+ * depth, seed, highlights layer, every other parameter (params), the shard count and the whole
+ * render's spp. Returns 0, or -1 with err naming the first difference ("PATH: ..."). */
+int reference_check_shard(const char *path, const reference_info *have, const char *want_path,
+                          const reference_info *want, char *err, size_t errlen);
 
 #endif

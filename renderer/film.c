@@ -25,6 +25,7 @@ int film_init(film *f, int width, int height) {
 
 void film_deinit(film *f) {
     for (int c = 0; c < COMP_COUNT; c++) free(f->sum[c]);
+    for (int c = 0; c <= COMP_COUNT; c++) free(f->sumsq[c]);
     free(f->rejected);
     memset(f, 0, sizeof *f);
 }
@@ -33,7 +34,62 @@ void film_clear(film *f) {
     size_t n = (size_t)f->width * (size_t)f->height;
     for (int c = 0; c < COMP_COUNT; c++) memset(f->sum[c], 0, 3 * n * sizeof(double));
     memset(f->rejected, 0, n * sizeof(uint32_t));
+    for (int c = 0; c <= COMP_COUNT && f->sumsq[0]; c++) memset(f->sumsq[c], 0, 3 * n * sizeof(double));
     f->passes = 0;
+}
+
+void film_moments_var_layer(const char *layer, char *out, size_t n) {
+    snprintf(out, n, "%s%s%s", MOMENTS_VAR_PREFIX, layer[0] ? "." : "", layer);
+}
+
+int film_enable_moments(film *f) {
+    size_t n = 3 * (size_t)f->width * (size_t)f->height;
+    for (int c = 0; c <= COMP_COUNT; c++) {
+        if (f->sumsq[c]) continue;
+        if (!(f->sumsq[c] = calloc(n, sizeof(double)))) {
+            for (int k = 0; k <= COMP_COUNT; k++) free(f->sumsq[k]), f->sumsq[k] = NULL;
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void film_add_squares(film *f, int i, const float rgb[COMP_COUNT][3]) {
+    double total[3] = {0, 0, 0};
+    for (int c = 0; c < COMP_COUNT; c++) {
+        if (rgb[c][0] == 0.0f && rgb[c][1] == 0.0f && rgb[c][2] == 0.0f) continue;
+        double *q = f->sumsq[c] + 3 * (size_t)i;
+        for (int k = 0; k < 3; k++) {
+            q[k] += (double)rgb[c][k] * (double)rgb[c][k];
+            total[k] += (double)rgb[c][k];
+        }
+    }
+    double *q = f->sumsq[FILM_TOTAL] + 3 * (size_t)i;
+    for (int k = 0; k < 3; k++) q[k] += total[k] * total[k];
+}
+
+void film_resolve_variance(const film *f, unsigned mask, float *var) {
+    size_t n = (size_t)f->width * (size_t)f->height;
+    int one = -1; /* the component alone in mask, else FILM_TOTAL (all of them) */
+    for (int c = 0; c < COMP_COUNT; c++)
+        if (mask == 1u << c) one = c;
+    if (!f->sumsq[0] || (one < 0 && mask != COMP_MASK_ALL)) {
+        memset(var, 0, sizeof(float) * 3 * n);
+        return;
+    }
+    const double *sq = f->sumsq[one < 0 ? FILM_TOTAL : one];
+    for (size_t i = 0; i < n; i++) {
+        long long count = f->passes - (long long)f->rejected[i];
+        double inv = count > 0 ? 1.0 / (double)count : 0.0;
+        for (int k = 0; k < 3; k++) {
+            double sum = 0.0;
+            for (int c = 0; c < COMP_COUNT; c++)
+                if (mask & (1u << c)) sum += f->sum[c][3 * i + (size_t)k];
+            double mean = sum * inv, v = sq[3 * i + (size_t)k] * inv - mean * mean;
+            v = v > 0.0 ? v : 0.0; /* rounding can take a constant pixel's below zero */
+            var[3 * i + (size_t)k] = v < (double)FLT_MAX ? (float)v : FLT_MAX;
+        }
+    }
 }
 
 size_t film_resolve(const film *f, unsigned mask, float *rgb) {
@@ -138,17 +194,39 @@ int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_m
 int film_save_exr_attrs(const film *f, unsigned layers_mask, const char *path, const exr_text_attr *attrs,
                         int num_attrs, write_mode mode, char *err, size_t errlen) {
     size_t n = 3 * (size_t)f->width * (size_t)f->height;
-    float *planes[1 + COMP_COUNT] = {0};
-    exr_layer layers[1 + COMP_COUNT];
+    enum { MAX_LAYERS = 2 * (1 + COMP_COUNT) + 1 };
+    float *planes[MAX_LAYERS] = {0};
+    exr_layer layers[MAX_LAYERS];
+    char names[COMP_COUNT + 1][64];
     int nl = 0, status = -1;
-    for (int c = -1; c < COMP_COUNT; c++) {
-        if (c >= 0 && !(layers_mask & (1u << c))) continue;
+    /* The means, then (with moments) the variances of the same layers and the dropped samples */
+    for (int pass = 0; pass < (f->sumsq[0] ? 2 : 1); pass++) {
+        for (int c = -1; c < COMP_COUNT; c++) {
+            if (c >= 0 && !(layers_mask & (1u << c))) continue;
+            if (!(planes[nl] = malloc(sizeof(float) * n))) {
+                snprintf(err, errlen, "%s: out of memory", path);
+                goto done;
+            }
+            unsigned mask = c < 0 ? COMP_MASK_ALL : 1u << c;
+            const char *name = c < 0 ? "" : film_component_names[c];
+            if (pass == 0) {
+                film_resolve(f, mask, planes[nl]);
+                layers[nl] = (exr_layer){name, planes[nl]};
+            } else {
+                film_resolve_variance(f, mask, planes[nl]);
+                film_moments_var_layer(name, names[c + 1], sizeof names[c + 1]);
+                layers[nl] = (exr_layer){names[c + 1], planes[nl]};
+            }
+            nl++;
+        }
+    }
+    if (f->sumsq[0]) {
         if (!(planes[nl] = malloc(sizeof(float) * n))) {
             snprintf(err, errlen, "%s: out of memory", path);
             goto done;
         }
-        film_resolve(f, c < 0 ? COMP_MASK_ALL : 1u << c, planes[nl]);
-        layers[nl] = (exr_layer){c < 0 ? "" : film_component_names[c], planes[nl]};
+        for (size_t i = 0; i < n; i++) planes[nl][i] = (float)f->rejected[i / 3];
+        layers[nl] = (exr_layer){MOMENTS_REJECTED, planes[nl]};
         nl++;
     }
     status = exr_save_layers_attrs(path, f->width, f->height, layers, nl, attrs, num_attrs, mode, err, errlen);

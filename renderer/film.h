@@ -29,11 +29,22 @@ typedef struct {
     double *sum[COMP_COUNT]; /* 3 per pixel */
     uint32_t *rejected;      /* per pixel: dropped samples (NaN or Inf) */
     long long passes;
+    /* Sums of squared samples, 3 per pixel, per component and (FILM_TOTAL) of the whole image,
+     * whose variance is not the components' (they covary): what merging shards exactly needs.
+     * NULL until film_enable_moments, so a render that does not keep them pays nothing. */
+    double *sumsq[COMP_COUNT + 1];
 } film;
+
+#define FILM_TOTAL COMP_COUNT /* sumsq's index of the whole image */
 
 int film_init(film *f, int width, int height); /* 0 or -1 (out of memory) */
 void film_deinit(film *f);
 void film_clear(film *f);
+
+/* Keeps the sums of squares from now on (call on a clear film). 0, or -1 out of memory. */
+int film_enable_moments(film *f);
+/* film_add's second moments, out of line: only shards keep them. */
+void film_add_squares(film *f, int i, const float rgb[COMP_COUNT][3]);
 
 /* Adds one sample (3 floats per component) to pixel i. A component that is zero is not
  * touched: the film is tens of megabytes, and a ray into the void or an unused component
@@ -46,6 +57,7 @@ static inline void film_add(film *f, int i, const float rgb[COMP_COUNT][3]) {
         s[1] += (double)rgb[c][1];
         s[2] += (double)rgb[c][2];
     }
+    if (f->sumsq[0]) film_add_squares(f, i, rgb);
 }
 
 /* Pixel i's sample of this pass was dropped: the pixel's mean is over its good samples. */
@@ -56,6 +68,20 @@ static inline void film_end_pass(film *f) { f->passes++; }
  * finite by construction: a mean beyond float's range is written as +-FLT_MAX. Returns how many
  * values were clamped so. */
 size_t film_resolve(const film *f, unsigned mask, float *rgb);
+/* The variance of one sample about the pixel's mean (population form: the sum of squared
+ * deviations over the count), of the components in mask, 3 floats per pixel; every value 0 without
+ * moments. A mask of all components is the whole image's variance (FILM_TOTAL). */
+void film_resolve_variance(const film *f, unsigned mask, float *var);
+
+/* The EXR channels that carry the moments (written by film_save_exr_attrs when the film keeps
+ * them, read back by glint merge): MOMENTS_VAR_PREFIX ".R,G,B" is the image's variance,
+ * MOMENTS_VAR_PREFIX ".direct.R,G,B" a component's, and MOMENTS_REJECTED ".R" (G and B the same)
+ * the pixel's dropped samples, so its count is the frames less them. */
+#define MOMENTS_VAR_PREFIX "moments.var"
+#define MOMENTS_REJECTED "moments.rejected"
+/* The variance layer's name of layer ("" the image, "direct", ...): "moments.var[.LAYER]". */
+void film_moments_var_layer(const char *layer, char *out, size_t n);
+
 /* Values film_save_exr would clamp: in the whole image and in the layers of layers_mask. */
 size_t film_count_clamped(const film *f, unsigned layers_mask);
 
@@ -86,7 +112,8 @@ void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p,
 float srgb_encode(float linear);
 
 /* Exports (atomic; see image_io.h for write_mode). The EXR holds R,G,B (the sum of the
- * components) plus one layer per component in layers_mask ("direct.R", ...), and in its header
+ * components) plus one layer per component in layers_mask ("direct.R", ...), the moments of
+ * the same layers when the film keeps them (above), and in its header
  * the string attributes attrs (film_save_exr_attrs; NULL when num_attrs is 0). The PNG is the
  * sum, tone-mapped with tp->op. Return 0, or -1 with err = "PATH: problem". */
 int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen);

@@ -112,6 +112,10 @@ typedef struct {
     unsigned only;     /* many-light methods: render only these film components (a mask of
                         * 1 << COMP_*), skipping the others' passes, to time one estimator alone;
                         * the path tracer renders whole paths regardless; 0: all */
+    /* A shard of a render split over machines: its frames are shard_index, shard_index +
+     * shard_count, ... of the whole render's sequence, so the shards' samples are disjoint and
+     * together those of one render; the film keeps the moments merging needs. 0: not a shard. */
+    int shard_index, shard_count;
     vl_params vl;
 } render_params;
 

@@ -81,6 +81,10 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         free(rs);
         return NULL;
     }
+    if (p->shard_count > 0 && film_enable_moments(&rs->film) != 0) {
+        session_destroy(rs);
+        return snprintf(err, errlen, "out of memory for a %dx%d image's moments", p->width, p->height), NULL;
+    }
     rs->pool = threadpool_create(p->threads);
     if (rs->pool) rs->workers = calloc((size_t)threadpool_size(rs->pool), sizeof(worker_stats));
     if (!rs->pool || !rs->workers) {
@@ -114,6 +118,14 @@ void session_destroy(render_session *rs) {
     free(rs->workers);
     film_deinit(&rs->film);
     free(rs);
+}
+
+/* The index of the next frame in the sequence of the whole render: a shard takes every
+ * shard_count-th frame from its own index, so the random numbers are the whole render's. */
+static uint64_t next_frame_index(const render_session *rs) {
+    const render_params *p = &rs->params;
+    if (p->shard_count <= 0) return (uint64_t)rs->frames;
+    return (uint64_t)p->shard_index + (uint64_t)rs->frames * (uint64_t)p->shard_count;
 }
 
 /* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
@@ -185,6 +197,7 @@ static void render_tile(void *ctx, int tile, int worker) {
     int x1 = x0 + TILE < p->width ? x0 + TILE : p->width;
     int y1 = y0 + TILE < p->height ? y0 + TILE : p->height;
     camera_raster raster = camera_raster_make(&rs->cam, p->width, p->height);
+    const uint64_t frame = next_frame_index(rs);
     uint64_t tile_start = clock_ns();
     /* Camera rays go in packets of PACKET_W x PACKET_H pixels: neighbours share most of their
      * BVH traversal. */
@@ -197,13 +210,13 @@ static void render_tile(void *ctx, int tile, int worker) {
             for (int y = by; y < by + PACKET_H && y < y1; y++) {
                 for (int x = bx; x < bx + PACKET_W && x < x1; x++, n++) {
                     pixel[n] = y * p->width + x;
-                    rng[n] = rng_for((uint64_t)pixel[n], (uint64_t)rs->frames, p->seed);
+                    rng[n] = rng_for((uint64_t)pixel[n], frame, p->seed);
                     /* A pixel's positions over frames follow the R2 sequence from a random start:
                      * any run of frames covers the pixel evenly, so a small bright feature inside
                      * it (a highlight seen in a curved mirror) converges faster than with
                      * independent positions, and each frame's position is still uniform. */
                     rng_state start = rng_for((uint64_t)pixel[n], UINT64_MAX, p->seed);
-                    vec2 j = sample_r2((int)(rs->frames & 0x3fffffff), rng_vec2(&start));
+                    vec2 j = sample_r2((int)(frame & 0x3fffffff), rng_vec2(&start));
                     d[n] = camera_raster_dir(&raster, (float)x + j.x, (float)y + j.y);
                 }
             }
@@ -220,13 +233,13 @@ static void render_tile(void *ctx, int tile, int worker) {
 
 int session_render_frame(render_session *rs) {
     const render_params *p = &rs->params;
+    const uint64_t frame = next_frame_index(rs);
     rs->adapt = p->method != METHOD_PT && vl_params_resolve(&p->vl).adapt == VL_ADAPT_ON;
     if (rs->adapt) {
-        pixel_alloc_plan(&rs->direct, MANYLIGHT_DIRECT_SAMPLES, MANYLIGHT_MAX_DIRECT_SAMPLES, (uint64_t)rs->frames,
+        pixel_alloc_plan(&rs->direct, MANYLIGHT_DIRECT_SAMPLES, MANYLIGHT_MAX_DIRECT_SAMPLES, frame,
                          p->seed ^ 0x646972656374ULL);
         if (rs->plan.virtual_lights)
-            pixel_alloc_plan(&rs->glossy, vl_params_resolve(&p->vl).glossy_rays, VL_MAX_GLOSSY_RAYS,
-                             (uint64_t)rs->frames, p->seed);
+            pixel_alloc_plan(&rs->glossy, vl_params_resolve(&p->vl).glossy_rays, VL_MAX_GLOSSY_RAYS, frame, p->seed);
     }
     if (rs->plan.highlights) {
         if (rs->plan.env_prefilter && (!rs->envf || rs->envf_map != rs->scene->env)) {
@@ -239,7 +252,7 @@ int session_render_frame(render_session *rs) {
     }
     if (rs->plan.virtual_lights) {
         uint64_t t0 = clock_ns();
-        if (manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, &rs->plan, rs->frames, rs->pool,
+        if (manylight_begin_frame(&rs->ml, rs->scene, &rs->cam, &rs->params, &rs->plan, (long long)frame, rs->pool,
                                   &rs->totals, rs->error, sizeof rs->error) != 0)
             return -1;
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;

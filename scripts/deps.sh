@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages glint needs, when any is missing. Sourced by run.sh and test.sh.
+# slurm-wlm and munge are for the test that stands up a one-node Slurm cluster (tests/test_slurm.sh).
 GLINT_PACKAGES=(
   build-essential cmake pkg-config
   libglfw3-dev libembree-dev libopenexr-dev libtinygltf-dev nlohmann-json3-dev
   libimgui-dev libstb-dev libgl-dev libcjson-dev libcairo2-dev fonts-dejavu-core
   xvfb xauth xdotool x11-xserver-utils embree-tools openexr clang-format
   clang libclang-rt-14-dev
+  slurm-wlm munge
 )
 # Opt-in, large: Blender (with the numpy its glTF importer needs) for the comparison against
 # Cycles (tests/bench/blender_twin.py, the blender ctest).
