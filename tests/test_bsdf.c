@@ -506,7 +506,7 @@ static void test_traps(void) {
         make_bsdf_gltf(v3(0.9f, 0.8f, 0.7f), 1.0f, 0.0f, 1.0f), /* fully anisotropic, razor-thin across */
         make_bsdf_gltf(v3s(0.5f), 0.0f, 0.0f, 0.0f),
         make_bsdf_gltf_layered(v3s(0.5f), 0.0f, 0.6f, 0.0f, /* a razor-sharp clear coat */
-                               &(gltf_layers){v3s(0.04f), 1.0f, v3s(0.0f), 0.0f, 1.0f, 0.0f}),
+                               &(gltf_layers){v3s(0.04f), 1.0f, v3s(0.0f), 0.0f, 1.0f, 0.0f, 0.0f, 0.0f}),
         make_bsdf_phong(v3s(0.1f), v3s(0.8f), 1e6f),
         make_bsdf_ward(v3s(0.1f), v3s(0.8f), 1e-4f, 1e-4f),
         make_bsdf_ward(v3s(0.0f), v3s(0.9f), 1e-3f, 0.8f),
@@ -548,7 +548,7 @@ static void test_traps(void) {
     /* A white sheen at its floor roughness peaks at the horizon, which neither cosine nor uniform
      * sampling follows: at grazing wo its weights reach tens (docs/design.md), but stay finite. */
     bsdf sheen = make_bsdf_gltf_layered(v3s(0.5f), 0.0f, 0.6f, 0.0f,
-                                        &(gltf_layers){v3s(0.04f), 1.0f, v3s(1.0f), 0.0f, 0.0f, 0.0f});
+                                        &(gltf_layers){v3s(0.04f), 1.0f, v3s(1.0f), 0.0f, 0.0f, 0.0f, 0.0f, 0.0f});
     float sheen_max = 0.0f;
     int sheen_bad = 0;
     for (int z = 0; z < 5; z++) {
