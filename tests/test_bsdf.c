@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "bsdf.h"
+#include "bsdf_sampler.h"
 #include "check.h"
 #include "rng.h"
 #include "stat_tests.h"
@@ -20,26 +21,6 @@ typedef struct {
 static vec3 dir_from_angles(double theta_deg, double phi_deg) {
     double t = theta_deg * PI_D / 180.0, p = phi_deg * PI_D / 180.0;
     return normalize3(v3((float)(sin(t) * cos(p)), (float)(sin(t) * sin(p)), (float)cos(t)));
-}
-
-/* ---- sampling against the pdf ----------------------------------------------------------------- */
-
-typedef struct {
-    const bsdf *b;
-    vec3 wo;
-} bsdf_ctx;
-
-static int sample_fn(void *c, float u_lobe, vec2 u, vec3 *w) {
-    const bsdf_ctx *x = c;
-    bsdf_sample_result s;
-    if (!bsdf_sample(x->b, x->wo, BSDF_ALL, u_lobe, u, &s)) return 0;
-    *w = s.wi;
-    return 1;
-}
-
-static double pdf_fn(void *c, vec3 w) {
-    const bsdf_ctx *x = c;
-    return bsdf_pdf(x->b, x->wo, w, BSDF_ALL);
 }
 
 /* ---- quadrature over the hemisphere ------------------------------------------------------------ */

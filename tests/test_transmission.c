@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "bsdf.h"
+#include "bsdf_sampler.h"
 #include "check.h"
 #include "rng.h"
 #include "scene.h"
@@ -33,24 +34,6 @@ static gltf_layers ior_layers(float ior) {
     float r = (ior - 1.0f) / (ior + 1.0f);
     x.dielectric_f0 = v3s(r * r);
     return x;
-}
-
-typedef struct {
-    const bsdf *b;
-    vec3 wo;
-} bsdf_ctx;
-
-static int sample_fn(void *c, float u_lobe, vec2 u, vec3 *w) {
-    const bsdf_ctx *x = c;
-    bsdf_sample_result s;
-    if (!bsdf_sample(x->b, x->wo, BSDF_ALL, u_lobe, u, &s)) return 0;
-    *w = s.wi;
-    return 1;
-}
-
-static double pdf_fn(void *c, vec3 w) {
-    const bsdf_ctx *x = c;
-    return bsdf_pdf(x->b, x->wo, w, BSDF_ALL);
 }
 
 /* Reflected and transmitted energy for light arriving from wo, by sampling: the adjoint weights
