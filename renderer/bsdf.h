@@ -3,11 +3,13 @@
  * bsdf.c.
  *
  * A bsdf is a diffuse lobe (Lambert, and glTF's sheen) plus a glossy lobe (one GGX, Phong or Ward
- * lobe, and glTF's clear coat, a second GGX lobe over everything), in the local shading frame:
- * +z is the shading normal, +x the tangent (the anisotropy direction). Reflection only: any
- * direction with z <= 0 gets f = 0 and pdf = 0. f excludes the cosine factor. The glTF model
+ * lobe, and glTF's clear coat, a second GGX lobe over everything), and glTF's transmission lobe,
+ * in the local shading frame: +z is the shading normal, +x the tangent (the anisotropy
+ * direction). wo is always above (z > 0; below it f = 0 and pdf = 0); the diffuse and glossy
+ * lobes reflect (wi above), the transmission lobe transmits (wi below). f excludes the cosine
+ * factor and is the radiance BSDF: for light paths use bsdf_adjoint_scale. The glTF model
  * couples its diffuse lobe to the dielectric's specular lobe (docs/design.md, "The glTF
- * material"). */
+ * material", "Transmission and volume"). */
 #ifndef GLINT_BSDF_H
 #define GLINT_BSDF_H
 
@@ -23,9 +25,12 @@ extern "C" {
  * the coupled diffuse and the ior, specular, sheen and clear coat extensions. */
 #define BSDF_MODEL_STAMP "glint-bsdf-2"
 
-/* Lobe masks: estimators that split path space ask for one lobe or both. BSDF_NOT_HIGHLIGHT,
- * for estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe. */
-enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_ALL = 3, BSDF_NOT_HIGHLIGHT = 4 };
+/* Lobe masks: estimators that split path space ask for some lobes. BSDF_NOT_HIGHLIGHT, for
+ * estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe.
+ * BSDF_TRANSMIT is the dielectric's transmission (KHR_materials_transmission): never a highlight
+ * lobe, never met by next-event estimation (shadow rays stop at glass), and a transmission does
+ * not count as a scattering event toward a path's depth (docs/design.md). */
+enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_NOT_HIGHLIGHT = 4, BSDF_TRANSMIT = 8, BSDF_ALL = 11 };
 
 /* The path-space split (docs/design.md): camera - glossy - glossy - light paths belong to the
  * highlight estimator when both glossy lobes are sharper than this roughness (microfacet alpha).
@@ -63,6 +68,13 @@ typedef struct {
     float sheen_rough; /* its perceptual roughness (alpha = rough^2), floored at BSDF_MIN_SHEEN_ROUGHNESS */
     float coat;        /* KHR_materials_clearcoat's weight: a GGX lobe, F0 0.04, part of BSDF_GLOSSY */
     float coat_alpha;  /* its roughness (alpha) */
+    /* KHR_materials_transmission: a GGX BTDF of the glossy lobe's roughness weighted by what the
+     * dielectric does not reflect, 1 - F(wo.h) (Schlick with couple_f0, couple_f90), part of
+     * BSDF_TRANSMIT. eta is the index below the surface over the index above (wo's side): the
+     * rough refraction of Walter et al. (2007); eta = 1 (within 1e-3) is thin-walled, the
+     * transmitted direction not bent (the reflection lobe mirrored through the surface). */
+    vec3 transmission; /* weight (1 - metallic) transmission times the base colour; 0: none */
+    float eta;         /* 0 without transmission */
     int dropped;       /* lobes left out by bsdf_only: the layers' attenuation of the rest stays */
 } bsdf;
 
@@ -77,13 +89,15 @@ typedef struct {
     float sheen_roughness;
     float clearcoat; /* KHR_materials_clearcoat */
     float clearcoat_roughness;
+    float transmission; /* KHR_materials_transmission */
+    float eta;          /* refraction at this hit (index below over above); 1: thin-walled */
 } gltf_layers;
 
 typedef struct {
     vec3 wi;   /* sampled direction (local frame) */
     vec3 f;    /* bsdf_eval(wo, wi, lobes) */
     float pdf; /* bsdf_pdf(wo, wi, lobes), solid angle */
-    int lobe;  /* BSDF_DIFFUSE or BSDF_GLOSSY: which lobe produced wi */
+    int lobe;  /* BSDF_DIFFUSE, BSDF_GLOSSY or BSDF_TRANSMIT: which lobe produced wi */
 } bsdf_sample_result;
 
 /* glTF 2.0 metallic-roughness, the spec's appendix B: mix(dielectric, metal, metallic), the
@@ -124,6 +138,7 @@ static inline int bsdf_lobes(const bsdf *b) {
     int lobes = 0;
     if (!is_black3(b->diffuse) || !is_black3(b->sheen)) lobes |= BSDF_DIFFUSE;
     if (bsdf_has_base_glossy(b) || b->coat > 0.0f) lobes |= BSDF_GLOSSY;
+    if (!is_black3(b->transmission)) lobes |= BSDF_TRANSMIT;
     return lobes & ~b->dropped;
 }
 /* b with only the lobes in the mask; the layers over them still attenuate them as in b. */
@@ -152,6 +167,15 @@ vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo);
 vec3 bsdf_diffuse_albedo(const bsdf *b, vec3 wo);
 /* Probability that bsdf_sample picks the glossy lobe for this wo (0 or 1 with one lobe). */
 float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes);
+/* The factor that turns f(wo, wi) into the adjoint f(wi, wo), for light paths (which sample
+ * from the light's side): (index at wi / index at wo)^2 = eta^2 for a refraction, else 1. */
+float bsdf_adjoint_scale(const bsdf *b, vec3 wo, vec3 wi);
+/* Whether b transmits without bending (thin-walled), or refracts. */
+static inline int bsdf_thin(const bsdf *b) { return fabsf(b->eta - 1.0f) < 1e-3f; }
+/* Whether a local direction w, from a sample or a light, lies on the side of the geometric
+ * surface its lobe says (above for reflection, below for transmission): the shading normal may
+ * say otherwise, and then the direction is no path. ng_dot = the world direction . ng. */
+static inline int bsdf_side_ok(vec3 w, float ng_dot) { return w.z > 0.0f ? ng_dot > 0.0f : ng_dot < 0.0f; }
 
 #ifdef __cplusplus
 }

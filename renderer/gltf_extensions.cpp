@@ -1,5 +1,6 @@
-// glint — KHR_texture_transform and KHR_materials_variants from tinygltf's JSON values, checked
-// (docs/design.md, "Texture transforms", "Material variants").
+// glint — KHR_texture_transform, KHR_materials_variants, KHR_materials_transmission and
+// KHR_materials_volume from tinygltf's JSON values, checked (docs/design.md, "Texture
+// transforms", "Material variants", "Transmission and volume").
 #include "gltf_extensions.h"
 
 #include <cmath>
@@ -31,7 +32,46 @@ long long index_below(const Value &v, double limit) {
     return d >= 0.0 && d < limit && d == std::floor(d) ? (long long)d : -1;
 }
 
+// A number v (named what) into *out: at least lo (a problem below it, and for anything but a
+// finite number), clamped to hi (*clamped set).
+std::string number_in(const Value &v, const char *what, double lo, double hi, float *out, bool *clamped) {
+    double d = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+    if (!std::isfinite(d) || std::fabs(d) > 1e20) return std::string(what) + " is not a finite number";
+    if (d < lo) return std::string(what) + " " + num(d) + " is below " + num(lo);
+    if (d > hi) d = hi, *clamped = true;
+    *out = (float)d;
+    return "";
+}
+
+// The same for the number under key (out untouched when absent).
+std::string bounded(const Value &obj, const char *key, double lo, double hi, float *out, bool *clamped) {
+    return obj.Has(key) ? number_in(obj.Get(key), key, lo, hi, out, clamped) : "";
+}
+
 } // namespace
+
+std::string material_transmission_volume(const std::string &name, const Value &e, material_ext *x,
+                                         const std::function<texture_slot(const char *)> &texture, bool *clamped) {
+    if (!e.IsObject()) return name + " is not an object";
+    std::string why;
+    if (name == "KHR_materials_transmission") {
+        why = bounded(e, "transmissionFactor", 0.0, 1.0, &x->transmission, clamped);
+        if (why.empty() && e.Has("transmissionTexture")) x->transmission_tex = texture("transmissionTexture");
+    } else {
+        why = bounded(e, "thicknessFactor", 0.0, 1e20, &x->thickness, clamped);
+        // The spec's attenuationDistance is positive; infinity (its default) is no absorption.
+        if (why.empty()) why = bounded(e, "attenuationDistance", 1e-30, 1e20, &x->attenuation_distance, clamped);
+        if (why.empty() && e.Has("attenuationColor")) {
+            const Value &c = e.Get("attenuationColor");
+            float rgb[3];
+            if (!c.IsArray() || c.ArrayLen() != 3) return name + ": attenuationColor is not three numbers";
+            for (int i = 0; i < 3 && why.empty(); i++)
+                why = number_in(c.Get(i), "attenuationColor", 0.0, 1.0, &rgb[i], clamped);
+            if (why.empty()) x->attenuation_color = v3(rgb[0], rgb[1], rgb[2]);
+        }
+    }
+    return why.empty() ? "" : name + ": " + why;
+}
 
 std::string texture_transform(const Value &x, float xf[6], int *texcoord) {
     if (!x.IsObject()) return "not an object";

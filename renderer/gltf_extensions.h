@@ -1,10 +1,12 @@
-// glint — glTF extensions that belong to no one material's parameters, read from tinygltf's JSON
-// values (C++ only, used by gltf_import.cpp): KHR_texture_transform on a texture reference and
-// KHR_materials_variants. Each returns "" or the problem, for the importer's one-line error.
+// glint — glTF extensions read from tinygltf's JSON values (C++ only, used by gltf_import.cpp):
+// KHR_texture_transform on a texture reference, KHR_materials_variants, and the material model's
+// KHR_materials_transmission and _volume. Each returns "" or the problem, for the importer's
+// one-line error.
 #ifndef GLINT_GLTF_EXTENSIONS_H
 #define GLINT_GLTF_EXTENSIONS_H
 
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,13 @@ inline std::string num(double v) {
 // (u' = xf[0] u + xf[1] v + xf[2], v' = xf[3] u + xf[4] v + xf[5]) and its texCoord, when it has
 // one, into *texcoord.
 std::string texture_transform(const tinygltf::Value &x, float xf[6], int *texcoord);
+
+// KHR_materials_transmission or KHR_materials_volume (name; e: the extension's object) into x;
+// texture reads one of the extension's textureInfo keys. Factors above their range are clamped
+// (*clamped set); a negative factor, a non-positive attenuationDistance or a non-number is the
+// problem.
+std::string material_transmission_volume(const std::string &name, const tinygltf::Value &e, material_ext *x,
+                                         const std::function<texture_slot(const char *)> &texture, bool *clamped);
 
 // The file's material variants, by name, into s.
 std::string read_variants(scene *s, const tinygltf::Model &m);

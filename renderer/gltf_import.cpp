@@ -459,6 +459,14 @@ struct importer {
                     ext_sheen(mat, e, label);
                 } else if (ext.first == "KHR_materials_clearcoat") {
                     ext_clearcoat(mat, e, label);
+                } else if (ext.first == "KHR_materials_transmission" || ext.first == "KHR_materials_volume") {
+                    bool clamped = false;
+                    std::string why = gltf_ext::material_transmission_volume(
+                        ext.first, e, &mat.ext, [&](const char *key) { return ext_texture(e, key, label); }, &clamped);
+                    if (!why.empty()) fail(label + ": " + why);
+                    if (clamped)
+                        scene_warn(s, "%s: %s: %s: a factor out of range, clamped", name.c_str(), label.c_str(),
+                                   ext.first.c_str());
                 }
             }
             // The papers' lobes: extras.glint = {model: "phong"|"ward", kd, ks, exponent, alpha_x, alpha_y, rotation}
@@ -745,10 +753,12 @@ struct importer {
     }
 
     void run() {
-        static const char *supported[] = {
-            "KHR_lights_punctual",     "KHR_materials_emissive_strength", "KHR_materials_anisotropy",
-            "KHR_materials_ior",       "KHR_materials_specular",          "KHR_materials_sheen",
-            "KHR_materials_clearcoat", "KHR_texture_transform",           "KHR_materials_variants"};
+        static const char *supported[] = {"KHR_lights_punctual",      "KHR_materials_emissive_strength",
+                                          "KHR_materials_anisotropy", "KHR_materials_ior",
+                                          "KHR_materials_specular",   "KHR_materials_sheen",
+                                          "KHR_materials_clearcoat",  "KHR_texture_transform",
+                                          "KHR_materials_variants",   "KHR_materials_transmission",
+                                          "KHR_materials_volume"};
         for (const std::string &e : m.extensionsUsed) {
             bool ok = false;
             for (const char *sup : supported) ok = ok || e == sup;

@@ -33,6 +33,8 @@ shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_di
     x.ng = h->ng;
     x.b = material_bsdf(s, h, &x.frame);
     x.wo = to_local(x.frame, neg3(ray_dir));
+    x.material = h->material;
+    x.backface = h->backface;
     return x;
 }
 
@@ -235,67 +237,142 @@ static int cluster_lights(manylight *m, const scene *s, const camera *cam, const
     return status;
 }
 
-/* One direction u through x's glossy lobe (x is scattering event k, reached with weight beta): the
- * direct light at the next hit, weighted (*t), and what carrying the path on needs (*b, *h, *wi).
- * Returns 0 when the direction ends there (sampled below the surface, Russian roulette, a miss). */
-static int glossy_direction(const scene *s, const shading_point *x, vec3 beta, int k, int lobes, vec2 u, rng_state *rng,
-                            render_stats *st, vec3 *t, vec3 *b, surface_hit *h, vec3 *wi) {
+/* The lobes of x traced through rather than gathered: a glossy lobe sharper than trace_alpha,
+ * where a handful of lights cannot represent the incoming light, and any transmission, which
+ * no light can be seen through (shadow rays stop at glass, docs/design.md). */
+static int traced_lobes(const manylight *m, const bsdf *b) {
+    int lobes = bsdf_lobes(b);
+    int sharp = (lobes & BSDF_GLOSSY) && bsdf_glossy_alpha(b) < m->trace_alpha;
+    return (sharp ? BSDF_GLOSSY : 0) | (lobes & BSDF_TRANSMIT);
+}
+
+/* One direction (u_lobe, u) through x's traced lobes (x is scattering event k, reached with weight
+ * beta in a medium of absorption *sigma): the direct light at the next hit, weighted (*t), and
+ * what carrying the path on needs (*b, *h, *wi, *sigma, *lobe). Through a transmission *t is 0: a
+ * transmission is no scattering event, and the direct estimator that reached x (its paths carry on
+ * through x's transmission) has the next hit's direct light. Returns 0 when the direction ends
+ * there (sampled on the wrong side of the surface, Russian roulette, a miss). */
+static int glossy_direction(const scene *s, const shading_point *x, int traced, vec3 beta, int k, int lobes,
+                            float u_lobe, vec2 u, rng_state *rng, render_stats *st, vec3 *t, vec3 *b, surface_hit *h,
+                            vec3 *wi, vec3 *sigma, int *lobe) {
     bsdf_sample_result bs;
-    if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, u, &bs) || !(bs.pdf > 0.0f)) return 0;
+    if (!bsdf_sample(&x->b, x->wo, traced, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) return 0;
     *wi = to_world(x->frame, bs.wi);
-    if (dot3(*wi, x->ng) <= 0.0f) return 0;
-    *b = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
+    if (!bsdf_side_ok(bs.wi, dot3(*wi, x->ng))) return 0;
+    *b = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
     if (k - 1 >= RR_FIRST_VERTEX && !russian_roulette(b, rng_float(rng))) return 0;
     if (is_black3(*b) || !is_finite3(*b)) return 0;
     st->glossy_bounces++;
-    /* Emission at the next hit is the direct light at x, which the shared estimator has. */
-    vec3 direct;
-    if (!pt_reflected_direct(s, offset_origin(s, x->p, x->ng, *wi), *wi, lobes, rng, &direct, h, st->rays)) return 0;
-    *t = mul3(*b, direct);
+    *lobe = bs.lobe;
+    *sigma = material_medium_after(&s->materials[x->material], x->backface, bs.lobe, *sigma);
+    vec3 o = offset_origin(s, x->p, x->ng, *wi);
+    *t = v3(0, 0, 0);
+    if (bs.lobe == BSDF_TRANSMIT) {
+        st->rays[RAY_BOUNCE]++;
+        if (!scene_intersect(s, o, *wi, INFINITY, h)) return 0;
+    } else {
+        /* Emission at the next hit is the direct light at x, which the shared estimator has. */
+        vec3 direct;
+        if (!pt_reflected_direct(s, o, *wi, *sigma, lobes, rng, &direct, h, st->rays)) return 0;
+        *t = mul3(*b, direct);
+    }
+    *b = mul3(*b, medium_transmittance(*sigma, h->t));
     return 1;
+}
+
+/* A path whose edge from x (event k) to its next scattering event crosses glass, which no virtual
+ * light is seen through (docs/design.md, "Transmission and volume"): one direction from x's
+ * gathered lobes (x->b) whose hit g transmits, then g's transmission alone (its reflection is the
+ * virtual lights' on g). Fills what glossy_direction fills: *t the direct light beyond g. Returns
+ * 0 when the direction meets no glass (those paths are the gather's) or ends. */
+static int glass_direction(const scene *s, const shading_point *x, vec3 beta, int k, rng_state *rng, render_stats *st,
+                           vec3 *t, vec3 *b, surface_hit *h, vec3 *wi, vec3 *sigma) {
+    bsdf_sample_result bs;
+    float u_lobe = rng_float(rng);
+    if (!bsdf_sample(&x->b, x->wo, BSDF_ALL, u_lobe, rng_vec2(rng), &bs) || !(bs.pdf > 0.0f)) return 0;
+    vec3 d = to_world(x->frame, bs.wi);
+    if (!bsdf_side_ok(bs.wi, dot3(d, x->ng))) return 0;
+    surface_hit g;
+    st->rays[RAY_BOUNCE]++;
+    if (!scene_intersect(s, offset_origin(s, x->p, x->ng, d), d, INFINITY, &g)) return 0;
+    shading_point gp = shading_point_at(s, &g, d);
+    if (!(bsdf_lobes(&gp.b) & BSDF_TRANSMIT)) return 0;
+    beta = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
+    beta = mul3(beta, medium_transmittance(*sigma, g.t));
+    int lobe;
+    return glossy_direction(s, &gp, BSDF_TRANSMIT, beta, k + 1, BSDF_ALL, 0.0f, rng_vec2(rng), rng, st, t, b, h, wi,
+                            sigma, &lobe);
 }
 
 vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, int max_depth, int split_first,
                         pixel_record *rec, rng_state *rng, render_stats *st) {
-    vec3 sum = v3(0, 0, 0), beta = v3s(1.0f);
+    vec3 sum = v3(0, 0, 0), beta = v3s(1.0f), sigma = v3s(0.0f);
     shading_point x = *x0;
-    /* x is scattering event k: gathering there makes paths of k + 1 events or more. */
-    for (int k = 1; k + 1 <= max_depth; k++) {
+    if (!m->glass && !traced_lobes(m, &x.b)) return manylight_shade(m, s, &x, m->terms, rng, st);
+    int through = 0; /* x was reached through a transmission */
+    /* x is scattering event k: gathering there makes paths of k + 1 events or more. A
+     * transmission leaves k as it is (pt.c counts depth so). */
+    for (int k = 1, vertex = 0; k + 1 <= max_depth && vertex <= max_depth + PT_MAX_TRANSMISSIONS; vertex++) {
         /* Only at the camera hit do the highlights own part of the gathered paths. */
-        vl_terms terms = k == 1 ? m->terms : VL_TERMS_ALL;
-        int sharp = (bsdf_lobes(&x.b) & BSDF_GLOSSY) && bsdf_glossy_alpha(&x.b) < m->trace_alpha;
-        if (!sharp) return add3(sum, mul3(beta, manylight_shade(m, s, &x, terms, rng, st)));
-        shading_point diffuse_only = x;
-        diffuse_only.b = bsdf_only(&x.b, BSDF_DIFFUSE);
-        sum = add3(sum, mul3(beta, manylight_shade(m, s, &diffuse_only, terms, rng, st)));
+        int at_camera = k == 1 && !through;
+        vl_terms terms = at_camera ? m->terms : VL_TERMS_ALL;
+        int traced = traced_lobes(m, &x.b);
+        shading_point gathered = x;
+        gathered.b = bsdf_only(&x.b, BSDF_ALL & ~traced);
+        int gather = bsdf_lobes(&gathered.b) != 0;
+        if (gather) sum = add3(sum, mul3(beta, manylight_shade(m, s, &gathered, terms, rng, st)));
+        /* The gathered lobes' paths through glass (scenes with glass only), and the traced lobes',
+         * each carry the path on with probability 1/2 when both are there. */
+        int glass = gather && m->glass;
+        if (!traced && !glass) break;
+        int via_glass = glass && (!traced || rng_float(rng) < 0.5f);
+        float pick = traced && glass ? 2.0f : 1.0f;
 
         /* At the camera hit the lobe is split: `split` stratified directions each take the direct
          * light at their next hit (the reflection of lit surfaces, where a single direction is
          * the noisiest part of the image), and one of them, chosen at random, carries the rest of
          * the path (with weight 1: it stands for the mean of the split's continuations). */
-        int split = k == 1 ? split_first : 1;
+        int split = at_camera ? split_first : 1;
         vec2 shift = rng_vec2(rng);
         int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
         /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (docs/design.md) when both
          * lobes are highlight lobes. */
-        int lobes =
-            k == 1 && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT : BSDF_ALL;
-        vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1);
+        int lobes = at_camera && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT
+                                                                                                 : BSDF_ALL;
+        vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1), next_sigma = sigma;
         surface_hit next;
-        int have_next = 0;
-        for (int j = 0; j < split; j++) {
-            vec3 t = v3(0, 0, 0), b;
+        int have_next = 0, next_lobe = 0;
+        for (int j = 0; traced && j < split; j++) {
+            vec3 t = v3(0, 0, 0), b, sg = sigma;
             surface_hit h;
             vec3 wi;
-            int ok = glossy_direction(s, &x, beta, k, lobes, split > 1 ? sample_r2(j, shift) : shift, rng, st, &t, &b,
-                                      &h, &wi);
-            if (k == 1 && rec) pixel_record_add(rec, avg3(t));
+            int lobe;
+            float u_lobe = rng_float(rng);
+            int ok = glossy_direction(s, &x, traced, beta, k, lobes, u_lobe, split > 1 ? sample_r2(j, shift) : shift,
+                                      rng, st, &t, &b, &h, &wi, &sg, &lobe);
+            if (at_camera && rec) pixel_record_add(rec, avg3(t));
             if (!ok) continue;
             sum = madd3(sum, t, 1.0f / (float)split);
-            if (j == chosen) next_beta = b, next = h, next_wi = wi, have_next = 1;
+            if (j == chosen && !via_glass)
+                next_beta = b, next = h, next_wi = wi, next_sigma = sg, next_lobe = lobe, have_next = 1;
+        }
+        if (glass) {
+            vec3 t = v3(0, 0, 0), b, sg = sigma, wi;
+            surface_hit h;
+            if (glass_direction(s, &gathered, beta, k, rng, st, &t, &b, &h, &wi, &sg)) {
+                sum = add3(sum, t);
+                if (via_glass) next_beta = b, next = h, next_wi = wi, next_sigma = sg, next_lobe = 0, have_next = 1;
+            }
         }
         if (!have_next) break;
-        beta = next_beta;
+        beta = scale3(next_beta, pick);
+        sigma = next_sigma;
+        if (next_lobe == BSDF_TRANSMIT) {
+            through = 1;
+        } else {
+            through |= via_glass;
+            k++;
+        }
         x = shading_point_at(s, &next, next_wi);
     }
     return sum;
@@ -337,6 +414,8 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     if (m->per_pixel >= (clustering ? vp->columns : m->set.count)) m->per_pixel = 0;
     m->candidates = vp->candidates;
     m->glossy_split = vp->glossy_rays;
+    m->glass = 0;
+    for (int j = 0; j < s->num_materials; j++) m->glass |= s->materials[j].ext.transmission > 0.0f;
     m->trace_alpha = vp->trace_glossy > 0.0f ? vp->trace_glossy : 0.0f;
     /* The light tree's per-light estimates serve resampling; its hierarchy, drawing through it. */
     if (m->per_pixel > 0 && (vp->select == VL_SELECT_TREE || m->candidates > 1) &&

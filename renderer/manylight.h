@@ -30,6 +30,7 @@ typedef struct {
     int candidates;     /* resampling candidates per pixel (1: the draws are shaded as they come) */
     float trace_alpha;  /* glossy lobes sharper than this are traced through, not gathered */
     int glossy_split;   /* directions traced through such a lobe at the camera hit (the mean with adapt) */
+    int glass;          /* the scene has transmissive materials: gathered paths are also traced through them */
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;

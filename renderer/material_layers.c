@@ -9,7 +9,9 @@ material_ext material_ext_default(void) {
     x.specular = 1.0f;
     x.specular_color = v3s(1.0f);
     x.specular_tex = x.specular_color_tex = x.sheen_color_tex = x.sheen_roughness_tex = x.clearcoat_tex =
-        x.clearcoat_roughness_tex = (texture_slot){.texture = -1};
+        x.clearcoat_roughness_tex = x.transmission_tex = (texture_slot){.texture = -1};
+    x.attenuation_distance = INFINITY;
+    x.attenuation_color = v3s(1.0f);
     return x;
 }
 
@@ -36,5 +38,29 @@ gltf_layers material_layers(const scene *s, const material *m, const surface_hit
         l.clearcoat = x->clearcoat * lookup_or_one(s, x->clearcoat_tex, h, 0).x;
         l.clearcoat_roughness = x->clearcoat_roughness * lookup_or_one(s, x->clearcoat_roughness_tex, h, 0).y;
     }
+    if (x->transmission > 0.0f) {
+        l.transmission = x->transmission * lookup_or_one(s, x->transmission_tex, h, 0).x;
+        /* A volume refracts: entering through the front (winding) side the index below is the
+         * ior, leaving through the back it is air's; thin-walled (or ior below 1, the spec-gloss
+         * convention) is not bent (docs/design.md, "Transmission and volume"). */
+        l.eta = 1.0f;
+        if (material_is_volume(m) && x->ior >= 1.0f) l.eta = h->backface ? 1.0f / x->ior : x->ior;
+    }
     return l;
+}
+
+vec3 material_absorption(const material *m) {
+    const material_ext *x = &m->ext;
+    if (!material_is_volume(m) || !isfinite(x->attenuation_distance) || !(x->attenuation_distance > 0.0f))
+        return v3s(0.0f);
+    /* A black channel absorbs at the rate of 1e-6 per attenuation distance: finite, so that
+     * exp(-sigma t) is 0 but sigma 0 never meets an infinity (a NaN). */
+    vec3 c = min3(max3(x->attenuation_color, v3s(1e-6f)), v3s(1.0f));
+    float inv = 1.0f / x->attenuation_distance;
+    return v3(-logf(c.x) * inv, -logf(c.y) * inv, -logf(c.z) * inv);
+}
+
+vec3 material_medium_after(const material *m, int backface, int lobe, vec3 sigma) {
+    if (lobe != BSDF_TRANSMIT || !material_is_volume(m)) return sigma;
+    return backface ? v3s(0.0f) : material_absorption(m);
 }

@@ -2,8 +2,9 @@
 
 #include "lights.h"
 
-/* The component a path belongs to, by the index of the vertex where it reaches an emitter
- * (0: the camera hit itself, 1: one bounce, i.e. direct lighting). */
+/* The component a path belongs to, by the scattering events before the vertex where it reaches
+ * an emitter, transmissions not counted (0: the camera hit itself, 1: one bounce, i.e. direct
+ * lighting, also through glass). */
 static inline film_component component_of(int emitter_vertex) {
     return emitter_vertex <= 1 ? COMP_DIRECT : COMP_INDIRECT;
 }
@@ -19,12 +20,12 @@ static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
 
 /* Emission le reached at vertex `depth` with MIS weight w: to its component, split into
  * highlights for the paths that reach the light at their third vertex. */
-static void add_emission(vec3 out[COMP_COUNT], int depth, int split_highlights, vec3 beta, vec3 beta_hl, vec3 le,
-                         float w) {
-    if (split_highlights && depth == 2)
+static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int split_highlights, vec3 beta, vec3 beta_hl,
+                         vec3 le, float w) {
+    if (split_highlights && depth == 2 && events == 2)
         add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
     else
-        out[component_of(depth)] = add3(out[component_of(depth)], scale3(mul3(beta, le), w));
+        out[component_of(events)] = add3(out[component_of(events)], scale3(mul3(beta, le), w));
 }
 
 /* A BSDF's lobes as next-event estimation sees them. */
@@ -47,19 +48,22 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
 }
 
 /* The path tracer, for a ray (o, d) whose closest hit the caller has traced: *first, or NULL when
- * the ray escaped. A continuation ray is a bounce of a path begun elsewhere: the emission it finds
- * first belongs to that path's direct light and is not counted. With split_highlights the paths
- * camera - glossy - glossy - light go to COMP_HIGHLIGHTS: the product of the two vertices'
- * highlight lobes, out of the same samples (the lobes add up to the BSDF). */
-static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surface_hit *first, rng_state *rng,
-                       vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation, int split_highlights,
-                       int first_lobes) {
+ * the ray escaped; the ray travels in a medium of absorption sigma. A continuation ray is a bounce
+ * of a path begun elsewhere: the emission it finds first belongs to that path's direct light and
+ * is not counted. With split_highlights the paths camera - glossy - glossy - light go to
+ * COMP_HIGHLIGHTS: the product of the two vertices' highlight lobes, out of the same samples (the
+ * lobes add up to the BSDF). max_depth counts scattering events; transmissions are free (beyond
+ * the depth only transmission carries on), up to PT_MAX_TRANSMISSIONS more vertices. */
+static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
+                       rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
+                       int split_highlights, int first_lobes) {
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     vec3 beta_hl = v3s(0.0f); /* the throughput through glossy lobes only (depths 1 and 2) */
     float prev_pdf = 0.0f;    /* solid-angle pdf of the BSDF sample that produced the current ray */
+    int prev_nee = 0;         /* whether next-event estimation could have found what that ray finds */
     vec3 prev_p = o;
-    for (int depth = 0;; depth++) {
+    for (int depth = 0, events = 0;; depth++) {
         surface_hit h;
         rays[depth == 0 && !continuation ? RAY_CAMERA : RAY_BOUNCE]++;
         int hit;
@@ -70,40 +74,49 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
         if (!hit) {
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (depth > 0 || !continuation)) {
-                float w = depth == 0 ? 1.0f : nee_emission_weight(s, prev_p, NULL, d, prev_pdf);
-                add_emission(out, depth, split_highlights, beta, beta_hl, le, w);
+                float w = prev_nee ? nee_emission_weight(s, prev_p, NULL, d, prev_pdf) : 1.0f;
+                add_emission(out, depth, events, split_highlights, mul3(beta, medium_transmittance(sigma, INFINITY)),
+                             beta_hl, le, w);
             }
             break;
         }
+        beta = mul3(beta, medium_transmittance(sigma, h.t));
         vec3 le = material_emission(s, &h);
         if (!is_black3(le) && (depth > 0 || !continuation)) {
-            float w = depth > 0 ? nee_emission_weight(s, prev_p, &h, d, prev_pdf) : 1.0f;
-            add_emission(out, depth, split_highlights, beta, beta_hl, le, w);
+            float w = prev_nee ? nee_emission_weight(s, prev_p, &h, d, prev_pdf) : 1.0f;
+            add_emission(out, depth, events, split_highlights, beta, beta_hl, le, w);
         }
-        if (depth >= max_depth) break;
+        if (depth >= max_depth + PT_MAX_TRANSMISSIONS) break;
 
         frame3 fr;
         bsdf b = material_bsdf(s, &h, &fr);
         vec3 wo = to_local(fr, neg3(d));
-        int lobes = depth > 0                           ? BSDF_ALL
+        int capped = events >= max_depth;
+        int lobes = capped                              ? BSDF_TRANSMIT
+                    : depth > 0                         ? BSDF_ALL
                     : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~bsdf_highlight_lobe(&b)
                                                         : first_lobes;
+        if (!(bsdf_lobes(&b) & lobes)) break;
 
-        /* Next-event estimation. */
-        float u_sel = rng_float(rng);
-        vec2 u_light = rng_vec2(rng);
-        bsdf_lobe lobe = {&b, fr, wo, lobes};
-        light_sample ls;
-        vec3 f;
-        vec3 arrival = nee_direct(s, h.p, h.ng, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
-        if (!is_black3(arrival)) {
-            vec3 c = mul3(mul3(beta, f), arrival);
-            if (split_highlights && depth == 1) {
-                vec3 wi = to_local(fr, ls.wi);
-                vec3 fg = scale3(bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b)), wi.z);
-                add_split(out, c, mul3(mul3(beta_hl, fg), arrival));
-            } else {
-                out[component_of(depth + 1)] = add3(out[component_of(depth + 1)], c);
+        /* Next-event estimation (not through the transmission: shadow rays stop at glass). */
+        if (!capped) {
+            float u_sel = rng_float(rng);
+            vec2 u_light = rng_vec2(rng);
+            bsdf_lobe lobe = {&b, fr, wo, lobes};
+            light_sample ls;
+            vec3 f;
+            vec3 arrival =
+                nee_direct(s, h.p, h.ng, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
+            if (!is_black3(arrival)) {
+                arrival = mul3(arrival, medium_transmittance(sigma, ls.dist));
+                vec3 c = mul3(mul3(beta, f), arrival);
+                if (split_highlights && depth == 1 && events == 1) {
+                    vec3 wi = to_local(fr, ls.wi);
+                    vec3 fg = scale3(bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b)), wi.z);
+                    add_split(out, c, mul3(mul3(beta_hl, fg), arrival));
+                } else {
+                    out[component_of(events + 1)] = add3(out[component_of(events + 1)], c);
+                }
             }
         }
 
@@ -113,13 +126,16 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
         bsdf_sample_result bs;
         if (!bsdf_sample(&b, wo, lobes, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
         vec3 wi = to_world(fr, bs.wi);
-        if (dot3(wi, h.ng) <= 0.0f) break; /* below the geometric surface: no transmission */
+        if (!bsdf_side_ok(bs.wi, dot3(wi, h.ng))) break; /* the shading normal's side, not the surface's */
         if (split_highlights && depth <= 1) {
             vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, bsdf_highlight_lobe(&b)), bs.wi.z / bs.pdf);
             beta_hl = depth == 0 ? fg : mul3(beta_hl, fg);
         }
-        beta = mul3(beta, scale3(bs.f, bs.wi.z / bs.pdf));
+        beta = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
         if (is_black3(beta) || !is_finite3(beta)) break;
+        sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
+        events += bs.lobe != BSDF_TRANSMIT;
+        prev_nee = bs.lobe != BSDF_TRANSMIT;
         prev_pdf = bs.pdf;
         prev_p = h.p;
         o = offset_origin(s, h.p, h.ng, wi);
@@ -131,7 +147,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, const surf
 
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
                  rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, first, rng, out, rays, 0, split_highlights, BSDF_ALL);
+    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL);
 }
 
 vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
@@ -140,7 +156,7 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     uint64_t camera_rays = rays[RAY_CAMERA];
     int n = first && samples > 1 ? samples : 1; /* an escaping ray has nothing to sample */
     for (int k = 0; k < n; k++) {
-        trace_path(s, 1, o, d, first, rng, out, rays, 0, 0, BSDF_ALL);
+        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL);
         sum = add3(sum, out[COMP_DIRECT]);
         if (rec && first) pixel_record_add(rec, avg3(out[COMP_DIRECT]));
     }
@@ -148,11 +164,11 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     return scale3(sum, 1.0f / (float)n);
 }
 
-int pt_reflected_direct(const scene *s, vec3 o, vec3 d, int lobes, rng_state *rng, vec3 *direct, surface_hit *first,
-                        uint64_t rays[RAY_KIND_COUNT]) {
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, rng_state *rng, vec3 *direct,
+                        surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
     int hit = scene_intersect(s, o, d, INFINITY, first);
-    trace_path(s, 1, o, d, hit ? first : NULL, rng, out, rays, 1, 0, lobes);
+    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, 0, lobes);
     *direct = out[COMP_DIRECT];
     return hit;
 }

@@ -19,6 +19,9 @@
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
                  rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
 
+/* Vertices a path may add beyond its depth by transmission alone (panes, a glass's two faces). */
+#define PT_MAX_TRANSMISSIONS 32
+
 /* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
  * max depth 1, so every method shares one direct estimator), the mean of `samples` estimates at
  * that hit; first as for pt_radiance. rec, when not NULL and there is a hit, records each one. */
@@ -29,8 +32,8 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
  * light that reaches the hit directly from an emitter and is reflected back along the ray by the
  * hit's BSDF lobes in the mask (BSDF_ALL, or BSDF_NOT_HIGHLIGHT where the highlight lobe's share
  * belongs to the highlight estimator). For estimators that continue a path and must not count the emission
- * their direct light has. */
-int pt_reflected_direct(const scene *s, vec3 o, vec3 d, int lobes, rng_state *rng, vec3 *direct, surface_hit *first,
-                        uint64_t rays[RAY_KIND_COUNT]);
+ * their direct light has. The ray travels in a medium of absorption sigma (0: air). */
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, rng_state *rng, vec3 *direct,
+                        surface_hit *first, uint64_t rays[RAY_KIND_COUNT]);
 
 #endif

@@ -55,7 +55,8 @@ typedef enum {
 } material_model;
 
 /* The glTF material extensions of the material model (KHR_materials_ior, _specular, _sheen,
- * _clearcoat): factors with their textures, combined at a hit by material_layers. */
+ * _clearcoat, _transmission, _volume): factors with their textures, combined at a hit by
+ * material_layers. */
 typedef struct {
     float ior;                            /* KHR_materials_ior: 1.5; 0 means F0 = 1 (spec-gloss conversions) */
     float specular;                       /* KHR_materials_specular: specularFactor, 1 */
@@ -70,6 +71,13 @@ typedef struct {
     float clearcoat_roughness;            /* perceptual */
     texture_slot clearcoat_tex;           /* linear: R */
     texture_slot clearcoat_roughness_tex; /* linear: G */
+    float transmission;                   /* KHR_materials_transmission: transmissionFactor, 0 */
+    texture_slot transmission_tex;        /* linear: R */
+    /* KHR_materials_volume: thicknessFactor > 0 makes the mesh a closed volume that refracts by
+     * the ior; its texture is for rasterisers (a ray measures the real path) and is not read. */
+    float thickness;            /* 0: thin-walled */
+    float attenuation_distance; /* INFINITY: no absorption */
+    vec3 attenuation_color;     /* 1 */
 } material_ext;
 
 /* glTF alphaMode. */
@@ -352,6 +360,25 @@ bsdf material_bsdf(const scene *s, const surface_hit *h, frame3 *frame);
 material_ext material_ext_default(void);
 /* A glTF material's extensions at a hit, their textures looked up (material_layers.c). */
 gltf_layers material_layers(const scene *s, const material *m, const surface_hit *h);
+/* KHR_materials_volume: the absorption coefficient inside m, -ln(attenuationColor) /
+ * attenuationDistance per channel (finite); 0 without a volume or without absorption. */
+vec3 material_absorption(const material *m);
+/* The medium a ray is in after scattering at h by `lobe`, having been in one of absorption sigma:
+ * a transmission through a volume's front (winding) side enters it, through its back leaves it
+ * for air; anything else stays. A ray leaving a volume it never entered (an open mesh) is in air.
+ * Nested volumes are not tracked. */
+vec3 material_medium_after(const material *m, int backface, int lobe, vec3 sigma);
+/* Beer-Lambert over distance t (INFINITY: a ray that escapes): exp(-sigma t), exactly 1 where
+ * sigma is 0 (no 0 x infinity). */
+static inline vec3 medium_transmittance(vec3 sigma, float t) {
+    if (is_black3(sigma)) return v3s(1.0f);
+    return v3(sigma.x > 0.0f ? expf(-sigma.x * t) : 1.0f, sigma.y > 0.0f ? expf(-sigma.y * t) : 1.0f,
+              sigma.z > 0.0f ? expf(-sigma.z * t) : 1.0f);
+}
+/* Whether m is a volume (KHR_materials_volume with a thickness): transmission there refracts. */
+static inline int material_is_volume(const material *m) {
+    return m->model == MATERIAL_GLTF && m->ext.thickness > 0.0f && m->ext.transmission > 0.0f;
+}
 /* Emitted radiance leaving the hit toward the side the ray came from (0 for the back of a
  * single-sided emitter). */
 vec3 material_emission(const scene *s, const surface_hit *h);

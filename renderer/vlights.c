@@ -5,6 +5,7 @@
 
 #include "knn.h"
 #include "lights.h"
+#include "pt.h"
 
 void vlight_set_free(vlight_set *set) {
     free(set->v);
@@ -39,17 +40,23 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
         float u_sel = rng_float(&rng);
         vec2 u_pos = rng_vec2(&rng), u_dir = rng_vec2(&rng);
         if (!light_sample_emission(s, u_sel, u_pos, u_dir, &e)) continue;
-        vec3 beta = e.power;
+        vec3 beta = e.power, sigma = v3s(0.0f);
         vec3 o = e.on_surface ? offset_origin(s, e.o, e.n, e.d) : e.o;
         vec3 d = e.d;
-        for (int depth = 1; depth < max_depth; depth++) {
+        /* events: scattering events so far, transmissions not counted (pt.c counts depth so); depth:
+         * every surface met, the lights' bounce. */
+        for (int depth = 1, events = 1; events < max_depth && depth < max_depth + PT_MAX_TRANSMISSIONS; depth++) {
             surface_hit h;
             (*bounce_rays)++;
             if (!scene_intersect(s, o, d, INFINITY, &h)) break;
+            beta = mul3(beta, medium_transmittance(sigma, h.t));
             virtual_light vl;
             memset(&vl, 0, sizeof vl);
-            vl.b = material_bsdf(s, &h, &vl.frame);
-            if (!bsdf_lobes(&vl.b)) break; /* black: absorbs everything */
+            bsdf b = material_bsdf(s, &h, &vl.frame);
+            if (!bsdf_lobes(&b)) break; /* black: absorbs everything */
+            /* No light is seen through a transmission (shadow rays stop at glass): the virtual
+             * light keeps the reflecting lobes, and the path carries on through the transmission. */
+            vl.b = bsdf_only(&b, BSDF_ALL & ~BSDF_TRANSMIT);
             vl.p = h.p;
             vl.ng = h.ng;
             vl.wi = to_local(vl.frame, neg3(d));
@@ -60,21 +67,25 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
             vec3 beta_in = scale3(beta, fmaxf(vl.wi.z, 0.0f) / dot3(neg3(d), h.ng));
             vl.power = beta_in;
             vl.depth = depth;
-            if (vl.wi.z > 0.0f && push(set, &vl) != 0) return -1;
-            if (depth + 1 >= max_depth) break;
+            if (vl.wi.z > 0.0f && bsdf_lobes(&vl.b) && push(set, &vl) != 0) return -1;
+            int capped = events + 1 >= max_depth;
+            if (capped && !(bsdf_lobes(&b) & BSDF_TRANSMIT)) break;
 
             bsdf_sample_result bs;
             float u_lobe = rng_float(&rng);
             vec2 u = rng_vec2(&rng);
-            if (!bsdf_sample(&vl.b, vl.wi, BSDF_ALL, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) break;
+            if (!bsdf_sample(&b, vl.wi, capped ? BSDF_TRANSMIT : BSDF_ALL, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) break;
             vec3 wi = to_world(vl.frame, bs.wi);
-            if (dot3(wi, h.ng) <= 0.0f) break;
-            vec3 gain = scale3(bs.f, dot3(wi, h.ng) / bs.pdf);
+            if (!bsdf_side_ok(bs.wi, dot3(wi, h.ng))) break;
+            /* Light flows from vl.wi to wi: the adjoint BSDF (refraction's eta^2). */
+            vec3 gain = scale3(bs.f, fabsf(dot3(wi, h.ng)) / bs.pdf * bsdf_adjoint_scale(&b, vl.wi, bs.wi));
             /* By the bounce's gain (the path's weight is the light's power), after a couple of
              * bounces. */
             if (depth >= 2 && !russian_roulette(&gain, rng_float(&rng))) break;
             beta = mul3(beta_in, gain);
             if (is_black3(beta) || !is_finite3(beta)) break;
+            sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
+            events += bs.lobe != BSDF_TRANSMIT;
             o = offset_origin(s, h.p, h.ng, wi);
             d = wi;
         }

@@ -29,6 +29,7 @@ typedef struct {
     frame3 frame;
     bsdf b;
     vec3 wo;
+    int material, backface; /* the hit's, for the medium beyond a transmission */
 } shading_point;
 
 /* Phi_j f_x(v, l) cos_x f_j(i_j, -l) cos_j / d^2, no visibility, unclamped. */

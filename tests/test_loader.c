@@ -280,7 +280,8 @@ static void test_materials(void) {
                          "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"material\":3}]}]";
     const char *extra =
         "\"extensionsUsed\":[\"KHR_materials_emissive_strength\",\"KHR_materials_clearcoat\",\"EXT_made_up\","
-        "\"KHR_materials_sheen\",\"KHR_materials_specular\",\"KHR_materials_ior\"],"
+        "\"KHR_materials_sheen\",\"KHR_materials_specular\",\"KHR_materials_ior\",\"KHR_materials_transmission\","
+        "\"KHR_materials_volume\"],"
         "\"materials\":["
         "{\"name\":\"phong\",\"extras\":{\"glint\":{\"model\":\"phong\",\"kd\":[0.1,0.2,0.3],\"ks\":[0.5,0.5,0.5],"
         "\"exponent\":250}}},"
@@ -293,7 +294,9 @@ static void test_materials(void) {
         "\"clearcoatRoughnessFactor\":0.3,\"clearcoatNormalTexture\":{\"index\":0}},"
         "\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.1,0.2,1.5],\"sheenRoughnessFactor\":0.4},"
         "\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[2,1,0.5]},"
-        "\"KHR_materials_ior\":{\"ior\":1.33}}}]";
+        "\"KHR_materials_ior\":{\"ior\":1.33},\"KHR_materials_transmission\":{\"transmissionFactor\":1.5},"
+        "\"KHR_materials_volume\":{\"thicknessFactor\":0.1,\"attenuationDistance\":2,"
+        "\"attenuationColor\":[0.5,1.2,0.25]}}}]";
     scene *s = load(write_gltf("materials.gltf", gltf_json(NULL, meshes, extra, NULL)), err, sizeof err);
     CHECK(s != NULL, "materials: %s", err);
     if (!s) return;
@@ -323,6 +326,14 @@ static void test_materials(void) {
             CHECK(fabsf(x->sheen_color.z - 1.0f) < 1e-6f && fabsf(x->sheen_roughness - 0.4f) < 1e-6f, "sheen");
             CHECK(x->specular == 0.5f && x->specular_color.x == 2.0f && fabsf(x->ior - 1.33f) < 1e-6f,
                   "specular %g (%g), ior %g", (double)x->specular, (double)x->specular_color.x, (double)x->ior);
+            /* transmission and the attenuation colour are 0-1 factors (clamped, with a warning) */
+            CHECK(x->transmission == 1.0f && fabsf(x->thickness - 0.1f) < 1e-6f && x->attenuation_distance == 2.0f &&
+                      x->attenuation_color.y == 1.0f && x->attenuation_color.z == 0.25f && material_is_volume(m),
+                  "transmission %g, volume %g %g (%g %g %g)", (double)x->transmission, (double)x->thickness,
+                  (double)x->attenuation_distance, (double)x->attenuation_color.x, (double)x->attenuation_color.y,
+                  (double)x->attenuation_color.z);
+            CHECK(fabsf(material_absorption(m).x - logf(2.0f) / 2.0f) < 1e-6f, "absorption %g",
+                  (double)material_absorption(m).x);
         } else if (m->ext.ior != 1.5f) {
             CHECK(0, "material %s: ior %g without KHR_materials_ior", m->name, (double)m->ext.ior);
         }
@@ -394,6 +405,18 @@ static void test_malformed(void) {
         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"material\":0}]}]";
     expect_error("missing texture", write_gltf("notex.gltf", gltf_json(NULL, tex_mesh, tex_extra, NULL)),
                  "no-such-texture.png");
+    const char *bad_volume[][2] = {
+        {"{\"KHR_materials_volume\":{\"attenuationDistance\":0}}", "attenuationDistance 0 is below"},
+        {"{\"KHR_materials_volume\":{\"thicknessFactor\":-1}}", "thicknessFactor -1 is below"},
+        {"{\"KHR_materials_volume\":{\"attenuationColor\":[1,1]}}", "attenuationColor is not three numbers"},
+        {"{\"KHR_materials_transmission\":{\"transmissionFactor\":\"x\"}}", "transmissionFactor is not a"},
+        {"{\"KHR_materials_transmission\":{\"transmissionTexture\":{\"index\":9}}}", "texture 9"}};
+    for (int i = 0; i < 5; i++) {
+        char extra[512];
+        snprintf(extra, sizeof extra, "\"materials\":[{\"extensions\":%s}]", bad_volume[i][0]);
+        expect_error(bad_volume[i][1], write_gltf("badvolume.gltf", gltf_json(NULL, tex_mesh, extra, NULL)),
+                     bad_volume[i][1]);
+    }
 
     /* An external .bin that is too short for its declared byteLength. */
     write_bytes(tmp_path("short.bin"), bin, 100);

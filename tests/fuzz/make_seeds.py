@@ -125,6 +125,20 @@ d["textures"] = [{"source": 0}]
 d["images"] = [{"uri": "tex.png"}]
 d["buffers"][0]["uri"] = "quad.bin"
 seeds["papers-materials.gltf"] = d
+# Glass: a transmission texture, a volume with absorption, a thin-walled pane (issue 21).
+d = embedded()
+d["meshes"][0]["primitives"][0]["material"] = 0
+d["materials"] = [{"name": "glass", "pbrMetallicRoughness": {"roughnessFactor": 0.2},
+                   "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1,
+                                                                 "transmissionTexture": {"index": 0}},
+                                  "KHR_materials_volume": {"thicknessFactor": 0.5, "attenuationDistance": 0.3,
+                                                           "attenuationColor": [0.9, 0.5, 0.1]},
+                                  "KHR_materials_ior": {"ior": 1.45}}}]
+d["textures"] = [{"source": 0}]
+d["images"] = [{"uri": "tex.png"}]
+d["buffers"][0]["uri"] = "quad.bin"
+d["extensionsUsed"] = ["KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_ior"]
+seeds["glass.gltf"] = d
 # Normal maps, texture transforms, alpha, emissive textures and material variants, instanced twice.
 tt = {"KHR_texture_transform": {"offset": [0.5, 0.25], "rotation": 0.7, "scale": [2, -1], "texCoord": 1}}
 d = embedded()
