@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "camera.h"
@@ -78,6 +79,11 @@ static void print_render_help(void) {
 
 /* --shard I/N: the frames I, I + N, ... of the render --spp asks for, which is then the whole
  * render's; the shard renders its share. 0, or -1 after a usage error. */
+static int has_suffix(const char *name, const char *suffix) {
+    size_t n = strlen(name), k = strlen(suffix);
+    return n > k && strcasecmp(name + n - k, suffix) == 0;
+}
+
 static int parse_shard(render_options *o) {
     long long i, n;
     char first[32];
@@ -144,6 +150,11 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         return cli_error("--highlights-layer: only pt and vsl+hl split highlights off (vpl and vsl count them "
                          "as indirect)"),
                -1;
+    /* The format follows the option, not the name: an EXR named .png would fool every viewer. */
+    if (o->out_exr && !has_suffix(o->out_exr, ".exr"))
+        return cli_error("%s: --out writes OpenEXR: name it .exr (--png writes a PNG)", o->out_exr), -1;
+    if (o->out_png && !has_suffix(o->out_png, ".png"))
+        return cli_error("%s: --png writes a PNG: name it .png (--out writes OpenEXR)", o->out_png), -1;
     if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
     if (o->shard) return parse_shard(o);
     return 0;
@@ -223,6 +234,7 @@ static int write_stats(const char *path, const render_options *o, const render_s
                 (unsigned long long)st.light_paths, (unsigned long long)st.vl_connections,
                 (unsigned long long)st.vsl_samples);
         fprintf(f, "  \"glossy_bounces\": %llu,\n", (unsigned long long)st.glossy_bounces);
+        fprintf(f, "  \"pixel_points\": %llu,\n", (unsigned long long)st.pixel_points);
         fprintf(f, "  \"clamped\": %llu,\n  \"rows\": %d,\n  \"columns\": %d", (unsigned long long)st.clamped,
                 vp.columns > 0 ? vp.rows : 0, vp.columns);
     }

@@ -400,11 +400,15 @@ static void test_output_roles(void) {
     char link_path[1100];
     snprintf(link_path, sizeof link_path, "%s/roles-link.gltf", tmp);
     CHECK(symlink("roles.gltf", link_path) == 0, "symlink: %s", strerror(errno));
-    expect_failure("render --spp 1 --size 8x8 --out same.exr --png same.exr", 2, "--out and --png name the same file");
+    /* The format follows the option: an EXR named .png (or a PNG named .exr) is refused. */
+    expect_failure("render --spp 1 --size 8x8 --out same.exr --png same.exr", 2, "--png writes a PNG");
+    expect_failure("render --spp 1 --size 8x8 --out picture.png", 2, "--out writes OpenEXR");
+    CHECK(!file_exists("picture.png"), "--out picture.png wrote a file");
     expect_failure("render --spp 1 --size 8x8 --out same.exr --stats ./same.exr", 2, "--out and --stats");
     expect_failure("render --spp 1 --size 8x8 --png same.png --stats ../cli/same.png", 2, "--png and --stats");
-    expect_failure("render roles.gltf --spp 1 --size 8x8 --png roles.gltf", 2, "is the scene");
-    expect_failure("render roles-link.gltf --spp 1 --size 8x8 --out roles.gltf", 2, "is the scene");
+    /* A scene is no .png or .exr: the names' check refuses it first. */
+    expect_failure("render roles.gltf --spp 1 --size 8x8 --png roles.gltf", 2, "--png writes a PNG");
+    expect_failure("render roles-link.gltf --spp 1 --size 8x8 --out roles.gltf", 2, "--out writes OpenEXR");
     expect_failure("render roles.gltf --env roles-sky.exr --spp 1 --size 8x8 --out roles-sky.exr", 2,
                    "is the environment map");
     expect_failure("info roles.gltf --obj roles.gltf", 2, "is the scene");
