@@ -418,23 +418,32 @@ static int hit_record(hl_hit *hit, const shading_point *q, vec3 weight, const fl
     return total > 0.0f && isfinite(total) ? HIT_VMF : HIT_NONE;
 }
 
-vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_state *rng, render_stats *st) {
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, int rays, rng_state *rng,
+                 render_stats *st) {
     vec3 sum = v3(0, 0, 0);
-    if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) return sum;
-    int n = h->secondary_rays;
+    int n = rays > 0 && rays <= HL_MAX_SECONDARY_RAYS ? rays : h->secondary_rays;
+    if (points < 1) return sum;
+    if (points > n) points = n;
+    int lit = 0;
+    for (int j = 0; j < points; j++) lit += bsdf_highlight_lobe(&xs[j].b) && xs[j].wo.z > 0.0f;
+    if (!lit) return sum;
     hl_hit hits[HL_MAX_SECONDARY_RAYS];
     vec3 dirs[HL_MAX_SECONDARY_RAYS];
     float alpha[HL_MAX_SECONDARY_RAYS];
     int count = 0;
-    st->hl_points++;
-    /* The N directions stratified over the lobe: a randomly shifted R2 sequence. */
+    st->hl_points += (uint64_t)lit;
+    /* The N directions stratified over the lobe: a randomly shifted R2 sequence, ray k from point
+     * k mod points, each point's rays weighted 1 / (points x its rays): the mean over the points. */
     vec2 shift = rng_vec2(rng);
     for (int k = 0; k < n; k++) {
+        const shading_point *x = &xs[k % points];
+        if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) continue;
+        int per_point = n / points + (k % points < n % points);
         bsdf_sample_result bs;
         if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, sample_r2(k, shift), &bs) || !(bs.pdf > 0.0f)) continue;
         vec3 wi = to_world(x->frame, bs.wi);
         if (dot3(wi, x->ng) <= 0.0f) continue;
-        vec3 weight = scale3(bs.f, bs.wi.z / (bs.pdf * (float)n));
+        vec3 weight = scale3(bs.f, bs.wi.z / (bs.pdf * (float)(per_point * points)));
         surface_hit hq;
         st->rays[RAY_BOUNCE]++;
         st->hl_secondary_rays++;

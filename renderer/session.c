@@ -32,6 +32,8 @@ typedef struct {
  * light is easy) a third of its frames for little (docs/benchmarks.md). */
 #define MANYLIGHT_DIRECT_SAMPLES 4
 #define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
+#define HL_MAX_ADAPT_RAYS 128           /* secondary rays per pixel, with --adapt */
+#define PIXEL_POINTS 32                 /* at most, camera hits a pixel's highlight rays start from (--adapt) */
 
 struct render_session {
     const scene *scene;
@@ -47,7 +49,7 @@ struct render_session {
     /* Many-light frames with --adapt: each pixel's directions through sharp lobes and direct-light
      * samples, from the spread of one sample's light in earlier frames */
     int adapt;
-    pixel_alloc glossy, direct;
+    pixel_alloc glossy, direct, highlight;
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
@@ -97,10 +99,15 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         return NULL;
     }
     if (pixel_alloc_init(&rs->glossy, p->width * p->height) != 0 ||
-        pixel_alloc_init(&rs->direct, p->width * p->height) != 0) {
+        pixel_alloc_init(&rs->direct, p->width * p->height) != 0 ||
+        pixel_alloc_init(&rs->highlight, p->width * p->height) != 0) {
         session_destroy(rs);
         return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
     }
+    /* A highlight record holds one value a frame (the merge's estimate over all its rays): with
+     * few values the spread is uncertain, so half the rays go to every pixel alike (all in
+     * proportion to the spread measured worse than none, docs/benchmarks.md). */
+    rs->highlight.even = 0.5f;
     rs->plan = session_make_plan(rs);
     rs->tiles_x = (p->width + TILE - 1) / TILE;
     rs->tiles_y = (p->height + TILE - 1) / TILE;
@@ -113,6 +120,7 @@ void session_destroy(render_session *rs) {
     manylight_deinit(&rs->ml);
     pixel_alloc_free(&rs->glossy);
     pixel_alloc_free(&rs->direct);
+    pixel_alloc_free(&rs->highlight);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -128,12 +136,63 @@ static uint64_t next_frame_index(const render_session *rs) {
     return (uint64_t)p->shard_index + (uint64_t)rs->frames * (uint64_t)p->shard_count;
 }
 
-/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
-static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 d, const surface_hit *first,
-                          rng_state *rng) {
+/* n camera hits spread over a pixel: the frame's own first (NULL: none), then more at R2
+ * positions over the pixel. */
+static void pixel_points(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                         const surface_hit *first, shading_point *xs, int n) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
-    if (!first && !s->env) { /* into the void: every component is zero, nothing to add */
+    rng_state start = rng_for((uint64_t)pixel, UINT64_MAX - 1, p->seed);
+    vec2 shift = rng_vec2(&start);
+    for (int j = 0; j < n; j++) {
+        const surface_hit *h = first;
+        surface_hit hit;
+        vec3 dir = d;
+        if (j > 0) {
+            int index = (int)((next_frame_index(rs) * (PIXEL_POINTS - 1) + (uint64_t)j) & 0x3fffffff);
+            vec2 u = sample_r2(index, shift);
+            dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
+            st->rays[RAY_CAMERA]++;
+            st->pixel_points++;
+            h = scene_intersect(s, rs->cam.position, dir, INFINITY, &hit) ? &hit : NULL;
+        }
+        if (h) {
+            xs[j] = shading_point_at(s, h, dir);
+        } else {
+            memset(&xs[j], 0, sizeof xs[j]);
+            xs[j].b.dropped = BSDF_ALL; /* no lobe: adds zero */
+        }
+    }
+}
+
+/* The highlights of a pixel. A highlight is often smaller than the pixel (a curved mirror's image
+ * of a lit speck), and there more positions in the pixel beat more rays from one: once the pixel
+ * has met a highlight lobe (with --adapt), each secondary ray starts from its own point of the
+ * pixel, up to PIXEL_POINTS. Earlier frames decide this, so each frame's estimate stays unbiased
+ * (docs/design.md, "Where the samples go"). */
+static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                             const surface_hit *first, rng_state *rng) {
+    rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
+    int rays = rs->adapt ? rs->highlight.samples[pixel] : rs->hl.secondary_rays;
+    int spread = rs->adapt && rs->highlight.rec[pixel].n > 0.0f;
+    int points = !spread || rays < 1 ? 1 : rays < PIXEL_POINTS ? rays : PIXEL_POINTS;
+    shading_point xs[PIXEL_POINTS];
+    pixel_points(rs, st, raster, pixel, d, first, xs, points);
+    vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, rays, &hl_rng, st);
+    /* Only pixels that meet a highlight lobe spend rays: only they keep a record. */
+    int any = 0;
+    for (int j = 0; j < points; j++) any |= bsdf_highlight_lobe(&xs[j].b);
+    if (rs->adapt && any) pixel_record_add_mean(&rs->highlight.rec[pixel], avg3(L), (float)rays);
+    return L;
+}
+
+/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
+static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                          const surface_hit *first, rng_state *rng) {
+    const scene *s = rs->scene;
+    const render_params *p = &rs->params;
+    int spread = rs->adapt && rs->plan.highlights && rs->highlight.rec[pixel].n > 0.0f;
+    if (!first && !s->env && !spread) { /* into the void: every component is zero, nothing to add */
         st->rays[RAY_CAMERA]++;
         return;
     }
@@ -154,21 +213,18 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
             st->rays[RAY_CAMERA]++;
         uint64_t t1 = clock_ns();
         st->pass_ns[PASS_DIRECT] += t1 - t0;
-        if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
+        if (first && depth > 1 && rs->plan.virtual_lights) {
             shading_point sp = shading_point_at(s, first, d);
-            rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
-            if (rs->plan.virtual_lights) {
-                L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth,
-                                                      rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
-                                                      rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
-                uint64_t t2 = clock_ns();
-                st->pass_ns[PASS_GATHER] += t2 - t1;
-                t1 = t2;
-            }
-            if (rs->plan.highlights) {
-                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &hl_rng, st);
-                st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
-            }
+            L[COMP_INDIRECT] =
+                manylight_indirect(&rs->ml, s, &sp, depth, rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
+                                   rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
+            uint64_t t2 = clock_ns();
+            st->pass_ns[PASS_GATHER] += t2 - t1;
+            t1 = t2;
+        }
+        if (depth > 1 && rs->plan.highlights) {
+            L[COMP_HIGHLIGHTS] = pixel_highlights(rs, st, raster, pixel, d, first, rng);
+            st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
         }
     }
     float sample[COMP_COUNT][3];
@@ -225,7 +281,7 @@ static void render_tile(void *ctx, int tile, int worker) {
             unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
             if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
             for (int i = 0; i < n; i++)
-                render_sample(rs, st, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
+                render_sample(rs, st, &raster, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
         }
     }
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;
@@ -240,6 +296,10 @@ int session_render_frame(render_session *rs) {
                          p->seed ^ 0x646972656374ULL);
         if (rs->plan.virtual_lights)
             pixel_alloc_plan(&rs->glossy, vl_params_resolve(&p->vl).glossy_rays, VL_MAX_GLOSSY_RAYS, frame, p->seed);
+        int hl_budget = vl_params_resolve(&p->vl).secondary_rays;
+        if (hl_budget > HL_MAX_ADAPT_RAYS) hl_budget = HL_MAX_ADAPT_RAYS;
+        if (rs->plan.highlights)
+            pixel_alloc_plan(&rs->highlight, hl_budget, HL_MAX_ADAPT_RAYS, frame, p->seed ^ 0x686967686cULL);
     }
     if (rs->plan.highlights) {
         if (rs->plan.env_prefilter && (!rs->envf || rs->envf_map != rs->scene->env)) {
@@ -273,6 +333,7 @@ int session_render_frame(render_session *rs) {
         t->vsl_samples += st->vsl_samples;
         t->clamped += st->clamped;
         t->glossy_bounces += st->glossy_bounces;
+        t->pixel_points += st->pixel_points;
         t->hl_points += st->hl_points;
         t->hl_secondary_rays += st->hl_secondary_rays;
         t->hl_lobes += st->hl_lobes;
@@ -291,6 +352,7 @@ void session_reset(render_session *rs) {
     film_clear(&rs->film);
     pixel_alloc_reset(&rs->glossy);
     pixel_alloc_reset(&rs->direct);
+    pixel_alloc_reset(&rs->highlight);
     rs->frames = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }
