@@ -430,6 +430,7 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
     hl_hit hits[HL_MAX_SECONDARY_RAYS];
     vec3 dirs[HL_MAX_SECONDARY_RAYS];
     float alpha[HL_MAX_SECONDARY_RAYS];
+    int hit_point[HL_MAX_SECONDARY_RAYS];
     int count = 0;
     st->hl_points += (uint64_t)lit;
     /* The N directions stratified over the lobe: a randomly shifted R2 sequence, ray k from point
@@ -471,29 +472,39 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
             continue;
         }
         dirs[count] = hit->mu;
+        hit_point[count] = k % points;
         alpha[count] = 0.0f;
         for (int b = 0; b < hit->bands; b++) alpha[count] += hit->lum[b];
         count++;
     }
     if (count == 0) return sum;
-
-    uint64_t t0 = clock_ns();
-    int assign[HL_MAX_SECONDARY_RAYS], members[HL_MAX_SECONDARY_RAYS];
-    int k = vmf_em(dirs, alpha, count, h->clusters, assign);
-    hl_cluster clusters[HL_MAX_CLUSTERS];
-    int used = 0;
-    for (int c = 0; c < k; c++) {
+    /* Each point's lobes are merged among themselves: rays from points spread over a curved mirror
+     * part ways, and lobes merged across them made the highlights 18% off on atelier. */
+    for (int j = 0; j < points; j++) {
+        uint64_t t0 = clock_ns();
+        int index[HL_MAX_SECONDARY_RAYS], assign[HL_MAX_SECONDARY_RAYS], members[HL_MAX_SECONDARY_RAYS];
+        vec3 pdirs[HL_MAX_SECONDARY_RAYS];
+        float palpha[HL_MAX_SECONDARY_RAYS];
         int m = 0;
         for (int i = 0; i < count; i++)
-            if (assign[i] == c) members[used + m++] = i;
-        cluster_make(&clusters[c], hits, &members[used], m);
-        used += m;
+            if (hit_point[i] == j) index[m] = i, pdirs[m] = dirs[i], palpha[m] = alpha[i], m++;
+        if (m == 0) continue;
+        int k = vmf_em(pdirs, palpha, m, h->clusters, assign);
+        hl_cluster clusters[HL_MAX_CLUSTERS];
+        int used = 0;
+        for (int c = 0; c < k; c++) {
+            int n_c = 0;
+            for (int i = 0; i < m; i++)
+                if (assign[i] == c) members[used + n_c++] = index[i];
+            cluster_make(&clusters[c], hits, &members[used], n_c);
+            used += n_c;
+        }
+        st->hl_merge_ns += clock_ns() - t0;
+        for (int c = 0; c < k; c++) {
+            lit_lobe l = {clusters[c].origin, clusters[c].n, &clusters[c], NULL, v3(0, 0, 0)};
+            sum = add3(sum, light_lobe(h, s, &l, rng, st));
+        }
+        st->hl_lobes += (uint64_t)k;
     }
-    st->hl_merge_ns += clock_ns() - t0;
-    for (int c = 0; c < k; c++) {
-        lit_lobe l = {clusters[c].origin, clusters[c].n, &clusters[c], NULL, v3(0, 0, 0)};
-        sum = add3(sum, light_lobe(h, s, &l, rng, st));
-    }
-    st->hl_lobes += (uint64_t)k;
     return sum;
 }
