@@ -37,6 +37,10 @@ std::string texture_transform(const tinygltf::Value &x, float xf[6], int *texcoo
 std::string material_transmission_volume(const std::string &name, const tinygltf::Value &e, material_ext *x,
                                          const std::function<texture_slot(const char *)> &texture, bool *clamped);
 
+// The scale of the normal textureInfo under key (e: an extension's object) into *scale, untouched
+// when absent; a non-number or one beyond +-limit is the problem.
+std::string normal_scale(const tinygltf::Value &e, const char *key, double limit, float *scale);
+
 // The file's material variants, by name, into s.
 std::string read_variants(scene *s, const tinygltf::Model &m);
 
