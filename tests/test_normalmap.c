@@ -303,6 +303,24 @@ static void test_tilt_matches_geometry(void) {
     CHECK_NEAR(images[0], images[1], 1e-4f * expect, "the mapped plane against the tilted one");
 }
 
+/* The direct light along the ray from (0, -1, 4) to the origin, where the test planes pass, under
+ * a directional light of radiance 2 travelling along dir; s is finalized and destroyed here. */
+static vec3 direct_at_centre(scene *s, vec3 dir, const char *what) {
+    light l = {.type = LIGHT_DIRECTIONAL, .color = v3s(2.0f), .direction = dir};
+    scene_add_light(s, &l);
+    ts_finalize(s);
+    vec3 o = v3(0.0f, -1.0f, 4.0f), d = normalize3(neg3(o));
+    surface_hit h;
+    vec3 comp[COMP_COUNT] = {{0}};
+    int hit = scene_intersect(s, o, d, INFINITY, &h);
+    CHECK(hit, "%s: no hit", what);
+    rng_state rng = rng_for(3, 0, 0);
+    uint64_t rays[RAY_KIND_COUNT] = {0};
+    if (hit) pt_radiance(s, 1, 0, o, d, &h, &rng, comp, rays);
+    scene_destroy(s);
+    return comp[COMP_DIRECT];
+}
+
 /* A glossy lobe sees the mapped normal too: the same ray on the mapped and on the tilted plane
  * (through the centre, where both planes pass) returns the same radiance. */
 static void test_glossy_tilt(void) {
@@ -322,18 +340,7 @@ static void test_glossy_tilt(void) {
         } else {
             square(s, mapped_material(s, m, texel, 1.0f), 0);
         }
-        light l = {.type = LIGHT_DIRECTIONAL, .color = v3s(2.0f), .direction = normalize3(v3(-0.1f, 0.2f, -1.0f))};
-        scene_add_light(s, &l);
-        ts_finalize(s);
-        vec3 o = v3(0.0f, -1.0f, 4.0f), d = normalize3(neg3(o));
-        surface_hit h;
-        CHECK(scene_intersect(s, o, d, INFINITY, &h), "glossy tilt: hit");
-        rng_state rng = rng_for(3, 0, 0);
-        vec3 comp[COMP_COUNT];
-        uint64_t rays[RAY_KIND_COUNT] = {0};
-        pt_radiance(s, 1, 0, o, d, &h, &rng, comp, rays);
-        out[geometric] = comp[COMP_DIRECT];
-        scene_destroy(s);
+        out[geometric] = direct_at_centre(s, normalize3(v3(-0.1f, 0.2f, -1.0f)), "glossy tilt");
     }
     CHECK(out[0].x > 0.01f, "glossy tilt: the test ray sees no highlight (%g)", out[0].x);
     CHECK_NEAR(out[0].x, out[1].x, 1e-4f * out[1].x, "glossy lobe on the mapped plane against the tilted one");
@@ -413,18 +420,7 @@ static void test_coat_tilt(void) {
                 tilted_square(s, ts_material(s, m), n_map);
             else
                 square(s, coat_material(s, m, texel, 1.0f, NULL), 0);
-            light l = {.type = LIGHT_DIRECTIONAL, .color = v3s(2.0f), .direction = neg3(to_light[k])};
-            scene_add_light(s, &l);
-            ts_finalize(s);
-            vec3 o = v3(0.0f, -1.0f, 4.0f), d = normalize3(neg3(o));
-            surface_hit h;
-            CHECK(scene_intersect(s, o, d, INFINITY, &h), "coat tilt: hit");
-            rng_state rng = rng_for(3, 0, 0);
-            vec3 comp[COMP_COUNT];
-            uint64_t rays[RAY_KIND_COUNT] = {0};
-            pt_radiance(s, 1, 0, o, d, &h, &rng, comp, rays);
-            out[geometric] = comp[COMP_DIRECT];
-            scene_destroy(s);
+            out[geometric] = direct_at_centre(s, neg3(to_light[k]), "coat tilt");
         }
         CHECK(out[1].x > 1e-3f, "coat tilt %d: the tilted plane's coat reflects nothing (%g)", k, out[1].x);
         /* 1e-3: near its peak the float GGX moves by a few 1e-4 for float-sized changes of direction
