@@ -1,6 +1,6 @@
 // glint — KHR_texture_transform, KHR_materials_variants, KHR_materials_transmission and
-// KHR_materials_volume, the clear coat's normal map's scale, from tinygltf's JSON values, checked (docs/design.md, "Texture
-// transforms", "Material variants", "Transmission and volume").
+// KHR_materials_volume, and the clear coat's normal map's scale, from tinygltf's JSON values,
+// checked (docs/design.md, "Texture transforms", "Material variants", "Transmission and volume").
 #include "gltf_extensions.h"
 
 #include <cmath>

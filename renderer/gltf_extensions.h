@@ -1,7 +1,7 @@
 // glint — glTF extensions read from tinygltf's JSON values (C++ only, used by gltf_import.cpp):
 // KHR_texture_transform on a texture reference, KHR_materials_variants, and the material model's
-// KHR_materials_transmission and _volume. Each returns "" or the problem, for the importer's
-// one-line error.
+// KHR_materials_transmission and _volume, and a normal textureInfo's scale inside an extension.
+// Each returns "" or the problem, for the importer's one-line error.
 #ifndef GLINT_GLTF_EXTENSIONS_H
 #define GLINT_GLTF_EXTENSIONS_H
 
