@@ -430,7 +430,7 @@ vec3 bsdf_diffuse_albedo(const bsdf *b, vec3 wo) {
     if (b->couple_f0 > 0.0f || b->couple_f90 > 0.0f) d = scale3(d, coupled_transmittance(b, wo.z));
     d = scale3(d, sheen_scale(b, wo.z, wo.z));
     if (!is_black3(b->sheen)) d = add3(d, scale3(b->sheen, sheen_albedo(b->sheen_rough, wo.z)));
-    return scale3(d, coat_scale_dirs(b, wo, wo));
+    return b->coat > 0.0f ? scale3(d, coat_scale_dirs(b, wo, wo)) : d;
 }
 
 /* ---- transmission (docs/design.md, "Transmission and volume") --------------------------------- */
@@ -723,7 +723,7 @@ vec3 bsdf_eval(const bsdf *b, vec3 wo, vec3 wi, int lobes) {
 float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi, int lobes) {
     if (wo.z <= 0.0f || wi.z == 0.0f) return 0.0f;
     lobes &= bsdf_lobes(b);
-    float pt = transmit_prob(b, wo, lobes);
+    float pt = lobes & BSDF_TRANSMIT ? transmit_prob(b, wo, lobes) : 0.0f; /* no call on the common path */
     if (wi.z < 0.0f) return pt > 0.0f ? pt * pdf_transmit(b, wo, wi) : 0.0f;
     float pg = reflect_glossy_prob(b, wo, lobes);
     float pdf = 0.0f;
@@ -736,7 +736,7 @@ int bsdf_sample(const bsdf *b, vec3 wo, int lobes, float u_lobe, vec2 u, bsdf_sa
     if (wo.z <= 0.0f) return 0;
     lobes &= bsdf_lobes(b);
     if (!lobes) return 0;
-    float pt = transmit_prob(b, wo, lobes);
+    float pt = lobes & BSDF_TRANSMIT ? transmit_prob(b, wo, lobes) : 0.0f; /* no call on the common path */
     vec3 wi;
     int lobe;
     if (u_lobe < pt) {
