@@ -361,12 +361,24 @@ static bsdf coat_lobe(const bsdf *b) {
     return c;
 }
 
+/* The coat's own normal (docs/design.md, "The glTF material"): the coat lobe is the one a surface
+ * tilted to coat_n reflects, its layer's albedo taken at the cosines to coat_n. */
+static int coat_tilted(const bsdf *b) { return b->coat_n.z < 1.0f - 1e-6f && length_sq3(b->coat_n) > 0.5f; }
+
+/* |cos| of w to the coat's normal. */
+static float coat_cos(const bsdf *b, vec3 w) { return fabsf(coat_tilted(b) ? dot3(b->coat_n, w) : w.z); }
+
 /* What a layer of weight w and albedo E leaves to what lies under it for the pair (wo, wi):
  * 1 - w max(E(wo), E(wi)), the sheen extension's reciprocal albedo scaling (docs/design.md). */
 static float coat_scale(const bsdf *b, float cos_o, float cos_i) {
     if (!(b->coat > 0.0f)) return 1.0f;
     float e = fmaxf(ggx_albedo(b->coat_alpha, 0.04f, 1.0f, cos_o), ggx_albedo(b->coat_alpha, 0.04f, 1.0f, cos_i));
     return 1.0f - b->coat * fminf(e, 1.0f);
+}
+
+/* The same for the pair's directions, at their cosines to the coat's normal. */
+static float coat_scale_dirs(const bsdf *b, vec3 wo, vec3 wi) {
+    return b->coat > 0.0f ? coat_scale(b, coat_cos(b, wo), coat_cos(b, wi)) : 1.0f;
 }
 
 static float sheen_scale(const bsdf *b, float cos_o, float cos_i) {
@@ -407,8 +419,8 @@ vec3 bsdf_glossy_albedo(const bsdf *b, vec3 wo) {
         base = scale3(b->specular, albedo_lookup(b->model == GLOSSY_PHONG ? ALBEDO_PHONG : ALBEDO_WARD, alpha, wo.z));
     }
     if (b->coat > 0.0f || !is_black3(b->sheen))
-        base = scale3(base, coat_scale(b, wo.z, wo.z) * sheen_scale(b, wo.z, wo.z));
-    if (b->coat > 0.0f) base = add3(base, v3s(b->coat * ggx_albedo(b->coat_alpha, 0.04f, 1.0f, wo.z)));
+        base = scale3(base, coat_scale_dirs(b, wo, wo) * sheen_scale(b, wo.z, wo.z));
+    if (b->coat > 0.0f) base = add3(base, v3s(b->coat * ggx_albedo(b->coat_alpha, 0.04f, 1.0f, coat_cos(b, wo))));
     return base;
 }
 
@@ -418,7 +430,7 @@ vec3 bsdf_diffuse_albedo(const bsdf *b, vec3 wo) {
     if (b->couple_f0 > 0.0f || b->couple_f90 > 0.0f) d = scale3(d, coupled_transmittance(b, wo.z));
     d = scale3(d, sheen_scale(b, wo.z, wo.z));
     if (!is_black3(b->sheen)) d = add3(d, scale3(b->sheen, sheen_albedo(b->sheen_rough, wo.z)));
-    return scale3(d, coat_scale(b, wo.z, wo.z));
+    return b->coat > 0.0f ? scale3(d, coat_scale_dirs(b, wo, wo)) : d;
 }
 
 /* ---- transmission (docs/design.md, "Transmission and volume") --------------------------------- */
@@ -568,7 +580,7 @@ static vec3 eval_diffuse_part(const bsdf *b, vec3 wo, vec3 wi) {
     vec3 f = eval_diffuse(b, wo, wi);
     if (!is_black3(b->sheen))
         f = add3(scale3(f, sheen_scale(b, wo.z, wi.z)), scale3(b->sheen, sheen_lobe(b->sheen_rough, wo, wi)));
-    return b->coat > 0.0f ? scale3(f, coat_scale(b, wo.z, wi.z)) : f;
+    return b->coat > 0.0f ? scale3(f, coat_scale_dirs(b, wo, wi)) : f;
 }
 
 /* A sheen lobe peaks near the horizon, where cosine sampling rarely goes: with a sheen, half the
@@ -590,28 +602,58 @@ static vec3 sample_diffuse_part(const bsdf *b, vec2 u) {
     return sample_cosine_hemisphere(u);
 }
 
+/* The coat's GGX lobe in the coat's frame (coat_frame_dirs: its wo and wi, both above it), times
+ * cos(wi, coat_n) / wi.z: what the tilted surface reflects per unit of the shading frame's
+ * cosine, so the coat's energy is its own albedo (the estimators' cosine is to the shading
+ * normal). Untilted, exactly the coat's lobe. */
+static int coat_frame_dirs(const bsdf *b, vec3 *wo, vec3 *wi) {
+    if (!coat_tilted(b)) return 1;
+    frame3 f = frame_from_normal(b->coat_n);
+    *wo = to_local(f, *wo);
+    *wi = to_local(f, *wi);
+    return wo->z > 0.0f && wi->z > 0.0f;
+}
+
+static vec3 eval_coat(const bsdf *b, vec3 wo, vec3 wi) {
+    bsdf c = coat_lobe(b);
+    float z = wi.z;
+    if (!coat_frame_dirs(b, &wo, &wi)) return v3s(0.0f);
+    vec3 f = eval_glossy(&c, wo, wi);
+    return coat_tilted(b) ? scale3(f, wi.z / fmaxf(z, 1e-6f)) : f;
+}
+
+static float pdf_coat(const bsdf *b, vec3 wo, vec3 wi) {
+    bsdf c = coat_lobe(b);
+    return coat_frame_dirs(b, &wo, &wi) ? pdf_glossy(&c, wo, wi) : 0.0f;
+}
+
+/* Sampled in the coat's frame; a direction below the shading frame's horizon is no sample. */
+static int sample_coat(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
+    bsdf c = coat_lobe(b);
+    if (!coat_tilted(b)) return sample_glossy(&c, wo, u, wi);
+    frame3 f = frame_from_normal(b->coat_n);
+    vec3 co = to_local(f, wo), ci;
+    if (!(co.z > 0.0f) || !sample_glossy(&c, co, u, &ci)) return 0;
+    *wi = to_world(f, ci);
+    return wi->z > 0.0f;
+}
+
 /* The glossy lobe: the base's own under the sheen and the coat, and the coat's. */
 static vec3 eval_glossy_part(const bsdf *b, vec3 wo, vec3 wi) {
     vec3 f = v3s(0.0f);
     if (bsdf_has_base_glossy(b)) {
         f = eval_glossy(b, wo, wi);
         if (b->coat > 0.0f || !is_black3(b->sheen))
-            f = scale3(f, coat_scale(b, wo.z, wi.z) * sheen_scale(b, wo.z, wi.z));
+            f = scale3(f, coat_scale_dirs(b, wo, wi) * sheen_scale(b, wo.z, wi.z));
     }
-    if (b->coat > 0.0f) {
-        bsdf c = coat_lobe(b);
-        f = add3(f, scale3(eval_glossy(&c, wo, wi), b->coat));
-    }
+    if (b->coat > 0.0f) f = add3(f, scale3(eval_coat(b, wo, wi), b->coat));
     return f;
 }
 
 static float pdf_glossy_part(const bsdf *b, vec3 wo, vec3 wi) {
     float pc = coat_select_prob(b, wo.z), p = 0.0f;
     if (pc < 1.0f) p += (1.0f - pc) * pdf_glossy(b, wo, wi);
-    if (pc > 0.0f) {
-        bsdf c = coat_lobe(b);
-        p += pc * pdf_glossy(&c, wo, wi);
-    }
+    if (pc > 0.0f) p += pc * pdf_coat(b, wo, wi);
     return p;
 }
 
@@ -620,10 +662,7 @@ static float pdf_glossy_part(const bsdf *b, vec3 wo, vec3 wi) {
  * samples both. */
 static int sample_glossy_part(const bsdf *b, vec3 wo, vec2 u, vec3 *wi) {
     float pc = coat_select_prob(b, wo.z);
-    if (u.x < pc) {
-        bsdf c = coat_lobe(b);
-        return sample_glossy(&c, wo, v2(fminf(u.x / pc, 0x1.fffffep-1f), u.y), wi);
-    }
+    if (u.x < pc) return sample_coat(b, wo, v2(fminf(u.x / pc, 0x1.fffffep-1f), u.y), wi);
     if (pc > 0.0f) u.x = fminf((u.x - pc) / (1.0f - pc), 0x1.fffffep-1f);
     return sample_glossy(b, wo, u, wi);
 }
@@ -667,7 +706,7 @@ float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes) {
 /* The transmission lobe under the sheen and the coat. */
 static vec3 eval_transmit_part(const bsdf *b, vec3 wo, vec3 wi) {
     vec3 f = eval_transmit(b, wo, wi);
-    if (b->coat > 0.0f || !is_black3(b->sheen)) f = scale3(f, coat_scale(b, wo.z, -wi.z) * sheen_scale(b, wo.z, -wi.z));
+    if (b->coat > 0.0f || !is_black3(b->sheen)) f = scale3(f, coat_scale_dirs(b, wo, wi) * sheen_scale(b, wo.z, -wi.z));
     return f;
 }
 
@@ -684,7 +723,7 @@ vec3 bsdf_eval(const bsdf *b, vec3 wo, vec3 wi, int lobes) {
 float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi, int lobes) {
     if (wo.z <= 0.0f || wi.z == 0.0f) return 0.0f;
     lobes &= bsdf_lobes(b);
-    float pt = transmit_prob(b, wo, lobes);
+    float pt = lobes & BSDF_TRANSMIT ? transmit_prob(b, wo, lobes) : 0.0f; /* no call on the common path */
     if (wi.z < 0.0f) return pt > 0.0f ? pt * pdf_transmit(b, wo, wi) : 0.0f;
     float pg = reflect_glossy_prob(b, wo, lobes);
     float pdf = 0.0f;
@@ -697,7 +736,7 @@ int bsdf_sample(const bsdf *b, vec3 wo, int lobes, float u_lobe, vec2 u, bsdf_sa
     if (wo.z <= 0.0f) return 0;
     lobes &= bsdf_lobes(b);
     if (!lobes) return 0;
-    float pt = transmit_prob(b, wo, lobes);
+    float pt = lobes & BSDF_TRANSMIT ? transmit_prob(b, wo, lobes) : 0.0f; /* no call on the common path */
     vec3 wi;
     int lobe;
     if (u_lobe < pt) {

@@ -68,6 +68,7 @@ typedef struct {
     float sheen_rough; /* its perceptual roughness (alpha = rough^2), floored at BSDF_MIN_SHEEN_ROUGHNESS */
     float coat;        /* KHR_materials_clearcoat's weight: a GGX lobe, F0 0.04, part of BSDF_GLOSSY */
     float coat_alpha;  /* its roughness (alpha) */
+    vec3 coat_n;       /* the coat's own normal in this frame (clearcoatNormalTexture); 0: +z */
     /* KHR_materials_transmission: a GGX BTDF of the glossy lobe's roughness weighted by what the
      * dielectric does not reflect, 1 - F(wo.h) (Schlick with couple_f0, couple_f90), part of
      * BSDF_TRANSMIT. eta is the index below the surface over the index above (wo's side): the

@@ -1,6 +1,6 @@
 // glint — KHR_texture_transform, KHR_materials_variants, KHR_materials_transmission and
-// KHR_materials_volume from tinygltf's JSON values, checked (docs/design.md, "Texture
-// transforms", "Material variants", "Transmission and volume").
+// KHR_materials_volume, and the clear coat's normal map's scale, from tinygltf's JSON values,
+// checked (docs/design.md, "Texture transforms", "Material variants", "Transmission and volume").
 #include "gltf_extensions.h"
 
 #include <cmath>
@@ -71,6 +71,16 @@ std::string material_transmission_volume(const std::string &name, const Value &e
         }
     }
     return why.empty() ? "" : name + ": " + why;
+}
+
+std::string normal_scale(const Value &e, const char *key, double limit, float *scale) {
+    if (!e.Has(key) || !e.Get(key).IsObject() || !e.Get(key).Has("scale")) return "";
+    const Value &v = e.Get(key).Get("scale");
+    double d = v.IsNumber() ? v.GetNumberAsDouble() : NAN;
+    if (!(std::fabs(d) <= limit))
+        return std::string(key) + ".scale " + num(d) + " is not a finite number up to " + num(limit);
+    *scale = (float)d;
+    return "";
 }
 
 std::string texture_transform(const Value &x, float xf[6], int *texcoord) {

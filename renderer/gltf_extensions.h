@@ -1,7 +1,7 @@
 // glint — glTF extensions read from tinygltf's JSON values (C++ only, used by gltf_import.cpp):
 // KHR_texture_transform on a texture reference, KHR_materials_variants, and the material model's
-// KHR_materials_transmission and _volume. Each returns "" or the problem, for the importer's
-// one-line error.
+// KHR_materials_transmission and _volume, and a normal textureInfo's scale inside an extension.
+// Each returns "" or the problem, for the importer's one-line error.
 #ifndef GLINT_GLTF_EXTENSIONS_H
 #define GLINT_GLTF_EXTENSIONS_H
 
@@ -36,6 +36,10 @@ std::string texture_transform(const tinygltf::Value &x, float xf[6], int *texcoo
 // problem.
 std::string material_transmission_volume(const std::string &name, const tinygltf::Value &e, material_ext *x,
                                          const std::function<texture_slot(const char *)> &texture, bool *clamped);
+
+// The scale of the normal textureInfo under key (e: an extension's object) into *scale, untouched
+// when absent; a non-number or one beyond +-limit is the problem.
+std::string normal_scale(const tinygltf::Value &e, const char *key, double limit, float *scale);
 
 // The file's material variants, by name, into s.
 std::string read_variants(scene *s, const tinygltf::Model &m);

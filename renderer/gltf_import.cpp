@@ -367,9 +367,10 @@ struct importer {
             factor(number_or(e, "clearcoatRoughnessFactor", 0.0), label, "clearcoatRoughnessFactor");
         mat.ext.clearcoat_tex = ext_texture(e, "clearcoatTexture", label);
         mat.ext.clearcoat_roughness_tex = ext_texture(e, "clearcoatRoughnessTexture", label);
-        if (e.Has("clearcoatNormalTexture"))
-            scene_warn(s, "%s: %s: clearcoatNormalTexture is not supported; the coat uses the surface's normal",
-                       name.c_str(), label.c_str());
+        mat.ext.clearcoat_normal_tex = ext_texture(e, "clearcoatNormalTexture", label);
+        std::string why =
+            gltf_ext::normal_scale(e, "clearcoatNormalTexture", MAX_INTENSITY, &mat.ext.clearcoat_normal_scale);
+        if (!why.empty()) fail(label + ": " + why);
     }
 
     // glTF's [0, 1] factors: a value above 1 is clamped, with one warning per material

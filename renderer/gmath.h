@@ -5,6 +5,16 @@
 #include <math.h>
 #include <stdint.h>
 
+#ifndef __cplusplus
+/* fmaxf and fminf as C defines them (of a NaN and a number, the number), inline: GCC calls the C
+ * library for them, and those calls, with the registers they clobber, cost the path tracer
+ * several percent (docs/benchmarks.md, 2026-11-25). */
+static inline float gm_fmaxf(float a, float b) { return a > b || isnan(b) ? a : b; }
+static inline float gm_fminf(float a, float b) { return a < b || isnan(b) ? a : b; }
+#define fmaxf gm_fmaxf
+#define fminf gm_fminf
+#endif
+
 #define PI_F 3.14159265358979323846f
 #define INV_PI_F 0.31830988618379067154f
 #define INV_2PI_F 0.15915494309189533577f

@@ -9,7 +9,8 @@ material_ext material_ext_default(void) {
     x.specular = 1.0f;
     x.specular_color = v3s(1.0f);
     x.specular_tex = x.specular_color_tex = x.sheen_color_tex = x.sheen_roughness_tex = x.clearcoat_tex =
-        x.clearcoat_roughness_tex = x.transmission_tex = (texture_slot){.texture = -1};
+        x.clearcoat_roughness_tex = x.clearcoat_normal_tex = x.transmission_tex = (texture_slot){.texture = -1};
+    x.clearcoat_normal_scale = 1.0f;
     x.attenuation_distance = INFINITY;
     x.attenuation_color = v3s(1.0f);
     return x;

@@ -133,7 +133,8 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         }
         beta = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
         if (is_black3(beta) || !is_finite3(beta)) break;
-        sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
+        if (bs.lobe == BSDF_TRANSMIT)
+            sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
         events += bs.lobe != BSDF_TRANSMIT;
         prev_nee = bs.lobe != BSDF_TRANSMIT;
         prev_pdf = bs.pdf;

@@ -754,7 +754,9 @@ bsdf material_bsdf(const scene *s, const surface_hit *h, frame3 *frame) {
             if (len > 1e-6f) rotate_tangent(frame, rx / len, ry / len);
         }
         gltf_layers layers = material_layers(s, m, h);
-        return make_bsdf_gltf_layered(mul3(m->base_color, tint), metallic, roughness, aniso, &layers);
+        bsdf b = make_bsdf_gltf_layered(mul3(m->base_color, tint), metallic, roughness, aniso, &layers);
+        if (b.coat > 0.0f) b.coat_n = to_local(*frame, h->coat_n);
+        return b;
     }
     }
 }

@@ -71,6 +71,8 @@ typedef struct {
     float clearcoat_roughness;            /* perceptual */
     texture_slot clearcoat_tex;           /* linear: R */
     texture_slot clearcoat_roughness_tex; /* linear: G */
+    texture_slot clearcoat_normal_tex;    /* linear: the coat's own normal map, as normalTexture */
+    float clearcoat_normal_scale;         /* its scale: multiplies the map's x and y */
     float transmission;                   /* KHR_materials_transmission: transmissionFactor, 0 */
     texture_slot transmission_tex;        /* linear: R */
     /* KHR_materials_volume: thicknessFactor > 0 makes the mesh a closed volume that refracts by
@@ -328,6 +330,8 @@ typedef struct {
     vec3 ng;        /* geometric normal, facing the incoming ray */
     frame3 shading; /* shading frame: n faces the incoming ray's side; t along the tangent for anisotropic
                     * materials, any direction for the rest */
+    vec3 coat_n;    /* a clear-coated glTF material's coat normal (world, same side as shading.n): the
+                    * interpolated normal, or the clearcoatNormalTexture's; else shading.n */
     vec2 uv0, uv1;
     int backface; /* the ray hit the triangle's back (winding) side */
 } surface_hit;

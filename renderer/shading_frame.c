@@ -41,13 +41,11 @@ static vec3 guard_normal(vec3 n, vec3 ng, vec3 wo) {
     return bend_toward(keep_reflection_above(bend_toward(n, ng), ng, wo), wo);
 }
 
-/* The normal map's tangent-space normal at the hit, its x and y turned (and mirrored) as
+/* A normal map's tangent-space normal at the hit, its x and y turned (and mirrored) as
  * KHR_texture_transform turns the texture on the surface, so that they follow the texture's own
  * u and v there (as tangents made from the transformed uvs would). */
-static vec3 map_normal(const scene *s, const material *m, const surface_hit *h) {
-    const texture_slot *slot = &m->normal_tex;
+static vec3 map_normal(const scene *s, const texture_slot *slot, float k, const surface_hit *h) {
     vec4 c = texture_lookup(s, *slot, h->uv0, h->uv1, 0);
-    float k = m->normal_scale;
     float x = (2.0f * c.x - 1.0f) * k, y = (2.0f * c.y - 1.0f) * k, z = 2.0f * c.z - 1.0f;
     if (slot->transformed) {
         /* The texture's u axis in (tangent, bitangent) axes: A^-1 (1, 0) with v turned up the
@@ -65,6 +63,15 @@ static vec3 map_normal(const scene *s, const material *m, const surface_hit *h) 
     return v3(x, y, z);
 }
 
+/* The map's normal in world space through the tangent frame f (front side); a degenerate texel (no
+ * direction) keeps f's normal, the interpolated one. */
+static vec3 mapped_normal(const scene *s, const texture_slot *slot, float k, const surface_hit *h, frame3 f) {
+    vec3 t = map_normal(s, slot, k, h);
+    vec3 p = add3(add3(scale3(f.t, t.x), scale3(f.b, t.y)), scale3(f.n, t.z));
+    float pl = length_sq3(p);
+    return pl > 1e-12f && isfinite(pl) ? scale3(p, 1.0f / sqrtf(pl)) : f.n;
+}
+
 void shading_frame_at_hit(const scene *s, surface_hit *h, float b1, float b2, vec3 d) {
     const uint32_t *v = &s->indices[3 * h->tri];
     float b0 = 1.0f - b1 - b2;
@@ -80,8 +87,13 @@ void shading_frame_at_hit(const scene *s, surface_hit *h, float b1, float b2, ve
     int mapped = m->normal_tex.texture >= 0;
     int anisotropic = (m->model == MATERIAL_WARD && m->alpha_x != m->alpha_y) ||
                       (m->model == MATERIAL_GLTF && m->anisotropy_strength > 0.0f);
-    if (!mapped && !anisotropic) {
+    /* KHR_materials_clearcoat: the coat's normal is its own map's, else the interpolated one (the
+     * base's map does not bump the coat). */
+    int coated = m->model == MATERIAL_GLTF && m->ext.clearcoat > 0.0f;
+    int coat_mapped = coated && m->ext.clearcoat_normal_tex.texture >= 0;
+    if (!mapped && !anisotropic && !coat_mapped) {
         h->shading = frame_from_normal(guard_normal(scale3(ns, side), ng, wo));
+        h->coat_n = h->shading.n;
         return;
     }
     /* The mesh's tangent frame (glTF: bitangent = cross(n, t) w), front side. */
@@ -91,19 +103,16 @@ void shading_frame_at_hit(const scene *s, surface_hit *h, float b1, float b2, ve
     frame3 f = frame_from_normal_tangent(ns, tan);
     float w = tg[v[0]].w < 0.0f ? -1.0f : 1.0f;
     f.b = scale3(f.b, w);
-    vec3 n = ns;
-    if (mapped) {
-        vec3 t = map_normal(s, m, h);
-        vec3 p = add3(add3(scale3(f.t, t.x), scale3(f.b, t.y)), scale3(f.n, t.z));
-        float pl = length_sq3(p);
-        /* A degenerate texel (no direction) keeps the interpolated normal. */
-        if (pl > 1e-12f && isfinite(pl)) n = scale3(p, 1.0f / sqrtf(pl));
-    }
-    n = scale3(n, side);
+    vec3 n = mapped ? mapped_normal(s, &m->normal_tex, m->normal_scale, h, f) : ns;
     /* Light arriving below the geometric surface never counts whatever n is: every estimator
      * tests directions against ng as well. */
-    n = guard_normal(n, ng, wo);
+    n = guard_normal(scale3(n, side), ng, wo);
     h->shading = frame_from_normal_tangent(n, scale3(f.t, side));
     /* Keep the handedness: anisotropy rotations and the map's y turn the right way. */
     h->shading.b = scale3(h->shading.b, w * side);
+    h->coat_n = h->shading.n;
+    if (coated) {
+        vec3 c = coat_mapped ? mapped_normal(s, &m->ext.clearcoat_normal_tex, m->ext.clearcoat_normal_scale, h, f) : ns;
+        h->coat_n = guard_normal(scale3(c, side), ng, wo);
+    }
 }

@@ -379,7 +379,23 @@ static void test_mis(void) {
     CHECK(bad == 0, "MIS weights: %d pairs do not sum to 1 (or are not finite)", bad);
 }
 
+/* gmath.h's inline fmaxf and fminf keep C's meaning (C11 F.10.9.2): of a NaN and a number, the
+ * number; of two NaNs, a NaN; infinities ordered. */
+static void test_fmax_fmin(void) {
+    const float v[] = {NAN, -INFINITY, -3.5f, -0.0f, 0.0f, 1e-38f, 2.0f, INFINITY};
+    int n = (int)(sizeof v / sizeof v[0]), bad = 0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            float a = v[i], b = v[j], mx = gm_fmaxf(a, b), mn = gm_fminf(a, b);
+            float ex = isnan(a) ? b : isnan(b) ? a : a > b ? a : b, en = isnan(a) ? b : isnan(b) ? a : a < b ? a : b;
+            /* Signed zeros compare equal; C lets either come back. */
+            bad += !(mx == ex || (isnan(mx) && isnan(ex))) || !(mn == en || (isnan(mn) && isnan(en)));
+        }
+    CHECK(bad == 0, "gm_fmaxf / gm_fminf: %d of %d pairs differ from C's fmaxf / fminf", bad, n * n);
+}
+
 int main(void) {
+    test_fmax_fmin();
     significance = chi2_significance(0.01, NUM_CHI2_TESTS);
     test_chi2_machinery();
     test_russian_roulette();
