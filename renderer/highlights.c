@@ -418,33 +418,24 @@ static int hit_record(hl_hit *hit, const shading_point *q, vec3 weight, const fl
     return total > 0.0f && isfinite(total) ? HIT_VMF : HIT_NONE;
 }
 
-vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, int rays, rng_state *rng,
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, int rays, rng_state *rng,
                  render_stats *st) {
     vec3 sum = v3(0, 0, 0);
+    if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) return sum;
     int n = rays > 0 && rays <= HL_MAX_SECONDARY_RAYS ? rays : h->secondary_rays;
-    if (points < 1) return sum;
-    if (points > n) points = n;
-    int lit = 0;
-    for (int j = 0; j < points; j++) lit += bsdf_highlight_lobe(&xs[j].b) && xs[j].wo.z > 0.0f;
-    if (!lit) return sum;
     hl_hit hits[HL_MAX_SECONDARY_RAYS];
     vec3 dirs[HL_MAX_SECONDARY_RAYS];
     float alpha[HL_MAX_SECONDARY_RAYS];
-    int hit_point[HL_MAX_SECONDARY_RAYS];
     int count = 0;
-    st->hl_points += (uint64_t)lit;
-    /* The N directions stratified over the lobe: a randomly shifted R2 sequence, ray k from point
-     * k mod points, each point's rays weighted 1 / (points x its rays): the mean over the points. */
+    st->hl_points++;
+    /* The N directions stratified over the lobe: a randomly shifted R2 sequence. */
     vec2 shift = rng_vec2(rng);
     for (int k = 0; k < n; k++) {
-        const shading_point *x = &xs[k % points];
-        if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) continue;
-        int per_point = n / points + (k % points < n % points);
         bsdf_sample_result bs;
         if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, sample_r2(k, shift), &bs) || !(bs.pdf > 0.0f)) continue;
         vec3 wi = to_world(x->frame, bs.wi);
         if (dot3(wi, x->ng) <= 0.0f) continue;
-        vec3 weight = scale3(bs.f, bs.wi.z / (bs.pdf * (float)(per_point * points)));
+        vec3 weight = scale3(bs.f, bs.wi.z / (bs.pdf * (float)n));
         surface_hit hq;
         st->rays[RAY_BOUNCE]++;
         st->hl_secondary_rays++;
@@ -472,39 +463,29 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
             continue;
         }
         dirs[count] = hit->mu;
-        hit_point[count] = k % points;
         alpha[count] = 0.0f;
         for (int b = 0; b < hit->bands; b++) alpha[count] += hit->lum[b];
         count++;
     }
     if (count == 0) return sum;
-    /* Each point's lobes are merged among themselves: rays from points spread over a curved mirror
-     * part ways, and lobes merged across them made the highlights 18% off on atelier. */
-    for (int j = 0; j < points; j++) {
-        uint64_t t0 = clock_ns();
-        int index[HL_MAX_SECONDARY_RAYS], assign[HL_MAX_SECONDARY_RAYS], members[HL_MAX_SECONDARY_RAYS];
-        vec3 pdirs[HL_MAX_SECONDARY_RAYS];
-        float palpha[HL_MAX_SECONDARY_RAYS];
+
+    uint64_t t0 = clock_ns();
+    int assign[HL_MAX_SECONDARY_RAYS], members[HL_MAX_SECONDARY_RAYS];
+    int k = vmf_em(dirs, alpha, count, h->clusters, assign);
+    hl_cluster clusters[HL_MAX_CLUSTERS];
+    int used = 0;
+    for (int c = 0; c < k; c++) {
         int m = 0;
         for (int i = 0; i < count; i++)
-            if (hit_point[i] == j) index[m] = i, pdirs[m] = dirs[i], palpha[m] = alpha[i], m++;
-        if (m == 0) continue;
-        int k = vmf_em(pdirs, palpha, m, h->clusters, assign);
-        hl_cluster clusters[HL_MAX_CLUSTERS];
-        int used = 0;
-        for (int c = 0; c < k; c++) {
-            int n_c = 0;
-            for (int i = 0; i < m; i++)
-                if (assign[i] == c) members[used + n_c++] = index[i];
-            cluster_make(&clusters[c], hits, &members[used], n_c);
-            used += n_c;
-        }
-        st->hl_merge_ns += clock_ns() - t0;
-        for (int c = 0; c < k; c++) {
-            lit_lobe l = {clusters[c].origin, clusters[c].n, &clusters[c], NULL, v3(0, 0, 0)};
-            sum = add3(sum, light_lobe(h, s, &l, rng, st));
-        }
-        st->hl_lobes += (uint64_t)k;
+            if (assign[i] == c) members[used + m++] = i;
+        cluster_make(&clusters[c], hits, &members[used], m);
+        used += m;
     }
+    st->hl_merge_ns += clock_ns() - t0;
+    for (int c = 0; c < k; c++) {
+        lit_lobe l = {clusters[c].origin, clusters[c].n, &clusters[c], NULL, v3(0, 0, 0)};
+        sum = add3(sum, light_lobe(h, s, &l, rng, st));
+    }
+    st->hl_lobes += (uint64_t)k;
     return sum;
 }

@@ -38,11 +38,9 @@ typedef struct {
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */
 hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf_filter *env_filter);
 
-/* The highlights of a pixel from its camera hits xs[0..points): light along camera - glossy(x) -
- * glossy(q) - light, reflected toward the camera, the mean over the points, from `rays` secondary
- * rays in all (0: the setup's N) shared among them. A point without a glossy lobe adds zero.
+/* The highlights at camera hit x: light along camera - glossy(x) - glossy(q) - light, reflected
+ * toward the camera, from `rays` secondary rays (0: the setup's N). Zero when x has no glossy lobe.
  * Counts work into st. */
-vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, int rays, rng_state *rng,
-                 render_stats *st);
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, int rays, rng_state *rng, render_stats *st);
 
 #endif

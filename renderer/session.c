@@ -33,7 +33,6 @@ typedef struct {
 #define MANYLIGHT_DIRECT_SAMPLES 4
 #define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
 #define HL_MAX_ADAPT_RAYS 128           /* secondary rays per pixel, with --adapt */
-#define PIXEL_POINTS 32                 /* at most, camera hits a pixel's highlight rays start from (--adapt) */
 
 struct render_session {
     const scene *scene;
@@ -136,63 +135,12 @@ static uint64_t next_frame_index(const render_session *rs) {
     return (uint64_t)p->shard_index + (uint64_t)rs->frames * (uint64_t)p->shard_count;
 }
 
-/* n camera hits spread over a pixel: the frame's own first (NULL: none), then more at R2
- * positions over the pixel. */
-static void pixel_points(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                         const surface_hit *first, shading_point *xs, int n) {
-    const scene *s = rs->scene;
-    const render_params *p = &rs->params;
-    rng_state start = rng_for((uint64_t)pixel, UINT64_MAX - 1, p->seed);
-    vec2 shift = rng_vec2(&start);
-    for (int j = 0; j < n; j++) {
-        const surface_hit *h = first;
-        surface_hit hit;
-        vec3 dir = d;
-        if (j > 0) {
-            int index = (int)((next_frame_index(rs) * (PIXEL_POINTS - 1) + (uint64_t)j) & 0x3fffffff);
-            vec2 u = sample_r2(index, shift);
-            dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
-            st->rays[RAY_CAMERA]++;
-            st->pixel_points++;
-            h = scene_intersect(s, rs->cam.position, dir, INFINITY, &hit) ? &hit : NULL;
-        }
-        if (h) {
-            xs[j] = shading_point_at(s, h, dir);
-        } else {
-            memset(&xs[j], 0, sizeof xs[j]);
-            xs[j].b.dropped = BSDF_ALL; /* no lobe: adds zero */
-        }
-    }
-}
-
-/* The highlights of a pixel. A highlight is often smaller than the pixel (a curved mirror's image
- * of a lit speck), and there more positions in the pixel beat more rays from one: once the pixel
- * has met a highlight lobe (with --adapt), each secondary ray starts from its own point of the
- * pixel, up to PIXEL_POINTS. Earlier frames decide this, so each frame's estimate stays unbiased
- * (docs/design.md, "Where the samples go"). */
-static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                             const surface_hit *first, rng_state *rng) {
-    rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
-    int rays = rs->adapt ? rs->highlight.samples[pixel] : rs->hl.secondary_rays;
-    int spread = rs->adapt && rs->highlight.rec[pixel].n > 0.0f;
-    int points = !spread || rays < 1 ? 1 : rays < PIXEL_POINTS ? rays : PIXEL_POINTS;
-    shading_point xs[PIXEL_POINTS];
-    pixel_points(rs, st, raster, pixel, d, first, xs, points);
-    vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, rays, &hl_rng, st);
-    /* Only pixels that meet a highlight lobe spend rays: only they keep a record. */
-    int any = 0;
-    for (int j = 0; j < points; j++) any |= bsdf_highlight_lobe(&xs[j].b);
-    if (rs->adapt && any) pixel_record_add_mean(&rs->highlight.rec[pixel], avg3(L), (float)rays);
-    return L;
-}
-
 /* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
-static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                          const surface_hit *first, rng_state *rng) {
+static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 d, const surface_hit *first,
+                          rng_state *rng) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
-    int spread = rs->adapt && rs->plan.highlights && rs->highlight.rec[pixel].n > 0.0f;
-    if (!first && !s->env && !spread) { /* into the void: every component is zero, nothing to add */
+    if (!first && !s->env) { /* into the void: every component is zero, nothing to add */
         st->rays[RAY_CAMERA]++;
         return;
     }
@@ -213,18 +161,27 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
             st->rays[RAY_CAMERA]++;
         uint64_t t1 = clock_ns();
         st->pass_ns[PASS_DIRECT] += t1 - t0;
-        if (first && depth > 1 && rs->plan.virtual_lights) {
+        if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
             shading_point sp = shading_point_at(s, first, d);
-            L[COMP_INDIRECT] =
-                manylight_indirect(&rs->ml, s, &sp, depth, rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
-                                   rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
-            uint64_t t2 = clock_ns();
-            st->pass_ns[PASS_GATHER] += t2 - t1;
-            t1 = t2;
-        }
-        if (depth > 1 && rs->plan.highlights) {
-            L[COMP_HIGHLIGHTS] = pixel_highlights(rs, st, raster, pixel, d, first, rng);
-            st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
+            rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
+            if (rs->plan.virtual_lights) {
+                L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth,
+                                                      rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
+                                                      rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
+                uint64_t t2 = clock_ns();
+                st->pass_ns[PASS_GATHER] += t2 - t1;
+                t1 = t2;
+            }
+            if (rs->plan.highlights) {
+                /* With --adapt the rays follow the spread of the pixel's highlights in earlier
+                 * frames (docs/design.md, "Where the samples go"); only pixels that meet a
+                 * highlight lobe spend rays, and only they keep a record. */
+                int rays = rs->adapt ? rs->highlight.samples[pixel] : rs->hl.secondary_rays;
+                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, rays, &hl_rng, st);
+                if (rs->adapt && bsdf_highlight_lobe(&sp.b))
+                    pixel_record_add_mean(&rs->highlight.rec[pixel], avg3(L[COMP_HIGHLIGHTS]), (float)rays);
+                st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
+            }
         }
     }
     float sample[COMP_COUNT][3];
@@ -281,7 +238,7 @@ static void render_tile(void *ctx, int tile, int worker) {
             unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
             if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
             for (int i = 0; i < n; i++)
-                render_sample(rs, st, &raster, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
+                render_sample(rs, st, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
         }
     }
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;
@@ -333,7 +290,6 @@ int session_render_frame(render_session *rs) {
         t->vsl_samples += st->vsl_samples;
         t->clamped += st->clamped;
         t->glossy_bounces += st->glossy_bounces;
-        t->pixel_points += st->pixel_points;
         t->hl_points += st->hl_points;
         t->hl_secondary_rays += st->hl_secondary_rays;
         t->hl_lobes += st->hl_lobes;
