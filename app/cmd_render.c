@@ -77,13 +77,14 @@ static void print_render_help(void) {
            DEFAULT_SPP, DEFAULT_WIDTH, DEFAULT_HEIGHT, DEFAULT_MAX_DEPTH, cli_vl_help());
 }
 
-/* --shard I/N: the frames I, I + N, ... of the render --spp asks for, which is then the whole
- * render's; the shard renders its share. 0, or -1 after a usage error. */
+/* Whether name ends in suffix, in either case. */
 static int has_suffix(const char *name, const char *suffix) {
     size_t n = strlen(name), k = strlen(suffix);
     return n > k && strcasecmp(name + n - k, suffix) == 0;
 }
 
+/* --shard I/N: the frames I, I + N, ... of the render --spp asks for, which is then the whole
+ * render's; the shard renders its share. 0, or -1 after a usage error. */
 static int parse_shard(render_options *o) {
     long long i, n;
     char first[32];
