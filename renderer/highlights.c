@@ -418,11 +418,10 @@ static int hit_record(hl_hit *hit, const shading_point *q, vec3 weight, const fl
     return total > 0.0f && isfinite(total) ? HIT_VMF : HIT_NONE;
 }
 
-vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, int rays, rng_state *rng,
-                 render_stats *st) {
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_state *rng, render_stats *st) {
     vec3 sum = v3(0, 0, 0);
     if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) return sum;
-    int n = rays > 0 && rays <= HL_MAX_SECONDARY_RAYS ? rays : h->secondary_rays;
+    int n = h->secondary_rays;
     hl_hit hits[HL_MAX_SECONDARY_RAYS];
     vec3 dirs[HL_MAX_SECONDARY_RAYS];
     float alpha[HL_MAX_SECONDARY_RAYS];

@@ -39,8 +39,7 @@ typedef struct {
 hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf_filter *env_filter);
 
 /* The highlights at camera hit x: light along camera - glossy(x) - glossy(q) - light, reflected
- * toward the camera, from `rays` secondary rays (0: the setup's N). Zero when x has no glossy lobe.
- * Counts work into st. */
-vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, int rays, rng_state *rng, render_stats *st);
+ * toward the camera. Zero when x has no glossy lobe. Counts work into st. */
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_state *rng, render_stats *st);
 
 #endif

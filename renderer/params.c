@@ -152,9 +152,9 @@ static const param_desc table[] = {
      .panel_format = "%d"},
     {.name = "adapt", .type = PARAM_CHOICE, .offset = F(adapt), .choices = adapts, .num_choices = 2,
      .def = VL_ADAPT_ON,
-     .help = "on: each pixel's glossy rays (N on average), direct-light\n"
-             "samples (4) and highlight rays follow how much its light varied\n"
-             "there in earlier frames; off: the same at every pixel",
+     .help = "on: each pixel's glossy rays (N on average) and direct-light\n"
+             "samples (4) follow how much one sample's light varied there in\n"
+             "earlier frames; off: the same at every pixel",
      .label = "adapt samples"},
     {.name = "secondary-rays", .type = PARAM_INT, .group = PARAM_HIGHLIGHTS, .offset = F(secondary_rays), .lo = 1,
      .hi = HL_MAX_SECONDARY_RAYS, .def = HL_DEFAULT_SECONDARY_RAYS, .value_name = "N",

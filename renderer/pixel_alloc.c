@@ -11,7 +11,6 @@
 
 int pixel_alloc_init(pixel_alloc *a, int pixels) {
     a->pixels = pixels;
-    a->even = 0.0f;
     a->rec = calloc((size_t)pixels, sizeof *a->rec);
     a->samples = calloc((size_t)pixels, 1);
     return a->rec && a->samples ? 0 : -1;
@@ -44,8 +43,7 @@ void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint6
             a->samples[i] = (uint8_t)budget;
             continue;
         }
-        const double even = (double)a->even;
-        double want = budget * (even + (1.0 - even) * record_sd(r) / mean);
+        double want = budget * record_sd(r) / mean;
         rng_state rng = rng_for((uint64_t)i, frame, seed ^ 0x676c6f7373ULL);
         int n = (int)floor(want + (double)rng_float(&rng)); /* stochastic rounding: the mean is kept */
         a->samples[i] = (uint8_t)(n < 1 ? 1 : n > max ? max : n);

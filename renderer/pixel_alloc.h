@@ -15,16 +15,13 @@ typedef struct {
     int pixels;
     pixel_record *rec;
     uint8_t *samples; /* this frame's samples per pixel */
-    float even;       /* the share of the budget every recorded pixel gets alike (0 at init): a hedge
-                       * where each record holds few values (a frame's estimate over many rays) */
 } pixel_alloc;
 
 int pixel_alloc_init(pixel_alloc *a, int pixels);
 void pixel_alloc_free(pixel_alloc *a);
 void pixel_alloc_reset(pixel_alloc *a);
 /* Sets every pixel's samples for the next frame: `budget` on average over the pixels with a
- * record, a share `even` alike and the rest in proportion to the standard deviation of one
- * sample's light there, within [1, max];
+ * record, in proportion to the standard deviation of one sample's light there, within [1, max];
  * the others take the budget. The frame's own samples never decide its allocation, so each frame
  * stays unbiased. */
 void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint64_t seed);
@@ -33,13 +30,5 @@ static inline void pixel_record_add(pixel_record *r, float v) {
     float d = v - r->mean;
     r->mean += d / r->n;
     r->m2 += d * (v - r->mean);
-}
-/* A record of an estimate that averaged w samples: it counts as w samples, and its squared
- * deviation, w times that of one sample's mean, is scaled back to one sample's (weighted Welford). */
-static inline void pixel_record_add_mean(pixel_record *r, float v, float w) {
-    r->n += w;
-    float d = v - r->mean;
-    r->mean += d * w / r->n;
-    r->m2 += w * w * d * (v - r->mean);
 }
 #endif

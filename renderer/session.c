@@ -32,7 +32,6 @@ typedef struct {
  * light is easy) a third of its frames for little (docs/benchmarks.md). */
 #define MANYLIGHT_DIRECT_SAMPLES 4
 #define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
-#define HL_MAX_ADAPT_RAYS 128           /* secondary rays per pixel, with --adapt */
 
 struct render_session {
     const scene *scene;
@@ -48,7 +47,7 @@ struct render_session {
     /* Many-light frames with --adapt: each pixel's directions through sharp lobes and direct-light
      * samples, from the spread of one sample's light in earlier frames */
     int adapt;
-    pixel_alloc glossy, direct, highlight;
+    pixel_alloc glossy, direct;
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
@@ -98,15 +97,10 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         return NULL;
     }
     if (pixel_alloc_init(&rs->glossy, p->width * p->height) != 0 ||
-        pixel_alloc_init(&rs->direct, p->width * p->height) != 0 ||
-        pixel_alloc_init(&rs->highlight, p->width * p->height) != 0) {
+        pixel_alloc_init(&rs->direct, p->width * p->height) != 0) {
         session_destroy(rs);
         return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
     }
-    /* A highlight record holds one value a frame (the merge's estimate over all its rays): with
-     * few values the spread is uncertain, so half the rays go to every pixel alike (all in
-     * proportion to the spread measured worse than none, docs/benchmarks.md). */
-    rs->highlight.even = 0.5f;
     rs->plan = session_make_plan(rs);
     rs->tiles_x = (p->width + TILE - 1) / TILE;
     rs->tiles_y = (p->height + TILE - 1) / TILE;
@@ -119,7 +113,6 @@ void session_destroy(render_session *rs) {
     manylight_deinit(&rs->ml);
     pixel_alloc_free(&rs->glossy);
     pixel_alloc_free(&rs->direct);
-    pixel_alloc_free(&rs->highlight);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -173,13 +166,7 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
                 t1 = t2;
             }
             if (rs->plan.highlights) {
-                /* With --adapt the rays follow the spread of the pixel's highlights in earlier
-                 * frames (docs/design.md, "Where the samples go"); only pixels that meet a
-                 * highlight lobe spend rays, and only they keep a record. */
-                int rays = rs->adapt ? rs->highlight.samples[pixel] : rs->hl.secondary_rays;
-                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, rays, &hl_rng, st);
-                if (rs->adapt && bsdf_highlight_lobe(&sp.b))
-                    pixel_record_add_mean(&rs->highlight.rec[pixel], avg3(L[COMP_HIGHLIGHTS]), (float)rays);
+                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &hl_rng, st);
                 st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
             }
         }
@@ -253,10 +240,6 @@ int session_render_frame(render_session *rs) {
                          p->seed ^ 0x646972656374ULL);
         if (rs->plan.virtual_lights)
             pixel_alloc_plan(&rs->glossy, vl_params_resolve(&p->vl).glossy_rays, VL_MAX_GLOSSY_RAYS, frame, p->seed);
-        int hl_budget = vl_params_resolve(&p->vl).secondary_rays;
-        if (hl_budget > HL_MAX_ADAPT_RAYS) hl_budget = HL_MAX_ADAPT_RAYS;
-        if (rs->plan.highlights)
-            pixel_alloc_plan(&rs->highlight, hl_budget, HL_MAX_ADAPT_RAYS, frame, p->seed ^ 0x686967686cULL);
     }
     if (rs->plan.highlights) {
         if (rs->plan.env_prefilter && (!rs->envf || rs->envf_map != rs->scene->env)) {
@@ -308,7 +291,6 @@ void session_reset(render_session *rs) {
     film_clear(&rs->film);
     pixel_alloc_reset(&rs->glossy);
     pixel_alloc_reset(&rs->direct);
-    pixel_alloc_reset(&rs->highlight);
     rs->frames = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }

@@ -764,22 +764,6 @@ static void test_pixel_alloc_plan(void) {
     pixel_alloc_plan(&a, 4, 8, 0, 7);
     CHECK(a.samples[1] == 4 && a.samples[2] == 4, "after a reset every pixel takes the budget");
     pixel_alloc_free(&a);
-
-    /* A record of means (the highlights' estimate over their rays): means of w samples of spread
-     * 1 about 5, w from 1 to 16, record one sample's spread, 1, and count w samples each. */
-    pixel_record r = {0};
-    rng_state rng = rng_for(3, 0, 11);
-    double count = 0.0;
-    for (int k = 0; k < 20000; k++) {
-        int w = 1 + k % 16;
-        double m = 0.0;
-        for (int j = 0; j < w; j++) m += rng_float(&rng) < 0.5f ? 4.0 : 6.0;
-        pixel_record_add_mean(&r, (float)(m / w), (float)w);
-        count += w;
-    }
-    CHECK_NEAR(r.mean, 5.0, 0.01, "mean of the means");
-    CHECK_NEAR(r.n, count, 1e-3 * count, "samples counted");
-    CHECK_NEAR(sqrt(r.m2 / (r.n - 1.0)), 1.0, 0.03, "one sample's spread from the means' records");
 }
 
 int main(void) {
