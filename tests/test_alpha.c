@@ -30,6 +30,13 @@ static int alpha_texture(scene *s) {
     return ts_texture(s, 8, 8, alphas);
 }
 
+/* A grey Lambert floor at y = 0 under the squares and around them; returns its material. */
+static int add_floor(scene *s) {
+    int floor_m = ts_lambert(s, v3s(0.8f), v3s(0), 0);
+    ts_quad(s, v3(-1, 0, -1), v3(-1, 0, 2), v3(2, 0, 2), v3(2, 0, -1), floor_m);
+    return floor_m;
+}
+
 /* The square [0,1]^2 at height y facing up, uvs: u = x, v = z. */
 static void square_at(scene *s, float y, int mat) {
     const vec3 p[4] = {v3(0, y, 0), v3(0, y, 1), v3(1, y, 1), v3(1, y, 0)};
@@ -94,8 +101,7 @@ static void test_mask_shadow(void) {
     scene *s = ts_new("mask shadow");
     material m = masked(alpha_texture(s), 0.4f);
     square_at(s, 1.0f, ts_material(s, m));
-    int floor_m = ts_lambert(s, v3s(0.8f), v3s(0), 0);
-    ts_quad(s, v3(-1, 0, -1), v3(-1, 0, 2), v3(2, 0, 2), v3(2, 0, -1), floor_m);
+    add_floor(s);
     light l = {.type = LIGHT_DIRECTIONAL, .color = v3s(2.0f), .direction = v3(0, -1, 0)};
     scene_add_light(s, &l);
     ts_finalize(s);
@@ -131,8 +137,7 @@ static void test_mask_vlights(void) {
     scene *s = ts_new("mask vlights");
     material m = masked(alpha_texture(s), 0.5f);
     square_at(s, 1.0f, ts_material(s, m));
-    int floor_m = ts_lambert(s, v3s(0.8f), v3s(0), 0);
-    ts_quad(s, v3(-1, 0, -1), v3(-1, 0, 2), v3(2, 0, 2), v3(2, 0, -1), floor_m);
+    add_floor(s);
     light l = {.type = LIGHT_POINT, .color = v3s(10.0f), .position = v3(0.5f, 2.0f, 0.5f)};
     scene_add_light(s, &l);
     ts_finalize(s);
@@ -180,8 +185,7 @@ static void test_mask_emitter(void) {
             const float uv[8] = {0.5f, 0, 1, 0, 1, 1, 0.5f, 1};
             ts_quad_uv(s, p, uv, ts_material(s, m));
         }
-        int floor_m = ts_lambert(s, v3s(0.8f), v3s(0), 0);
-        ts_quad(s, v3(-1, 0, -1), v3(-1, 0, 2), v3(2, 0, 2), v3(2, 0, -1), floor_m);
+        int floor_m = add_floor(s);
         ts_quad(s, v3(-1, 2, -1), v3(2, 2, -1), v3(2, 2, 2), v3(-1, 2, 2), floor_m); /* a ceiling: indirect light */
         ts_finalize(s);
         camera cam = camera_look_at(v3(0.5f, 0.5f, 3.0f), v3(0.5f, 0.2f, 0.5f), v3(0, 1, 0), 1.0f);
@@ -245,8 +249,7 @@ static void test_blend_statistics(void) {
 static void test_blend_shadow(void) {
     scene *s = ts_new("blend shadow");
     square_at(s, 1.0f, ts_material(s, blend(0.35f)));
-    int floor_m = ts_lambert(s, v3s(0.8f), v3s(0), 0);
-    ts_quad(s, v3(-1, 0, -1), v3(-1, 0, 2), v3(2, 0, 2), v3(2, 0, -1), floor_m);
+    add_floor(s);
     light l = {.type = LIGHT_DIRECTIONAL, .color = v3s(2.0f), .direction = v3(0, -1, 0)};
     scene_add_light(s, &l);
     ts_finalize(s);

@@ -436,14 +436,7 @@ static void test_coat_tilt(void) {
 static void test_vsl_matches_pt(void) {
     scene *s = ts_new("bumpy room");
     unsigned char px[32 * 32 * 4];
-    rng_state rng = rng_for(5, 0, 0);
-    for (int i = 0; i < 32 * 32; i++) {
-        float a = 2.0f * PI_F * rng_float(&rng), t = 0.7f * rng_float(&rng);
-        px[4 * i] = (unsigned char)(127.5f + 127.5f * sinf(t) * cosf(a));
-        px[4 * i + 1] = (unsigned char)(127.5f + 127.5f * sinf(t) * sinf(a));
-        px[4 * i + 2] = (unsigned char)(127.5f + 127.5f * cosf(t));
-        px[4 * i + 3] = 255;
-    }
+    ts_random_normal_map(px, 32 * 32, 5, 0.7f);
     material m = ts_phong(v3(0.7f, 0.6f, 0.5f), v3s(0), 1.0f);
     m.normal_tex = (texture_slot){.texture = ts_texture(s, 32, 32, px)};
     int wall = ts_material(s, m);

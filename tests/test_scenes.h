@@ -8,6 +8,7 @@
 
 #include "camera.h"
 #include "lights.h"
+#include "rng.h"
 #include "scene.h"
 #include "session.h"
 
@@ -71,6 +72,19 @@ static inline void ts_quad(scene *s, vec3 p0, vec3 p1, vec3 p2, vec3 p3, int mat
     const vec3 p[4] = {p0, p1, p2, p3};
     const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
     ts_quad_uv(s, p, uv, mat);
+}
+
+/* A tangent-space normal map of n texels (RGBA8), each normal tilted by a random angle up to
+ * max_tilt (radians) in a random direction. */
+static inline void ts_random_normal_map(unsigned char *rgba, int n, uint64_t seed, float max_tilt) {
+    rng_state rng = rng_for(seed, 0, 0);
+    for (int i = 0; i < n; i++) {
+        float a = 2.0f * PI_F * rng_float(&rng), t = max_tilt * rng_float(&rng);
+        rgba[4 * i] = (unsigned char)(127.5f + 127.5f * sinf(t) * cosf(a));
+        rgba[4 * i + 1] = (unsigned char)(127.5f + 127.5f * sinf(t) * sinf(a));
+        rgba[4 * i + 2] = (unsigned char)(127.5f + 127.5f * cosf(t));
+        rgba[4 * i + 3] = 255;
+    }
 }
 
 /* A texture of w x h 8-bit RGBA texels (repeat wrapping); returns its index. */

@@ -66,14 +66,7 @@ static void test_closed_form(void) {
  * were transformed (tangents generated from them): rotations, non-uniform and mirroring scales. */
 static void test_normal_map(void) {
     unsigned char px[8 * 8 * 4];
-    rng_state rng = rng_for(9, 0, 0);
-    for (int i = 0; i < 8 * 8; i++) {
-        float a = 2.0f * PI_F * rng_float(&rng), t = 0.6f * rng_float(&rng);
-        px[4 * i] = (unsigned char)(127.5f + 127.5f * sinf(t) * cosf(a));
-        px[4 * i + 1] = (unsigned char)(127.5f + 127.5f * sinf(t) * sinf(a));
-        px[4 * i + 2] = (unsigned char)(127.5f + 127.5f * cosf(t));
-        px[4 * i + 3] = 255;
-    }
+    ts_random_normal_map(px, 8 * 8, 9, 0.6f);
     const double cases[][5] = {
         {0.3, 0.1, 0.7, 1.0, 1.0}, {0.0, 0.0, 2.5, 2.0, 0.5}, {0.2, 0.0, 0.0, -1.0, 1.0}, {0.0, 0.4, -1.0, 1.5, -0.75}};
     const vec3 p[4] = {v3(0, 0, 0), v3(1, 0, 0), v3(1, 1, 0), v3(0, 1, 0)};
