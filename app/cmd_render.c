@@ -235,6 +235,7 @@ static int write_stats(const char *path, const render_options *o, const render_s
                 (unsigned long long)st.light_paths, (unsigned long long)st.vl_connections,
                 (unsigned long long)st.vsl_samples);
         fprintf(f, "  \"glossy_bounces\": %llu,\n", (unsigned long long)st.glossy_bounces);
+        fprintf(f, "  \"pixel_points\": %llu,\n", (unsigned long long)st.pixel_points);
         fprintf(f, "  \"clamped\": %llu,\n  \"rows\": %d,\n  \"columns\": %d", (unsigned long long)st.clamped,
                 vp.columns > 0 ? vp.rows : 0, vp.columns);
     }

@@ -38,8 +38,12 @@ typedef struct {
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */
 hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf_filter *env_filter);
 
-/* The highlights at camera hit x: light along camera - glossy(x) - glossy(q) - light, reflected
- * toward the camera. Zero when x has no glossy lobe. Counts work into st. */
-vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *x, rng_state *rng, render_stats *st);
+/* The highlights of a pixel from its camera hits xs[0..points): light along camera - glossy(x) -
+ * glossy(q) - light, reflected toward the camera, the mean over the points, from the setup's N
+ * secondary rays shared among them; each point merges its own lobes. A point without a glossy lobe
+ * adds zero. *sharp is set when some point's lobe is sharp enough that its members take its image
+ * (a pixel worth spreading over). Counts work into st. */
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, rng_state *rng,
+                 render_stats *st, int *sharp);
 
 #endif

@@ -32,6 +32,7 @@ typedef struct {
  * light is easy) a third of its frames for little (docs/benchmarks.md). */
 #define MANYLIGHT_DIRECT_SAMPLES 4
 #define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
+#define HL_PIXEL_POINTS 8 /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
 
 struct render_session {
     const scene *scene;
@@ -48,6 +49,7 @@ struct render_session {
      * samples, from the spread of one sample's light in earlier frames */
     int adapt;
     pixel_alloc glossy, direct;
+    uint8_t *hl_sharp;       /* per pixel: met a sharp highlight lobe (its highlights spread over it) */
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
@@ -97,7 +99,8 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
         return NULL;
     }
     if (pixel_alloc_init(&rs->glossy, p->width * p->height) != 0 ||
-        pixel_alloc_init(&rs->direct, p->width * p->height) != 0) {
+        pixel_alloc_init(&rs->direct, p->width * p->height) != 0 ||
+        !(rs->hl_sharp = calloc((size_t)p->width * (size_t)p->height, 1))) {
         session_destroy(rs);
         return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
     }
@@ -113,6 +116,7 @@ void session_destroy(render_session *rs) {
     manylight_deinit(&rs->ml);
     pixel_alloc_free(&rs->glossy);
     pixel_alloc_free(&rs->direct);
+    free(rs->hl_sharp);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -128,12 +132,62 @@ static uint64_t next_frame_index(const render_session *rs) {
     return (uint64_t)p->shard_index + (uint64_t)rs->frames * (uint64_t)p->shard_count;
 }
 
-/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
-static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 d, const surface_hit *first,
-                          rng_state *rng) {
+/* n camera hits spread over a pixel: the frame's own first (NULL: none), then more at R2
+ * positions over the pixel. */
+static void pixel_points(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                         const surface_hit *first, shading_point *xs, int n) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
-    if (!first && !s->env) { /* into the void: every component is zero, nothing to add */
+    rng_state start = rng_for((uint64_t)pixel, UINT64_MAX - 1, p->seed);
+    vec2 shift = rng_vec2(&start);
+    for (int j = 0; j < n; j++) {
+        const surface_hit *h = first;
+        surface_hit hit;
+        vec3 dir = d;
+        if (j > 0) {
+            int index = (int)((next_frame_index(rs) * (HL_PIXEL_POINTS - 1) + (uint64_t)j) & 0x3fffffff);
+            vec2 u = sample_r2(index, shift);
+            dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
+            st->rays[RAY_CAMERA]++;
+            st->pixel_points++;
+            h = scene_intersect(s, rs->cam.position, dir, INFINITY, &hit) ? &hit : NULL;
+        }
+        if (h) {
+            xs[j] = shading_point_at(s, h, dir);
+        } else {
+            memset(&xs[j], 0, sizeof xs[j]);
+            xs[j].b.dropped = BSDF_ALL; /* no lobe: adds zero */
+        }
+    }
+}
+
+/* The highlights of a pixel. A highlight is often smaller than the pixel (a curved mirror's image
+ * of a lit speck), and there more positions in the pixel beat more rays from one: once the pixel
+ * has met a sharp highlight lobe in an earlier frame (with --adapt), each secondary ray starts
+ * from its own point of the pixel. Earlier frames decide this, so each frame's estimate stays
+ * unbiased; and a sharp lobe's members take its image, not the sample's spread, so one ray a point
+ * merges as well as N (docs/design.md, "Where the samples go"). */
+static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                             const surface_hit *first, rng_state *rng) {
+    rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
+    int rays = rs->hl.secondary_rays;
+    int points = rs->adapt && rs->hl_sharp[pixel] ? (rays < HL_PIXEL_POINTS ? rays : HL_PIXEL_POINTS) : 1;
+    if (!first && points == 1) return v3(0, 0, 0);
+    shading_point xs[HL_PIXEL_POINTS];
+    pixel_points(rs, st, raster, pixel, d, first, xs, points);
+    int sharp = 0;
+    vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, &hl_rng, st, &sharp);
+    if (sharp) rs->hl_sharp[pixel] = 1; /* read from the next frame on: one sample a pixel a frame */
+    return L;
+}
+
+/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
+static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                          const surface_hit *first, rng_state *rng) {
+    const scene *s = rs->scene;
+    const render_params *p = &rs->params;
+    int spread = rs->adapt && rs->plan.highlights && rs->hl_sharp[pixel];
+    if (!first && !s->env && !spread) { /* into the void: every component is zero, nothing to add */
         st->rays[RAY_CAMERA]++;
         return;
     }
@@ -154,9 +208,8 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
             st->rays[RAY_CAMERA]++;
         uint64_t t1 = clock_ns();
         st->pass_ns[PASS_DIRECT] += t1 - t0;
-        if (first && depth > 1 && (rs->plan.virtual_lights || rs->plan.highlights)) {
+        if (first && depth > 1 && rs->plan.virtual_lights) {
             shading_point sp = shading_point_at(s, first, d);
-            rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
             if (rs->plan.virtual_lights) {
                 L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth,
                                                       rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
@@ -165,10 +218,10 @@ static void render_sample(render_session *rs, render_stats *st, int pixel, vec3 
                 st->pass_ns[PASS_GATHER] += t2 - t1;
                 t1 = t2;
             }
-            if (rs->plan.highlights) {
-                L[COMP_HIGHLIGHTS] = hl_estimate(&rs->hl, s, &sp, &hl_rng, st);
-                st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
-            }
+        }
+        if (depth > 1 && rs->plan.highlights) {
+            L[COMP_HIGHLIGHTS] = pixel_highlights(rs, st, raster, pixel, d, first, rng);
+            st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
         }
     }
     float sample[COMP_COUNT][3];
@@ -225,7 +278,7 @@ static void render_tile(void *ctx, int tile, int worker) {
             unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
             if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
             for (int i = 0; i < n; i++)
-                render_sample(rs, st, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
+                render_sample(rs, st, &raster, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
         }
     }
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;
@@ -273,6 +326,7 @@ int session_render_frame(render_session *rs) {
         t->vsl_samples += st->vsl_samples;
         t->clamped += st->clamped;
         t->glossy_bounces += st->glossy_bounces;
+        t->pixel_points += st->pixel_points;
         t->hl_points += st->hl_points;
         t->hl_secondary_rays += st->hl_secondary_rays;
         t->hl_lobes += st->hl_lobes;
@@ -291,6 +345,7 @@ void session_reset(render_session *rs) {
     film_clear(&rs->film);
     pixel_alloc_reset(&rs->glossy);
     pixel_alloc_reset(&rs->direct);
+    memset(rs->hl_sharp, 0, (size_t)rs->params.width * (size_t)rs->params.height);
     rs->frames = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }

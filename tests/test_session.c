@@ -100,8 +100,12 @@ static void check_only(void) {
         for (int c = 0; c < COMP_COUNT; c++)
             CHECK((rendered >> c & 1u) ? sum[c] > 0.0 && isfinite(sum[c]) : sum[c] == 0.0,
                   "only %#x: component %d sums to %g", masks[k], c, sum[c]);
-        CHECK(st.rays[RAY_CAMERA] == (uint64_t)(2 * W * H), "only %#x: %llu camera rays for %d", masks[k],
-              (unsigned long long)st.rays[RAY_CAMERA], 2 * W * H);
+        /* One camera ray a pixel a frame, and those of the pixels' extra highlight points (--adapt) */
+        CHECK(st.rays[RAY_CAMERA] == (uint64_t)(2 * W * H) + st.pixel_points,
+              "only %#x: %llu camera rays for %d + %llu", masks[k], (unsigned long long)st.rays[RAY_CAMERA], 2 * W * H,
+              (unsigned long long)st.pixel_points);
+        CHECK(st.pixel_points < (uint64_t)(2 * W * H * 8), "only %#x: %llu extra points", masks[k],
+              (unsigned long long)st.pixel_points);
         CHECK((rendered & I) ? st.virtual_lights > 0 : st.virtual_lights == 0 && st.pass_ns[PASS_GATHER] == 0,
               "only %#x: %llu virtual lights", masks[k], (unsigned long long)st.virtual_lights);
         CHECK((rendered & HL) ? st.hl_points > 0 : st.hl_points == 0 && st.pass_ns[PASS_HIGHLIGHTS] == 0,
