@@ -176,7 +176,7 @@ static double moments_density(const band_moments *bm, const vmf *v, vec3 s) {
  * (HL_MAX_IMAGE_VAR: beyond, GGX's tails, which no Gaussian band follows, carry visible light).
  * Measured on test_highlights' corners of GGX alpha 0.09 planes, whose bands have variances up to
  * 0.009: taking their images lost 17% of the highlights, 7% when only images below 0.01 were taken,
- * and at an edge (the paper's Fig. 6) the error rose from 0.04 to 0.16. Such x keep the sample's
+ * and at an edge (the paper's Fig. 6) the error rose from 0.04 to 0.20. Such x keep the sample's
  * spread; the chrome of roughness 0.12 (variances 0.0016 and 0.0002) takes its image. */
 #define HL_MAX_X_VAR 0.002
 #define HL_MAX_IMAGE_VAR 0.008
