@@ -210,14 +210,12 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
         st->pass_ns[PASS_DIRECT] += t1 - t0;
         if (first && depth > 1 && rs->plan.virtual_lights) {
             shading_point sp = shading_point_at(s, first, d);
-            if (rs->plan.virtual_lights) {
-                L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth,
-                                                      rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
-                                                      rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
-                uint64_t t2 = clock_ns();
-                st->pass_ns[PASS_GATHER] += t2 - t1;
-                t1 = t2;
-            }
+            L[COMP_INDIRECT] =
+                manylight_indirect(&rs->ml, s, &sp, depth, rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
+                                   rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
+            uint64_t t2 = clock_ns();
+            st->pass_ns[PASS_GATHER] += t2 - t1;
+            t1 = t2;
         }
         if (depth > 1 && rs->plan.highlights) {
             L[COMP_HIGHLIGHTS] = pixel_highlights(rs, st, raster, pixel, d, first, rng);
