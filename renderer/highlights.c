@@ -570,7 +570,7 @@ static vec3 merge_and_light(const hl_setup *h, const scene *s, const hl_hit *hit
         cluster_make(&clusters[c], hits, &members[used], n_c);
         used += n_c;
     }
-    st->hl_merge_ns += clock_ns() - t0;
+    if (h->mode == HL_MERGED) st->hl_merge_ns += clock_ns() - t0; /* unmerged: clusters of one, no merging */
     for (int c = 0; c < k; c++) {
         lit_lobe l = {clusters[c].origin, clusters[c].n, &clusters[c], NULL, v3(0, 0, 0)};
         sum = add3(sum, light_lobe(h, s, &l, rng, st));
