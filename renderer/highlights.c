@@ -195,10 +195,16 @@ static vec3 image_of_offset(const hl_hit *h, vec3 v, vec3 li, double dl, int far
     return madd3(r, dq, (float)((double)h->t / dl));
 }
 
-/* Whether band xb of the member's x is narrow enough to take its image (HL_MAX_X_VAR). */
-static int x_band_narrow(const hl_hit *h, int xb) {
-    return h->x_fitted && (double)length_sq3(h->x_axis1[xb]) <= HL_MAX_X_VAR &&
-           (double)length_sq3(h->x_axis2[xb]) <= HL_MAX_X_VAR;
+/* Whether a band of x's lobe, given by its two scaled axes, is narrow enough to take its image. */
+static int axes_narrow(vec3 axis1, vec3 axis2) {
+    return (double)length_sq3(axis1) <= HL_MAX_X_VAR && (double)length_sq3(axis2) <= HL_MAX_X_VAR;
+}
+
+static int x_band_narrow(const hl_hit *h, int xb) { return h->x_fitted && axes_narrow(h->x_axis1[xb], h->x_axis2[xb]); }
+
+/* Where band xb's image puts the member's lobe, as the light along li (dl away, or far) sees it. */
+static vec3 image_centre(const hl_hit *h, int xb, vec3 li, double dl, int far) {
+    return normalize3(add3(h->mu, image_of_offset(h, h->x_offset[xb], li, dl, far)));
 }
 
 /* Adds member h, its weight scaled by g, to the components' moments as the light along li (dl away,
@@ -214,13 +220,13 @@ static void members_add(band_moments *bm, const hl_hit *h, vec3 li, vec3 wl, dou
         vec3 c = h->mu, a1 = v3(0, 0, 0), a2 = v3(0, 0, 0);
         double x_rbar = 1.0;
         int image = 0;
-        if (h->x_fitted) {
+        if (x_band_narrow(h, xb)) {
             a1 = image_of_offset(h, h->x_axis1[xb], li, dl, far);
             a2 = image_of_offset(h, h->x_axis2[xb], li, dl, far);
             double var = 0.5 * (double)(length_sq3(a1) + length_sq3(a2));
-            image = x_band_narrow(h, xb) && var < HL_MAX_IMAGE_VAR;
+            image = var < HL_MAX_IMAGE_VAR;
             if (image) {
-                c = normalize3(add3(h->mu, image_of_offset(h, h->x_offset[xb], li, dl, far)));
+                c = image_centre(h, xb, li, dl, far);
                 x_rbar = vmf_rbar_from_kappa(1.0 / fmax(var, 1e-12));
                 if (turn) a1 = rotate_onto(li, wl, a1), a2 = rotate_onto(li, wl, a2);
             }
@@ -481,7 +487,7 @@ static x_lobe x_lobe_fit(const shading_point *x) {
         xl.mu[b] = mu;
         xl.axis1[b] = scale3(cross3(mu, a), (float)sqrt(1.0 / (k * sq))); /* along the plane of incidence */
         xl.axis2[b] = scale3(a, (float)sqrt(sq / k));
-        if (fmax(1.0 / (k * sq), sq / k) > HL_MAX_X_VAR) xl.sharp = 0;
+        if (!axes_narrow(xl.axis1[b], xl.axis2[b])) xl.sharp = 0;
     }
     xl.fitted = 1;
     return xl;
@@ -554,9 +560,7 @@ static vec3 merge_and_light(const hl_setup *h, const scene *s, const hl_hit *hit
         const hl_hit *hit = &hits[index[i]];
         /* Clustered by where x's lobe's image lies, where it is taken: members of one smooth
          * surface coincide. */
-        dirs[i] = x_band_narrow(hit, 0)
-                      ? normalize3(add3(hit->mu, image_of_offset(hit, hit->x_offset[0], hit->mu, 0.0, 1)))
-                      : hit->mu;
+        dirs[i] = x_band_narrow(hit, 0) ? image_centre(hit, 0, hit->mu, 0.0, 1) : hit->mu;
         alpha[i] = 0.0f;
         for (int b = 0; b < hit->bands; b++) alpha[i] += hit->lum[b];
     }
