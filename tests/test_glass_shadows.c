@@ -7,7 +7,7 @@
  * pane (next-event estimation and the BSDF's paths through the pane weighted against each other)
  * and with a rough one (light through it found by the BSDF's paths alone), and the noise the
  * smooth pane's shadow rays take away; vsl and vsl+hl against the path tracer in a box divided by
- * a pane. */
+ * a pane; the path tracer's highlights layer and the highlight estimator's behind a pane. */
 #include <math.h>
 
 #include "check.h"
@@ -286,6 +286,24 @@ static void test_highlight_split(void) {
     CHECK(bad_sum == 0, "pane: indirect != split indirect + highlights at %d channels", bad_sum);
     CHECK(ind_total > 0.0 && rest_total <= 1e-6 * ind_total, "pane, depth 2: %.3g of the indirect is not highlights",
           rest_total / ind_total);
+    /* The highlight estimator, tracing each secondary hit's lobe (shadow rays and lobe samples
+     * through the pane), against the path tracer's layer. */
+    p.seed = 22;
+    float *ref = ts_render_with(s, &cam, &p, 512, 1u << COMP_HIGHLIGHTS);
+    render_params q = {.width = HW, .height = HH, .method = METHOD_VSL_HL, .max_depth = 2, .seed = 23};
+    q.vl.count = 64;
+    q.vl.merge = HL_MERGE_TRACE;
+    q.vl.secondary_rays = 16;
+    float *est = ts_render_with(s, &cam, &q, 64, 1u << COMP_HIGHLIGHTS);
+    for (int c = 0; c < 3; c++) {
+        double a = 0, b = 0;
+        for (int i = 0; i < HN; i++) a += est[3 * i + c], b += ref[3 * i + c];
+        printf("highlights behind a pane, channel %d: vsl+hl %.4f, pt %.4f\n", c, a / HN, b / HN);
+        CHECK(b > 0.0 && fabs(a / b - 1.0) < 0.03, "highlights behind a pane, channel %d: %.5f against pt's %.5f", c,
+              a / HN, b / HN);
+    }
+    free(ref);
+    free(est);
     free(ind);
     free(ind_split);
     free(hl);
