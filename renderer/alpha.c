@@ -18,12 +18,13 @@ enum { ALPHA_CLASS_OPAQUE = 0, ALPHA_CLASS_TESTED, ALPHA_CLASS_INVISIBLE, ALPHA_
 /* Beside the class: the material's glass may let shadow rays through (in the tested geometry). */
 enum { ALPHA_PASSES_SHADOWS = 4 };
 
-/* Glass whose transmission may be smooth and unbent somewhere: its roughness factor at the floor
- * (textures only lower it), and no refracting volume (material_layers' eta). bsdf_pass_through
- * decides at each hit. */
+/* Glass whose transmission may be smooth and unbent somewhere: not metal and its roughness at the
+ * floor, by its factors or somewhere in its metallic-roughness texture (which only lowers them),
+ * and no refracting volume (material_layers' eta). bsdf_pass_through decides at each hit. */
 static int may_pass_shadows(const material *m) {
-    if (m->model != MATERIAL_GLTF || !(m->ext.transmission > 0.0f) || !(m->metallic < 1.0f)) return 0;
-    if (!(m->roughness * m->roughness <= BSDF_MIN_ALPHA)) return 0;
+    int textured = m->metal_rough_tex.texture >= 0;
+    if (m->model != MATERIAL_GLTF || !(m->ext.transmission > 0.0f)) return 0;
+    if (!textured && (!(m->metallic < 1.0f) || !(m->roughness * m->roughness <= BSDF_MIN_ALPHA))) return 0;
     return !material_is_volume(m) || m->ext.ior < 1.0f || fabsf(m->ext.ior - 1.0f) < 1e-3f;
 }
 

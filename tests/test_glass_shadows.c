@@ -122,6 +122,31 @@ static void test_point_light(void) {
     }
 }
 
+/* A pane whose factors say rough metal (glTF's defaults, 1 and 1) but whose metallic-roughness
+ * texture says smooth glass (G and B 0; as TransmissionRoughnessTest's): it passes shadow rays
+ * where the texture says so, and not where it says rough (G 1). */
+static void test_textured_pane(void) {
+    for (int rough = 0; rough <= 1; rough++) {
+        scene *s = floor_scene("textured pane");
+        const unsigned char texel[4] = {0, rough ? 255 : 0, 0, 255};
+        material m = glass(1.0f, IOR, 0.0f, v3s(1), INFINITY);
+        m.metallic = 1.0f;
+        m.metal_rough_tex = (texture_slot){.texture = ts_texture(s, 1, 1, texel)};
+        pane(s, 1.0f, ts_material(s, m));
+        light pl = {.type = LIGHT_POINT, .color = v3s(20.0f), .position = v3(0, 3.0f, 0)};
+        scene_add_light(s, &pl);
+        ts_finalize(s);
+        float *img = render_direct(s, METHOD_PT, 4, 8);
+        for (int ch = 0; ch < 3; ch++) {
+            double mean, sd, want = rough ? 0.0 : ALBEDO / PI_D * 20.0 / 9.0 * pane_t(1.0, IOR, ch);
+            image_stats(img, ch, &mean, &sd);
+            CHECK_NEAR(mean, want, 3e-3 * want, "pane textured %s, channel %d", rough ? "rough" : "smooth", ch);
+        }
+        free(img);
+        scene_destroy(s);
+    }
+}
+
 /* What still stops shadow rays: a rough pane, a refracting slab (the point light is dark below
  * them: no sampled path can find it); and an ior-1 slab that absorbs, passed with its faces'
  * (1 - F) t tint each and exp(-sigma d) between. */
@@ -314,6 +339,7 @@ int main(void) {
     test_transmittance();
     test_point_light();
     test_stops_and_slab();
+    test_textured_pane();
     test_area_light();
     test_box_against_pt();
     test_highlight_split();
