@@ -239,7 +239,7 @@ static int cluster_lights(manylight *m, const scene *s, const camera *cam, const
 
 /* The lobes of x traced through rather than gathered: a glossy lobe sharper than trace_alpha,
  * where a handful of lights cannot represent the incoming light, and any transmission, which
- * no light can be seen through (shadow rays stop at glass, docs/design.md). */
+ * no virtual light is seen through (docs/design.md, "Transmission and volume"). */
 static int traced_lobes(const manylight *m, const bsdf *b) {
     int lobes = bsdf_lobes(b);
     int sharp = (lobes & BSDF_GLOSSY) && bsdf_glossy_alpha(b) < m->trace_alpha;

@@ -54,8 +54,9 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
             memset(&vl, 0, sizeof vl);
             bsdf b = material_bsdf(s, &h, &vl.frame);
             if (!bsdf_lobes(&b)) break; /* black: absorbs everything */
-            /* No light is seen through a transmission (shadow rays stop at glass): the virtual
-             * light keeps the reflecting lobes, and the path carries on through the transmission. */
+            /* No virtual light is seen through a transmission (the gather's visibility stops at
+             * glass): the virtual light keeps the reflecting lobes, and the path carries on
+             * through the transmission. */
             vl.b = bsdf_only(&b, BSDF_ALL & ~BSDF_TRANSMIT);
             vl.p = h.p;
             vl.ng = h.ng;
