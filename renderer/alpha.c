@@ -149,9 +149,20 @@ static void alpha_filter(const struct RTCFilterFunctionNArguments *args) {
     }
 }
 
-/* Occlusion: alpha as above; then glass that shadow rays may pass, when the query records it
- * (scene_transmittance), is recorded once per triangle (Embree may report a hit twice) and
- * passed. More glass than the record holds blocks the ray. */
+/* Whether glass that may pass shadow rays is smooth at barycentrics (b1, b2) of triangle t by its
+ * metallic-roughness texture (glTF's factor times texel; bsdf_pass_through has the last word):
+ * rough texels block the ray here, at once, rather than after the query. */
+static int smooth_here(const scene *s, const material *m, int t, float b1, float b2) {
+    if (m->metal_rough_tex.texture < 0) return 1;
+    vec4 mr =
+        texture_lookup(s, m->metal_rough_tex, triangle_uv(s, s->uv0, t, b1, b2), triangle_uv(s, s->uv1, t, b1, b2), 0);
+    float r = m->roughness * mr.y;
+    return m->metallic * mr.z < 1.0f && r * r <= BSDF_MIN_ALPHA;
+}
+
+/* Occlusion: alpha as above; then glass that shadow rays may pass, smooth at the hit, when the
+ * query records it (scene_transmittance), is recorded once per triangle (Embree may report a hit
+ * twice) and passed. More glass than the record holds blocks the ray. */
 static void occlusion_filter(const struct RTCFilterFunctionNArguments *args) {
     const scene *s = args->geometryUserPtr;
     shadow_context *ctx = (shadow_context *)args->context;
@@ -163,7 +174,9 @@ static void occlusion_filter(const struct RTCFilterFunctionNArguments *args) {
             args->valid[i] = 0;
             continue;
         }
-        if (!ctx->record || !scene_material_passes_shadows(s, s->tri_material[t])) continue;
+        if (!ctx->record || !scene_material_passes_shadows(s, s->tri_material[t]) ||
+            !smooth_here(s, &s->materials[s->tri_material[t]], t, b1, b2))
+            continue;
         int k = 0;
         while (k < ctx->count && ctx->hit[k].tri != t) k++;
         if (k == ctx->count) {

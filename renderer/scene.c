@@ -714,13 +714,13 @@ int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax) {
     return occluded(s, o, d, tmax, 0, &ctx);
 }
 
-vec3 scene_transmittance(const scene *s, vec3 o, vec3 d, float tmax, vec3 sigma) {
-    shadow_context ctx;
-    if (occluded(s, o, d, tmax, 1, &ctx)) return v3s(0.0f);
-    /* The glass met, in order along the ray (the filter saw it in the BVH's order). */
+/* The glass a shadow ray recorded (ctx), in order along the ray (the filter saw it in the BVH's
+ * order): each surface's pass and Beer-Lambert between. Apart, so that shadow rays meeting no
+ * glass keep a small frame. */
+static vec3 glass_transmittance(const scene *s, const shadow_context *ctx, vec3 o, vec3 d, float tmax, vec3 sigma) {
     surface_hit h[SCENE_MAX_GLASS];
-    for (int k = 0; k < ctx.count; k++) {
-        complete_hit(s, d, ctx.hit[k].tri, ctx.hit[k].b1, ctx.hit[k].b2, 0.0f, &h[k]);
+    for (int k = 0; k < ctx->count; k++) {
+        complete_hit(s, d, ctx->hit[k].tri, ctx->hit[k].b1, ctx->hit[k].b2, 0.0f, &h[k]);
         h[k].t = dot3(sub3(h[k].p, o), d);
         for (int j = k; j > 0 && h[j].t < h[j - 1].t; j--) {
             surface_hit tmp = h[j];
@@ -729,7 +729,7 @@ vec3 scene_transmittance(const scene *s, vec3 o, vec3 d, float tmax, vec3 sigma)
     }
     vec3 tr = v3s(1.0f);
     float t0 = 0.0f;
-    for (int k = 0; k < ctx.count && !is_black3(tr); k++) {
+    for (int k = 0; k < ctx->count && !is_black3(tr); k++) {
         /* A ray through an edge or a corner meets each triangle there: one crossing. */
         if (k > 0 && h[k].material == h[k - 1].material && h[k].t - h[k - 1].t <= scene_offset_eps(s, h[k].p)) continue;
         tr = mul3(tr, medium_transmittance(sigma, h[k].t - t0));
@@ -737,6 +737,12 @@ vec3 scene_transmittance(const scene *s, vec3 o, vec3 d, float tmax, vec3 sigma)
         t0 = h[k].t;
     }
     return mul3(tr, medium_transmittance(sigma, tmax - t0));
+}
+
+vec3 scene_transmittance(const scene *s, vec3 o, vec3 d, float tmax, vec3 sigma) {
+    shadow_context ctx;
+    if (occluded(s, o, d, tmax, 1, &ctx)) return v3s(0.0f);
+    return ctx.count ? glass_transmittance(s, &ctx, o, d, tmax, sigma) : medium_transmittance(sigma, tmax);
 }
 
 vec3 scene_glass_pass(const scene *s, const surface_hit *h, vec3 d, vec3 *sigma) {
