@@ -42,12 +42,13 @@ static double pane_t(double c, double ior, int channel) {
     return (1.0 - f) * TRANSMISSION * tint[channel];
 }
 
-/* The floor y = 0 (Lambert ALBEDO), 40 m wide, and a horizontal pane at height y of material mat. */
+/* The floor y = 0 (Lambert ALBEDO), 40 m wide. */
 static scene *floor_scene(const char *name) {
     scene *s = ts_new(name);
     ts_quad(s, v3(-20, 0, 20), v3(20, 0, 20), v3(20, 0, -20), v3(-20, 0, -20), ts_lambert(s, v3s(ALBEDO), v3s(0), 0));
     return s;
 }
+/* A horizontal pane as wide at height y, of material mat. */
 static void pane(scene *s, float y, int mat) {
     ts_quad(s, v3(-20, y, 20), v3(20, y, 20), v3(20, y, -20), v3(-20, y, -20), mat);
 }
