@@ -235,7 +235,9 @@ int scene_build_bvh(scene *s, char *err, size_t errlen) {
     unsigned char(*ranges)[2] = malloc(2 * (size_t)s->num_images + 2);
     if (!ranges) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
     for (int i = 0; i < s->num_images; i++) ranges[i][0] = 255, ranges[i][1] = 0;
+    s->has_glass = 0;
     for (int m = 0; m < s->num_materials; m++) {
+        s->has_glass |= s->materials[m].ext.transmission > 0.0f;
         cls[m] = (unsigned char)alpha_class(s, &s->materials[m], ranges);
         if (cls[m] != ALPHA_CLASS_INVISIBLE && filters && may_pass_shadows(&s->materials[m]))
             cls[m] = ALPHA_CLASS_TESTED | ALPHA_PASSES_SHADOWS;

@@ -29,12 +29,13 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int split_
         out[component_of(events)] = add3(out[component_of(events)], scale3(mul3(beta, le), w));
 }
 
-/* A BSDF's lobes as next-event estimation sees them. */
+/* A BSDF's lobes as next-event estimation sees them: their value, and the pdf of the lobes the
+ * vertex samples its continuation from (pdf_lobes). */
 typedef struct {
     const bsdf *b;
     frame3 fr;
     vec3 wo;
-    int lobes;
+    int lobes, pdf_lobes;
 } bsdf_lobe;
 
 static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lobe_pdf) {
@@ -44,7 +45,7 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
     vec3 f = bsdf_eval(l->b, l->wo, wi, l->lobes);
     /* A delta light's weight needs no lobe pdf: skip evaluating it (point and spot lights are
      * common, and this runs at every vertex). */
-    if (!ls->delta && !is_black3(f)) *lobe_pdf = bsdf_pdf(l->b, l->wo, wi, l->lobes);
+    if (!ls->delta && !is_black3(f)) *lobe_pdf = bsdf_pdf(l->b, l->wo, wi, l->pdf_lobes);
     return scale3(f, wi.z);
 }
 
@@ -68,6 +69,11 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
     int prev_nee = 0;
     vec3 prev_p = o;
     int passes = 0; /* such glass passed after the second scattering event (the highlight split) */
+    /* With first_lobes BSDF_NOT_HIGHLIGHT: the share of the path that left the first vertex by its
+     * highlight lobe. Its light is the highlight estimator's while only glass that shadow rays
+     * pass lies between; at the first other vertex it joins the path (docs/design.md). Only in
+     * scenes with glass: without, it could only be lost. */
+    vec3 held = v3s(0.0f);
     for (int depth = 0, events = 0;; depth++) {
         surface_hit h;
         rays[depth == 0 && !continuation ? RAY_CAMERA : RAY_BOUNCE]++;
@@ -99,8 +105,10 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         bsdf b = material_bsdf(s, &h, &fr);
         vec3 wo = to_local(fr, neg3(d));
         int capped = events >= max_depth;
+        int hold =
+            !capped && depth == 0 && first_lobes == BSDF_NOT_HIGHLIGHT && s->has_glass ? bsdf_highlight_lobe(&b) : 0;
         int lobes = capped                              ? BSDF_TRANSMIT
-                    : depth > 0                         ? BSDF_ALL
+                    : depth > 0 || hold                 ? BSDF_ALL
                     : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~bsdf_highlight_lobe(&b)
                                                         : first_lobes;
         if (!(bsdf_lobes(&b) & lobes)) break;
@@ -109,7 +117,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         if (!capped) {
             float u_sel = rng_float(rng);
             vec2 u_light = rng_vec2(rng);
-            bsdf_lobe lobe = {&b, fr, wo, lobes};
+            bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes};
             light_sample ls;
             vec3 f;
             vec3 arrival =
@@ -133,8 +141,16 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         if (!bsdf_sample(&b, wo, lobes, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
         vec3 wi = to_world(fr, bs.wi);
         if (!bsdf_side_ok(bs.wi, dot3(wi, h.ng))) break; /* the shading normal's side, not the surface's */
-        vec3 weight = scale3(bs.f, fabsf(bs.wi.z) / bs.pdf);
+        vec3 weight = scale3(hold ? bsdf_eval(&b, wo, bs.wi, lobes & ~hold) : bs.f, fabsf(bs.wi.z) / bs.pdf);
         int passed = bs.lobe == BSDF_TRANSMIT && !is_black3(material_pass_through(s, &h, &b, wo));
+        if (hold) {
+            held = mul3(beta, scale3(bsdf_eval(&b, wo, bs.wi, hold), fabsf(bs.wi.z) / bs.pdf));
+        } else if (!is_black3(held)) {
+            if (passed)
+                held = mul3(held, weight);
+            else
+                beta = add3(beta, held), held = v3s(0.0f);
+        }
         if (split_highlights && depth <= 1) {
             vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, bsdf_highlight_lobe(&b)), bs.wi.z / bs.pdf);
             beta_hl = depth == 0 ? fg : mul3(beta_hl, fg);
@@ -143,7 +159,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             passes++;
         }
         beta = mul3(beta, weight);
-        if (is_black3(beta) || !is_finite3(beta)) break;
+        if ((is_black3(beta) && is_black3(held)) || !is_finite3(beta) || !is_finite3(held)) break;
         if (bs.lobe == BSDF_TRANSMIT)
             sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
         events += bs.lobe != BSDF_TRANSMIT;
@@ -155,7 +171,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         o = offset_origin(s, h.p, h.ng, wi);
         d = wi;
 
-        if (depth >= RR_FIRST_VERTEX && !russian_roulette(&beta, rng_float(rng))) break;
+        if (depth >= RR_FIRST_VERTEX && is_black3(held) && !russian_roulette(&beta, rng_float(rng))) break;
     }
 }
 

@@ -195,6 +195,7 @@ typedef struct scene {
     int32_t *bvh_tri[2];
     int bvh_count[2];
     unsigned char *alpha_class;
+    int has_glass; /* some material transmits (KHR_materials_transmission); set with the classes */
     /* Per triangle, for emissive triangles with an emissive texture (emissive.c): the texture's
      * mean over the triangle, 0 in the channels where it is black all over; NULL without such. */
     vec3 *tri_emit_tex;
