@@ -4,7 +4,9 @@
  * so camera rays, bounces, shadow rays and light paths all see the same cut-outs; triangles no
  * ray can see are left out. MASK cuts out below its cutoff; BLEND lets a ray through with
  * probability 1 - alpha, decided by a hash of the ray and the triangle: threads and runs agree,
- * and over random rays the transmission is 1 - alpha on average. */
+ * and over random rays the transmission is 1 - alpha on average. Glass that shadow rays may pass
+ * (smooth, unbent: docs/design.md, "Transmission and volume") sits in the second geometry too:
+ * its occlusion filter records the hit for scene_transmittance and lets the ray on. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,7 +14,27 @@
 #include "rng.h"
 #include "scene_parts.h"
 
-enum { ALPHA_CLASS_OPAQUE = 0, ALPHA_CLASS_TESTED, ALPHA_CLASS_INVISIBLE };
+enum { ALPHA_CLASS_OPAQUE = 0, ALPHA_CLASS_TESTED, ALPHA_CLASS_INVISIBLE, ALPHA_CLASS_MASK = 3 };
+/* Beside the class: the material's glass may let shadow rays through (in the tested geometry). */
+enum { ALPHA_PASSES_SHADOWS = 4 };
+
+/* Glass whose transmission may be smooth and unbent somewhere: not metal and its roughness at the
+ * floor, by its factors or somewhere in its metallic-roughness texture (which only lowers them),
+ * and no refracting volume (material_layers' eta). bsdf_pass_through decides at each hit. */
+static int may_pass_shadows(const material *m) {
+    int textured = m->metal_rough_tex.texture >= 0;
+    if (m->model != MATERIAL_GLTF || !(m->ext.transmission > 0.0f)) return 0;
+    if (!textured && (!(m->metallic < 1.0f) || !(m->roughness * m->roughness <= BSDF_MIN_ALPHA))) return 0;
+    return !material_is_volume(m) || m->ext.ior < 1.0f || fabsf(m->ext.ior - 1.0f) < 1e-3f;
+}
+
+int scene_material_passes_shadows(const scene *s, int m) {
+    return s->alpha_class && (s->alpha_class[m] & ALPHA_PASSES_SHADOWS);
+}
+
+vec3 material_pass_through(const scene *s, const surface_hit *h, const bsdf *b, vec3 wo) {
+    return scene_material_passes_shadows(s, h->material) ? bsdf_pass_through(b, wo) : v3s(0.0f);
+}
 
 float material_alpha(const scene *s, const material *m, vec2 uv0, vec2 uv1) {
     float a = m->base_alpha;
@@ -92,24 +114,77 @@ float alpha_ray_hash(vec3 o, vec3 d, int tri) {
     return ray_hash(od, (unsigned)tri);
 }
 
+/* Whether lane i's hit on triangle t (barycentrics b1, b2) stands by its material's alpha. */
+static int alpha_hit_stands(const scene *s, const struct RTCFilterFunctionNArguments *args, unsigned i, int t, float b1,
+                            float b2) {
+    const material *m = &s->materials[s->tri_material[t]];
+    if (m->alpha == ALPHA_OPAQUE) return 1; /* glass in this geometry for its shadows */
+    unsigned n = args->N;
+    float a = material_alpha(s, m, triangle_uv(s, s->uv0, t, b1, b2), triangle_uv(s, s->uv1, t, b1, b2));
+    float u = 0.0f;
+    if (m->alpha == ALPHA_BLEND) {
+        float od[6]; /* org_x, org_y, org_z, then dir_x, dir_y, dir_z after tnear */
+        for (unsigned k = 0; k < 3; k++) od[k] = ray_f(args->ray, n, k, i), od[3 + k] = ray_f(args->ray, n, 4 + k, i);
+        u = ray_hash(od, (unsigned)t);
+    }
+    return alpha_keeps(m, a, u);
+}
+
+/* The hit's triangle and barycentrics (NaN barycentrics, a ray in the triangle's plane: a corner). */
+static int filter_hit(const scene *s, const struct RTCFilterFunctionNArguments *args, unsigned i, float *b1,
+                      float *b2) {
+    unsigned n = args->N;
+    *b1 = hit_f(args->hit, n, 3, i), *b2 = hit_f(args->hit, n, 4, i);
+    if (!isfinite(*b1) || !isfinite(*b2)) *b1 = *b2 = 0.0f;
+    return s->bvh_tri[1][hit_u(args->hit, n, 5, i)]; /* primID */
+}
+
 static void alpha_filter(const struct RTCFilterFunctionNArguments *args) {
     const scene *s = args->geometryUserPtr;
-    unsigned n = args->N;
-    for (unsigned i = 0; i < n; i++) {
+    for (unsigned i = 0; i < args->N; i++) {
         if (args->valid[i] == 0) continue;
-        int t = s->bvh_tri[1][hit_u(args->hit, n, 5, i)]; /* primID */
-        const material *m = &s->materials[s->tri_material[t]];
-        float b1 = hit_f(args->hit, n, 3, i), b2 = hit_f(args->hit, n, 4, i);
-        if (!isfinite(b1) || !isfinite(b2)) b1 = b2 = 0.0f;
-        float a = material_alpha(s, m, triangle_uv(s, s->uv0, t, b1, b2), triangle_uv(s, s->uv1, t, b1, b2));
-        float u = 0.0f;
-        if (m->alpha == ALPHA_BLEND) {
-            float od[6]; /* org_x, org_y, org_z, then dir_x, dir_y, dir_z after tnear */
-            for (unsigned k = 0; k < 3; k++)
-                od[k] = ray_f(args->ray, n, k, i), od[3 + k] = ray_f(args->ray, n, 4 + k, i);
-            u = ray_hash(od, (unsigned)t);
+        float b1, b2;
+        int t = filter_hit(s, args, i, &b1, &b2);
+        if (!alpha_hit_stands(s, args, i, t, b1, b2)) args->valid[i] = 0;
+    }
+}
+
+/* Whether glass that may pass shadow rays is smooth at barycentrics (b1, b2) of triangle t by its
+ * metallic-roughness texture (glTF's factor times texel; bsdf_pass_through has the last word):
+ * rough texels block the ray here, at once, rather than after the query. */
+static int smooth_here(const scene *s, const material *m, int t, float b1, float b2) {
+    if (m->metal_rough_tex.texture < 0) return 1;
+    vec4 mr =
+        texture_lookup(s, m->metal_rough_tex, triangle_uv(s, s->uv0, t, b1, b2), triangle_uv(s, s->uv1, t, b1, b2), 0);
+    float r = m->roughness * mr.y;
+    return m->metallic * mr.z < 1.0f && r * r <= BSDF_MIN_ALPHA;
+}
+
+/* Occlusion: alpha as above; then glass that shadow rays may pass, smooth at the hit, when the
+ * query records it (scene_transmittance), is recorded once per triangle (Embree may report a hit
+ * twice) and passed. More glass than the record holds blocks the ray. */
+static void occlusion_filter(const struct RTCFilterFunctionNArguments *args) {
+    const scene *s = args->geometryUserPtr;
+    shadow_context *ctx = (shadow_context *)args->context;
+    for (unsigned i = 0; i < args->N; i++) {
+        if (args->valid[i] == 0) continue;
+        float b1, b2;
+        int t = filter_hit(s, args, i, &b1, &b2);
+        if (!alpha_hit_stands(s, args, i, t, b1, b2)) {
+            args->valid[i] = 0;
+            continue;
         }
-        if (!alpha_keeps(m, a, u)) args->valid[i] = 0;
+        if (!ctx->record || !scene_material_passes_shadows(s, s->tri_material[t]) ||
+            !smooth_here(s, &s->materials[s->tri_material[t]], t, b1, b2))
+            continue;
+        int k = 0;
+        while (k < ctx->count && ctx->hit[k].tri != t) k++;
+        if (k == ctx->count) {
+            if (k == SCENE_MAX_GLASS) continue;
+            ctx->hit[k].tri = t, ctx->hit[k].b1 = b1, ctx->hit[k].b2 = b2;
+            ctx->count++;
+        }
+        args->valid[i] = 0;
     }
 }
 
@@ -160,9 +235,15 @@ int scene_build_bvh(scene *s, char *err, size_t errlen) {
     unsigned char(*ranges)[2] = malloc(2 * (size_t)s->num_images + 2);
     if (!ranges) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
     for (int i = 0; i < s->num_images; i++) ranges[i][0] = 255, ranges[i][1] = 0;
-    for (int m = 0; m < s->num_materials; m++) cls[m] = (unsigned char)alpha_class(s, &s->materials[m], ranges);
+    s->has_glass = 0;
+    for (int m = 0; m < s->num_materials; m++) {
+        s->has_glass |= s->materials[m].ext.transmission > 0.0f;
+        cls[m] = (unsigned char)alpha_class(s, &s->materials[m], ranges);
+        if (cls[m] != ALPHA_CLASS_INVISIBLE && filters && may_pass_shadows(&s->materials[m]))
+            cls[m] = ALPHA_CLASS_TESTED | ALPHA_PASSES_SHADOWS;
+    }
     free(ranges);
-    for (int t = 0; t < s->num_triangles; t++) counts[cls[s->tri_material[t]]]++;
+    for (int t = 0; t < s->num_triangles; t++) counts[cls[s->tri_material[t]] & ALPHA_CLASS_MASK]++;
     if (counts[ALPHA_CLASS_TESTED] && !filters) {
         scene_warn(s, "%s: this Embree has no filter functions: alpha modes are drawn opaque", s->path);
         for (int m = 0; m < s->num_materials; m++) cls[m] = ALPHA_CLASS_OPAQUE;
@@ -185,7 +266,7 @@ int scene_build_bvh(scene *s, char *err, size_t errlen) {
             if (!s->bvh_indices[g] || !s->bvh_tri[g]) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
         }
         for (int t = 0; t < s->num_triangles; t++) {
-            int g = cls[s->tri_material[t]];
+            int g = cls[s->tri_material[t]] & ALPHA_CLASS_MASK;
             if (g == ALPHA_CLASS_INVISIBLE) continue;
             memcpy(&s->bvh_indices[g][3 * s->bvh_count[g]], &s->indices[3 * t], 3 * sizeof(uint32_t));
             s->bvh_tri[g][s->bvh_count[g]++] = t;
@@ -196,7 +277,7 @@ int scene_build_bvh(scene *s, char *err, size_t errlen) {
             if (g == 1) {
                 rtcSetGeometryUserData(geom, s);
                 rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
-                rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+                rtcSetGeometryOccludedFilterFunction(geom, occlusion_filter);
             }
             rtcCommitGeometry(geom);
             rtcAttachGeometryByID(s->rtc, geom, g);
@@ -221,5 +302,5 @@ int scene_bvh_vertices_moved(scene *s) {
 }
 
 int scene_triangle_invisible(const scene *s, int t) {
-    return s->alpha_class && s->alpha_class[s->tri_material[t]] == ALPHA_CLASS_INVISIBLE;
+    return s->alpha_class && (s->alpha_class[s->tri_material[t]] & ALPHA_CLASS_MASK) == ALPHA_CLASS_INVISIBLE;
 }

@@ -710,6 +710,17 @@ static vec3 eval_transmit_part(const bsdf *b, vec3 wo, vec3 wi) {
     return f;
 }
 
+vec3 bsdf_pass_through(const bsdf *b, vec3 wo) {
+    /* The lobe's own sample weight f |cos| / pdf at its centre, wi = -wo (thin-walled: the mirrored
+     * reflection of h = n): (1 - F) G2 / G1 times the tint, what its samples carry on average. */
+    if (!(bsdf_lobes(b) & BSDF_TRANSMIT) || !bsdf_thin(b) || b->alpha_x > BSDF_MIN_ALPHA ||
+        b->alpha_y > BSDF_MIN_ALPHA || !(wo.z > 0.0f))
+        return v3s(0.0f);
+    vec3 wi = neg3(wo);
+    float pdf = pdf_transmit(b, wo, wi);
+    return pdf > 0.0f ? scale3(eval_transmit_part(b, wo, wi), wo.z / pdf) : v3s(0.0f);
+}
+
 vec3 bsdf_eval(const bsdf *b, vec3 wo, vec3 wi, int lobes) {
     if (wo.z <= 0.0f || wi.z == 0.0f) return v3s(0.0f);
     lobes &= bsdf_lobes(b);

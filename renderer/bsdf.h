@@ -28,8 +28,9 @@ extern "C" {
 /* Lobe masks: estimators that split path space ask for some lobes. BSDF_NOT_HIGHLIGHT, for
  * estimators that meet the BSDF only at a hit, means every lobe but bsdf_highlight_lobe.
  * BSDF_TRANSMIT is the dielectric's transmission (KHR_materials_transmission): never a highlight
- * lobe, never met by next-event estimation (shadow rays stop at glass), and a transmission does
- * not count as a scattering event toward a path's depth (docs/design.md). */
+ * lobe, never sampled by next-event estimation (shadow rays pass only smooth unbent glass,
+ * bsdf_pass_through), and a transmission does not count as a scattering event toward a path's
+ * depth (docs/design.md). */
 enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_NOT_HIGHLIGHT = 4, BSDF_TRANSMIT = 8, BSDF_ALL = 11 };
 
 /* The path-space split (docs/design.md): camera - glossy - glossy - light paths belong to the
@@ -173,6 +174,12 @@ float bsdf_glossy_select_prob(const bsdf *b, vec3 wo, int lobes);
 float bsdf_adjoint_scale(const bsdf *b, vec3 wo, vec3 wi);
 /* Whether b transmits without bending (thin-walled), or refracts. */
 static inline int bsdf_thin(const bsdf *b) { return fabsf(b->eta - 1.0f) < 1e-3f; }
+/* A shadow ray's passage through b (docs/design.md, "Transmission and volume"): for a smooth
+ * (roughness at BSDF_MIN_ALPHA) transmission that does not bend, what its lobe lets through
+ * straight along -wo, as its own samples carry it: (1 - F) x transmission x base colour (x the
+ * coat's and sheen's scaling). Black for rough or refracting transmission and without one:
+ * shadow rays stop there. */
+vec3 bsdf_pass_through(const bsdf *b, vec3 wo);
 /* Whether a local direction w, from a sample or a light, lies on the side of the geometric
  * surface its lobe says (above for reflection, below for transmission): the shading normal may
  * say otherwise, and then the direction is no path. ng_dot = the world direction . ng. */

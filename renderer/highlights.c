@@ -390,6 +390,33 @@ static int lobe_sample(const lit_lobe *l, rng_state *rng, vec3 *wi) {
     return 1;
 }
 
+/* The emission the lobe's sample wi finds, weighted against next-event estimation's light sample:
+ * at its hit and, as shadow rays do, beyond glass they pass (scene_glass_pass). */
+static vec3 lobe_emission(const scene *s, const lit_lobe *l, vec3 wi, int env_by_sampling, render_stats *st) {
+    vec3 sum = v3(0, 0, 0), tr = v3s(1.0f), sigma = v3s(0.0f), o = offset_origin(s, l->origin, l->n, wi);
+    for (int k = 0; k <= SCENE_MAX_GLASS && !is_black3(tr); k++) {
+        surface_hit e;
+        float pdf;
+        st->rays[RAY_BOUNCE]++;
+        if (!scene_intersect(s, o, wi, INFINITY, &e)) {
+            vec3 f = env_by_sampling ? lobe_eval(l, wi, wi, 1, &pdf) : v3(0, 0, 0);
+            tr = mul3(tr, medium_transmittance(sigma, INFINITY));
+            if (!is_black3(f) && pdf > 0.0f)
+                sum = add3(sum, scale3(mul3(mul3(f, tr), env_eval(s, wi)),
+                                       nee_emission_weight(s, l->origin, NULL, wi, pdf) / pdf));
+            break;
+        }
+        tr = mul3(tr, medium_transmittance(sigma, e.t));
+        vec3 le = s->tri_light[e.tri] >= 0 ? material_emission(s, &e) : v3(0, 0, 0);
+        vec3 f = is_black3(le) ? le : lobe_eval(l, wi, e.p, 0, &pdf);
+        if (!is_black3(f) && pdf > 0.0f)
+            sum = add3(sum, scale3(mul3(mul3(f, tr), le), nee_emission_weight(s, l->origin, &e, wi, pdf) / pdf));
+        tr = mul3(tr, scene_glass_pass(s, &e, wi, &sigma));
+        o = offset_origin(s, e.p, e.ng, wi);
+    }
+    return sum;
+}
+
 /* Light reflected by the lobe: punctual lights one shadow ray each; area lights (and, traced, the
  * environment) by one light sample and one lobe sample with the power heuristic; in the vMF modes
  * the environment by the prefiltered map and a ray along the lobe's mean. */
@@ -403,35 +430,19 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
         if (!light_sample_one(s, li, l->origin, v2(0.5f, 0.5f), &ls)) continue;
         vec3 f = lobe_eval(l, ls.wi, ls.p_light, !isfinite(ls.dist), &pdf);
         if (is_black3(f)) continue; /* outside the lobe: no shadow ray */
-        if (light_sample_visible(s, l->origin, l->n, &ls, &st->rays[RAY_SHADOW])) sum = add3(sum, mul3(f, ls.radiance));
+        vec3 tr = light_sample_visible(s, l->origin, l->n, &ls, v3s(0.0f), &st->rays[RAY_SHADOW]);
+        sum = add3(sum, mul3(mul3(f, ls.radiance), tr));
     }
     int env_by_sampling = traced && s->env_light >= 0;
     if (h->area_lights || env_by_sampling) {
         float u_sel = rng_float(rng);
         vec2 u = rng_vec2(rng);
         lobe_nee ctx = {l, s, env_by_sampling};
-        vec3 f_light, arrival = nee_direct(s, l->origin, l->n, u_sel, u, lobe_toward, &ctx, &st->rays[RAY_SHADOW],
-                                           &f_light, NULL);
+        vec3 f_light, arrival = nee_direct(s, l->origin, l->n, v3s(0.0f), u_sel, u, lobe_toward, &ctx,
+                                           &st->rays[RAY_SHADOW], &f_light, NULL);
         sum = add3(sum, mul3(f_light, arrival));
         vec3 wi;
-        if (lobe_sample(l, rng, &wi)) {
-            surface_hit e;
-            st->rays[RAY_BOUNCE]++;
-            if (scene_intersect(s, offset_origin(s, l->origin, l->n, wi), wi, INFINITY, &e)) {
-                int li = s->tri_light[e.tri];
-                vec3 le = li >= 0 ? material_emission(s, &e) : v3(0, 0, 0);
-                float pdf;
-                vec3 f = is_black3(le) ? le : lobe_eval(l, wi, e.p, 0, &pdf);
-                if (!is_black3(f) && pdf > 0.0f)
-                    sum = add3(sum, scale3(mul3(f, le), nee_emission_weight(s, l->origin, &e, wi, pdf) / pdf));
-            } else if (env_by_sampling) {
-                float pdf;
-                vec3 f = lobe_eval(l, wi, wi, 1, &pdf);
-                if (!is_black3(f) && pdf > 0.0f)
-                    sum = add3(
-                        sum, scale3(mul3(f, env_eval(s, wi)), nee_emission_weight(s, l->origin, NULL, wi, pdf) / pdf));
-            }
-        }
+        if (lobe_sample(l, rng, &wi)) sum = add3(sum, lobe_emission(s, l, wi, env_by_sampling, st));
     }
     if (!traced && h->env_filter) {
         /* One occlusion ray along the heaviest band's mean decides for the lobe (paper, Sec. 6.4). */

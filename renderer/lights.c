@@ -223,7 +223,7 @@ static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light
     return 0;
 }
 
-int light_sample_visible(const scene *s, vec3 p, vec3 ng, const light_sample *ls, uint64_t *shadow_rays) {
+vec3 light_sample_visible(const scene *s, vec3 p, vec3 ng, const light_sample *ls, vec3 sigma, uint64_t *shadow_rays) {
     vec3 org = offset_origin(s, p, ng, ls->wi);
     vec3 dir = ls->wi;
     float tmax = INFINITY;
@@ -231,11 +231,11 @@ int light_sample_visible(const scene *s, vec3 p, vec3 ng, const light_sample *ls
         vec3 target = ls->delta ? ls->p_light : offset_origin(s, ls->p_light, ls->n_light, neg3(ls->wi));
         vec3 span = sub3(target, org);
         tmax = length3(span);
-        if (!(tmax > 0.0f)) return 0;
+        if (!(tmax > 0.0f)) return v3s(0.0f);
         dir = scale3(span, 1.0f / tmax);
     }
     ++*shadow_rays;
-    return !scene_occluded(s, org, dir, tmax);
+    return scene_transmittance(s, org, dir, tmax, sigma);
 }
 
 float light_pdf_triangle(const scene *s, int li, vec3 p, const surface_hit *h) {
@@ -255,7 +255,7 @@ float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, 
     return mis_power(lobe_pdf, li >= 0 ? light_pdf_triangle(s, li, p, h) : 0.0f);
 }
 
-vec3 nee_direct(const scene *s, vec3 p, vec3 ng, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
+vec3 nee_direct(const scene *s, vec3 p, vec3 ng, vec3 sigma, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
                 uint64_t *shadow_rays, vec3 *f, light_sample *out) {
     light_sample ls;
     *f = v3(0, 0, 0);
@@ -263,8 +263,9 @@ vec3 nee_direct(const scene *s, vec3 p, vec3 ng, float u_select, vec2 u, nee_lob
     if (out) *out = ls;
     float lobe_pdf = 0.0f;
     *f = lobe(ctx, &ls, &lobe_pdf);
-    if (is_black3(*f) || !light_sample_visible(s, p, ng, &ls, shadow_rays)) return v3(0, 0, 0);
-    return scale3(ls.radiance, nee_light_weight(&ls, lobe_pdf) / ls.pdf);
+    if (is_black3(*f)) return v3(0, 0, 0);
+    vec3 tr = light_sample_visible(s, p, ng, &ls, sigma, shadow_rays);
+    return is_black3(tr) ? tr : mul3(tr, scale3(ls.radiance, nee_light_weight(&ls, lobe_pdf) / ls.pdf));
 }
 
 float light_pdf_env(const scene *s, vec3 d) {

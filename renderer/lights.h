@@ -27,10 +27,11 @@ int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sa
  * has no selection probability in it. */
 int light_sample_one(const scene *s, int light, vec3 p, vec2 u, light_sample *out);
 
-/* Whether the sampled light reaches p (geometric normal ng): one shadow ray, offset off p's
- * surface toward the light, ending short of the sampled point (off the emitter) or unbounded for
- * directional and environment light. Counts the ray into *shadow_rays. */
-int light_sample_visible(const scene *s, vec3 p, vec3 ng, const light_sample *ls, uint64_t *shadow_rays);
+/* What of the sampled light reaches p (geometric normal ng), p in a medium of absorption sigma:
+ * one shadow ray, offset off p's surface toward the light, ending short of the sampled point (off
+ * the emitter) or unbounded for directional and environment light; it passes smooth unbent glass
+ * (scene_transmittance). Black when blocked. Counts the ray into *shadow_rays. */
+vec3 light_sample_visible(const scene *s, vec3 p, vec3 ng, const light_sample *ls, vec3 sigma, uint64_t *shadow_rays);
 
 /* A ray leaving a light, for light tracing (virtual lights). */
 typedef struct {
@@ -55,7 +56,8 @@ float light_pdf_env(const scene *s, vec3 d);
 /* Next-event estimation's two multiple-importance weights (the power heuristic, one sample each),
  * the one rule the path tracer and the highlight estimator share. For a light sample: against the
  * lobe that could have found the same direction (lobe_pdf, solid angle); a delta light cannot be
- * found, so 1. For emission found by sampling the lobe from p: against light_sample_direct's pdf
+ * found, so 1. For emission found by sampling the lobe from p, directly or beyond glass that
+ * shadow rays pass (docs/design.md, "Transmission and volume"): against light_sample_direct's pdf
  * for the same point (h: an emissive triangle's hit; NULL: the environment along d). */
 static inline float nee_light_weight(const light_sample *ls, float lobe_pdf) {
     return ls->delta ? 1.0f : mis_power(ls->pdf, lobe_pdf);
@@ -69,9 +71,10 @@ typedef vec3 (*nee_lobe_fn)(const void *lobe, const light_sample *ls, float *lob
 
 /* Next-event estimation, the one routine: picks a light from p (u_select, u), keeps it only above
  * the geometric surface (ng), asks the lobe for its value *f and traces one shadow ray when that is
- * not black. Returns the light's weighted arrival Le w / pdf (black when nothing arrives); the
- * contribution is *f times it. *ls (optional) receives the sample. */
-vec3 nee_direct(const scene *s, vec3 p, vec3 ng, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
+ * not black (through smooth unbent glass, from a medium of absorption sigma:
+ * light_sample_visible). Returns the light's weighted arrival Le T w / pdf (black when nothing
+ * arrives); the contribution is *f times it. *ls (optional) receives the sample. */
+vec3 nee_direct(const scene *s, vec3 p, vec3 ng, vec3 sigma, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
                 uint64_t *shadow_rays, vec3 *f, light_sample *ls);
 
 /* Rebuilds the light list after geometry, materials or the environment changed: keeps the

@@ -239,7 +239,7 @@ static int cluster_lights(manylight *m, const scene *s, const camera *cam, const
 
 /* The lobes of x traced through rather than gathered: a glossy lobe sharper than trace_alpha,
  * where a handful of lights cannot represent the incoming light, and any transmission, which
- * no light can be seen through (shadow rays stop at glass, docs/design.md). */
+ * no virtual light is seen through (docs/design.md, "Transmission and volume"). */
 static int traced_lobes(const manylight *m, const bsdf *b) {
     int lobes = bsdf_lobes(b);
     int sharp = (lobes & BSDF_GLOSSY) && bsdf_glossy_alpha(b) < m->trace_alpha;
@@ -248,13 +248,15 @@ static int traced_lobes(const manylight *m, const bsdf *b) {
 
 /* One direction (u_lobe, u) through x's traced lobes (x is scattering event k, reached with weight
  * beta in a medium of absorption *sigma): the direct light at the next hit, weighted (*t), and
- * what carrying the path on needs (*b, *h, *wi, *sigma, *lobe). Through a transmission *t is 0: a
- * transmission is no scattering event, and the direct estimator that reached x (its paths carry on
- * through x's transmission) has the next hit's direct light. Returns 0 when the direction ends
- * there (sampled on the wrong side of the surface, Russian roulette, a miss). */
-static int glossy_direction(const scene *s, const shading_point *x, int traced, vec3 beta, int k, int lobes,
-                            float u_lobe, vec2 u, rng_state *rng, render_stats *st, vec3 *t, vec3 *b, surface_hit *h,
-                            vec3 *wi, vec3 *sigma, int *lobe) {
+ * what carrying the path on needs (*b, *h, *wi, *sigma, *lobe). Through a transmission *t is 0
+ * unless through_direct: a transmission is no scattering event, and the direct estimator that
+ * reached x (its paths carry on through x's transmission) has the next hit's direct light; glass
+ * reached by a gathered lobe's direction (glass_direction) had no such estimator before it, so
+ * there the next hit's direct light is taken. Returns 0 when the direction ends there (sampled on
+ * the wrong side of the surface, Russian roulette, a miss). */
+static int glossy_direction(const scene *s, const shading_point *x, int traced, int through_direct, vec3 beta, int k,
+                            int lobes, float u_lobe, vec2 u, rng_state *rng, render_stats *st, vec3 *t, vec3 *b,
+                            surface_hit *h, vec3 *wi, vec3 *sigma, int *lobe) {
     bsdf_sample_result bs;
     if (!bsdf_sample(&x->b, x->wo, traced, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) return 0;
     *wi = to_world(x->frame, bs.wi);
@@ -267,7 +269,7 @@ static int glossy_direction(const scene *s, const shading_point *x, int traced, 
     *sigma = material_medium_after(&s->materials[x->material], x->backface, bs.lobe, *sigma);
     vec3 o = offset_origin(s, x->p, x->ng, *wi);
     *t = v3(0, 0, 0);
-    if (bs.lobe == BSDF_TRANSMIT) {
+    if (bs.lobe == BSDF_TRANSMIT && !through_direct) {
         st->rays[RAY_BOUNCE]++;
         if (!scene_intersect(s, o, *wi, INFINITY, h)) return 0;
     } else {
@@ -283,8 +285,9 @@ static int glossy_direction(const scene *s, const shading_point *x, int traced, 
 /* A path whose edge from x (event k) to its next scattering event crosses glass, which no virtual
  * light is seen through (docs/design.md, "Transmission and volume"): one direction from x's
  * gathered lobes (x->b) whose hit g transmits, then g's transmission alone (its reflection is the
- * virtual lights' on g). Fills what glossy_direction fills: *t the direct light beyond g. Returns
- * 0 when the direction meets no glass (those paths are the gather's) or ends. */
+ * virtual lights' on g). Fills what glossy_direction fills: *t the direct light at the hit beyond g
+ * (the light of x's first bounce there, which the gather cannot see through g). Returns 0 when the
+ * direction meets no glass (those paths are the gather's) or ends. */
 static int glass_direction(const scene *s, const shading_point *x, vec3 beta, int k, rng_state *rng, render_stats *st,
                            vec3 *t, vec3 *b, surface_hit *h, vec3 *wi, vec3 *sigma) {
     bsdf_sample_result bs;
@@ -300,7 +303,7 @@ static int glass_direction(const scene *s, const shading_point *x, vec3 beta, in
     beta = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
     beta = mul3(beta, medium_transmittance(*sigma, g.t));
     int lobe;
-    return glossy_direction(s, &gp, BSDF_TRANSMIT, beta, k + 1, BSDF_ALL, 0.0f, rng_vec2(rng), rng, st, t, b, h, wi,
+    return glossy_direction(s, &gp, BSDF_TRANSMIT, 1, beta, k + 1, BSDF_ALL, 0.0f, rng_vec2(rng), rng, st, t, b, h, wi,
                             sigma, &lobe);
 }
 
@@ -348,7 +351,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
             vec3 wi;
             int lobe;
             float u_lobe = rng_float(rng);
-            int ok = glossy_direction(s, &x, traced, beta, k, lobes, u_lobe, split > 1 ? sample_r2(j, shift) : shift,
+            int ok = glossy_direction(s, &x, traced, 0, beta, k, lobes, u_lobe, split > 1 ? sample_r2(j, shift) : shift,
                                       rng, st, &t, &b, &h, &wi, &sg, &lobe);
             if (at_camera && rec) pixel_record_add(rec, avg3(t));
             if (!ok) continue;

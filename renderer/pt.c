@@ -18,8 +18,9 @@ static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
     out[COMP_INDIRECT] = add3(out[COMP_INDIRECT], v3(fmaxf(rest.x, 0.0f), fmaxf(rest.y, 0.0f), fmaxf(rest.z, 0.0f)));
 }
 
-/* Emission le reached at vertex `depth` with MIS weight w: to its component, split into
- * highlights for the paths that reach the light at their third vertex. */
+/* Emission le reached at vertex `depth` (glass that shadow rays pass after the second scattering
+ * event not counted) with MIS weight w: to its component, split into highlights for the paths
+ * that reach the light at their third vertex. */
 static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int split_highlights, vec3 beta, vec3 beta_hl,
                          vec3 le, float w) {
     if (split_highlights && depth == 2 && events == 2)
@@ -28,12 +29,13 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int split_
         out[component_of(events)] = add3(out[component_of(events)], scale3(mul3(beta, le), w));
 }
 
-/* A BSDF's lobes as next-event estimation sees them. */
+/* A BSDF's lobes as next-event estimation sees them: their value, and the pdf of the lobes the
+ * vertex samples its continuation from (pdf_lobes). */
 typedef struct {
     const bsdf *b;
     frame3 fr;
     vec3 wo;
-    int lobes;
+    int lobes, pdf_lobes;
 } bsdf_lobe;
 
 static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lobe_pdf) {
@@ -43,7 +45,7 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
     vec3 f = bsdf_eval(l->b, l->wo, wi, l->lobes);
     /* A delta light's weight needs no lobe pdf: skip evaluating it (point and spot lights are
      * common, and this runs at every vertex). */
-    if (!ls->delta && !is_black3(f)) *lobe_pdf = bsdf_pdf(l->b, l->wo, wi, l->lobes);
+    if (!ls->delta && !is_black3(f)) *lobe_pdf = bsdf_pdf(l->b, l->wo, wi, l->pdf_lobes);
     return scale3(f, wi.z);
 }
 
@@ -60,9 +62,18 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     vec3 beta_hl = v3s(0.0f); /* the throughput through glossy lobes only (depths 1 and 2) */
-    float prev_pdf = 0.0f;    /* solid-angle pdf of the BSDF sample that produced the current ray */
-    int prev_nee = 0;         /* whether next-event estimation could have found what that ray finds */
+    /* The last scattering vertex (prev_p): the pdf of the BSDF sample that left it and whether
+     * next-event estimation there could have found what the ray finds, also beyond glass that
+     * shadow rays pass (material_pass_through), which leaves these as they are. */
+    float prev_pdf = 0.0f;
+    int prev_nee = 0;
     vec3 prev_p = o;
+    int passes = 0; /* such glass passed after the second scattering event (the highlight split) */
+    /* With first_lobes BSDF_NOT_HIGHLIGHT: the share of the path that left the first vertex by its
+     * highlight lobe. Its light is the highlight estimator's while only glass that shadow rays
+     * pass lies between; at the first other vertex it joins the path (docs/design.md). Only in
+     * scenes with glass: without, it could only be lost. */
+    vec3 held = v3s(0.0f);
     for (int depth = 0, events = 0;; depth++) {
         surface_hit h;
         rays[depth == 0 && !continuation ? RAY_CAMERA : RAY_BOUNCE]++;
@@ -73,18 +84,20 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             h = *first;
         if (!hit) {
             vec3 le = env_eval(s, d);
-            if (!is_black3(le) && (depth > 0 || !continuation)) {
+            if (!is_black3(le) && (events > 0 || !continuation)) {
                 float w = prev_nee ? nee_emission_weight(s, prev_p, NULL, d, prev_pdf) : 1.0f;
-                add_emission(out, depth, events, split_highlights, mul3(beta, medium_transmittance(sigma, INFINITY)),
-                             beta_hl, le, w);
+                add_emission(out, depth - passes, events, split_highlights,
+                             mul3(beta, medium_transmittance(sigma, INFINITY)), beta_hl, le, w);
             }
             break;
         }
         beta = mul3(beta, medium_transmittance(sigma, h.t));
         vec3 le = material_emission(s, &h);
-        if (!is_black3(le) && (depth > 0 || !continuation)) {
+        /* A continuation's light before its first scattering event is the direct light of the
+         * vertex it left (through glass too), which that path has. */
+        if (!is_black3(le) && (events > 0 || !continuation)) {
             float w = prev_nee ? nee_emission_weight(s, prev_p, &h, d, prev_pdf) : 1.0f;
-            add_emission(out, depth, events, split_highlights, beta, beta_hl, le, w);
+            add_emission(out, depth - passes, events, split_highlights, beta, beta_hl, le, w);
         }
         if (depth >= max_depth + PT_MAX_TRANSMISSIONS) break;
 
@@ -92,23 +105,24 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         bsdf b = material_bsdf(s, &h, &fr);
         vec3 wo = to_local(fr, neg3(d));
         int capped = events >= max_depth;
+        int hold =
+            !capped && depth == 0 && first_lobes == BSDF_NOT_HIGHLIGHT && s->has_glass ? bsdf_highlight_lobe(&b) : 0;
         int lobes = capped                              ? BSDF_TRANSMIT
-                    : depth > 0                         ? BSDF_ALL
+                    : depth > 0 || hold                 ? BSDF_ALL
                     : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~bsdf_highlight_lobe(&b)
                                                         : first_lobes;
         if (!(bsdf_lobes(&b) & lobes)) break;
 
-        /* Next-event estimation (not through the transmission: shadow rays stop at glass). */
+        /* Next-event estimation (the reflecting lobes; shadow rays pass only smooth unbent glass). */
         if (!capped) {
             float u_sel = rng_float(rng);
             vec2 u_light = rng_vec2(rng);
-            bsdf_lobe lobe = {&b, fr, wo, lobes};
+            bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes};
             light_sample ls;
             vec3 f;
             vec3 arrival =
-                nee_direct(s, h.p, h.ng, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
+                nee_direct(s, h.p, h.ng, sigma, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
             if (!is_black3(arrival)) {
-                arrival = mul3(arrival, medium_transmittance(sigma, ls.dist));
                 vec3 c = mul3(mul3(beta, f), arrival);
                 if (split_highlights && depth == 1 && events == 1) {
                     vec3 wi = to_local(fr, ls.wi);
@@ -127,22 +141,37 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         if (!bsdf_sample(&b, wo, lobes, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
         vec3 wi = to_world(fr, bs.wi);
         if (!bsdf_side_ok(bs.wi, dot3(wi, h.ng))) break; /* the shading normal's side, not the surface's */
+        vec3 weight = scale3(hold ? bsdf_eval(&b, wo, bs.wi, lobes & ~hold) : bs.f, fabsf(bs.wi.z) / bs.pdf);
+        int passed = bs.lobe == BSDF_TRANSMIT && !is_black3(material_pass_through(s, &h, &b, wo));
+        if (hold) {
+            held = mul3(beta, scale3(bsdf_eval(&b, wo, bs.wi, hold), fabsf(bs.wi.z) / bs.pdf));
+        } else if (!is_black3(held)) {
+            if (passed)
+                held = mul3(held, weight);
+            else
+                beta = add3(beta, held), held = v3s(0.0f);
+        }
         if (split_highlights && depth <= 1) {
             vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, bsdf_highlight_lobe(&b)), bs.wi.z / bs.pdf);
             beta_hl = depth == 0 ? fg : mul3(beta_hl, fg);
+        } else if (passed && events == 2) {
+            beta_hl = mul3(beta_hl, weight);
+            passes++;
         }
-        beta = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
-        if (is_black3(beta) || !is_finite3(beta)) break;
+        beta = mul3(beta, weight);
+        if ((is_black3(beta) && is_black3(held)) || !is_finite3(beta) || !is_finite3(held)) break;
         if (bs.lobe == BSDF_TRANSMIT)
             sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
         events += bs.lobe != BSDF_TRANSMIT;
-        prev_nee = bs.lobe != BSDF_TRANSMIT;
-        prev_pdf = bs.pdf;
-        prev_p = h.p;
+        if (!passed) {
+            prev_nee = bs.lobe != BSDF_TRANSMIT;
+            prev_pdf = bs.pdf;
+            prev_p = h.p;
+        }
         o = offset_origin(s, h.p, h.ng, wi);
         d = wi;
 
-        if (depth >= RR_FIRST_VERTEX && !russian_roulette(&beta, rng_float(rng))) break;
+        if (depth >= RR_FIRST_VERTEX && is_black3(held) && !russian_roulette(&beta, rng_float(rng))) break;
     }
 }
 

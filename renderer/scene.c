@@ -698,13 +698,59 @@ unsigned scene_intersect_packet(const scene *s, vec3 o, const vec3 *d, int n, su
     return hits;
 }
 
-int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax) {
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+/* One occlusion query; with record, the glass passed is in ctx. */
+static int occluded(const scene *s, vec3 o, vec3 d, float tmax, int record, shadow_context *ctx) {
+    rtcInitIntersectContext(&ctx->rtc);
+    ctx->record = record;
+    ctx->count = 0;
     struct RTCRay r;
     init_ray(&r, o, d, tmax);
-    rtcOccluded1(s->rtc, &ctx, &r);
+    rtcOccluded1(s->rtc, &ctx->rtc, &r);
     return r.tfar < 0.0f; /* Embree sets tfar to -inf on a hit */
+}
+
+int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax) {
+    shadow_context ctx;
+    return occluded(s, o, d, tmax, 0, &ctx);
+}
+
+/* The glass a shadow ray recorded (ctx), in order along the ray (the filter saw it in the BVH's
+ * order): each surface's pass and Beer-Lambert between. Apart, so that shadow rays meeting no
+ * glass keep a small frame. */
+static vec3 glass_transmittance(const scene *s, const shadow_context *ctx, vec3 o, vec3 d, float tmax, vec3 sigma) {
+    surface_hit h[SCENE_MAX_GLASS];
+    for (int k = 0; k < ctx->count; k++) {
+        complete_hit(s, d, ctx->hit[k].tri, ctx->hit[k].b1, ctx->hit[k].b2, 0.0f, &h[k]);
+        h[k].t = dot3(sub3(h[k].p, o), d);
+        for (int j = k; j > 0 && h[j].t < h[j - 1].t; j--) {
+            surface_hit tmp = h[j];
+            h[j] = h[j - 1], h[j - 1] = tmp;
+        }
+    }
+    vec3 tr = v3s(1.0f);
+    float t0 = 0.0f;
+    for (int k = 0; k < ctx->count && !is_black3(tr); k++) {
+        /* A ray through an edge or a corner meets each triangle there: one crossing. */
+        if (k > 0 && h[k].material == h[k - 1].material && h[k].t - h[k - 1].t <= scene_offset_eps(s, h[k].p)) continue;
+        tr = mul3(tr, medium_transmittance(sigma, h[k].t - t0));
+        tr = mul3(tr, scene_glass_pass(s, &h[k], d, &sigma));
+        t0 = h[k].t;
+    }
+    return mul3(tr, medium_transmittance(sigma, tmax - t0));
+}
+
+vec3 scene_transmittance(const scene *s, vec3 o, vec3 d, float tmax, vec3 sigma) {
+    shadow_context ctx;
+    if (occluded(s, o, d, tmax, 1, &ctx)) return v3s(0.0f);
+    return ctx.count ? glass_transmittance(s, &ctx, o, d, tmax, sigma) : medium_transmittance(sigma, tmax);
+}
+
+vec3 scene_glass_pass(const scene *s, const surface_hit *h, vec3 d, vec3 *sigma) {
+    if (!scene_material_passes_shadows(s, h->material)) return v3s(0.0f);
+    frame3 fr;
+    bsdf b = material_bsdf(s, h, &fr);
+    *sigma = material_medium_after(&s->materials[h->material], h->backface, BSDF_TRANSMIT, *sigma);
+    return material_pass_through(s, h, &b, to_local(fr, neg3(d)));
 }
 
 /* ---- materials at hits --------------------------------------------------------------------- */

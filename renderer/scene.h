@@ -195,6 +195,7 @@ typedef struct scene {
     int32_t *bvh_tri[2];
     int bvh_count[2];
     unsigned char *alpha_class;
+    int has_glass; /* some material transmits (KHR_materials_transmission); set with the classes */
     /* Per triangle, for emissive triangles with an emissive texture (emissive.c): the texture's
      * mean over the triangle, 0 in the channels where it is black all over; NULL without such. */
     vec3 *tri_emit_tex;
@@ -343,8 +344,18 @@ int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h);
  * hit, and then h[i] is filled as scene_intersect fills it. */
 #define SCENE_PACKET 16
 unsigned scene_intersect_packet(const scene *s, vec3 o, const vec3 *d, int n, surface_hit *h);
-/* 1 if anything blocks o + t d for t in (0, tmax). */
+/* 1 if anything blocks o + t d for t in (0, tmax): glass too. */
 int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax);
+/* What reaches o + tmax d from o along d for a shadow ray (docs/design.md, "Transmission and
+ * volume"): black when anything but glass that shadow rays pass is in the way (or more than
+ * SCENE_MAX_GLASS of it), else the product of that glass's scene_glass_pass and Beer-Lambert in
+ * the media between (the ray starts in a medium of absorption sigma). */
+#define SCENE_MAX_GLASS 16
+vec3 scene_transmittance(const scene *s, vec3 o, vec3 d, float tmax, vec3 sigma);
+/* What the surface at hit h lets through of a ray along d by the shadow rays' rule
+ * (material_pass_through; black: h stops it), and the medium beyond it in *sigma
+ * (material_medium_after). For estimators that follow a ray through such glass as shadow rays do. */
+vec3 scene_glass_pass(const scene *s, const surface_hit *h, vec3 d, vec3 *sigma);
 
 /* Ray origin leaving a surface point toward dir without hitting its own triangle: offset along
  * the geometric normal by an epsilon relative to the scene's size and the point's magnitude. */
@@ -383,6 +394,11 @@ static inline vec3 medium_transmittance(vec3 sigma, float t) {
 static inline int material_is_volume(const material *m) {
     return m->model == MATERIAL_GLTF && m->ext.thickness > 0.0f && m->ext.transmission > 0.0f;
 }
+/* What a shadow ray along -wo (local) takes through the hit's surface, whose BSDF is b: its
+ * bsdf_pass_through where the scene lets shadow rays through its material (alpha.c; not without
+ * Embree's filter functions), else black. The path tracer asks the same of a transmission it
+ * samples, so that its light found through glass and next-event estimation's share weights. */
+vec3 material_pass_through(const scene *s, const surface_hit *h, const bsdf *b, vec3 wo);
 /* Emitted radiance leaving the hit toward the side the ray came from (0 for the back of a
  * single-sided emitter). */
 vec3 material_emission(const scene *s, const surface_hit *h);

@@ -79,6 +79,19 @@ float material_alpha(const scene *s, const material *m, vec2 uv0, vec2 uv1);
 float material_coverage(const scene *s, const surface_hit *h);
 /* BLEND's number in [0, 1) for the ray (o, d) meeting triangle tri (tests compare against it). */
 float alpha_ray_hash(vec3 o, vec3 d, int tri);
+/* Whether shadow rays may pass material m's glass (then bsdf_pass_through decides at a hit). */
+int scene_material_passes_shadows(const scene *s, int m);
+/* The context of every occlusion query (scene.c): Embree hands the filters its first member.
+ * With record set, the glass a shadow ray may pass is recorded here (each triangle once, at most
+ * SCENE_MAX_GLASS; more blocks the ray) instead of blocking it; without, glass blocks. */
+typedef struct {
+    struct RTCIntersectContext rtc;
+    int record, count;
+    struct {
+        int tri;
+        float b1, b2;
+    } hit[SCENE_MAX_GLASS];
+} shadow_context;
 
 /* ---- variants.c ---------------------------------------------------------------------------- */
 

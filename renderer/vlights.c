@@ -44,8 +44,11 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
         vec3 o = e.on_surface ? offset_origin(s, e.o, e.n, e.d) : e.o;
         vec3 d = e.d;
         /* events: scattering events so far, transmissions not counted (pt.c counts depth so); depth:
-         * every surface met, the lights' bounce. */
-        for (int depth = 1, events = 1; events < max_depth && depth < max_depth + PT_MAX_TRANSMISSIONS; depth++) {
+         * every surface met; bounce: the lights' bounce, every surface met but glass that shadow
+         * rays pass (the highlight estimator sees the light through it, so the first surface
+         * beyond it is bounce 1, as for the path tracer's split: docs/design.md). */
+        for (int depth = 1, events = 1, bounce = 1; events < max_depth && depth < max_depth + PT_MAX_TRANSMISSIONS;
+             depth++) {
             surface_hit h;
             (*bounce_rays)++;
             if (!scene_intersect(s, o, d, INFINITY, &h)) break;
@@ -54,8 +57,9 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
             memset(&vl, 0, sizeof vl);
             bsdf b = material_bsdf(s, &h, &vl.frame);
             if (!bsdf_lobes(&b)) break; /* black: absorbs everything */
-            /* No light is seen through a transmission (shadow rays stop at glass): the virtual
-             * light keeps the reflecting lobes, and the path carries on through the transmission. */
+            /* No virtual light is seen through a transmission (the gather's visibility stops at
+             * glass): the virtual light keeps the reflecting lobes, and the path carries on
+             * through the transmission. */
             vl.b = bsdf_only(&b, BSDF_ALL & ~BSDF_TRANSMIT);
             vl.p = h.p;
             vl.ng = h.ng;
@@ -66,7 +70,7 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
              * at the gather in vsl.c): the path tracer's answer with any normal map. */
             vec3 beta_in = scale3(beta, fmaxf(vl.wi.z, 0.0f) / dot3(neg3(d), h.ng));
             vl.power = beta_in;
-            vl.depth = depth;
+            vl.depth = bounce;
             if (vl.wi.z > 0.0f && bsdf_lobes(&vl.b) && push(set, &vl) != 0) return -1;
             int capped = events + 1 >= max_depth;
             if (capped && !(bsdf_lobes(&b) & BSDF_TRANSMIT)) break;
@@ -86,6 +90,7 @@ int vlights_trace(const scene *s, int target, int max_depth, uint64_t seed, uint
             if (is_black3(beta) || !is_finite3(beta)) break;
             sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
             events += bs.lobe != BSDF_TRANSMIT;
+            bounce += bs.lobe != BSDF_TRANSMIT || is_black3(material_pass_through(s, &h, &b, vl.wi));
             o = offset_origin(s, h.p, h.ng, wi);
             d = wi;
         }

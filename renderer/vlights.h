@@ -18,7 +18,7 @@ typedef struct {
     bsdf b;       /* the material there */
     vec3 power;   /* Phi_j: flux, already divided by the number of light paths */
     float radius; /* r_j of the spherical light (0 until set) */
-    int depth;    /* bounce: 1 = the first surface a light path hit */
+    int depth;    /* bounce: 1 = the first surface a light path hit, glass that shadow rays pass not counted */
 } virtual_light;
 
 typedef struct {

@@ -163,4 +163,28 @@ static inline void ts_stats(const float *img, int n, double *mean, double *sem) 
     *sem = sqrt(var > 0 ? var / n : 0.0);
 }
 
+/* vsl and vsl+hl against the path tracer's mean over a w x h image at max_depth (pt 1024 frames;
+ * the virtual-light methods 128 frames of 1024 lights, 32 resampled a pixel, radius multiplier 1):
+ * ratios[0] for vsl, ratios[1] for vsl+hl. */
+static inline void ts_vsl_mean_ratios(const scene *s, const camera *cam, int w, int h, int max_depth,
+                                      double ratios[2]) {
+    double ref_mean, mean, sem;
+    render_params pp = {.width = w, .height = h, .max_depth = max_depth, .seed = 1};
+    float *ref = ts_render_with(s, cam, &pp, 1024, ~0u);
+    ts_stats(ref, w * h, &ref_mean, &sem);
+    for (int k = 0; k < 2; k++) {
+        render_params p = {
+            .width = w, .height = h, .method = k ? METHOD_VSL_HL : METHOD_VSL, .max_depth = max_depth, .seed = 2};
+        p.vl.count = 1024;
+        p.vl.per_pixel = 32;
+        p.vl.radius_mult = 1.0f;
+        float *img = ts_render_with(s, cam, &p, 128, ~0u);
+        ts_stats(img, w * h, &mean, &sem);
+        ratios[k] = mean / ref_mean;
+        printf("%s, %s: mean ratio to PT %.4f (PT mean %.4f)\n", s->path, method_name(p.method), ratios[k], ref_mean);
+        free(img);
+    }
+    free(ref);
+}
+
 #endif
