@@ -92,6 +92,7 @@ typedef struct {
     uint64_t rel_error_serial, rel_error_resets;
     uint64_t preview_frames; /* reduced-resolution frames published, ever */
     int error_paused;        /* the last full frame was not from the reference's camera: no error */
+    int standing;            /* refinement held and no frame in flight: the image stands still */
 } view_stats;
 
 /* Everything the two threads hand each other; every field under lock except abort_frame. */

@@ -133,11 +133,14 @@ void refinement_hold(shared_state *sh) {
     sh->stats.reset_at += cli_now() - t0; /* time held is not refinement time */
 }
 
+/* Held as asked, and the render thread stands: a frame already under way when the pause came
+ * runs to its end (a stopped frame would leave part of its samples in the film). */
 static int held(const ui_thread *u) {
     const ui_controls *c = &u->ctl;
     long long frames = frames_of_current_state(u);
-    return frames >= 1 && (c->paused || (c->spp_limit > 0 && frames >= c->spp_limit) ||
-                           (c->time_limit > 0.0 && seconds_since(u->stats.reset_at) >= c->time_limit));
+    return frames >= 1 && u->stats.standing &&
+           (c->paused || (c->spp_limit > 0 && frames >= c->spp_limit) ||
+            (c->time_limit > 0.0 && seconds_since(u->stats.reset_at) >= c->time_limit));
 }
 
 void push_refinement(ui_thread *u) {
@@ -173,6 +176,15 @@ int panel_script_action(ui_thread *u, const script_action *a) {
     case ACT_RESUME:
         u->ctl.paused = a->kind == ACT_PAUSE;
         push_refinement(u);
+        return 1;
+    case ACT_WAIT_HELD:
+        if (!u->script_waiting) { /* one drawn frame first: a key pressed just before acts in it */
+            u->script_waiting = 1;
+            return 0;
+        }
+        /* nothing holds refinement: nothing to wait for */
+        if (!held(u) && (u->ctl.paused || u->ctl.spp_limit > 0 || u->ctl.time_limit > 0.0)) return 0;
+        u->script_waiting = 0;
         return 1;
     case ACT_SLEEP:
         if (!u->script_waiting) {

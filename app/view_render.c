@@ -499,6 +499,7 @@ static void *render_main(void *arg) {
         }
         uint64_t resets_seen = sh->stats.resets;
         int held = !preview && gen == applied && !resize && refinement_held(sh, session_frames(rt->full));
+        sh->stats.standing = held;
         pthread_mutex_unlock(&sh->lock);
         if (held) { /* paused, or at the spp or time limit */
             refinement_hold(sh);

@@ -73,6 +73,7 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
         {"pause", ACT_PAUSE, 0, 0, 0},
         {"resume", ACT_RESUME, 0, 0, 0},
         {"sleep", ACT_SLEEP, 1, 1, 0},
+        {"wait-held", ACT_WAIT_HELD, 0, 0, 0},
         {"wait-file", ACT_WAIT_FILE, 1, 0, 1},
         {"buttons", ACT_BUTTONS, 0, 0, 0},
         {"wheel", ACT_WHEEL, 3, 3, 0},

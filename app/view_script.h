@@ -10,7 +10,7 @@
  *   frame                     reference-camera       sky
  *   quit                      pause                  resume
  *   sleep SECONDS             wait-file FILE         buttons
- *   wheel X Y STEPS           variant NAME|default
+ *   wheel X Y STEPS           variant NAME|default   wait-held
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -19,7 +19,8 @@
  * has tried them (a failed one changes nothing); `env none` clears the environment. `frame` views
  * the whole scene, `reference-camera` goes back to the reference's. `sleep` lets time pass, changing
  * nothing (while a test sends real input events); `wait-file` waits until FILE exists (a test
- * makes it once its input events are sent); `buttons` prints where the panel's visible buttons
+ * makes it once its input events are sent); `wait-held` waits until refinement stands still
+ * (paused or at a limit, the frame under way finished; at once when nothing holds it); `buttons` prints where the panel's visible buttons
  * are, one line each ("button X0 Y0 X1 Y1 LABEL", window units), for a test to click; `wheel`
  * puts the cursor at X Y (window units) and turns the wheel there by STEPS (up positive) in the
  * same frame, as a wheel event arriving with the cursor's move does.
@@ -57,6 +58,7 @@ typedef enum {
     ACT_PAUSE,     /* refinement stops... */
     ACT_RESUME,    /* ...and goes on */
     ACT_SLEEP,     /* the script waits SECONDS, the viewer runs on */
+    ACT_WAIT_HELD, /* the script waits until refinement stands */
     ACT_WAIT_FILE, /* the script waits until a file exists */
     ACT_BUTTONS,   /* where the panel's buttons are */
     ACT_WHEEL,     /* the cursor moved and the wheel turned at once */

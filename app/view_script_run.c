@@ -295,6 +295,7 @@ void run_script(ui_thread *u) {
         case ACT_QUIT: u->quit = 1; break;
         case ACT_PAUSE:
         case ACT_RESUME:
+        case ACT_WAIT_HELD:
         case ACT_SLEEP:
             if (!panel_script_action(u, a)) return;
             break;

@@ -25,7 +25,7 @@ probe() { "$probe" "$@" || echo 999999; }
 cat >docked.txt <<'EOF'
 wait 1
 pause
-sleep 0.2
+wait-held
 stats
 screenshot image.png
 window-shot window.png
@@ -68,7 +68,7 @@ done
 cat >pause.txt <<'EOF'
 wait 1
 pause
-sleep 0.5
+wait-held
 stats
 sleep 1
 stats
@@ -76,11 +76,11 @@ resume
 wait 2
 stats
 set spp 2
-sleep 1
+wait-held
 stats
 set spp 0
 key space
-sleep 0.5
+wait-held
 stats
 sleep 1
 stats
@@ -109,7 +109,7 @@ rc=$?
 grep '^stats ' out.txt >stats.txt
 [ "$(field 1 frames)" = 3 ] && [ "$(field 1 held)" = 1 ] || fail "--spp 3 did not stop at 3: $(field 1 frames)"
 # (not `wait 3`: a loaded machine may render fewer than 3 frames in the second, and wait for ever)
-printf 'wait 1\nsleep 2\nstats\nquit\n' >timelimit.txt
+printf 'wait 1\nsleep 2\nwait-held\nstats\nquit\n' >timelimit.txt
 view --size 160x90 --time 1 --script timelimit.txt
 grep '^stats ' out.txt >stats.txt
 [ "$(field 1 time_limit)" = 1 ] && [ "$(field 1 held)" = 1 ] || fail "--time 1 did not stop: $(cat stats.txt)"
