@@ -112,6 +112,9 @@ static void layout_make(const plot_desc *p, layout *l) {
             if (p->series[s].lo && usable(p->log_y, p->series[s].lo[i])) ymin = fmin(ymin, p->series[s].lo[i]);
             if (p->series[s].hi && usable(p->log_y, p->series[s].hi[i])) ymax = fmax(ymax, p->series[s].hi[i]);
         }
+    /* The readings too: a budget the runs overshot (a loaded machine) still shows where it is. */
+    if (xmin <= xmax && usable(p->log_x, p->mark_x)) xmin = fmin(xmin, p->mark_x), xmax = fmax(xmax, p->mark_x);
+    if (ymin <= ymax && usable(p->log_y, p->mark_y)) ymin = fmin(ymin, p->mark_y), ymax = fmax(ymax, p->mark_y);
     axis_fit(&l->x, p->log_x, xmin, xmax);
     axis_fit(&l->y, p->log_y, ymin, ymax);
 }
