@@ -36,7 +36,8 @@ enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_NOT_HIGHLIGHT = 4, BSDF_TRANSMIT 
 /* The path-space split (docs/design.md): camera - glossy - glossy - light paths belong to the
  * highlight estimator when both glossy lobes are sharper than this roughness (microfacet alpha).
  * A rougher lobe reflects much like a diffuse one: it stays with the many-light estimators, costs
- * no highlight rays, and cone sampling integrates it well (the effect plan's diffuse kernel). */
+ * no highlight rays, and the VSL integral needs no sampling of its lobe (the effect plan's
+ * diffuse kernel). */
 #define BSDF_HIGHLIGHT_ALPHA 0.5f
 
 typedef enum {

@@ -137,7 +137,7 @@ float lighttree_importance(const lt_node *n, const lt_receiver *r) {
     /* Two angles bound how far any light's direction strays from dir: that of the ball holding the
      * centres, and that of the ball holding the spheres. The centres decide where nothing can
      * arrive: shade_one drops a light whose centre is behind (or in) either surface. The spheres
-     * widen what does arrive: a VSL straddling a horizon still sends part of its cone. */
+     * widen what does arrive: a VSL's disk straddling a horizon still sends part of its light. */
     float cos_c, sin_c, cos_b, sin_b, cos_r, sin_r;
     ball_angle(half_diag, dist2, &cos_c, &sin_c);
     ball_angle(half_diag + n->radius, dist2, &cos_b, &sin_b);
@@ -154,7 +154,7 @@ float lighttree_importance(const lt_node *n, const lt_receiver *r) {
     cos_e = 0.5f * (cos_e + cos_minus_clamped(ce, c, s));
     float emit = n->phi_diffuse * cos_e * INV_PI_F;
     /* The lobes: blurred by how much their axes differ, by the spheres (the VSL integral averages
-     * a lobe over its sphere) and by where in the group the light sits. */
+     * a lobe over the light's disk) and by where in the group the light sits. */
     ball_angle(n->radius, dist2, &cos_r, &sin_r);
     float blur = 0.5f * ((1.0f - cos_r) + (1.0f - cos_c));
     if (n->phi_glossy > 0.0f)

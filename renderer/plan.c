@@ -234,11 +234,12 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
         snprintf(p.why_kernel, sizeof p.why_kernel, "%s", !vsl ? "not this method" : "no virtual lights");
     else if (a->glossy)
         snprintf(p.why_kernel, sizeof p.why_kernel,
-                 "three strategies where a glossy lobe (alpha < %g) takes part, cone sampling for the rest",
+                 "three strategies where a glossy lobe (alpha < %g) takes part, two for the rest",
                  (double)BSDF_HIGHLIGHT_ALPHA);
     else
         snprintf(p.why_kernel, sizeof p.why_kernel,
-                 "diffuse-only (cone sampling): no glossy lobe sharper than alpha %g", (double)BSDF_HIGHLIGHT_ALPHA);
+                 "diffuse-only (points on the disk): no glossy lobe sharper than alpha %g",
+                 (double)BSDF_HIGHLIGHT_ALPHA);
     if (method != METHOD_VSL_HL) {
         snprintf(p.why_highlights, sizeof p.why_highlights, "not this method");
     } else if (p.max_depth < 2 || !emitters) {

@@ -4,8 +4,8 @@
  * pass the plan drops either has nothing to add (no surface can pass light on: no virtual
  * lights), or the estimate it owned goes back to the estimator that covers it without it (no
  * glossy surface sees another: the VSL gather keeps the glossy-glossy paths), or it only chooses
- * how to sample (diffuse-only pairs: the VSL integral by cone sampling alone). `--plan full` runs
- * every pass, so tests can compare. */
+ * how to sample (diffuse-only pairs: the VSL integral by points on the light's disk). `--plan
+ * full` runs every pass, so tests can compare. */
 #ifndef GLINT_PLAN_H
 #define GLINT_PLAN_H
 
@@ -56,7 +56,7 @@ typedef struct {
     int max_depth;          /* scattering events the scene needs (at most what was asked) */
     int virtual_lights;     /* vpl, vsl, vsl+hl: trace virtual lights and gather from them */
     int vsl_all_strategies; /* the three-strategy VSL integral for every pair (else only where a
-                             * glossy lobe is involved; diffuse pairs by cone sampling) */
+                             * glossy lobe is involved; diffuse pairs by points on the disk) */
     int highlights;         /* vsl+hl: the highlight pass (else the VSL gather keeps those paths) */
     int env_prefilter;      /* vsl+hl: the vMF-prefiltered environment */
     /* why, one line each */

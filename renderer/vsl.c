@@ -44,73 +44,82 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
     return saturate(vl->power, f, (double)lx.z * -(double)dot3(l, vl->ng) / (double)d2);
 }
 
-/* Omega_j: the cone from x around the sphere (p_j, r_j), or x's hemisphere when x is inside. */
+/* The light's disk: the sphere's cross-section in the light's tangent plane (docs/design.md,
+ * "Virtual spherical lights"). x lies in front of that plane at height h. */
 typedef struct {
-    int inside;
-    vec3 axis;      /* unit, x -> p_j (outside only) */
-    float omc;      /* 1 - cos(theta_max) */
-    float sin2_max; /* sin^2(theta_max) = (r/d)^2: the membership test, exact for tiny cones */
-    frame3 cone;    /* around axis */
-} solid_angle;
+    float h;        /* x's height above the light's plane, > 0 where anything arrives */
+    float omc;      /* 1 - cos of the cone from x around the sphere (1: x inside it) */
+    float inv_area; /* 1 / (pi r^2) */
+    frame3 plane;   /* about the geometric normal: the disk lies in the surface, whatever the shading */
+} light_disk;
 
-static solid_angle omega_of(const virtual_light *vl, const shading_point *x) {
-    solid_angle o = {0};
+static light_disk disk_of(const virtual_light *vl, const shading_point *x) {
+    light_disk o = {0};
     vec3 d = sub3(vl->p, x->p);
     float dist = length3(d);
-    if (!(dist > vl->radius)) {
-        o.inside = 1;
-        o.omc = 1.0f;
-        return o;
-    }
-    float s = vl->radius / dist;
-    o.axis = scale3(d, 1.0f / dist);
-    o.omc = cone_one_minus_cos(s);
-    o.sin2_max = s * s;
-    o.cone = frame_from_normal(o.axis);
+    o.h = -dot3(d, vl->ng);
+    o.inv_area = 1.0f / (PI_F * vl->radius * vl->radius);
+    o.omc = dist > vl->radius ? cone_one_minus_cos(vl->radius / dist) : 1.0f;
+    o.plane = frame_from_normal(vl->ng);
     return o;
 }
 
-static int in_omega(const solid_angle *o, const shading_point *x, vec3 l) {
-    if (o->inside) return dot3(l, x->frame.n) > 0.0f;
-    float c = dot3(l, o->axis);
-    return c > 0.0f && length_sq3(cross3(l, o->axis)) <= o->sin2_max;
+/* Where the ray from x along l meets the light's plane, if within the disk: the solid-angle pdf
+ * of sampling that point uniformly over the disk (t^2 / (cos_j pi r^2)); 0 off the disk. */
+static float disk_pdf(const light_disk *o, const virtual_light *vl, const shading_point *x, vec3 l) {
+    float cos_j = -dot3(l, vl->ng);
+    if (!(cos_j > 0.0f) || !(o->h > 0.0f)) return 0.0f;
+    float t = o->h / cos_j;
+    vec3 off = sub3(madd3(x->p, l, t), vl->p);
+    if (!(length_sq3(off) <= vl->radius * vl->radius)) return 0.0f;
+    return t * t * o->inv_area / cos_j;
 }
 
+/* f_x cos_x f_j over the disk's solid angle: the light leaving the disk with the light's BSDF,
+ * its cosine carried by the solid angle the disk's area spans. */
 static vec3 integrand(const virtual_light *vl, const shading_point *x, vl_terms terms, vec3 l, vec3 *lx, vec3 *lj) {
     *lx = to_local(x->frame, l);
     *lj = to_local(vl->frame, neg3(l));
-    float cos_j = -dot3(l, vl->ng); /* geometric: shading normals' adjoint (vlights.c) */
-    if (lx->z <= 0.0f || lj->z <= 0.0f || !(cos_j > 0.0f)) return v3(0, 0, 0);
-    return scale3(bsdf_pair(vl, x, *lx, *lj, BSDF_ALL, terms), lx->z * cos_j);
+    if (lx->z <= 0.0f || lj->z <= 0.0f) return v3(0, 0, 0);
+    return scale3(bsdf_pair(vl, x, *lx, *lj, BSDF_ALL, terms), lx->z);
 }
 
 vec3 vsl_integrand(const virtual_light *vl, const shading_point *x, vl_terms terms, vec3 l) {
-    solid_angle o = omega_of(vl, x);
+    light_disk o = disk_of(vl, x);
     vec3 lx, lj;
-    return in_omega(&o, x, l) ? integrand(vl, x, terms, l, &lx, &lj) : v3(0, 0, 0);
+    return disk_pdf(&o, vl, x, l) > 0.0f ? integrand(vl, x, terms, l, &lx, &lj) : v3(0, 0, 0);
 }
 
 vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
                   int *samples) {
-    solid_angle o = omega_of(vl, x);
-    /* Proportional to |Omega| = 2 pi (1 - cos theta_max): 100 at the hemisphere, at least 1. */
-    int n = o.inside ? VSL_MAX_SAMPLES : (int)ceilf((float)VSL_MAX_SAMPLES * o.omc);
-    n = n < 1 ? 1 : (n > VSL_MAX_SAMPLES ? VSL_MAX_SAMPLES : n);
+    light_disk o = disk_of(vl, x);
+    /* Proportional to the sphere's cone |Omega| = 2 pi (1 - cos theta_max), which holds the disk:
+     * 100 at the hemisphere, at least 1. */
+    int n = (int)ceilf((float)VSL_MAX_SAMPLES * o.omc);
+    /* Points spread over the disk; where either lobe is glossy, both BSDFs too; where x is inside
+     * the sphere, close to the disk, x's BSDF too, which finds the disk where the area's pdf is
+     * poor. They take turns from a random start, so each sample's strategy is uniform (the
+     * one-sample model, weights (1/S) p_t), and each takes at least one: a far light's one sample
+     * from x's BSDF would miss the disk most of the time and make the rest count S times. */
+    int inside = o.omc >= 1.0f;
+    int strategies = all_strategies || bsdf_highlight_lobe(&x->b) || bsdf_highlight_lobe(&vl->b) ? 3 : 1 + inside;
+    n = n < strategies ? strategies : (n > VSL_MAX_SAMPLES ? VSL_MAX_SAMPLES : n);
     if (samples) *samples = n;
-    float pdf_cone_uniform = o.inside ? 0.0f : pdf_uniform_cone(o.omc);
-    /* The strategies take turns from a random start, so each sample's strategy is uniform: the
-     * one-sample model, weights (1/3) p_t. Where neither lobe is glossy the integrand is smooth
-     * over the cone and cone sampling alone does (the effect plan's diffuse kernel). */
-    int strategies = all_strategies || bsdf_highlight_lobe(&x->b) || bsdf_highlight_lobe(&vl->b) ? 3 : 1;
-    unsigned strategy = strategies == 3 ? (unsigned)(rng_float(rng) * 3.0f) : 0u;
+    if (!(o.h > 0.0f)) return v3(0, 0, 0);
+    unsigned strategy = (unsigned)(rng_float(rng) * (float)strategies);
+    if (strategy >= (unsigned)strategies) strategy = 0;
     double sum[3] = {0.0, 0.0, 0.0}; /* double: a razor-sharp lobe over a tiny pdf must not overflow */
     for (int k = 0; k < n; k++, strategy = (strategy + 1) % (unsigned)strategies) {
         vec2 u = rng_vec2(rng);
         float u_lobe = rng_float(rng);
         vec3 l;
         if (strategy == 0) {
-            l = o.inside ? to_world(x->frame, sample_cosine_hemisphere(u))
-                         : to_world(o.cone, sample_uniform_cone(u, o.omc));
+            vec2 q = sample_concentric_disk(u);
+            vec3 y = to_world(o.plane, v3(q.x * vl->radius, q.y * vl->radius, 0.0f));
+            vec3 d = sub3(add3(vl->p, y), x->p);
+            float len = length3(d);
+            if (!(len > 0.0f)) continue;
+            l = scale3(d, 1.0f / len);
         } else {
             const bsdf *b = strategy == 1 ? &x->b : &vl->b;
             vec3 wo = strategy == 1 ? x->wo : vl->wi;
@@ -120,15 +129,15 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
             l = to_world(f, bs.wi);
             if (strategy == 2) l = neg3(l);
         }
-        if (!in_omega(&o, x, l)) continue;
+        float p_disk = disk_pdf(&o, vl, x, l);
+        if (!(p_disk > 0.0f)) continue;
         vec3 lx, lj;
         vec3 g = integrand(vl, x, terms, l, &lx, &lj);
         if (is_black3(g)) continue;
-        float p_cone = o.inside ? pdf_cosine_hemisphere(lx) : pdf_cone_uniform;
-        float p_sum = strategies == 1
-                          ? p_cone
-                          : p_cone + bsdf_pdf(&x->b, x->wo, lx, BSDF_ALL) + bsdf_pdf(&vl->b, vl->wi, lj, BSDF_ALL);
-        if (!(p_sum > 0.0f)) continue;
+        float p_sum = p_disk;
+        if (strategies >= 2) p_sum += bsdf_pdf(&x->b, x->wo, lx, BSDF_ALL);
+        if (strategies == 3) p_sum += bsdf_pdf(&vl->b, vl->wi, lj, BSDF_ALL);
+        if (!(p_sum > 0.0f) || !isfinite(p_sum)) continue;
         double w = (double)strategies / (double)p_sum;
         sum[0] += (double)g.x * w;
         sum[1] += (double)g.y * w;
@@ -149,10 +158,12 @@ static double disk_share(double h) {
 }
 
 double vsl_front_share(const virtual_light *vl, const shading_point *x) {
-    vec3 d = sub3(vl->p, x->p);
-    double r = (double)vl->radius;
-    double a = disk_share((double)dot3(d, x->ng) / r), b = disk_share(-(double)dot3(d, vl->ng) / r);
-    return fmin(a, b) * sqrt(fmax(a, b));
+    /* x's plane meets the light's along a line at distance delta / sin(psi) from the disk's
+     * centre (delta: the centre's height above x's plane, psi: the angle between the planes). */
+    double delta = (double)dot3(sub3(vl->p, x->p), x->ng);
+    double sin_psi = (double)length3(cross3(x->ng, vl->ng)), r = (double)vl->radius;
+    if (delta >= r * sin_psi) return 1.0;
+    return disk_share(delta / (r * sin_psi));
 }
 
 vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies,

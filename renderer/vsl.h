@@ -1,6 +1,7 @@
 /* glint — what one virtual light sends to one shading point: the VPL baseline (a point light
- * with the 1/d^2 geometry term) and the virtual spherical light (VSL paper Eq. 5). Visibility and
- * clamping are the caller's (vl_shade does both). */
+ * with the 1/d^2 geometry term) and the virtual spherical light (VSL paper Eq. 5, over the
+ * sphere's great disk in the light's plane). Visibility and clamping are the caller's
+ * (shade_one in manylight.c does both). */
 #ifndef GLINT_VSL_H
 #define GLINT_VSL_H
 
@@ -38,31 +39,30 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
 /* Largest number of integration samples for one VSL (when x is inside its sphere, |Omega| = 2pi). */
 #define VSL_MAX_SAMPLES 100
 
-/* Phi_j / (pi r_j^2 share) x the integral over the cone Omega_j of Eq. 5, no visibility: uniform
- * cone sampling (cosine-weighted hemisphere when x is inside the sphere), BSDF sampling at x and
- * BSDF sampling at the light, one sample model with the balance heuristic; ceil(100 |Omega|/2pi)
- * samples, at least 1. Unless all_strategies, a pair without a glossy lobe sharper than
- * BSDF_HIGHLIGHT_ALPHA uses cone sampling alone. share is vsl_front_share: where the sphere
- * reaches behind x's surface or the light's, that part would send its light from inside the
- * geometry and the paper's estimator loses it (half of what a light on the floor by a wall sends
- * to the wall, 10-20% along a room's edges); the rest of the sphere carries it instead
- * (docs/design.md). *samples (optional) receives the count used. */
+/* Phi_j / (pi r_j^2 share) x the integral of f_x cos_x f_j over the solid angle of the light's
+ * disk (radius r_j about p_j in its tangent plane; the disk's solid angle carries cos_j), no
+ * visibility: points spread evenly over the disk, BSDF sampling at x and BSDF sampling at the
+ * light, one-sample model with the balance heuristic; ceil(100 |Omega|/2pi) samples with Omega
+ * the sphere's cone, at least one a strategy. Unless all_strategies, a pair without a glossy lobe
+ * sharper than BSDF_HIGHLIGHT_ALPHA takes points on the disk alone (and x's BSDF where x is inside
+ * the sphere). The result is the mean of point lights spread
+ * over the disk: a facing plane receives all the light's power, a wall beside it half, at any
+ * distance (docs/design.md, "Virtual spherical lights"). share is vsl_front_share. *samples
+ * (optional) receives the count used. */
 vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies,
                       rng_state *rng, int *samples);
 
-/* The share of the sphere's cross-section in front of the receiver's tangent plane and of the
- * light's (1 when the sphere clears both): each plane cuts a disk seen edge-on to it at the
- * centre's distance from it over r; the two shares a and b (a <= b) combine as a sqrt(b), between
- * the smaller alone (measured 4% short where both cut) and their product (8-14% over). Within 4%
- * of the energy the point light sends to a wall at any distance of the light from it (test_vsl). */
+/* The share of the light's disk in front of the receiver's tangent plane (1 when the disk clears
+ * it): the part beyond would send its light from inside the receiver's surface, and the rest of
+ * the disk carries it instead. */
 double vsl_front_share(const virtual_light *vl, const shading_point *x);
 
-/* The integral of Eq. 5 alone (without Phi / (pi r^2)), for tests. */
+/* The integral alone (without Phi / (pi r^2 share)), for tests. */
 vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies, rng_state *rng,
                   int *samples);
 
-/* The Eq. 5 integrand at direction l (world, from x): f_x cos_x f_j cos_j with the term split,
- * zero outside Omega_j. Exposed for brute-force checks. */
+/* The integrand at direction l (world, from x): f_x cos_x f_j with the term split, zero where
+ * l misses the disk. Exposed for brute-force checks. */
 vec3 vsl_integrand(const virtual_light *vl, const shading_point *x, vl_terms terms, vec3 l);
 
 #endif

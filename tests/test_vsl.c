@@ -39,30 +39,27 @@ static shading_point make_x(vec3 p, vec3 n, vec3 toward_viewer, bsdf b) {
 
 static double avg(vec3 c) { return ((double)c.x + (double)c.y + (double)c.z) / 3.0; }
 
-/* Midpoint quadrature of the integrand over the cone of half-angle theta_max around axis (in
- * theta, phi with the sin(theta) Jacobian), in double. */
-static double quadrature(const virtual_light *vl, const shading_point *x, vl_terms terms, vec3 axis, double theta_max,
-                         int nt, int np) {
-    frame3 f = frame_from_normal(axis);
-    double sum = 0.0;
+/* The integral over the light's disk by midpoint quadrature over its area (polar, uniform in the
+ * squared radius and the angle), in double: each point's integrand times the solid angle its area
+ * spans from x, cos_j dA / t^2. Independent of the estimator's solid-angle sampling. */
+static double quadrature_omega(const virtual_light *vl, const shading_point *x, int nt, int np) {
+    double sum = 0.0, r = vl->radius;
+    frame3 plane = frame_from_normal(vl->ng);
     for (int i = 0; i < nt; i++) {
-        double t = theta_max * (i + 0.5) / nt;
-        double st = sin(t), ct = cos(t);
+        double rho = r * sqrt((i + 0.5) / nt);
         for (int j = 0; j < np; j++) {
             double phi = 2.0 * PI_D * (j + 0.5) / np;
-            vec3 l = to_world(f, v3((float)(st * cos(phi)), (float)(st * sin(phi)), (float)ct));
-            sum += avg(vsl_integrand(vl, x, terms, l)) * st;
+            vec3 y = add3(vl->p, to_world(plane, v3((float)(rho * cos(phi)), (float)(rho * sin(phi)), 0.0f)));
+            vec3 d = sub3(y, x->p);
+            double t2 = (double)length_sq3(d);
+            if (!(t2 > 0.0)) continue;
+            vec3 l = scale3(d, (float)(1.0 / sqrt(t2)));
+            double cos_j = -(double)dot3(l, vl->ng);
+            if (!(cos_j > 0.0)) continue;
+            sum += avg(vsl_integrand(vl, x, VL_TERMS_ALL, l)) * cos_j / t2;
         }
     }
-    return sum * (theta_max / nt) * (2.0 * PI_D / np);
-}
-
-/* The integral over Omega_j by quadrature: the cone, or x's hemisphere when x is inside. */
-static double quadrature_omega(const virtual_light *vl, const shading_point *x, int nt, int np) {
-    vec3 d = sub3(vl->p, x->p);
-    double dist = length3(d);
-    if (dist <= vl->radius) return quadrature(vl, x, VL_TERMS_ALL, x->frame.n, PI_D / 2, nt, np);
-    return quadrature(vl, x, VL_TERMS_ALL, scale3(d, (float)(1.0 / dist)), asin(vl->radius / dist), nt, np);
+    return sum * PI_D * r * r / ((double)nt * np);
 }
 
 /* Brute force for razor-sharp lobes: plain importance sampling of one BSDF (no MIS, no cone
@@ -124,7 +121,7 @@ static void test_integral_against_brute_force(void) {
     bsdf phong_sharp = make_bsdf_phong(v3s(0.0f), v3s(0.9f), 1e4f);
     double sem, ref, ref_sem = 0.0;
 
-    /* x inside the sphere: the hemisphere, 100 samples each. */
+    /* x inside the sphere, close above the disk: 100 samples each. */
     {
         virtual_light vl = make_vl(v3(0.3f, 0, 0.3f), v3(-1, 0, 0), v3(-1, 0, 1), diffuse, 1.0f, 2);
         shading_point x = make_x(v3(0, 0, 0), v3(0, 0, 1), v3(0, 0.3f, 1), phong);
@@ -132,7 +129,7 @@ static void test_integral_against_brute_force(void) {
         double got = estimate(&vl, &x, 4000, &sem, "inside");
         agree("inside", got, sem, ref, 0.0, 2e-3);
     }
-    /* Touching: the sphere's surface just off x; the cone is nearly a hemisphere. */
+    /* Touching: the sphere's surface just off x, the disk seen nearly edge-on. */
     {
         vec3 p = v3(0.8f, 0.0f, 0.6f);
         virtual_light vl = make_vl(p, v3(-1, 0, -0.2f), v3(-1, 0.5f, 0), phong, length3(p) / 1.0001f, 2);
@@ -191,8 +188,8 @@ static void test_integral_against_brute_force(void) {
     }
 }
 
-/* Pairs without a glossy lobe (Lambert, or GGX rough enough to count as diffuse) take cone
- * sampling alone unless all strategies are asked for: both must match the quadrature. */
+/* Pairs without a glossy lobe (Lambert, or GGX rough enough to count as diffuse) take points on
+ * the disk and x's BSDF alone unless all strategies are asked for: both must match the quadrature. */
 static void test_diffuse_kernel(void) {
     bsdf diffuse = make_bsdf_lambert(v3s(0.7f));
     bsdf rough = make_bsdf_gltf(v3(0.8f, 0.6f, 0.4f), 0.0f, 0.9f, 0.0f); /* alpha 0.81 */
@@ -306,7 +303,8 @@ static void test_degenerate(void) {
 /* Energy by a wall: a diffuse light on the floor at distance delta from a wall sends the wall half
  * its power (its cosine lobe, half of it toward the wall), whatever delta. Integrated over the wall
  * (a grid dense near the light), the VSL must deliver that within 6% for delta from 0.05 r to 2 r
- * (measured: within 4%); without the front share it delivered 0.26 at 0.05 r and 0.36 at 0.5 r.
+ * (measured: within 2%, the disk's share in front of the wall carrying the part beyond it; the
+ * sphere's cone gave 0.26 at 0.05 r and 0.36 at 0.5 r without a share, within 4% with one).
  * The point light on the same grid gives the quadrature's own error (its tail beyond the grid). */
 static void test_energy_by_a_wall(void) {
     bsdf white = make_bsdf_lambert(v3s(1.0f));
@@ -334,6 +332,41 @@ static void test_energy_by_a_wall(void) {
                (double)delta, vsl, vpl);
         CHECK(fabs(vsl / vpl - 1.0) < 0.06, "a light %.2f r from a wall sends it %.4f, the point light %.4f",
               (double)delta, vsl, vpl);
+    }
+}
+
+/* Energy to a facing surface: a diffuse light on a plane sends all its power to a parallel plane
+ * facing it at height h, whatever h. Integrating over the sphere's cone (the paper's Eq. 5, with a
+ * front share for the sphere's part behind either plane) delivered 2.29 times that at h = 0.02 r
+ * and 1.35 at 0.5 r (the Cornell box's ceiling over its lamp, 1 cm below it); the disk delivers it
+ * within 1% (measured). Checked within 4%. */
+static void test_energy_to_a_facing_plane(void) {
+    bsdf white = make_bsdf_lambert(v3s(1.0f));
+    const float heights[] = {0.02f, 0.1f, 0.5f, 2.0f};
+    for (int k = 0; k < 4; k++) {
+        float h = heights[k];
+        virtual_light vl = make_vl(v3(0, 0, 0), v3(0, 0, 1), v3(0.3f, 0, 1), white, 1.0f, 2);
+        rng_state rng = rng_make(37, (uint64_t)k);
+        /* the plane z = h facing down, on a grid uniform in asinh(x / a), asinh(y / a) */
+        const double a = 0.02, S = asinh(60.0 / a);
+        const int n = 120;
+        double vsl = 0.0, vpl = 0.0;
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double s = -S + (i + 0.5) * 2.0 * S / n, t = -S + (j + 0.5) * 2.0 * S / n;
+                double x = a * sinh(s), y = a * sinh(t),
+                       area = a * cosh(s) * a * cosh(t) * (2.0 * S / n) * (2.0 * S / n);
+                shading_point p = make_x(v3((float)x, (float)y, h), v3(0, 0, -1), v3(0.1f, 0, -1), white);
+                double L = 0.0;
+                for (int m = 0; m < 4; m++) L += avg(vsl_contribution(&vl, &p, VL_TERMS_ALL, 0, &rng, NULL));
+                vsl += L / 4.0 * PI_D * area;
+                double d2 = x * x + y * y + (double)h * h;
+                vpl += (double)h * h / (PI_D * d2 * d2) * area;
+            }
+        printf("light %.2f r below a facing plane: the plane receives %.4f of its power (point light %.4f)\n",
+               (double)h, vsl, vpl);
+        CHECK(fabs(vsl / vpl - 1.0) < 0.04, "a light %.2f r below a facing plane sends it %.4f, the point light %.4f",
+              (double)h, vsl, vpl);
     }
 }
 
@@ -524,7 +557,7 @@ static void test_light_selection_unbiased(void) {
                 {"through the tree", VL_SELECT_TREE, 1},
                 {"resampled from tree draws", VL_SELECT_TREE, 8}};
     for (int method = METHOD_VPL; method <= METHOD_VSL; method++) {
-        const int frames = 200;
+        const int frames = 128;
         render_params p = vl_params_for((render_method)method, 256);
         p.vl.clamp = VL_CLAMP_OFF;
         p.vl.trace_glossy = -1.0f; /* every lobe gathered: the selection is all that differs */
@@ -576,14 +609,15 @@ static void test_trace_glossy_matches_pt(void) {
     int depths[2] = {2, 5};
     for (int k = 0; k < 2; k++) {
         const scene *s = boxes[k];
-        float *ref = ts_render(s, &cam, W, H, 8192, depths[k], 5, INDIRECT);
-        float *pt = ts_render(s, &cam, W, H, 2048, depths[k], 6, INDIRECT);
+        const int frames = 1024;
+        float *ref = ts_render(s, &cam, W, H, 4 * frames, depths[k], 5, INDIRECT);
+        float *pt = ts_render(s, &cam, W, H, frames, depths[k], 6, INDIRECT);
         render_params p = vl_params_for(METHOD_VSL, 64);
         p.max_depth = depths[k];
         p.vl.trace_glossy = 0.3f;
         char err[256];
         render_session *rs = session_create(s, &cam, &p, err, sizeof err);
-        for (int f = 0; f < 2048; f++) session_render_frame(rs);
+        for (int f = 0; f < frames; f++) session_render_frame(rs);
         float *traced = malloc(sizeof(float) * 3 * NPIX);
         film_resolve(session_film(rs), INDIRECT, traced);
         render_stats st = session_stats(rs);
@@ -597,7 +631,7 @@ static void test_trace_glossy_matches_pt(void) {
         CHECK(fabs(ratio - 1.0) < 0.03, "depth %d: traced glossy indirect mean off by %+.4f", depths[k], ratio - 1.0);
         CHECK(e_traced < 1.5 * e_pt + 0.01, "depth %d: traced glossy indirect L2 %.4f vs path tracing's %.4f",
               depths[k], e_traced, e_pt);
-        CHECK(st.glossy_bounces >= (uint64_t)(0.95 * 2048 * NPIX), "depth %d: only %llu glossy bounces", depths[k],
+        CHECK(st.glossy_bounces >= (uint64_t)(0.95 * frames * NPIX), "depth %d: only %llu glossy bounces", depths[k],
               (unsigned long long)st.glossy_bounces);
         CHECK(st.vl_connections == 0, "depth %d: %llu virtual lights shaded where nothing is gathered", depths[k],
               (unsigned long long)st.vl_connections);
@@ -658,7 +692,8 @@ static void test_no_leak_through_thin_walls(void) {
     scene_destroy(s);
 }
 
-/* A point light on a wall and one a micrometre off it: thousands of frames, nothing non-finite. */
+/* A point light on a wall and one a micrometre off it: 500 frames of 32 lights each, for each
+ * method and way of treating sharp lobes, nothing non-finite. */
 static void test_lights_touching_surfaces(void) {
     material m = material_default();
     m.model = MATERIAL_PHONG;
@@ -678,14 +713,14 @@ static void test_lights_touching_surfaces(void) {
             p.vl.clamp = VL_CLAMP_OFF;
             char err[256];
             render_session *rs = session_create(s, &cam, &p, err, sizeof err);
-            for (int f = 0; f < 2000; f++) session_render_frame(rs);
+            for (int f = 0; f < 500; f++) session_render_frame(rs);
             float img[8 * 6 * 3];
             film_resolve(session_film(rs), COMP_MASK_ALL, img);
             render_stats st = session_stats(rs);
             CHECK(st.rejected_samples == 0, "light %d, %s, run %d: %llu samples were NaN or Inf", k,
                   method_name(p.method), run, (unsigned long long)st.rejected_samples);
             CHECK(all_finite(img, 48), "light %d, %s, run %d: non-finite pixels", k, method_name(p.method), run);
-            CHECK(st.virtual_lights >= 2000u * 32u, "light %d: virtual_lights_total %llu", k,
+            CHECK(st.virtual_lights >= 500u * 32u, "light %d: virtual_lights_total %llu", k,
                   (unsigned long long)st.virtual_lights);
             session_destroy(rs);
         }
@@ -773,6 +808,7 @@ int main(void) {
     test_terms_split();
     test_degenerate();
     test_energy_by_a_wall();
+    test_energy_to_a_facing_plane();
     test_diffuse_box_against_pt();
     test_glossy_box_energy();
     test_layered_box_against_pt();
