@@ -20,10 +20,11 @@
  * the whole scene, `reference-camera` goes back to the reference's. `sleep` lets time pass, changing
  * nothing (while a test sends real input events); `wait-file` waits until FILE exists (a test
  * makes it once its input events are sent); `wait-held` waits until refinement stands still
- * (paused or at a limit, the frame under way finished; at once when nothing holds it); `buttons` prints where the panel's visible buttons
- * are, one line each ("button X0 Y0 X1 Y1 LABEL", window units), for a test to click; `wheel`
- * puts the cursor at X Y (window units) and turns the wheel there by STEPS (up positive) in the
- * same frame, as a wheel event arriving with the cursor's move does.
+ * (paused or at a limit, the frame under way finished; at once when nothing holds it); `buttons`
+ * prints where the panel's visible buttons are, one line each ("button X0 Y0 X1 Y1 LABEL", window
+ * units), for a test to click; `wheel` puts the cursor at X Y (window units) and turns the wheel
+ * there by STEPS (up positive) in the same frame, as a wheel event arriving with the cursor's move
+ * does.
  * `move-light` moves light INDEX (as the panel lists them) by a world-space offset and selects it;
  * `spin` orbits continuously, a little every drawn frame, as a held mouse drag would. `variant`
  * shows the scene's material variant NAME (`default`: the file's materials), as the panel's choice

@@ -113,13 +113,15 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
         vec2 u = rng_vec2(rng);
         float u_lobe = rng_float(rng);
         vec3 l;
-        if (strategy == 0) {
+        float p_disk;
+        if (strategy == 0) { /* on the disk by construction: its pdf t^2 / (cos_j pi r^2), cos_j = h / t */
             vec2 q = sample_concentric_disk(u);
             vec3 y = to_world(o.plane, v3(q.x * vl->radius, q.y * vl->radius, 0.0f));
             vec3 d = sub3(add3(vl->p, y), x->p);
             float len = length3(d);
             if (!(len > 0.0f)) continue;
             l = scale3(d, 1.0f / len);
+            p_disk = len * len * len * o.inv_area / o.h;
         } else {
             const bsdf *b = strategy == 1 ? &x->b : &vl->b;
             vec3 wo = strategy == 1 ? x->wo : vl->wi;
@@ -128,9 +130,9 @@ vec3 vsl_integral(const virtual_light *vl, const shading_point *x, vl_terms term
             if (!bsdf_sample(b, wo, BSDF_ALL, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) continue;
             l = to_world(f, bs.wi);
             if (strategy == 2) l = neg3(l);
+            p_disk = disk_pdf(&o, vl, x, l);
         }
-        float p_disk = disk_pdf(&o, vl, x, l);
-        if (!(p_disk > 0.0f)) continue;
+        if (!(p_disk > 0.0f) || !isfinite(p_disk)) continue;
         vec3 lx, lj;
         vec3 g = integrand(vl, x, terms, l, &lx, &lj);
         if (is_black3(g)) continue;
