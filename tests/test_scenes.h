@@ -120,9 +120,10 @@ static inline void ts_finalize(scene *s) {
     }
 }
 
-/* Renders spp frames with the given parameters; returns the per-pixel mean image of the
- * components in mask (caller frees). */
-static inline float *ts_render_with(const scene *s, const camera *cam, const render_params *p, int spp, unsigned mask) {
+/* Renders spp frames with the given parameters once; out[k] is the per-pixel mean image of the
+ * components in masks[k] (caller frees each). */
+static inline void ts_render_layers(const scene *s, const camera *cam, const render_params *p, int spp, int n,
+                                    const unsigned *masks, float **out) {
     char err[256];
     render_session *rs = session_create(s, cam, p, err, sizeof err);
     if (!rs) {
@@ -134,12 +135,21 @@ static inline float *ts_render_with(const scene *s, const camera *cam, const ren
             fprintf(stderr, "ts_render: %s\n", session_error(rs));
             abort();
         }
-    float *img = malloc(sizeof(float) * 3 * (size_t)p->width * (size_t)p->height);
-    film_resolve(session_film(rs), mask, img);
+    for (int k = 0; k < n; k++) {
+        out[k] = malloc(sizeof(float) * 3 * (size_t)p->width * (size_t)p->height);
+        film_resolve(session_film(rs), masks[k], out[k]);
+    }
     render_stats st = session_stats(rs);
     if (st.rejected_samples)
         fprintf(stderr, "ts_render: %llu rejected samples\n", (unsigned long long)st.rejected_samples);
     session_destroy(rs);
+}
+
+/* Renders spp frames with the given parameters; returns the per-pixel mean image of the
+ * components in mask (caller frees). */
+static inline float *ts_render_with(const scene *s, const camera *cam, const render_params *p, int spp, unsigned mask) {
+    float *img;
+    ts_render_layers(s, cam, p, spp, 1, &mask, &img);
     return img;
 }
 
