@@ -594,8 +594,8 @@ static vec3 merge_and_light(const hl_setup *h, const scene *s, const hl_hit *hit
     return sum;
 }
 
-vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, rng_state *rng,
-                 render_stats *st, int *sharp) {
+vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
+                 rng_state *rng, render_stats *st, int *sharp) {
     vec3 sum = v3(0, 0, 0);
     int n = h->secondary_rays;
     if (points < 1) return sum;
@@ -617,15 +617,17 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
     }
     if (!lit) return sum;
     st->hl_points += (uint64_t)lit;
-    /* The N directions stratified over the lobes: a randomly shifted R2 sequence, ray k from point
-     * k mod points, each point's rays weighted 1 / (points x its rays): the mean over the points. */
-    vec2 shift = rng_vec2(rng);
+    /* The N directions stratified over the lobes and over frames (each point's run), ray k from
+     * point k mod points, each point's rays weighted 1 / (points x its rays): the mean over the
+     * points. */
     for (int k = 0; k < n; k++) {
         const shading_point *x = &xs[k % points];
         if (xl[k % points].fitted < 0) continue;
         int per_point = n / points + (k % points < n % points);
         bsdf_sample_result bs;
-        if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, sample_r2(k / points, shift), &bs) || !(bs.pdf > 0.0f))
+        if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, qmc_run_point(runs[k % points], (uint32_t)(k / points)),
+                         &bs) ||
+            !(bs.pdf > 0.0f))
             continue;
         vec3 wi = to_world(x->frame, bs.wi);
         if (dot3(wi, x->ng) <= 0.0f) continue;

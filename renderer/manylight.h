@@ -9,6 +9,7 @@
 #include "params.h"
 #include "pixel_alloc.h"
 #include "plan.h"
+#include "sampling.h"
 #include "threadpool.h"
 #include "vsl.h"
 
@@ -22,15 +23,16 @@ typedef struct {
 typedef struct {
     vl_kernel kernel;
     vl_terms terms;
-    int all_strategies; /* the three-strategy VSL integral for every pair (the plan's choice) */
-    int clamp;          /* on for this method? */
-    float clamp_bound;  /* this frame's bound */
-    float radius_mult;  /* this frame's multiplier */
-    int per_pixel;      /* 0: every entry */
-    int candidates;     /* resampling candidates per pixel (1: the draws are shaded as they come) */
-    float trace_alpha;  /* glossy lobes sharper than this are traced through, not gathered */
-    int glossy_split;   /* directions traced through such a lobe at the camera hit (the mean with adapt) */
-    int glass;          /* the scene has transmissive materials: gathered paths are also traced through them */
+    int all_strategies;    /* the three-strategy VSL integral for every pair (the plan's choice) */
+    int clamp;             /* on for this method? */
+    float clamp_bound;     /* this frame's bound */
+    float radius_mult;     /* this frame's multiplier */
+    int per_pixel;         /* 0: every entry */
+    int candidates;        /* resampling candidates at the camera hit (1: the draws are shaded as they come) */
+    int candidates_beyond; /* ... and at a path's later hits */
+    float trace_alpha;     /* glossy lobes sharper than this are traced through, not gathered */
+    int glossy_split;      /* directions traced through such a lobe at the camera hit (the mean with adapt) */
+    int glass;             /* the scene has transmissive materials: gathered paths are also traced through them */
     vlight_set set;
     ml_entry *entries;
     int num_entries, cap_entries;
@@ -50,17 +52,19 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
                           size_t errlen);
 
 /* Light at x from this frame's virtual lights (visibility, clamping, scaling included), the paths
- * in `terms` (the frame's m->terms at the camera hit, VL_TERMS_ALL beyond). */
-vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, vl_terms terms, rng_state *rng,
-                     render_stats *st);
+ * in `terms` (the frame's m->terms at the camera hit, VL_TERMS_ALL beyond), resampled from
+ * `candidates` draws (m->candidates at the camera hit, m->candidates_beyond further on). */
+vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x, vl_terms terms, int candidates,
+                     rng_state *rng, render_stats *st);
 
 /* Indirect light at the camera hit x (scattering event 1 of at most max_depth): gathered from
  * the virtual lights, except through a glossy lobe sharper than trace_alpha, where a handful of
  * lights cannot represent the incoming light: that lobe is sampled, and the path picks up the
  * direct light at the next hit and gathers there (the same rule again). At the camera hit the
- * lobe is sampled in `split` directions; rec, when not NULL, records each one's light. */
+ * lobe is sampled in `split` directions, the first `split` points of seq (the pixel's run); rec,
+ * when not NULL, records each one's light. */
 vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, int max_depth, int split,
-                        pixel_record *rec, rng_state *rng, render_stats *st);
+                        qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st);
 
 /* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
 shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);

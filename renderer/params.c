@@ -134,7 +134,7 @@ static const param_desc table[] = {
     {.name = "candidates", .type = PARAM_INT, .offset = F(candidates), .lo = 1, .hi = VL_MAX_CANDIDATES,
      .def = VL_DEFAULT_CANDIDATES, .value_name = "M",
      .help = "draws per pixel, from which its lights are resampled by that\n"
-             "estimate; 1 = the draws are shaded as they come",
+             "estimate (a quarter at later hits); 1 = shaded as drawn",
      .label = "candidates", .unit = "draws per pixel", .panel_lo = 1, .panel_hi = 128, .panel_log = 1,
      .panel_format = "%d",
      .panel_lo_text = "1 (as drawn)"},

@@ -52,8 +52,8 @@ typedef struct {
                           * VL_DEFAULT_PER_PIXEL without clustering and every representative with */
     int candidates;      /* per pixel: lights drawn (by power, cluster norm or the tree) from which
                           * the pixel's per_pixel lights are resampled in proportion to an estimate
-                          * of what each sends there; 1: the draws are shaded as they come
-                          * [VL_DEFAULT_CANDIDATES] */
+                          * of what each sends there; 1: the draws are shaded as they come. At the
+                          * camera hit; a path's later hits draw a quarter [VL_DEFAULT_CANDIDATES] */
     int select;          /* VL_SELECT_*: where a pixel's light draws come from (without clustering) [power] */
     float trace_glossy;  /* a receiver's glossy lobe with roughness alpha below this is not
                           * gathered from the lights: the camera path goes on through it (BSDF
@@ -87,7 +87,7 @@ enum { VL_ADAPT_DEFAULT = 0, VL_ADAPT_ON, VL_ADAPT_OFF };
 #define VL_DEFAULT_CLAMP_GROWTH 0.5f
 #define VL_DEFAULT_ROWS 300
 #define VL_DEFAULT_PER_PIXEL 2
-#define VL_DEFAULT_CANDIDATES 16
+#define VL_DEFAULT_CANDIDATES 32
 #define VL_MAX_CANDIDATES 256 /* they live on the stack */
 #define VL_DEFAULT_TRACE_GLOSSY 0.35f
 #define VL_DEFAULT_GLOSSY_RAYS 4

@@ -58,7 +58,7 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
  * the depth only transmission carries on), up to PT_MAX_TRANSMISSIONS more vertices. */
 static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
                        rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
-                       int split_highlights, int first_lobes) {
+                       int split_highlights, int first_lobes, const qmc_run *first_run) {
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     vec3 beta_hl = v3s(0.0f); /* the throughput through glossy lobes only (depths 1 and 2) */
@@ -136,7 +136,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
         /* Continue the path by sampling the BSDF. */
         float u_lobe = rng_float(rng);
-        vec2 u_dir = rng_vec2(rng);
+        vec2 u_dir = depth == 0 && first_run ? qmc_run_point(*first_run, 0) : rng_vec2(rng);
         bsdf_sample_result bs;
         if (!bsdf_sample(&b, wo, lobes, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
         vec3 wi = to_world(fr, bs.wi);
@@ -176,8 +176,8 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 }
 
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
-                 rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL);
+                 qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
+    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL, &run);
 }
 
 vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
@@ -186,7 +186,7 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     uint64_t camera_rays = rays[RAY_CAMERA];
     int n = first && samples > 1 ? samples : 1; /* an escaping ray has nothing to sample */
     for (int k = 0; k < n; k++) {
-        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL);
+        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL, NULL);
         sum = add3(sum, out[COMP_DIRECT]);
         if (rec && first) pixel_record_add(rec, avg3(out[COMP_DIRECT]));
     }
@@ -198,7 +198,7 @@ int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, r
                         surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
     int hit = scene_intersect(s, o, d, INFINITY, first);
-    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, 0, lobes);
+    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, 0, lobes, NULL);
     *direct = out[COMP_DIRECT];
     return hit;
 }

@@ -8,16 +8,18 @@
 #include "params.h"
 #include "pixel_alloc.h"
 #include "rng.h"
+#include "sampling.h"
 #include "scene.h"
 
 /* Radiance along the camera ray (o, d) whose closest hit the caller has traced (first; NULL when
  * the ray escaped), split by path-space component: out[COMP_DIRECT] gets emission
  * seen directly and light arriving at the first hit directly from an emitter, out[COMP_INDIRECT]
  * the rest; with split_highlights, the paths camera - glossy lobe - glossy lobe - light go to
- * out[COMP_HIGHLIGHTS] instead (the highlight estimator's subset, docs/design.md). Counts rays into
+ * out[COMP_HIGHLIGHTS] instead (the highlight estimator's subset, docs/design.md). The direction
+ * leaving the first hit is the first point of run (the pixel's run over frames). Counts rays into
  * rays[]. */
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
-                 rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
+                 qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
 
 /* Vertices a path may add beyond its depth by transmission alone (panes, a glass's two faces). */
 #define PT_MAX_TRANSMISSIONS 32

@@ -50,6 +50,25 @@ static inline vec2 sample_r2(int k, vec2 u) {
     return r;
 }
 
+/* A pixel's run of a 2D low-discrepancy sequence over frames: points index, index + 1, ... of
+ * the Sobol (0,2)-sequence (van der Corput and Sobol's second dimension), each coordinate's bits
+ * XORed with the pixel's own random scramble. A pixel that keeps its scramble and starts each
+ * frame where the last one stopped covers [0,1)^2 evenly over any run of frames, not only within
+ * each frame, and every point is still uniform. Not R2: pixel positions follow R2 over frames, and
+ * two R2 runs indexed by the frame tie each direction to the position (the pixel would converge
+ * to an average over a slice of its domain); base-2 digits and the plastic number do not. */
+typedef struct {
+    uint32_t index;
+    uint32_t scramble_x, scramble_y;
+} qmc_run;
+static inline vec2 qmc_run_point(qmc_run r, uint32_t k) {
+    uint32_t i = r.index + k, x = 0, y = 0;
+    for (uint32_t b = 1u << 31, v = 1u << 31; i; i >>= 1, b >>= 1, v ^= v >> 1)
+        if (i & 1u) x |= b, y ^= v;
+    /* 24 bits: a float in [0,1) without rounding up to 1 */
+    return v2((float)((x ^ r.scramble_x) >> 8) * 0x1p-24f, (float)((y ^ r.scramble_y) >> 8) * 0x1p-24f);
+}
+
 /* Multiple importance sampling weights for strategy a against b (one sample each). */
 static inline float mis_balance(float pdf_a, float pdf_b) {
     /* As a ratio: the sum of two pdfs near FLT_MAX would overflow. */

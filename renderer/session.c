@@ -161,6 +161,18 @@ static void pixel_points(render_session *rs, render_stats *st, const camera_rast
     }
 }
 
+/* The pixel's run of the low-discrepancy sequence for one of its estimators (stream, < 16): the
+ * same scramble every frame, starting after the `taken` points its earlier frames used. Each
+ * shard has its own scrambles, so shards' points are independent, not the same ones. */
+enum { RUN_PATH = 0, RUN_HIGHLIGHTS = 1, RUN_HIGHLIGHT_POINTS = 2, RUN_STREAMS = 16 };
+static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken) {
+    const render_params *p = &rs->params;
+    uint64_t shard = p->shard_count > 0 ? (uint64_t)p->shard_index : 0;
+    rng_state start = rng_for((uint64_t)pixel, UINT64_MAX - 2 - (shard * RUN_STREAMS + stream), p->seed);
+    uint32_t sx = rng_next_u32(&start);
+    return (qmc_run){(uint32_t)taken, sx, rng_next_u32(&start)};
+}
+
 /* The highlights of a pixel. A highlight is often smaller than the pixel (a curved mirror's image
  * of a lit speck), and there more positions in the pixel beat more rays from one: once the pixel
  * has met a sharp highlight lobe in an earlier frame (with --adapt), each secondary ray starts
@@ -176,7 +188,14 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     shading_point xs[HL_PIXEL_POINTS];
     pixel_points(rs, st, raster, pixel, d, first, xs, points);
     int sharp = 0;
-    vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, &hl_rng, st, &sharp);
+    /* Each point its own run (its rays' directions over frames); spread points get fresh ones. */
+    qmc_run runs[HL_PIXEL_POINTS];
+    for (int j = 0; j < points; j++) {
+        int per_point = rays / points + (j < rays % points);
+        runs[j] = pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
+                            (uint64_t)rs->frames * (uint64_t)per_point);
+    }
+    vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, runs, &hl_rng, st, &sharp);
     if (sharp) rs->hl_sharp[pixel] = 1; /* read from the next frame on: one sample a pixel a frame */
     return L;
 }
@@ -194,7 +213,8 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     vec3 L[COMP_COUNT];
     int depth = rs->plan.max_depth;
     if (p->method == METHOD_PT) {
-        pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, first, rng, L, st->rays);
+        pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, first,
+                    pixel_run(rs, pixel, RUN_PATH, (uint64_t)rs->frames), rng, L, st->rays);
     } else {
         /* Many lights: the shared direct estimator, then the virtual lights at the hit and the
          * highlights, each pass timed. */
@@ -210,9 +230,11 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
         st->pass_ns[PASS_DIRECT] += t1 - t0;
         if (first && depth > 1 && rs->plan.virtual_lights) {
             shading_point sp = shading_point_at(s, first, d);
-            L[COMP_INDIRECT] =
-                manylight_indirect(&rs->ml, s, &sp, depth, rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split,
-                                   rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
+            int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
+            /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
+            uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : (uint64_t)rs->frames * (uint64_t)split;
+            L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, split, pixel_run(rs, pixel, RUN_PATH, taken),
+                                                  rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
             uint64_t t2 = clock_ns();
             st->pass_ns[PASS_GATHER] += t2 - t1;
             t1 = t2;

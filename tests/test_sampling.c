@@ -1,5 +1,7 @@
 /* Sampling routines against the densities they claim: chi-square tests over equal-solid-angle or
  * equal-probability bins, pdfs that integrate to 1, exactness for tiny cones and sharp lobes. */
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "check.h"
@@ -9,7 +11,7 @@
 
 #define PI_D 3.14159265358979323846
 #define SAMPLES 200000L
-#define NUM_CHI2_TESTS 24
+#define NUM_CHI2_TESTS 25
 
 static double significance;
 
@@ -394,6 +396,68 @@ static void test_fmax_fmin(void) {
     CHECK(bad == 0, "gm_fmaxf / gm_fminf: %d of %d pairs differ from C's fmaxf / fminf", bad, n * n);
 }
 
+/* ---- a pixel's run over frames ---------------------------------------------------------------- */
+
+/* Every block of 2^m points starting at a multiple of 2^m is a net, whatever the scramble: each
+ * elementary box of area 2^-m (2^a by 2^(m-a) cells) holds exactly one point. */
+static void test_qmc_run_nets(void) {
+    rng_state rng = rng_for(11, 0, 0);
+    for (int trial = 0; trial < 20; trial++) {
+        enum { M = 6, N = 1 << M };
+        qmc_run run = {(uint32_t)N * (rng_next_u32(&rng) >> 12), rng_next_u32(&rng), rng_next_u32(&rng)};
+        for (int a = 0; a <= M; a++) {
+            int count[N] = {0}, nx = 1 << a, ny = N >> a;
+            for (uint32_t k = 0; k < N; k++) {
+                vec2 u = qmc_run_point(run, k);
+                CHECK(u.x >= 0.0f && u.x < 1.0f && u.y >= 0.0f && u.y < 1.0f, "point outside [0,1)^2");
+                count[(int)(u.y * (float)ny) * nx + (int)(u.x * (float)nx)]++;
+            }
+            int bad = 0;
+            for (int c = 0; c < N; c++) bad += count[c] != 1;
+            CHECK(bad == 0, "trial %d: %d of the %d x %d boxes do not hold exactly one point", trial, bad, nx, ny);
+        }
+    }
+}
+
+/* Over scrambles, any one point of a run is uniform (chi-square over 16 x 16 cells). */
+static void test_qmc_run_uniform(void) {
+    enum { CELLS = 16 };
+    static double counts[CELLS * CELLS];
+    rng_state rng = rng_for(12, 0, 0);
+    for (long i = 0; i < SAMPLES; i++) {
+        qmc_run run = {1234567u, rng_next_u32(&rng), rng_next_u32(&rng)};
+        vec2 u = qmc_run_point(run, 5);
+        counts[(int)(u.y * CELLS) * CELLS + (int)(u.x * CELLS)] += 1.0;
+    }
+    double chi2 = 0.0, expect = (double)SAMPLES / (CELLS * CELLS);
+    for (int c = 0; c < CELLS * CELLS; c++) chi2 += (counts[c] - expect) * (counts[c] - expect) / expect;
+    double p = chi2_upper_tail(chi2, CELLS * CELLS - 1);
+    CHECK(p > significance, "one point over scrambles: chi2 = %.1f, p = %.3g", chi2, p);
+}
+
+/* A pixel's positions follow R2 over frames and its directions its run, both indexed by the frame:
+ * together they must still fill [0,1)^4, or the pixel converges to an average over a slice of its
+ * domain. The share of frames whose four coordinates fall in one of the 16 half-space boxes must tend
+ * to 1/16 for every scramble and shift (two R2 runs give 0 to 1/4: each direction a shifted
+ * position). */
+static void test_qmc_run_independent_of_positions(void) {
+    rng_state rng = rng_for(13, 0, 0);
+    double worst = 0.0;
+    for (int trial = 0; trial < 16; trial++) {
+        vec2 shift = rng_vec2(&rng);
+        qmc_run run = {0, rng_next_u32(&rng), rng_next_u32(&rng)};
+        enum { FRAMES = 1 << 14 };
+        int both = 0;
+        for (int f = 0; f < FRAMES; f++) {
+            vec2 pos = sample_r2(f, shift), dir = qmc_run_point(run, (uint32_t)f);
+            both += pos.x < 0.5f && dir.x < 0.5f && pos.y < 0.5f && dir.y >= 0.5f;
+        }
+        worst = fmax(worst, fabs((double)both / FRAMES - 1.0 / 16.0));
+    }
+    printf("positions and directions over 16384 frames: largest error of a 1/16 share %.5f\n", worst);
+    CHECK(worst < 0.004, "positions and directions over frames are tied: a share of 1/16 off by %.4f", worst);
+}
+
 int main(void) {
     test_fmax_fmin();
     significance = chi2_significance(0.01, NUM_CHI2_TESTS);
@@ -408,5 +472,8 @@ int main(void) {
     test_alias();
     test_dist2d();
     test_mis();
+    test_qmc_run_nets();
+    test_qmc_run_uniform();
+    test_qmc_run_independent_of_positions();
     return check_exit("test_sampling");
 }
