@@ -338,7 +338,8 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
          * random, carries the rest of the path (with weight 1: it stands for the mean of the
          * split's continuations). */
         int split = at_camera ? split_first : 1;
-        qmc_run run = at_camera ? seq : (qmc_run){0, rng_next_u32(rng), rng_next_u32(rng)};
+        qmc_run run = seq;
+        if (!at_camera) run.scramble_x = rng_next_u32(rng), run.scramble_y = rng_next_u32(rng), run.index = 0;
         int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
         /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (docs/design.md) when both
          * lobes are highlight lobes. */
@@ -419,7 +420,8 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     if (m->per_pixel >= (clustering ? vp->columns : m->set.count)) m->per_pixel = 0;
     m->candidates = vp->candidates;
     /* Beyond the camera hit a gather's light is a smaller share of the pixel's, through the path's
-     * earlier bounces: a quarter of the draws cost less and measured no worse (docs/benchmarks.md). */
+     * earlier bounces: there a quarter of the draws saves more time than the error it adds
+     * (docs/benchmarks.md). */
     m->candidates_beyond = vp->candidates > 4 ? vp->candidates / 4 : 1;
     m->glossy_split = vp->glossy_rays;
     m->glass = 0;

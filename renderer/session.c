@@ -162,12 +162,15 @@ static void pixel_points(render_session *rs, render_stats *st, const camera_rast
 }
 
 /* The pixel's run of the low-discrepancy sequence for one of its estimators (stream, < 16): the
- * same scramble every frame, starting after the `taken` points its earlier frames used. Each
- * shard has its own scrambles, so shards' points are independent, not the same ones. */
+ * same scramble every frame, starting after the `taken` points its earlier frames used. Counted in
+ * the whole render's frames (next_frame_index) where a frame's count is fixed, so a shard's points
+ * are the whole render's and merged shards equal one render; a count only this session knows
+ * (own_count: the record's, with --adapt) gets a scramble per shard, so shards never repeat each
+ * other's points. */
 enum { RUN_PATH = 0, RUN_HIGHLIGHTS = 1, RUN_HIGHLIGHT_POINTS = 2, RUN_STREAMS = 16 };
-static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken) {
+static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken, int own_count) {
     const render_params *p = &rs->params;
-    uint64_t shard = p->shard_count > 0 ? (uint64_t)p->shard_index : 0;
+    uint64_t shard = own_count && p->shard_count > 0 ? (uint64_t)p->shard_index + 1 : 0;
     rng_state start = rng_for((uint64_t)pixel, UINT64_MAX - 2 - (shard * RUN_STREAMS + stream), p->seed);
     uint32_t sx = rng_next_u32(&start);
     return (qmc_run){(uint32_t)taken, sx, rng_next_u32(&start)};
@@ -193,7 +196,7 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     for (int j = 0; j < points; j++) {
         int per_point = rays / points + (j < rays % points);
         runs[j] = pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
-                            (uint64_t)rs->frames * (uint64_t)per_point);
+                            next_frame_index(rs) * (uint64_t)per_point, 0);
     }
     vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, runs, &hl_rng, st, &sharp);
     if (sharp) rs->hl_sharp[pixel] = 1; /* read from the next frame on: one sample a pixel a frame */
@@ -214,7 +217,7 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     int depth = rs->plan.max_depth;
     if (p->method == METHOD_PT) {
         pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, first,
-                    pixel_run(rs, pixel, RUN_PATH, (uint64_t)rs->frames), rng, L, st->rays);
+                    pixel_run(rs, pixel, RUN_PATH, next_frame_index(rs), 0), rng, L, st->rays);
     } else {
         /* Many lights: the shared direct estimator, then the virtual lights at the hit and the
          * highlights, each pass timed. */
@@ -232,9 +235,10 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
             shading_point sp = shading_point_at(s, first, d);
             int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
             /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
-            uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : (uint64_t)rs->frames * (uint64_t)split;
-            L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, depth, split, pixel_run(rs, pixel, RUN_PATH, taken),
-                                                  rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
+            uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : next_frame_index(rs) * (uint64_t)split;
+            L[COMP_INDIRECT] =
+                manylight_indirect(&rs->ml, s, &sp, depth, split, pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
+                                   rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
             uint64_t t2 = clock_ns();
             st->pass_ns[PASS_GATHER] += t2 - t1;
             t1 = t2;
