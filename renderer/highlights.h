@@ -42,9 +42,9 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
 /* The highlights of a pixel from its camera hits xs[0..points): light along camera - glossy(x) -
  * glossy(q) - light, reflected toward the camera, the mean over the points, from the setup's N
  * secondary rays shared among them (ray k from point k mod points, its direction point k / points
- * of runs[k mod points], the point's run over frames); each point merges its own lobes. A point without a glossy lobe
- * adds zero. *sharp is set when some point's lobe is sharp enough that its members take its image
- * (a pixel worth spreading over). Counts work into st. */
+ * of runs[k mod points], the point's run over frames); each point merges its own lobes. A point
+ * without a glossy lobe adds zero. *sharp is set when some point's lobe is sharp enough that its
+ * members take its image (a pixel worth spreading over). Counts work into st. */
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
                  rng_state *rng, render_stats *st, int *sharp);
 
