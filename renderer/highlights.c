@@ -623,7 +623,7 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
     for (int k = 0; k < n; k++) {
         const shading_point *x = &xs[k % points];
         if (xl[k % points].fitted < 0) continue;
-        int per_point = n / points + (k % points < n % points);
+        int per_point = hl_rays_of_point(n, points, k % points);
         bsdf_sample_result bs;
         if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, qmc_run_point(runs[k % points], (uint32_t)(k / points)),
                          &bs) ||

@@ -45,6 +45,9 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
  * of runs[k mod points], the point's run over frames); each point merges its own lobes. A point
  * without a glossy lobe adds zero. *sharp is set when some point's lobe is sharp enough that its
  * members take its image (a pixel worth spreading over). Counts work into st. */
+/* How many of n secondary rays start from point j of `points`: ray k from point k mod points. */
+static inline int hl_rays_of_point(int n, int points, int j) { return n / points + (j < n % points); }
+
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
                  rng_state *rng, render_stats *st, int *sharp);
 

@@ -194,9 +194,8 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     /* Each point its own run (its rays' directions over frames); spread points get fresh ones. */
     qmc_run runs[HL_PIXEL_POINTS];
     for (int j = 0; j < points; j++) {
-        int per_point = rays / points + (j < rays % points);
         runs[j] = pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
-                            next_frame_index(rs) * (uint64_t)per_point, 0);
+                            next_frame_index(rs) * (uint64_t)hl_rays_of_point(rays, points, j), 0);
     }
     vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, runs, &hl_rng, st, &sharp);
     if (sharp) rs->hl_sharp[pixel] = 1; /* read from the next frame on: one sample a pixel a frame */

@@ -45,10 +45,10 @@ vec3 vpl_contribution(const virtual_light *vl, const shading_point *x, int gloss
  * light, one-sample model with the balance heuristic; ceil(100 |Omega|/2pi) samples with Omega
  * the sphere's cone, at least one a strategy. Unless all_strategies, a pair without a glossy lobe
  * sharper than BSDF_HIGHLIGHT_ALPHA takes points on the disk alone (and x's BSDF where x is inside
- * the sphere). The result is the mean of point lights spread
- * over the disk: a facing plane receives all the light's power, a wall beside it half, at any
- * distance (docs/design.md, "Virtual spherical lights"). share is vsl_front_share. *samples
- * (optional) receives the count used. */
+ * the sphere). The result is the mean of point lights spread over the disk: a facing plane
+ * receives all the light's power, a wall beside it half, at any distance (docs/design.md,
+ * "Virtual spherical lights"). share is vsl_front_share. *samples (optional) receives the count
+ * used. */
 vec3 vsl_contribution(const virtual_light *vl, const shading_point *x, vl_terms terms, int all_strategies,
                       rng_state *rng, int *samples);
 
