@@ -594,6 +594,10 @@ static vec3 merge_and_light(const hl_setup *h, const scene *s, const hl_hit *hit
     return sum;
 }
 
+int hl_point_sharp(const hl_setup *h, const shading_point *x) {
+    return h->mode == HL_MERGED && bsdf_highlight_lobe(&x->b) && x->wo.z > 0.0f && x_lobe_fit(x).sharp;
+}
+
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
                  rng_state *rng, render_stats *st, int *sharp) {
     vec3 sum = v3(0, 0, 0);

@@ -39,16 +39,20 @@ typedef struct {
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */
 hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf_filter *env_filter);
 
+/* How many of n secondary rays start from point j of `points`: ray k from point k mod points. */
+static inline int hl_rays_of_point(int n, int points, int j) { return n / points + (j < n % points); }
+
 /* The highlights of a pixel from its camera hits xs[0..points): light along camera - glossy(x) -
  * glossy(q) - light, reflected toward the camera, the mean over the points, from the setup's N
  * secondary rays shared among them (ray k from point k mod points, its direction point k / points
  * of runs[k mod points], the point's run over frames); each point merges its own lobes. A point
- * without a glossy lobe adds zero. *sharp is set when some point's lobe is sharp enough that its
- * members take its image (a pixel worth spreading over). Counts work into st. */
-/* How many of n secondary rays start from point j of `points`: ray k from point k mod points. */
-static inline int hl_rays_of_point(int n, int points, int j) { return n / points + (j < n % points); }
-
+ * without a glossy lobe adds zero. *sharp is set when some point's lobe is sharp (hl_point_sharp):
+ * a pixel worth spreading over. Counts work into st. */
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
                  rng_state *rng, render_stats *st, int *sharp);
+
+/* Whether x has a highlight lobe sharp enough that its members take its image (every band of its
+ * vMF fit narrow; docs/design.md, "Merging without the sample's spread"). */
+int hl_point_sharp(const hl_setup *h, const shading_point *x);
 
 #endif

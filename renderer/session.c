@@ -32,7 +32,11 @@ typedef struct {
  * light is easy) a third of its frames for little (docs/benchmarks.md). */
 #define MANYLIGHT_DIRECT_SAMPLES 4
 #define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
-#define HL_PIXEL_POINTS 8 /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
+#define HL_PIXEL_POINTS 8     /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
+#define HL_SHARP_RAY_FACTOR 4 /* ... and N times this many secondary rays (docs/benchmarks.md, 2026-11-28) */
+/* A pixel's highlight state with --adapt: not yet probed (reset), or whether it has met a sharp
+ * highlight lobe. */
+enum { HL_PIXEL_UNPROBED = 0, HL_PIXEL_BROAD, HL_PIXEL_SHARP };
 
 struct render_session {
     const scene *scene;
@@ -49,7 +53,7 @@ struct render_session {
      * samples, from the spread of one sample's light in earlier frames */
     int adapt;
     pixel_alloc glossy, direct;
-    uint8_t *hl_sharp;       /* per pixel: met a sharp highlight lobe (its highlights spread over it) */
+    uint8_t *hl_state;       /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
@@ -100,7 +104,7 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
     }
     if (pixel_alloc_init(&rs->glossy, p->width * p->height) != 0 ||
         pixel_alloc_init(&rs->direct, p->width * p->height) != 0 ||
-        !(rs->hl_sharp = calloc((size_t)p->width * (size_t)p->height, 1))) {
+        !(rs->hl_state = calloc((size_t)p->width * (size_t)p->height, 1))) {
         session_destroy(rs);
         return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
     }
@@ -116,7 +120,7 @@ void session_destroy(render_session *rs) {
     manylight_deinit(&rs->ml);
     pixel_alloc_free(&rs->glossy);
     pixel_alloc_free(&rs->direct);
-    free(rs->hl_sharp);
+    free(rs->hl_state);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -176,17 +180,42 @@ static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, u
     return (qmc_run){(uint32_t)taken, sx, rng_next_u32(&start)};
 }
 
+/* A pixel's first highlight state: whether a camera hit at a position of its own in the pixel has
+ * a sharp highlight lobe. The position is drawn apart from the frames' samples, so the frame that
+ * reads the state stays unbiased. Without the probe every pixel's first frame took one point, and a
+ * speck smaller than the pixel was either missed by it or weighed a whole frame. */
+static int probe_state(render_session *rs, render_stats *st, const camera_raster *raster, int pixel) {
+    const render_params *p = &rs->params;
+    rng_state r = rng_for((uint64_t)pixel, UINT64_MAX >> 1, p->seed); /* no frame's stream */
+    vec2 u = rng_vec2(&r);
+    vec3 dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
+    st->rays[RAY_CAMERA]++;
+    st->pixel_points++;
+    surface_hit h;
+    if (!scene_intersect(rs->scene, rs->cam.position, dir, INFINITY, &h)) return HL_PIXEL_BROAD;
+    shading_point x = shading_point_at(rs->scene, &h, dir);
+    return hl_point_sharp(&rs->hl, &x) ? HL_PIXEL_SHARP : HL_PIXEL_BROAD;
+}
+
 /* The highlights of a pixel. A highlight is often smaller than the pixel (a curved mirror's image
  * of a lit speck), and there more positions in the pixel beat more rays from one: once the pixel
- * has met a sharp highlight lobe in an earlier frame (with --adapt), each secondary ray starts
- * from its own point of the pixel. Earlier frames decide this, so each frame's estimate stays
- * unbiased; and a sharp lobe's members take its image, not the sample's spread, so one ray a point
- * merges as well as N (docs/design.md, "Where the samples go"). */
+ * has met a sharp highlight lobe in an earlier frame or its probe (with --adapt), its secondary
+ * rays start from HL_PIXEL_POINTS points spread over the pixel, and it takes HL_SHARP_RAY_FACTOR times
+ * as many: few pixels see a sharp lobe, and each is worth more rays than a pixel's share. Earlier
+ * frames decide this, so each frame's estimate stays unbiased; and a sharp lobe's members take its
+ * image, not the sample's spread, so the merge's expectation does not depend on how many rays it
+ * merged (docs/design.md, "Where the samples go"). */
 static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
                              const surface_hit *first, rng_state *rng) {
     rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
-    int rays = rs->hl.secondary_rays;
-    int points = rs->adapt && rs->hl_sharp[pixel] ? (rays < HL_PIXEL_POINTS ? rays : HL_PIXEL_POINTS) : 1;
+    hl_setup setup = rs->hl;
+    int spread = rs->adapt && rs->hl_state[pixel] == HL_PIXEL_SHARP;
+    int points = 1;
+    if (spread) {
+        int n = setup.secondary_rays * HL_SHARP_RAY_FACTOR;
+        points = setup.secondary_rays < HL_PIXEL_POINTS ? setup.secondary_rays : HL_PIXEL_POINTS;
+        setup.secondary_rays = n < HL_MAX_SECONDARY_RAYS ? n : HL_MAX_SECONDARY_RAYS;
+    }
     if (!first && points == 1) return v3(0, 0, 0);
     shading_point xs[HL_PIXEL_POINTS];
     pixel_points(rs, st, raster, pixel, d, first, xs, points);
@@ -195,10 +224,10 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     qmc_run runs[HL_PIXEL_POINTS];
     for (int j = 0; j < points; j++) {
         runs[j] = pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
-                            next_frame_index(rs) * (uint64_t)hl_rays_of_point(rays, points, j), 0);
+                            next_frame_index(rs) * (uint64_t)hl_rays_of_point(setup.secondary_rays, points, j), 0);
     }
-    vec3 L = hl_estimate(&rs->hl, rs->scene, xs, points, runs, &hl_rng, st, &sharp);
-    if (sharp) rs->hl_sharp[pixel] = 1; /* read from the next frame on: one sample a pixel a frame */
+    vec3 L = hl_estimate(&setup, rs->scene, xs, points, runs, &hl_rng, st, &sharp);
+    if (sharp) rs->hl_state[pixel] = HL_PIXEL_SHARP; /* read from the next frame on: one sample a pixel a frame */
     return L;
 }
 
@@ -207,7 +236,11 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
                           const surface_hit *first, rng_state *rng) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
-    int spread = rs->adapt && rs->plan.highlights && rs->hl_sharp[pixel];
+    int spread = 0;
+    if (rs->adapt && rs->plan.highlights) {
+        if (rs->hl_state[pixel] == HL_PIXEL_UNPROBED) rs->hl_state[pixel] = (uint8_t)probe_state(rs, st, raster, pixel);
+        spread = rs->hl_state[pixel] == HL_PIXEL_SHARP;
+    }
     if (!first && !s->env && !spread) { /* into the void: every component is zero, nothing to add */
         st->rays[RAY_CAMERA]++;
         return;
@@ -368,7 +401,7 @@ void session_reset(render_session *rs) {
     film_clear(&rs->film);
     pixel_alloc_reset(&rs->glossy);
     pixel_alloc_reset(&rs->direct);
-    memset(rs->hl_sharp, 0, (size_t)rs->params.width * (size_t)rs->params.height);
+    memset(rs->hl_state, HL_PIXEL_UNPROBED, (size_t)rs->params.width * (size_t)rs->params.height);
     rs->frames = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }
