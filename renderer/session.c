@@ -200,11 +200,11 @@ static int probe_state(render_session *rs, render_stats *st, const camera_raster
 /* The highlights of a pixel. A highlight is often smaller than the pixel (a curved mirror's image
  * of a lit speck), and there more positions in the pixel beat more rays from one: once the pixel
  * has met a sharp highlight lobe in an earlier frame or its probe (with --adapt), its secondary
- * rays start from HL_PIXEL_POINTS points spread over the pixel, and it takes HL_SHARP_RAY_FACTOR times
- * as many: few pixels see a sharp lobe, and each is worth more rays than a pixel's share. Earlier
- * frames decide this, so each frame's estimate stays unbiased; and a sharp lobe's members take its
- * image, not the sample's spread, so the merge's expectation does not depend on how many rays it
- * merged (docs/design.md, "Where the samples go"). */
+ * rays start from HL_PIXEL_POINTS points spread over the pixel, and it takes HL_SHARP_RAY_FACTOR
+ * times as many: few pixels see a sharp lobe, and each is worth more rays than a pixel's share.
+ * Earlier frames decide this, so each frame's estimate stays unbiased; and a sharp lobe's members
+ * take its image, not the sample's spread, so the merge's expectation does not depend on how many
+ * rays it merged (docs/design.md, "Where the samples go"). */
 static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
                              const surface_hit *first, rng_state *rng) {
     rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
