@@ -594,9 +594,14 @@ static vec3 merge_and_light(const hl_setup *h, const scene *s, const hl_hit *hit
     return sum;
 }
 
-int hl_point_sharp(const hl_setup *h, const shading_point *x) {
-    return h->mode == HL_MERGED && bsdf_highlight_lobe(&x->b) && x->wo.z > 0.0f && x_lobe_fit(x).sharp;
+/* Camera hit x's lobe as the estimator takes it: fitted = -1 when x has no highlight lobe facing
+ * the camera; unmerged, unfitted (each member is its own sampled lobe, the paper's Fig. 4 top). */
+static x_lobe point_lobe(const hl_setup *h, const shading_point *x) {
+    if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) return (x_lobe){.fitted = -1};
+    return h->mode == HL_MERGED ? x_lobe_fit(x) : (x_lobe){0};
 }
+
+int hl_point_sharp(const hl_setup *h, const shading_point *x) { return point_lobe(h, x).sharp; }
 
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
                  rng_state *rng, render_stats *st, int *sharp) {
@@ -609,14 +614,9 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
     x_lobe xl[HL_MAX_SECONDARY_RAYS];
     int lit = 0;
     for (int j = 0; j < points; j++) {
-        const shading_point *x = &xs[j];
-        if (!bsdf_highlight_lobe(&x->b) || !(x->wo.z > 0.0f)) {
-            xl[j].fitted = -1; /* no lobe here */
-            continue;
-        }
+        xl[j] = point_lobe(h, &xs[j]);
+        if (xl[j].fitted < 0) continue;
         lit++;
-        /* Unmerged, each member is its own sampled lobe (the paper's Fig. 4 top). */
-        xl[j] = h->mode == HL_MERGED ? x_lobe_fit(x) : (x_lobe){0};
         *sharp |= xl[j].sharp;
     }
     if (!lit) return sum;
