@@ -7,15 +7,17 @@
 /* f_x(wo, lx) f_j(wi_j, lj) with the path-space split applied (both directions local, above):
  * the highlights' part is the product of both ends' highlight lobes. */
 static vec3 bsdf_pair(const virtual_light *vl, const shading_point *x, vec3 lx, vec3 lj, int lobes_j, vl_terms terms) {
-    if (terms == VL_TERMS_ALL || vl->depth != 1)
+    int split = terms != VL_TERMS_ALL && vl->depth == 1;
+    int hx = split ? bsdf_highlight_lobe(&x->b) : 0, hj = split ? lobes_j & bsdf_highlight_lobe(&vl->b) : 0;
+    if (!hx || !hj) /* no product of highlight lobes (where x's sharp lobes are traced, the common case) */
         return terms == VL_TERMS_HIGHLIGHTS
                    ? v3(0, 0, 0)
                    : mul3(bsdf_eval(&x->b, x->wo, lx, BSDF_ALL), bsdf_eval(&vl->b, vl->wi, lj, lobes_j));
-    vec3 gg = mul3(bsdf_eval(&x->b, x->wo, lx, bsdf_highlight_lobe(&x->b)),
-                   bsdf_eval(&vl->b, vl->wi, lj, lobes_j & bsdf_highlight_lobe(&vl->b)));
-    if (terms == VL_TERMS_HIGHLIGHTS) return gg;
-    vec3 all = mul3(bsdf_eval(&x->b, x->wo, lx, BSDF_ALL), bsdf_eval(&vl->b, vl->wi, lj, lobes_j));
-    return max3(sub3(all, gg), v3(0, 0, 0)); /* exact up to rounding; never below zero */
+    /* Each lobe evaluated once (bsdf_eval adds its lobes): all - gg = fx_rest fj + fx_hl fj_rest. */
+    vec3 fx_hl = bsdf_eval(&x->b, x->wo, lx, hx), fj_hl = bsdf_eval(&vl->b, vl->wi, lj, hj);
+    if (terms == VL_TERMS_HIGHLIGHTS) return mul3(fx_hl, fj_hl);
+    vec3 fx_rest = bsdf_eval(&x->b, x->wo, lx, BSDF_ALL & ~hx), fj_rest = bsdf_eval(&vl->b, vl->wi, lj, lobes_j & ~hj);
+    return add3(mul3(fx_rest, add3(fj_hl, fj_rest)), mul3(fx_hl, fj_rest));
 }
 
 /* A cap on one light's contribution: far above any real radiance, far below FLT_MAX, so sums and
