@@ -23,6 +23,7 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
     h.mode = r.merge == HL_MERGE_OFF ? HL_UNMERGED : r.merge == HL_MERGE_TRACE ? HL_TRACED : HL_MERGED;
     h.secondary_rays = r.secondary_rays;
     h.clusters = r.clusters;
+    h.share = r.share == HL_SHARE_ON;
     h.env_filter = env_filter;
     return h;
 }
@@ -603,6 +604,46 @@ static x_lobe point_lobe(const hl_setup *h, const shading_point *x) {
 
 int hl_point_sharp(const hl_setup *h, const shading_point *x) { return point_lobe(h, x).sharp; }
 
+/* Secondary hit q, reached from x along world direction wi (local wl, t away) with x's sample
+ * weight, as one of x's members: recorded in *hit (returns 1), or lit at once through its own
+ * BSDF and added to *sum, or nothing (returns 0). */
+static int member_record(const hl_setup *h, const scene *s, const shading_point *x, const x_lobe *xl,
+                         const shading_point *q, vec3 wi, vec3 wl, float t, vec3 weight, hl_hit *hit, rng_state *rng,
+                         render_stats *st, vec3 *sum) {
+    float x_share[VMF_LOBE_BANDS];
+    vmf_glossy_band_shares(&x->b, x->wo, wl, x_share);
+    int rec = h->mode == HL_TRACED ? HIT_TRACE : hit_record(hit, q, weight, x_share);
+    if (rec == HIT_TRACE) {
+        lit_lobe l = {q->p, q->ng, NULL, q, weight};
+        *sum = add3(*sum, light_lobe(h, s, &l, rng, st));
+        st->hl_lobes++;
+        return 0;
+    }
+    if (rec == HIT_NONE) return 0;
+    hit_record_x(hit, xl, wi, t, q->frame.n);
+    if (h->mode == HL_UNMERGED) { /* a cluster of one */
+        int one = 0;
+        *sum = add3(*sum, merge_and_light(h, s, hit, &one, 1, rng, st));
+        return 0;
+    }
+    return 1;
+}
+
+/* One secondary ray from x along its lobe's sample u: the hit q when it has a highlight lobe
+ * (shaded as seen from x), with x's sample weight (before dividing by the rays) and the world
+ * direction. */
+static int secondary_hit(const scene *s, const shading_point *x, vec2 u, render_stats *st, surface_hit *hq,
+                         shading_point *q, bsdf_sample_result *bs, vec3 *wi) {
+    if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, u, bs) || !(bs->pdf > 0.0f)) return 0;
+    *wi = to_world(x->frame, bs->wi);
+    if (dot3(*wi, x->ng) <= 0.0f) return 0;
+    st->rays[RAY_BOUNCE]++;
+    st->hl_secondary_rays++;
+    if (!scene_intersect(s, offset_origin(s, x->p, x->ng, *wi), *wi, INFINITY, hq)) return 0;
+    *q = shading_point_at(s, hq, *wi);
+    return bsdf_highlight_lobe(&q->b) != 0; /* a rough lobe: the VSLs keep these paths */
+}
+
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
                  rng_state *rng, render_stats *st, int *sharp) {
     vec3 sum = v3(0, 0, 0);
@@ -625,40 +666,16 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
      * point k mod points, each point's rays weighted 1 / (points x its rays): the mean over the
      * points. */
     for (int k = 0; k < n; k++) {
-        const shading_point *x = &xs[k % points];
-        if (xl[k % points].fitted < 0) continue;
-        int per_point = hl_rays_of_point(n, points, k % points);
-        bsdf_sample_result bs;
-        if (!bsdf_sample(&x->b, x->wo, BSDF_GLOSSY, 0.0f, qmc_run_point(runs[k % points], (uint32_t)(k / points)),
-                         &bs) ||
-            !(bs.pdf > 0.0f))
-            continue;
-        vec3 wi = to_world(x->frame, bs.wi);
-        if (dot3(wi, x->ng) <= 0.0f) continue;
-        vec3 weight = scale3(bs.f, bs.wi.z / (bs.pdf * (float)(per_point * points)));
+        int j = k % points;
+        if (xl[j].fitted < 0) continue;
         surface_hit hq;
-        st->rays[RAY_BOUNCE]++;
-        st->hl_secondary_rays++;
-        if (!scene_intersect(s, offset_origin(s, x->p, x->ng, wi), wi, INFINITY, &hq)) continue;
-        shading_point q = shading_point_at(s, &hq, wi);
-        if (!bsdf_highlight_lobe(&q.b)) continue; /* a rough lobe: the VSLs keep these paths */
-        hl_hit *hit = &hits[count];
-        float x_share[VMF_LOBE_BANDS];
-        vmf_glossy_band_shares(&x->b, x->wo, bs.wi, x_share);
-        int rec = h->mode == HL_TRACED ? HIT_TRACE : hit_record(hit, &q, weight, x_share);
-        if (rec == HIT_TRACE) {
-            lit_lobe l = {q.p, q.ng, NULL, &q, weight};
-            sum = add3(sum, light_lobe(h, s, &l, rng, st));
-            st->hl_lobes++;
-            continue;
-        }
-        if (rec == HIT_NONE) continue;
-        hit_record_x(hit, &xl[k % points], wi, hq.t, q.frame.n);
-        if (h->mode == HL_UNMERGED) { /* a cluster of one */
-            sum = add3(sum, merge_and_light(h, s, hits, &count, 1, rng, st));
-            continue;
-        }
-        hit_point[count++] = k % points;
+        shading_point q;
+        bsdf_sample_result bs;
+        vec3 wi;
+        if (!secondary_hit(s, &xs[j], qmc_run_point(runs[j], (uint32_t)(k / points)), st, &hq, &q, &bs, &wi)) continue;
+        vec3 weight = scale3(bs.f, bs.wi.z / (bs.pdf * (float)(hl_rays_of_point(n, points, j) * points)));
+        if (member_record(h, s, &xs[j], &xl[j], &q, wi, bs.wi, hq.t, weight, &hits[count], rng, st, &sum))
+            hit_point[count++] = j;
     }
     /* Each point's lobes are merged among themselves: rays from points spread over a curved mirror
      * part ways, and lobes merged across them made the highlights 18% off on atelier. */
@@ -669,4 +686,108 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
         if (m > 0) sum = add3(sum, merge_and_light(h, s, hits, index, m, rng, st));
     }
     return sum;
+}
+
+/* ---- hits shared among neighbouring pixels ----------------------------------------------------- */
+
+/* A secondary hit in a block's pool: q as shaded from the point whose ray found it, and each point's
+ * density of finding it. */
+typedef struct {
+    shading_point q;
+    int from;
+    float pdf_area[HL_SHARE_POINTS]; /* per unit area at q; 0 where the point cannot find q */
+} pool_hit;
+
+/* Where q (on the side its normal ng faces) lies from x: unit *dir, *dist away, and x's density of
+ * finding it by sampling its glossy lobe, per unit area at q (the solid angle's pdf times
+ * cos at q / dist^2); 0 where x's sampling cannot reach it. Visibility is the caller's. */
+static float area_pdf(const shading_point *x, vec3 qp, vec3 qng, vec3 *dir, float *dist) {
+    vec3 d = sub3(qp, x->p);
+    float len = length3(d);
+    if (!(len > 0.0f)) return 0.0f;
+    *dir = scale3(d, 1.0f / len);
+    *dist = len;
+    float cq = -dot3(*dir, qng);
+    vec3 wl = to_local(x->frame, *dir);
+    if (!(dot3(*dir, x->ng) > 0.0f) || !(cq > 0.0f) || !(wl.z > 0.0f)) return 0.0f;
+    float p = bsdf_pdf(&x->b, x->wo, wl, BSDF_GLOSSY);
+    return p > 0.0f ? p * cq / (len * len) : 0.0f;
+}
+
+/* Whether x sees q along unit dir (a shadow ray between the offset points). */
+static int sees(const scene *s, const shading_point *x, const shading_point *q, vec3 dir, render_stats *st) {
+    vec3 org = offset_origin(s, x->p, x->ng, dir), target = offset_origin(s, q->p, q->ng, neg3(dir));
+    vec3 span = sub3(target, org);
+    float len = length3(span);
+    st->rays[RAY_SHADOW]++;
+    return len > 0.0f && dot3(span, dir) > 0.0f && !scene_occluded(s, org, scale3(span, 1.0f / len), len);
+}
+
+void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *xs, int m, qmc_run run, const int *slot,
+                        rng_state *rngs, render_stats *st, vec3 *out) {
+    int n = h->secondary_rays < HL_SHARE_MAX_RAYS ? h->secondary_rays : HL_SHARE_MAX_RAYS;
+    pool_hit pool[HL_SHARE_POINTS * HL_SHARE_MAX_RAYS];
+    int count = 0;
+    x_lobe xl[HL_SHARE_POINTS];
+    /* A point merges up to 4N members, and the merge's expectation moves with the members per
+     * cluster (atelier's floor: 1.000 of the reference at N = 8, K = 4; 1.124 at N = 32, K = 4;
+     * 1.006 at N = 32, K = 8): twice the clusters. */
+    hl_setup merge = *h;
+    merge.clusters = 2 * h->clusters < HL_MAX_CLUSTERS ? 2 * h->clusters : HL_MAX_CLUSTERS;
+    for (int j = 0; j < m; j++) {
+        out[j] = v3(0, 0, 0);
+        xl[j] = point_lobe(h, &xs[j]);
+        if (xl[j].fitted >= 0) st->hl_points++;
+    }
+    /* The point in slot j takes the block's points j N .. j N + N - 1: its own run of N is
+     * stratified (every fourth point would hold some of the sample's bits fixed, and the point would
+     * sample one part of its lobe), and so are the block's 4N together. */
+    for (int j = 0; j < m; j++) {
+        for (int k = 0; xl[j].fitted >= 0 && k < n; k++) {
+            surface_hit hq;
+            bsdf_sample_result bs;
+            vec3 wi;
+            uint32_t index = (uint32_t)(slot[j] * n + k);
+            if (!secondary_hit(s, &xs[j], qmc_run_point(run, index), st, &hq, &pool[count].q, &bs, &wi)) continue;
+            pool[count++].from = j;
+        }
+    }
+    /* Every point's density at every hit, zero where it does not see the hit (a shadow ray, but
+     * for the point that found it): the balance heuristic over the points' samplings is then
+     * unbiased for each point. */
+    for (int i = 0; i < count; i++) {
+        pool_hit *ph = &pool[i];
+        for (int j = 0; j < m; j++) {
+            vec3 d;
+            float dist;
+            ph->pdf_area[j] = xl[j].fitted >= 0 ? area_pdf(&xs[j], ph->q.p, ph->q.ng, &d, &dist) : 0.0f;
+            if (ph->pdf_area[j] > 0.0f && j != ph->from && !sees(s, &xs[j], &ph->q, d, st)) ph->pdf_area[j] = 0.0f;
+        }
+    }
+    for (int a = 0; a < m; a++) {
+        const shading_point *x = &xs[a];
+        hl_hit hits[HL_SHARE_POINTS * HL_SHARE_MAX_RAYS];
+        int index[HL_SHARE_POINTS * HL_SHARE_MAX_RAYS], members = 0;
+        vec3 sum = v3(0, 0, 0);
+        for (int i = 0; xl[a].fitted >= 0 && i < count; i++) {
+            const pool_hit *ph = &pool[i];
+            if (!(ph->pdf_area[a] > 0.0f)) continue;
+            double area = 0.0;
+            for (int j = 0; j < m; j++) area += (double)n * (double)ph->pdf_area[j];
+            vec3 d;
+            float dist;
+            area_pdf(x, ph->q.p, ph->q.ng, &d, &dist);
+            vec3 wl = to_local(x->frame, d);
+            /* The pooled density in x's solid angle: per unit area x dist^2 / cos at q. */
+            double pdf = area * (double)dist * (double)dist / (double)-dot3(d, ph->q.ng);
+            vec3 weight = scale3(bsdf_eval(&x->b, x->wo, wl, BSDF_GLOSSY), (float)((double)wl.z / pdf));
+            shading_point q = ph->q;
+            q.wo = to_local(q.frame, neg3(d));
+            if (!(q.wo.z > 0.0f) || !is_finite3(weight) || is_black3(weight)) continue;
+            if (member_record(h, s, x, &xl[a], &q, d, wl, dist, weight, &hits[members], &rngs[a], st, &sum))
+                index[members] = members, members++;
+        }
+        if (members > 0) sum = add3(sum, merge_and_light(&merge, s, hits, index, members, &rngs[a], st));
+        out[a] = sum;
+    }
 }

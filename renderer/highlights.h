@@ -34,6 +34,7 @@ typedef struct {
     const struct env_vmf_filter *env_filter; /* the scene's environment, prefiltered; NULL: none */
     int num_punctual;                        /* the scene's point, spot and directional lights (first in its list) */
     int area_lights;                         /* whether it has emissive triangles */
+    int share;                               /* neighbouring pixels share their secondary hits */
 } hl_setup;
 
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */
@@ -55,4 +56,13 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
  * vMF fit narrow; docs/design.md, "Merging without the sample's spread"). */
 int hl_point_sharp(const hl_setup *h, const shading_point *x);
 
+/* The highlights of up to HL_SHARE_POINTS neighbouring pixels' camera hits xs (one each, a 2x2
+ * block), which share their secondary hits: each point traces the setup's N rays (N at most
+ * HL_SHARE_MAX_RAYS), the one in slot j taking points j N .. j N + N - 1 of the block's run, and
+ * every point merges every hit it sees into 2K lobes, weighted by the balance heuristic over the
+ * points' sampling densities (docs/design.md, "Hits shared by neighbours"). out[j]: point j's
+ * highlights (zero without a glossy lobe). */
+#define HL_SHARE_POINTS 4
+void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *xs, int m, qmc_run run, const int *slot,
+                        rng_state *rngs, render_stats *st, vec3 *out);
 #endif

@@ -41,6 +41,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     r.secondary_rays = int_or(vp->secondary_rays, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_SECONDARY_RAYS);
     r.clusters = int_or(vp->clusters, HL_DEFAULT_CLUSTERS, HL_MAX_CLUSTERS);
     if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_ON;
+    if (vp->share == HL_SHARE_DEFAULT) r.share = HL_SHARE_OFF;
     return r;
 }
 
@@ -77,6 +78,7 @@ static const param_choice clamps[] = {{NULL, VL_CLAMP_DEFAULT, "method default"}
                                       {"off", VL_CLAMP_OFF, "off"}};
 static const param_choice selects[] = {{"power", VL_SELECT_POWER, "by power"}, {"tree", VL_SELECT_TREE, "light tree"}};
 static const param_choice adapts[] = {{"on", VL_ADAPT_ON, "on"}, {"off", VL_ADAPT_OFF, "off"}};
+static const param_choice shares[] = {{"on", HL_SHARE_ON, "on"}, {"off", HL_SHARE_OFF, "off"}};
 static const param_choice merges[] = {{"on", HL_MERGE_ON, "on"}, {"off", HL_MERGE_OFF, "off"},
                                       {"trace", HL_MERGE_TRACE, "trace"}};
 
@@ -173,6 +175,12 @@ static const param_desc table[] = {
              "paper's comparison); trace: no vMFs, each hit's true glossy lobe\n"
              "(the path tracer's answer for the same paths)",
      .label = "merge"},
+    {.name = "share", .type = PARAM_CHOICE, .group = PARAM_HIGHLIGHTS, .offset = F(share), .choices = shares,
+     .num_choices = 2, .def = HL_SHARE_OFF,
+     .help = "on: 2x2 blocks of pixels whose lobes are not sharp share their\n"
+             "secondary hits, each pixel merging the block's into 2K lobes\n"
+             "(N up to " STR(HL_SHARE_MAX_RAYS) "); off: each pixel its own",
+     .label = "share hits"},
 };
 /* clang-format on */
 

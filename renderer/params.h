@@ -68,6 +68,7 @@ typedef struct {
     int secondary_rays; /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
     int clusters;       /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
     int merge;          /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
+    int share;          /* HL_SHARE_*: 2x2 blocks of pixels with broad lobes share their secondary hits [off] */
 } vl_params;
 
 enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
@@ -95,10 +96,12 @@ enum { VL_ADAPT_DEFAULT = 0, VL_ADAPT_ON, VL_ADAPT_OFF };
 /* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the
  * path tracer's estimate of the same paths, to see what the approximation costs) */
 enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };
+enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
 #define HL_DEFAULT_SECONDARY_RAYS 8
 #define HL_DEFAULT_CLUSTERS 4
 #define HL_MAX_CLUSTERS 8
 #define HL_MAX_SECONDARY_RAYS 256 /* the paper uses 32-64; per-hit records live on the stack */
+#define HL_SHARE_MAX_RAYS 16      /* N beyond this: no sharing (a block's pool lives on the stack) */
 
 /* Zero means default for every field. */
 typedef struct {

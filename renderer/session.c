@@ -171,7 +171,13 @@ static void pixel_points(render_session *rs, render_stats *st, const camera_rast
  * are the whole render's and merged shards equal one render; a count only this session knows
  * (own_count: the record's, with --adapt) gets a scramble per shard, so shards never repeat each
  * other's points. */
-enum { RUN_PATH = 0, RUN_HIGHLIGHTS = 1, RUN_HIGHLIGHT_POINTS = 2, RUN_STREAMS = 16 };
+enum {
+    RUN_PATH = 0,
+    RUN_HIGHLIGHTS = 1,
+    RUN_HIGHLIGHT_POINTS = 2,
+    RUN_HIGHLIGHT_BLOCK = 2 + HL_PIXEL_POINTS,
+    RUN_STREAMS = 16
+};
 static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken, int own_count) {
     const render_params *p = &rs->params;
     uint64_t shard = own_count && p->shard_count > 0 ? (uint64_t)p->shard_index + 1 : 0;
@@ -231,16 +237,14 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     return L;
 }
 
-/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL. */
+/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL; its
+ * highlights, when its block shared them, in shared_hl. */
 static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                          const surface_hit *first, rng_state *rng) {
+                          const surface_hit *first, rng_state *rng, const vec3 *shared_hl) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
-    int spread = 0;
-    if (rs->adapt && rs->plan.highlights) {
-        if (rs->hl_state[pixel] == HL_PIXEL_UNPROBED) rs->hl_state[pixel] = (uint8_t)probe_state(rs, st, raster, pixel);
-        spread = rs->hl_state[pixel] == HL_PIXEL_SHARP;
-    }
+    /* render_tile probed the pixel's highlight state */
+    int spread = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_SHARP;
     if (!first && !s->env && !spread) { /* into the void: every component is zero, nothing to add */
         st->rays[RAY_CAMERA]++;
         return;
@@ -276,7 +280,7 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
             t1 = t2;
         }
         if (depth > 1 && rs->plan.highlights) {
-            L[COMP_HIGHLIGHTS] = pixel_highlights(rs, st, raster, pixel, d, first, rng);
+            L[COMP_HIGHLIGHTS] = shared_hl ? *shared_hl : pixel_highlights(rs, st, raster, pixel, d, first, rng);
             st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
         }
     }
@@ -295,6 +299,42 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
         film_reject(&rs->film, pixel);
         st->rejected_samples++;
     }
+}
+
+/* The highlights of a packet's pixels whose camera hits have a broad highlight lobe, 2x2 blocks of
+ * them sharing their secondary hits (hl_estimate_shared): such pixels see nearly the same lobe, so
+ * each merges four pixels' hits for the cost of its own and the shadow rays to the others'. Pixels
+ * that spread over sharp lobes keep their own. shared[i] is set where has_shared[i]. */
+static void block_highlights(render_session *rs, render_stats *st, const int *pixel, const vec3 *d,
+                             const surface_hit *hit, unsigned hits, int n, vec3 *shared, int *has_shared) {
+    const render_params *p = &rs->params;
+    uint64_t t0 = clock_ns(), frame = next_frame_index(rs);
+    for (int block = 0; block < SCENE_PACKET / HL_SHARE_POINTS; block++) {
+        shading_point xs[HL_SHARE_POINTS];
+        int idx[HL_SHARE_POINTS], slot[HL_SHARE_POINTS], m = 0, corner = -1;
+        rng_state rngs[HL_SHARE_POINTS];
+        for (int i = 0; i < n; i++) {
+            int px = pixel[i] % p->width, py = pixel[i] / p->width;
+            if ((px / 2 % 2) + 2 * (py / 2 % 2) != block || !(hits >> i & 1u)) continue;
+            if (rs->adapt && rs->hl_state[pixel[i]] == HL_PIXEL_SHARP) continue;
+            shading_point x = shading_point_at(rs->scene, &hit[i], d[i]);
+            if (hl_point_sharp(&rs->hl, &x)) continue;
+            corner = (py & ~1) * p->width + (px & ~1);
+            xs[m] = x;
+            idx[m] = i;
+            slot[m] = (py & 1) * 2 + (px & 1);
+            rngs[m] = rng_for((uint64_t)pixel[i], frame | (1ull << 63), p->seed); /* no other stream's */
+            m++;
+        }
+        if (m == 0) continue;
+        /* The block's run, named by its top-left pixel: a pixel's points never collide with it. */
+        qmc_run run =
+            pixel_run(rs, corner, RUN_HIGHLIGHT_BLOCK, frame * (uint64_t)(HL_SHARE_POINTS * rs->hl.secondary_rays), 0);
+        vec3 out[HL_SHARE_POINTS];
+        hl_estimate_shared(&rs->hl, rs->scene, xs, m, run, slot, rngs, st, out);
+        for (int j = 0; j < m; j++) shared[idx[j]] = out[j], has_shared[idx[j]] = 1;
+    }
+    st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t0;
 }
 
 static void render_tile(void *ctx, int tile, int worker) {
@@ -333,8 +373,19 @@ static void render_tile(void *ctx, int tile, int worker) {
             uint64_t t0 = timed ? clock_ns() : 0;
             unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
             if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
+            /* Each pixel's highlight state before any pixel's highlights: a block shares only
+             * among pixels that are not spread. */
+            int highlights = p->method != METHOD_PT && rs->plan.highlights && rs->plan.max_depth > 1;
+            for (int i = 0; highlights && rs->adapt && i < n; i++)
+                if (rs->hl_state[pixel[i]] == HL_PIXEL_UNPROBED)
+                    rs->hl_state[pixel[i]] = (uint8_t)probe_state(rs, st, &raster, pixel[i]);
+            vec3 shared[SCENE_PACKET];
+            int has_shared[SCENE_PACKET] = {0};
+            if (highlights && rs->hl.share && rs->hl.secondary_rays <= HL_SHARE_MAX_RAYS)
+                block_highlights(rs, st, pixel, d, hit, hits, n, shared, has_shared);
             for (int i = 0; i < n; i++)
-                render_sample(rs, st, &raster, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i]);
+                render_sample(rs, st, &raster, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i],
+                              has_shared[i] ? &shared[i] : NULL);
         }
     }
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;
