@@ -411,10 +411,10 @@ static shading_point floor_point(const scene *s, vec3 p) {
 
 /* Neighbouring pixels share their secondary hits (hl_estimate_shared): a hit counts for a point
  * only where that point sees it, and each point's density of finding it only where that point
- * sees it. Two floor points, the second inside a closed box through the floor: the second must get nothing, and the
- * first what it gets alone (the exact mode: no vMF in the way), whatever the box hides. Without
- * the shadow rays to the other point, the boxed point took the first's hits and the first lost
- * about half its highlights to the boxed point's density. */
+ * sees it. Two floor points, the second inside a closed box through the floor: the second must
+ * get nothing, and the first what it gets alone (the exact mode: no vMF in the way), whatever the
+ * box hides. Without the shadow rays to the other point, the boxed point took the first's hits
+ * and the first lost about half its highlights to the boxed point's density. */
 static void test_shared_hits_see_their_points(void) {
     scene *s = floor_and_wall_unfinished(60.0f, 0, 3.0f, NULL);
     vec3 open = v3(-0.05f, 0, 0.4f), boxed = v3(0.05f, 0, 0.4f);
