@@ -691,11 +691,14 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
 /* ---- hits shared among neighbouring pixels ----------------------------------------------------- */
 
 /* A secondary hit in a block's pool: q as shaded from the point whose ray found it, and each point's
- * density of finding it. */
+ * direction to it, distance and density of finding it. */
 typedef struct {
     shading_point q;
     int from;
+    vec3 dir[HL_SHARE_POINTS];
+    float dist[HL_SHARE_POINTS];
     float pdf_area[HL_SHARE_POINTS]; /* per unit area at q; 0 where the point cannot find q */
+    double rays_pdf;                 /* N times their sum: the block's density at q */
 } pool_hit;
 
 /* Where q (on the side its normal ng faces) lies from x: unit *dir, *dist away, and x's density of
@@ -757,11 +760,12 @@ void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *
      * unbiased for each point. */
     for (int i = 0; i < count; i++) {
         pool_hit *ph = &pool[i];
+        ph->rays_pdf = 0.0;
         for (int j = 0; j < m; j++) {
-            vec3 d;
-            float dist;
-            ph->pdf_area[j] = xl[j].fitted >= 0 ? area_pdf(&xs[j], ph->q.p, ph->q.ng, &d, &dist) : 0.0f;
-            if (ph->pdf_area[j] > 0.0f && j != ph->from && !sees(s, &xs[j], &ph->q, d, st)) ph->pdf_area[j] = 0.0f;
+            float *p = &ph->pdf_area[j];
+            *p = xl[j].fitted >= 0 ? area_pdf(&xs[j], ph->q.p, ph->q.ng, &ph->dir[j], &ph->dist[j]) : 0.0f;
+            if (*p > 0.0f && j != ph->from && !sees(s, &xs[j], &ph->q, ph->dir[j], st)) *p = 0.0f;
+            ph->rays_pdf += (double)n * (double)*p;
         }
     }
     for (int a = 0; a < m; a++) {
@@ -772,14 +776,10 @@ void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *
         for (int i = 0; xl[a].fitted >= 0 && i < count; i++) {
             const pool_hit *ph = &pool[i];
             if (!(ph->pdf_area[a] > 0.0f)) continue;
-            double area = 0.0;
-            for (int j = 0; j < m; j++) area += (double)n * (double)ph->pdf_area[j];
-            vec3 d;
-            float dist;
-            area_pdf(x, ph->q.p, ph->q.ng, &d, &dist);
-            vec3 wl = to_local(x->frame, d);
+            vec3 d = ph->dir[a], wl = to_local(x->frame, d);
+            float dist = ph->dist[a];
             /* The pooled density in x's solid angle: per unit area x dist^2 / cos at q. */
-            double pdf = area * (double)dist * (double)dist / (double)-dot3(d, ph->q.ng);
+            double pdf = ph->rays_pdf * (double)dist * (double)dist / (double)-dot3(d, ph->q.ng);
             vec3 weight = scale3(bsdf_eval(&x->b, x->wo, wl, BSDF_GLOSSY), (float)((double)wl.z / pdf));
             shading_point q = ph->q;
             q.wo = to_local(q.frame, neg3(d));
