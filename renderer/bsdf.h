@@ -181,6 +181,12 @@ static inline int bsdf_thin(const bsdf *b) { return fabsf(b->eta - 1.0f) < 1e-3f
  * coat's and sheen's scaling). Black for rough or refracting transmission and without one:
  * shadow rays stop there. */
 vec3 bsdf_pass_through(const bsdf *b, vec3 wo);
+/* Whether b transmits through a rough lobe (roughness above BSDF_MIN_ALPHA), wide enough for a
+ * light sample to land in: next-event estimation looks through it. Smooth transmission is a
+ * delta for it, as a mirror is. */
+static inline int bsdf_transmits_rough(const bsdf *b) {
+    return (bsdf_lobes(b) & BSDF_TRANSMIT) && (b->alpha_x > BSDF_MIN_ALPHA || b->alpha_y > BSDF_MIN_ALPHA);
+}
 /* Whether a local direction w, from a sample or a light, lies on the side of the geometric
  * surface its lobe says (above for reflection, below for transmission): the shading normal may
  * say otherwise, and then the direction is no path. ng_dot = the world direction . ng. */

@@ -30,23 +30,24 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int split_
 }
 
 /* A BSDF's lobes as next-event estimation sees them: their value, and the pdf of the lobes the
- * vertex samples its continuation from (pdf_lobes). */
+ * vertex samples its continuation from (pdf_lobes); for lights above the surface, or with below
+ * those beyond it (its transmission). */
 typedef struct {
     const bsdf *b;
     frame3 fr;
     vec3 wo;
-    int lobes, pdf_lobes;
+    int lobes, pdf_lobes, below;
 } bsdf_lobe;
 
 static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lobe_pdf) {
     const bsdf_lobe *l = ctx;
     vec3 wi = to_local(l->fr, ls->wi);
-    if (!(wi.z > 0.0f)) return v3(0, 0, 0);
+    if (!(l->below ? wi.z < 0.0f : wi.z > 0.0f)) return v3(0, 0, 0);
     vec3 f = bsdf_eval(l->b, l->wo, wi, l->lobes);
     /* A delta light's weight needs no lobe pdf: skip evaluating it (point and spot lights are
      * common, and this runs at every vertex). */
     if (!ls->delta && !is_black3(f)) *lobe_pdf = bsdf_pdf(l->b, l->wo, wi, l->pdf_lobes);
-    return scale3(f, wi.z);
+    return scale3(f, fabsf(wi.z));
 }
 
 /* The path tracer, for a ray (o, d) whose closest hit the caller has traced: *first, or NULL when
@@ -113,17 +114,34 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
                                                         : first_lobes;
         if (!(bsdf_lobes(&b) & lobes)) break;
 
-        /* Next-event estimation (the reflecting lobes; shadow rays pass only smooth unbent glass). */
+        /* Next-event estimation: lights above the surface through the reflecting lobes (shadow rays
+         * pass only smooth unbent glass), and lights beyond rough glass through its transmission,
+         * at a capped vertex too (a transmission is no scattering event). The share held for the
+         * highlights is the path's at a vertex's own light. */
+        vec3 nee_beta = add3(beta, held);
+        int through = (lobes & BSDF_TRANSMIT) && bsdf_transmits_rough(&b) && (events > 0 || !continuation);
+        if (through) {
+            float u_sel = rng_float(rng);
+            vec2 u_light = rng_vec2(rng);
+            bsdf_lobe lobe = {&b, fr, wo, BSDF_TRANSMIT, lobes, 1};
+            vec3 beyond = material_medium_after(&s->materials[h.material], h.backface, BSDF_TRANSMIT, sigma);
+            light_sample ls;
+            vec3 f;
+            vec3 arrival = nee_direct(s, h.p, neg3(h.ng), beyond, u_sel, u_light, bsdf_lobe_toward, &lobe,
+                                      &rays[RAY_SHADOW], &f, &ls);
+            if (!is_black3(arrival))
+                out[component_of(events)] = add3(out[component_of(events)], mul3(mul3(nee_beta, f), arrival));
+        }
         if (!capped) {
             float u_sel = rng_float(rng);
             vec2 u_light = rng_vec2(rng);
-            bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes};
+            bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes, 0};
             light_sample ls;
             vec3 f;
             vec3 arrival =
                 nee_direct(s, h.p, h.ng, sigma, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
             if (!is_black3(arrival)) {
-                vec3 c = mul3(mul3(beta, f), arrival);
+                vec3 c = mul3(mul3(nee_beta, f), arrival);
                 if (split_highlights && depth == 1 && events == 1) {
                     vec3 wi = to_local(fr, ls.wi);
                     vec3 fg = scale3(bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b)), wi.z);
@@ -164,7 +182,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             sigma = material_medium_after(&s->materials[h.material], h.backface, bs.lobe, sigma);
         events += bs.lobe != BSDF_TRANSMIT;
         if (!passed) {
-            prev_nee = bs.lobe != BSDF_TRANSMIT;
+            prev_nee = bs.lobe != BSDF_TRANSMIT || through;
             prev_pdf = bs.pdf;
             prev_p = h.p;
         }

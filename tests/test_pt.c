@@ -50,17 +50,6 @@ static void test_furnace_box(float a, int max_depth) {
     scene_destroy(s);
 }
 
-/* A constant sky: a 4x2 image of ones. */
-static void set_constant_env(scene *s, float value) {
-    image_rgb img = {4, 2, malloc(sizeof(float) * 3 * 8)};
-    for (int i = 0; i < 24; i++) img.rgb[i] = value;
-    char err[256];
-    if (scene_set_env_image(s, &img, 0.0f, err, sizeof err) != 0) {
-        fprintf(stderr, "set_constant_env: %s\n", err);
-        abort();
-    }
-}
-
 /* Directional albedo of b for wo, by quadrature over the hemisphere in (1 - cos theta, phi), with
  * the theta grid dense near the lobe's peak (log-spaced in 1 - cos around the mirror direction
  * wo reflected about z works only at normal incidence, which is all this test uses). */
@@ -91,7 +80,7 @@ static void test_env_furnace(const char *name, material mat) {
     int m = ts_material(s, mat);
     ts_box(s, v3(-0.5f, -0.5f, -0.5f), v3(0.5f, 0.5f, 0.5f), 0, m);
     ts_finalize(s);
-    set_constant_env(s, 1.0f);
+    ts_constant_env(s, 1.0f);
     camera cam = camera_look_at(v3(0, 0, 3), v3(0, 0, 0), v3(0, 1, 0), 0.02f);
     const int w = 16, h = 16, n = w * h;
     float *img = ts_render(s, &cam, w, h, 256, 8, 11, ALL);

@@ -120,6 +120,17 @@ static inline void ts_finalize(scene *s) {
     }
 }
 
+/* A constant sky of radiance value (a 4x2 image). */
+static inline void ts_constant_env(scene *s, float value) {
+    image_rgb img = {4, 2, malloc(sizeof(float) * 3 * 8)};
+    for (int i = 0; i < 24; i++) img.rgb[i] = value;
+    char err[256];
+    if (scene_set_env_image(s, &img, 0.0f, err, sizeof err) != 0) {
+        fprintf(stderr, "ts_constant_env: %s\n", err);
+        abort();
+    }
+}
+
 /* Renders spp frames with the given parameters once; out[k] is the per-pixel mean image of the
  * components in masks[k] (caller frees each). */
 static inline void ts_render_layers(const scene *s, const camera *cam, const render_params *p, int spp, int n,
