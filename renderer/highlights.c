@@ -726,8 +726,8 @@ static int sees(const scene *s, const shading_point *x, const shading_point *q, 
     return len > 0.0f && dot3(span, dir) > 0.0f && !scene_occluded(s, org, scale3(span, 1.0f / len), len);
 }
 
-void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *xs, int m, qmc_run run, const int *slot,
-                        rng_state *rngs, render_stats *st, vec3 *out) {
+unsigned hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *xs, int m, qmc_run run,
+                            const int *slot, rng_state *rngs, render_stats *st, vec3 *out) {
     int n = h->secondary_rays < HL_SHARE_MAX_RAYS ? h->secondary_rays : HL_SHARE_MAX_RAYS;
     pool_hit pool[HL_SHARE_POINTS * HL_SHARE_MAX_RAYS];
     int count = 0;
@@ -737,9 +737,15 @@ void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *
      * 1.006 at N = 32, K = 8): twice the clusters. */
     hl_setup merge = *h;
     merge.clusters = 2 * h->clusters < HL_MAX_CLUSTERS ? 2 * h->clusters : HL_MAX_CLUSTERS;
+    unsigned estimated = 0;
     for (int j = 0; j < m; j++) {
         out[j] = v3(0, 0, 0);
         xl[j] = point_lobe(h, &xs[j]);
+        if (xl[j].sharp) { /* its own estimator's: no rays, no density, no estimate here */
+            xl[j].fitted = -1;
+            continue;
+        }
+        estimated |= 1u << j;
         if (xl[j].fitted >= 0) st->hl_points++;
     }
     /* The point in slot j takes the block's points j N .. j N + N - 1: its own run of N is
@@ -790,4 +796,5 @@ void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *
         if (members > 0) sum = add3(sum, merge_and_light(&merge, s, hits, index, members, &rngs[a], st));
         out[a] = sum;
     }
+    return estimated;
 }

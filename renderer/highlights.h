@@ -61,8 +61,9 @@ int hl_point_sharp(const hl_setup *h, const shading_point *x);
  * HL_SHARE_MAX_RAYS), the one in slot j taking points j N .. j N + N - 1 of the block's run, and
  * every point merges every hit it sees into 2K lobes, weighted by the balance heuristic over the
  * points' sampling densities (docs/design.md, "Hits shared by neighbours"). out[j]: point j's
- * highlights (zero without a glossy lobe). */
+ * highlights (zero without a glossy lobe). Points whose lobe is sharp (hl_point_sharp) take no
+ * part and are left to their own estimator: returns the mask of the others. */
 #define HL_SHARE_POINTS 4
-void hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *xs, int m, qmc_run run, const int *slot,
-                        rng_state *rngs, render_stats *st, vec3 *out);
+unsigned hl_estimate_shared(const hl_setup *h, const scene *s, const shading_point *xs, int m, qmc_run run,
+                            const int *slot, rng_state *rngs, render_stats *st, vec3 *out);
 #endif

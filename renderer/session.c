@@ -317,10 +317,8 @@ static void block_highlights(render_session *rs, render_stats *st, const int *pi
             int px = pixel[i] % p->width, py = pixel[i] / p->width;
             if ((px / 2 % 2) + 2 * (py / 2 % 2) != block || !(hits >> i & 1u)) continue;
             if (rs->adapt && rs->hl_state[pixel[i]] == HL_PIXEL_SHARP) continue;
-            shading_point x = shading_point_at(rs->scene, &hit[i], d[i]);
-            if (hl_point_sharp(&rs->hl, &x)) continue;
             corner = (py & ~1) * p->width + (px & ~1);
-            xs[m] = x;
+            xs[m] = shading_point_at(rs->scene, &hit[i], d[i]);
             idx[m] = i;
             slot[m] = (py & 1) * 2 + (px & 1);
             rngs[m] = rng_for((uint64_t)pixel[i], frame | (1ull << 63), p->seed); /* no other stream's */
@@ -331,8 +329,9 @@ static void block_highlights(render_session *rs, render_stats *st, const int *pi
         qmc_run run =
             pixel_run(rs, corner, RUN_HIGHLIGHT_BLOCK, frame * (uint64_t)(HL_SHARE_POINTS * rs->hl.secondary_rays), 0);
         vec3 out[HL_SHARE_POINTS];
-        hl_estimate_shared(&rs->hl, rs->scene, xs, m, run, slot, rngs, st, out);
-        for (int j = 0; j < m; j++) shared[idx[j]] = out[j], has_shared[idx[j]] = 1;
+        unsigned estimated = hl_estimate_shared(&rs->hl, rs->scene, xs, m, run, slot, rngs, st, out);
+        for (int j = 0; j < m; j++)
+            if (estimated >> j & 1u) shared[idx[j]] = out[j], has_shared[idx[j]] = 1;
     }
     st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t0;
 }
