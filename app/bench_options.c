@@ -46,13 +46,13 @@ static const bench_preset presets[] = {
     {"highlights-whole",
      "the whole renderer, its highlights layer compared: path tracing against\n"
      "vsl+hl with the settings of highlights, 8 and 32 secondary rays",
-     {"--component", "highlights", "--run", "pt", HL_SETTINGS, "--sweep", "secondary-rays=8,32", "--seeds", "2",
-      "--times", "10,30", NULL}},
+     {"--component", "highlights", "--dim-highlights", "off", "--run", "pt", HL_SETTINGS, "--sweep",
+      "secondary-rays=8,32", "--seeds", "2", "--times", "10,30", NULL}},
     {"plan",
      "what the effect plan saves: vsl+hl with the passes the scene calls for\n"
      "against every pass forced on, the indirect light",
-     {"--run", "vsl+hl", "--sweep", "plan=auto,full", "--component", "indirect", "--seeds", "2", "--times", "15,30",
-      NULL}},
+     {"--run", "vsl+hl", "--sweep", "plan=auto,full", "--component", "indirect", "--dim-highlights", "off", "--seeds",
+      "2", "--times", "15,30", NULL}},
 };
 #undef HL_SETTINGS
 enum { NUM_PRESETS = sizeof presets / sizeof presets[0] };

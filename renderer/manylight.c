@@ -307,18 +307,19 @@ static int glass_direction(const scene *s, const shading_point *x, vec3 beta, in
                             sigma, &lobe);
 }
 
-vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, int max_depth, int split_first,
-                        qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st) {
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, vl_terms camera_terms,
+                        int max_depth, int split_first, qmc_run seq, pixel_record *rec, rng_state *rng,
+                        render_stats *st) {
     vec3 sum = v3(0, 0, 0), beta = v3s(1.0f), sigma = v3s(0.0f);
     shading_point x = *x0;
-    if (!m->glass && !traced_lobes(m, &x.b)) return manylight_shade(m, s, &x, m->terms, m->candidates, rng, st);
+    if (!m->glass && !traced_lobes(m, &x.b)) return manylight_shade(m, s, &x, camera_terms, m->candidates, rng, st);
     int through = 0; /* x was reached through a transmission */
     /* x is scattering event k: gathering there makes paths of k + 1 events or more. A
      * transmission leaves k as it is (pt.c counts depth so). */
     for (int k = 1, vertex = 0; k + 1 <= max_depth && vertex <= max_depth + PT_MAX_TRANSMISSIONS; vertex++) {
         /* Only at the camera hit do the highlights own part of the gathered paths. */
         int at_camera = k == 1 && !through;
-        vl_terms terms = at_camera ? m->terms : VL_TERMS_ALL;
+        vl_terms terms = at_camera ? camera_terms : VL_TERMS_ALL;
         int traced = traced_lobes(m, &x.b);
         shading_point gathered = x;
         gathered.b = bsdf_only(&x.b, BSDF_ALL & ~traced);
@@ -343,8 +344,9 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
         /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (docs/design.md) when both
          * lobes are highlight lobes. */
-        int lobes = at_camera && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b) ? BSDF_NOT_HIGHLIGHT
-                                                                                                 : BSDF_ALL;
+        int lobes = at_camera && camera_terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b)
+                        ? BSDF_NOT_HIGHLIGHT
+                        : BSDF_ALL;
         vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1), next_sigma = sigma;
         surface_hit next;
         int have_next = 0, next_lobe = 0;

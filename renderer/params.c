@@ -42,6 +42,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     r.clusters = int_or(vp->clusters, HL_DEFAULT_CLUSTERS, HL_MAX_CLUSTERS);
     if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_ON;
     if (vp->share == HL_SHARE_DEFAULT) r.share = HL_SHARE_OFF;
+    r.dim_share = float_or(vp->dim_share, HL_DEFAULT_DIM_SHARE);
     return r;
 }
 
@@ -181,6 +182,13 @@ static const param_desc table[] = {
              "secondary hits, each pixel merging the block's into 2K lobes\n"
              "(N up to " STR(HL_SHARE_MAX_RAYS) "); off: each pixel its own",
      .label = "share hits"},
+    {.name = "dim-highlights", .type = PARAM_FLOAT, .group = PARAM_HIGHLIGHTS, .offset = F(dim_share), .lo = 0,
+     .hi = 1, .off_word = "off", .zero_is_off = 1, .def = HL_DEFAULT_DIM_SHARE, .value_name = "S",
+     .help = "with --adapt on: a pixel whose highlights came to less than S of\n"
+             "its light in its first " STR(HL_DIM_FRAMES) " frames leaves them to the virtual lights\n"
+             "from then on (no secondary rays there); off: highlights everywhere",
+     .label = "dim highlights below", .unit = "of the pixel's light", .panel_lo = 0, .panel_hi = 0.1,
+     .panel_format = "%.3f", .panel_lo_text = "never"},
 };
 /* clang-format on */
 

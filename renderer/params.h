@@ -69,6 +69,9 @@ typedef struct {
     int clusters;       /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
     int merge;          /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
     int share;          /* HL_SHARE_*: 2x2 blocks of pixels with broad lobes share their secondary hits [off] */
+    float dim_share;    /* with adapt: a pixel whose highlights were below this share of its light in
+                         * its first HL_DIM_FRAMES frames leaves them to the virtual lights' paths
+                         * from then on; < 0: never [HL_DEFAULT_DIM_SHARE] */
 } vl_params;
 
 enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
@@ -102,6 +105,11 @@ enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
 #define HL_MAX_CLUSTERS 8
 #define HL_MAX_SECONDARY_RAYS 256 /* the paper uses 32-64; per-hit records live on the stack */
 #define HL_SHARE_MAX_RAYS 16      /* N beyond this: no sharing (a block's pool lives on the stack) */
+/* Most pixels whose camera hit has a highlight lobe see hardly any highlight: on the built-in rooms
+ * the highlight pass reaches 42-53 k pixels a frame, of which 7-35 k get any highlight, many of
+ * those under 0.3% of their light (docs/benchmarks.md, 2026-11-28). */
+#define HL_DEFAULT_DIM_SHARE 0.01f
+#define HL_DIM_FRAMES 2 /* the frames a pixel's highlights are estimated before it is judged */
 
 /* Zero means default for every field. */
 typedef struct {

@@ -34,9 +34,9 @@ typedef struct {
 #define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
 #define HL_PIXEL_POINTS 8     /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
 #define HL_SHARP_RAY_FACTOR 4 /* ... and N times this many secondary rays (docs/benchmarks.md, 2026-11-28) */
-/* A pixel's highlight state with --adapt: not yet probed (reset), or whether it has met a sharp
- * highlight lobe. */
-enum { HL_PIXEL_UNPROBED = 0, HL_PIXEL_BROAD, HL_PIXEL_SHARP };
+/* A pixel's highlight state with --adapt: not yet probed (reset), whether it has met a sharp
+ * highlight lobe, or dim: its highlights left to the virtual lights (highlights_dim). */
+enum { HL_PIXEL_UNPROBED = 0, HL_PIXEL_BROAD, HL_PIXEL_SHARP, HL_PIXEL_DIM };
 
 struct render_session {
     const scene *scene;
@@ -55,6 +55,7 @@ struct render_session {
     pixel_alloc glossy, direct;
     uint8_t *hl_state;       /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
+    float hl_dim_share;      /* ... and vl_params.dim_share, resolved */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
     scene_analysis analysis;
@@ -245,6 +246,7 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     const render_params *p = &rs->params;
     /* render_tile probed the pixel's highlight state */
     int spread = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_SHARP;
+    int dim = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_DIM;
     if (!first && !s->env && !spread) { /* into the void: every component is zero, nothing to add */
         st->rays[RAY_CAMERA]++;
         return;
@@ -272,14 +274,14 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
             int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
             /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
             uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : next_frame_index(rs) * (uint64_t)split;
-            L[COMP_INDIRECT] =
-                manylight_indirect(&rs->ml, s, &sp, depth, split, pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
-                                   rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
+            L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, dim ? VL_TERMS_ALL : rs->ml.terms, depth, split,
+                                                  pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
+                                                  rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
             uint64_t t2 = clock_ns();
             st->pass_ns[PASS_GATHER] += t2 - t1;
             t1 = t2;
         }
-        if (depth > 1 && rs->plan.highlights) {
+        if (depth > 1 && rs->plan.highlights && !dim) {
             L[COMP_HIGHLIGHTS] = shared_hl ? *shared_hl : pixel_highlights(rs, st, raster, pixel, d, first, rng);
             st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
         }
@@ -301,6 +303,19 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     }
 }
 
+/* Whether a pixel's highlights in its earlier frames came to less than `share` of its light: then
+ * the virtual lights' paths take them from now on (docs/design.md, "Where the samples go"). The
+ * earlier frames decide, so each later frame's estimate stays unbiased. */
+static int highlights_dim(const film *f, int pixel, float share) {
+    double part = 0.0, all = 0.0;
+    for (int c = 0; c < COMP_COUNT; c++) {
+        const double *v = f->sum[c] + 3 * (size_t)pixel;
+        all += v[0] + v[1] + v[2];
+        if (c == COMP_HIGHLIGHTS) part = v[0] + v[1] + v[2];
+    }
+    return !(part > (double)share * all);
+}
+
 /* The highlights of a packet's pixels whose camera hits have a broad highlight lobe, 2x2 blocks of
  * them sharing their secondary hits (hl_estimate_shared): such pixels see nearly the same lobe, so
  * each merges four pixels' hits for the cost of its own and the shadow rays to the others'. Pixels
@@ -316,7 +331,8 @@ static void block_highlights(render_session *rs, render_stats *st, const int *pi
         for (int i = 0; i < n; i++) {
             int px = pixel[i] % p->width, py = pixel[i] / p->width;
             if ((px / 2 % 2) + 2 * (py / 2 % 2) != block || !(hits >> i & 1u)) continue;
-            if (rs->adapt && rs->hl_state[pixel[i]] == HL_PIXEL_SHARP) continue;
+            if (rs->adapt && (rs->hl_state[pixel[i]] == HL_PIXEL_SHARP || rs->hl_state[pixel[i]] == HL_PIXEL_DIM))
+                continue;
             corner = (py & ~1) * p->width + (px & ~1);
             xs[m] = shading_point_at(rs->scene, &hit[i], d[i]);
             idx[m] = i;
@@ -375,9 +391,13 @@ static void render_tile(void *ctx, int tile, int worker) {
             /* Each pixel's highlight state before any pixel's highlights: a block shares only
              * among pixels that are not spread. */
             int highlights = p->method != METHOD_PT && rs->plan.highlights && rs->plan.max_depth > 1;
-            for (int i = 0; highlights && rs->adapt && i < n; i++)
+            for (int i = 0; highlights && rs->adapt && i < n; i++) {
                 if (rs->hl_state[pixel[i]] == HL_PIXEL_UNPROBED)
                     rs->hl_state[pixel[i]] = (uint8_t)probe_state(rs, st, &raster, pixel[i]);
+                if (rs->frames == HL_DIM_FRAMES && rs->hl_dim_share >= 0.0f && rs->plan.virtual_lights &&
+                    highlights_dim(&rs->film, pixel[i], rs->hl_dim_share))
+                    rs->hl_state[pixel[i]] = HL_PIXEL_DIM;
+            }
             vec3 shared[SCENE_PACKET];
             int has_shared[SCENE_PACKET] = {0};
             if (highlights && rs->hl.share && rs->hl.secondary_rays <= HL_SHARE_MAX_RAYS)
@@ -408,6 +428,7 @@ int session_render_frame(render_session *rs) {
         }
         rs->totals.env_filter_bytes = rs->plan.env_prefilter ? env_vmf_filter_bytes(rs->envf) : 0;
         rs->hl = hl_setup_from(rs->scene, &rs->params.vl, rs->plan.env_prefilter ? rs->envf : NULL);
+        rs->hl_dim_share = vl_params_resolve(&rs->params.vl).dim_share;
     }
     if (rs->plan.virtual_lights) {
         uint64_t t0 = clock_ns();

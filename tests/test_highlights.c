@@ -49,6 +49,7 @@ static render_params hl_params(int merge, int clusters, int rays) {
     p.vl.merge = merge;
     p.vl.clusters = clusters;
     p.vl.secondary_rays = rays;
+    p.vl.dim_share = -1.0f; /* the estimator at every pixel: these tests read its layer alone */
     return p;
 }
 
@@ -654,6 +655,94 @@ static void test_first_frame_spread(void) {
     scene_destroy(s);
 }
 
+/* A session of `method` with --dim-highlights `share` (0: the default), judged after DIM_EARLY
+ * frames and run DIM_LATER more: the whole image's and the highlights' totals of the early frames
+ * and of the later ones, and the highlight points each took. */
+enum { DIM_EARLY = HL_DIM_FRAMES, DIM_LATER = 4 };
+typedef struct {
+    double early, early_hl, later, later_hl;
+    unsigned long long early_points, later_points;
+} dim_run;
+
+static dim_run run_dim(const scene *s, const camera *cam, render_method method, float share, uint64_t seed,
+                       float *img) {
+    dim_run r = {0};
+    render_params p = hl_params(HL_MERGE_ON, 0, 8);
+    p.method = method;
+    p.max_depth = 3;
+    p.seed = seed;
+    p.vl.dim_share = share;
+    char err[256];
+    render_session *rs = session_create(s, cam, &p, err, sizeof err);
+    CHECK(rs != NULL, "session: %s", err);
+    if (!rs) return r;
+    for (int f = 0; f < DIM_EARLY; f++) session_render_frame(rs);
+    film_resolve(session_film(rs), COMP_MASK_ALL, img);
+    r.early = total(img, NPIX);
+    film_resolve(session_film(rs), HL, img);
+    r.early_hl = total(img, NPIX);
+    r.early_points = session_stats(rs).hl_points;
+    for (int f = 0; f < DIM_LATER; f++) session_render_frame(rs);
+    /* the film keeps means */
+    film_resolve(session_film(rs), COMP_MASK_ALL, img);
+    r.later = ((DIM_EARLY + DIM_LATER) * total(img, NPIX) - DIM_EARLY * r.early) / DIM_LATER;
+    film_resolve(session_film(rs), HL, img);
+    r.later_hl = ((DIM_EARLY + DIM_LATER) * total(img, NPIX) - DIM_EARLY * r.early_hl) / DIM_LATER;
+    r.later_points = session_stats(rs).hl_points - r.early_points;
+    session_destroy(rs);
+    return r;
+}
+
+/* A pixel whose highlights were dim in its first HL_DIM_FRAMES frames (--dim-highlights) leaves
+ * them to the virtual lights' paths. With every pixel judged dim (S = 1) the later frames must
+ * take no secondary ray and write no highlight, and their whole image must be vsl's for the same
+ * frames: were the highlights' paths dropped there instead, it would read their share (printed)
+ * low. With the default S the highlight estimator must keep the pixels whose highlights are
+ * bright: the later frames' highlights at least 95% of the early frames'. */
+static void test_dim_pixels(void) {
+    enum { SEEDS = 32 };
+    scene *s = floor_and_wall(60.0f, 0, 3.0f);
+    camera cam = floor_camera();
+    float *img = malloc(sizeof(float) * 3 * NPIX);
+    double diff = 0.0, diff2 = 0.0, level = 0.0, hl_share = 0.0, kept = 0.0, early_hl = 0.0, written = 0.0;
+    unsigned long long dim_points = 0, early_points = 0, later_points = 0;
+    for (int b = 0; b < SEEDS; b++) {
+        uint64_t seed = 900 + (uint64_t)b;
+        dim_run all_dim = run_dim(s, &cam, METHOD_VSL_HL, 1.0f, seed, img);
+        dim_run vsl = run_dim(s, &cam, METHOD_VSL, 1.0f, seed, img);
+        dim_run def = run_dim(s, &cam, METHOD_VSL_HL, 0.0f, seed, img);
+        dim_points += all_dim.later_points;
+        written = fmax(written, fabs(all_dim.later_hl) / all_dim.early_hl);
+        hl_share += all_dim.early_hl / all_dim.early / SEEDS;
+        double d = all_dim.later - vsl.later;
+        diff += d;
+        diff2 += d * d;
+        level += vsl.later / SEEDS;
+        early_points += def.early_points;
+        later_points += def.later_points;
+        early_hl += def.early_hl / SEEDS;
+        kept += def.later_hl / SEEDS;
+    }
+    free(img);
+    double mean = diff / SEEDS, se = sqrt(fmax(diff2 / SEEDS - mean * mean, 0.0) / (SEEDS - 1));
+    double early_rate = (double)early_points / DIM_EARLY, later_rate = (double)later_points / DIM_LATER;
+    printf("dim pixels: S = 1: later frames %.4f - vsl's %.4f = %.4f +- %.4f (highlights %.1f%% of the image), "
+           "%llu highlight points; S default: highlight points a frame %.0f -> %.0f, highlights %.4f -> %.4f\n",
+           level + mean, level, mean, se, 100.0 * hl_share, dim_points, early_rate / SEEDS, later_rate / SEEDS,
+           early_hl, kept);
+    CHECK(dim_points == 0 && written < 1e-4, "%llu highlight points at pixels judged dim, highlights %g written",
+          dim_points, written);
+    CHECK(hl_share > 0.05, "the highlights are %.1f%% of the image: the test would not see them lost",
+          100.0 * hl_share);
+    CHECK(level > 0.0 && fabs(mean) < 4.0 * se + 0.01 * level,
+          "with every pixel dim the later frames read %.4f, vsl %.4f (+- %.4f)", level + mean, level, se);
+    CHECK(later_rate < 0.9 * early_rate, "no pixel judged dim at the default share (%.0f -> %.0f points a frame)",
+          early_rate / SEEDS, later_rate / SEEDS);
+    CHECK(kept > 0.95 * early_hl, "the later frames' highlights %.4f, the early frames' %.4f: bright ones judged dim",
+          kept, early_hl);
+    scene_destroy(s);
+}
+
 static void test_vmf_modes_close_to_exact(void) {
     for (int env = 0; env <= 2; env += 2) vmf_modes_close_to_exact(env, NULL);
     material brushed = material_default();
@@ -674,5 +763,6 @@ int main(void) {
     test_split_against_path_tracer();
     test_hard_cases();
     test_first_frame_spread();
+    test_dim_pixels();
     return check_exit("test_highlights");
 }
