@@ -24,6 +24,7 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
     h.secondary_rays = r.secondary_rays;
     h.clusters = r.clusters;
     h.share = r.share == HL_SHARE_ON;
+    h.dim_share = r.dim_share;
     h.env_filter = env_filter;
     return h;
 }

@@ -35,6 +35,7 @@ typedef struct {
     int num_punctual;                        /* the scene's point, spot and directional lights (first in its list) */
     int area_lights;                         /* whether it has emissive triangles */
     int share;                               /* neighbouring pixels share their secondary hits */
+    float dim_share; /* with --adapt: pixels whose highlights were below this share leave them; < 0: never */
 } hl_setup;
 
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */

@@ -61,9 +61,9 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
  * camera_terms there (m->terms, or VL_TERMS_ALL at a pixel whose highlights the virtual lights
  * take): gathered from the virtual lights, except through a glossy lobe sharper than trace_alpha,
  * where a handful of lights cannot represent the incoming light: that lobe is sampled, and the
- * path picks up the direct light at the next hit and gathers there (the same rule again). At the camera hit the
- * lobe is sampled in `split` directions, the first `split` points of seq (the pixel's run); rec,
- * when not NULL, records each one's light. */
+ * path picks up the direct light at the next hit and gathers there (the same rule again). At the
+ * camera hit the lobe is sampled in `split` directions, the first `split` points of seq (the
+ * pixel's run); rec, when not NULL, records each one's light. */
 vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, vl_terms camera_terms,
                         int max_depth, int split, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st);
 

@@ -55,7 +55,6 @@ struct render_session {
     pixel_alloc glossy, direct;
     uint8_t *hl_state;       /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
     hl_setup hl;             /* vsl+hl: this frame's highlight settings */
-    float hl_dim_share;      /* ... and vl_params.dim_share, resolved */
     env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
     const env_map *envf_map; /* ... the map it was built from */
     scene_analysis analysis;
@@ -394,8 +393,8 @@ static void render_tile(void *ctx, int tile, int worker) {
             for (int i = 0; highlights && rs->adapt && i < n; i++) {
                 if (rs->hl_state[pixel[i]] == HL_PIXEL_UNPROBED)
                     rs->hl_state[pixel[i]] = (uint8_t)probe_state(rs, st, &raster, pixel[i]);
-                if (rs->frames == HL_DIM_FRAMES && rs->hl_dim_share >= 0.0f && rs->plan.virtual_lights &&
-                    highlights_dim(&rs->film, pixel[i], rs->hl_dim_share))
+                if (rs->frames == HL_DIM_FRAMES && rs->hl.dim_share >= 0.0f && rs->plan.virtual_lights &&
+                    highlights_dim(&rs->film, pixel[i], rs->hl.dim_share))
                     rs->hl_state[pixel[i]] = HL_PIXEL_DIM;
             }
             vec3 shared[SCENE_PACKET];
@@ -428,7 +427,6 @@ int session_render_frame(render_session *rs) {
         }
         rs->totals.env_filter_bytes = rs->plan.env_prefilter ? env_vmf_filter_bytes(rs->envf) : 0;
         rs->hl = hl_setup_from(rs->scene, &rs->params.vl, rs->plan.env_prefilter ? rs->envf : NULL);
-        rs->hl_dim_share = vl_params_resolve(&rs->params.vl).dim_share;
     }
     if (rs->plan.virtual_lights) {
         uint64_t t0 = clock_ns();
