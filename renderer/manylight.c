@@ -255,8 +255,8 @@ static int traced_lobes(const manylight *m, const bsdf *b) {
  * there the next hit's direct light is taken. Returns 0 when the direction ends there (sampled on
  * the wrong side of the surface, Russian roulette, a miss). */
 static int glossy_direction(const scene *s, const shading_point *x, int traced, int through_direct, vec3 beta, int k,
-                            int lobes, float u_lobe, vec2 u, rng_state *rng, render_stats *st, vec3 *t, vec3 *b,
-                            surface_hit *h, vec3 *wi, vec3 *sigma, int *lobe) {
+                            int lobes, float u_lobe, vec2 u, rng_state *rng, render_stats *st, vec3 *t, vec3 *t_hl,
+                            vec3 *b, surface_hit *h, vec3 *wi, vec3 *sigma, int *lobe) {
     bsdf_sample_result bs;
     if (!bsdf_sample(&x->b, x->wo, traced, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) return 0;
     *wi = to_world(x->frame, bs.wi);
@@ -269,14 +269,23 @@ static int glossy_direction(const scene *s, const shading_point *x, int traced, 
     *sigma = material_medium_after(&s->materials[x->material], x->backface, bs.lobe, *sigma);
     vec3 o = offset_origin(s, x->p, x->ng, *wi);
     *t = v3(0, 0, 0);
+    if (t_hl) *t_hl = v3(0, 0, 0);
     if (bs.lobe == BSDF_TRANSMIT && !through_direct) {
         st->rays[RAY_BOUNCE]++;
         if (!scene_intersect(s, o, *wi, INFINITY, h)) return 0;
     } else {
-        /* Emission at the next hit is the direct light at x, which the shared estimator has. */
-        vec3 direct;
-        if (!pt_reflected_direct(s, o, *wi, *sigma, lobes, rng, &direct, h, st->rays)) return 0;
+        /* Emission at the next hit is the direct light at x, which the shared estimator has. With
+         * t_hl, the part through both hits' highlight lobes goes there (pt.c's split). */
+        int hl = t_hl ? bsdf_highlight_lobe(&x->b) : 0;
+        vec3 direct, direct_hl;
+        if (!pt_reflected_direct(s, o, *wi, *sigma, lobes, rng, &direct, hl ? &direct_hl : NULL, h, st->rays)) return 0;
         *t = mul3(*b, direct);
+        if (hl) {
+            vec3 b_hl = mul3(beta, scale3(bsdf_eval(&x->b, x->wo, bs.wi, hl), fabsf(bs.wi.z) / bs.pdf));
+            *t_hl = mul3(b_hl, direct_hl);
+            /* the rest of the highlight lobes' light: the lobes add up to the BSDF */
+            *t = add3(*t, sub3(mul3(*b, direct_hl), *t_hl));
+        }
     }
     *b = mul3(*b, medium_transmittance(*sigma, h->t));
     return 1;
@@ -303,29 +312,40 @@ static int glass_direction(const scene *s, const shading_point *x, vec3 beta, in
     beta = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
     beta = mul3(beta, medium_transmittance(*sigma, g.t));
     int lobe;
-    return glossy_direction(s, &gp, BSDF_TRANSMIT, 1, beta, k + 1, BSDF_ALL, 0.0f, rng_vec2(rng), rng, st, t, b, h, wi,
-                            sigma, &lobe);
+    return glossy_direction(s, &gp, BSDF_TRANSMIT, 1, beta, k + 1, BSDF_ALL, 0.0f, rng_vec2(rng), rng, st, t, NULL, b,
+                            h, wi, sigma, &lobe);
 }
 
-vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, vl_terms camera_terms,
-                        int max_depth, int split_first, qmc_run seq, pixel_record *rec, rng_state *rng,
-                        render_stats *st) {
+/* The camera hit's gather. With highlights, the paths in every term, the highlights' own to
+ * *highlights: a second gather of that term alone where x's gathered lobes hold a highlight lobe. */
+static vec3 camera_gather(const manylight *m, const scene *s, const shading_point *x, vec3 *highlights, rng_state *rng,
+                          render_stats *st) {
+    if (!highlights) return manylight_shade(m, s, x, m->terms, m->candidates, rng, st);
+    if (bsdf_highlight_lobe(&x->b))
+        *highlights = add3(*highlights, manylight_shade(m, s, x, VL_TERMS_HIGHLIGHTS, m->candidates, rng, st));
+    return manylight_shade(m, s, x, VL_TERMS_NO_HIGHLIGHTS, m->candidates, rng, st);
+}
+
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, vec3 *highlights, int max_depth,
+                        int split_first, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st) {
     vec3 sum = v3(0, 0, 0), beta = v3s(1.0f), sigma = v3s(0.0f);
     shading_point x = *x0;
-    if (!m->glass && !traced_lobes(m, &x.b)) return manylight_shade(m, s, &x, camera_terms, m->candidates, rng, st);
+    if (!m->glass && !traced_lobes(m, &x.b)) return camera_gather(m, s, &x, highlights, rng, st);
     int through = 0; /* x was reached through a transmission */
     /* x is scattering event k: gathering there makes paths of k + 1 events or more. A
      * transmission leaves k as it is (pt.c counts depth so). */
     for (int k = 1, vertex = 0; k + 1 <= max_depth && vertex <= max_depth + PT_MAX_TRANSMISSIONS; vertex++) {
         /* Only at the camera hit do the highlights own part of the gathered paths. */
         int at_camera = k == 1 && !through;
-        vl_terms terms = at_camera ? camera_terms : VL_TERMS_ALL;
         int traced = traced_lobes(m, &x.b);
         shading_point gathered = x;
         gathered.b = bsdf_only(&x.b, BSDF_ALL & ~traced);
         int gather = bsdf_lobes(&gathered.b) != 0;
         int candidates = at_camera ? m->candidates : m->candidates_beyond;
-        if (gather) sum = add3(sum, mul3(beta, manylight_shade(m, s, &gathered, terms, candidates, rng, st)));
+        if (gather)
+            sum =
+                add3(sum, mul3(beta, at_camera ? camera_gather(m, s, &gathered, highlights, rng, st)
+                                               : manylight_shade(m, s, &gathered, VL_TERMS_ALL, candidates, rng, st)));
         /* The gathered lobes' paths through glass (scenes with glass only), and the traced lobes',
          * each carry the path on with probability 1/2 when both are there. */
         int glass = gather && m->glass;
@@ -343,24 +363,26 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         if (!at_camera) run.scramble_x = rng_next_u32(rng), run.scramble_y = rng_next_u32(rng), run.index = 0;
         int chosen = split > 1 ? (int)fminf(rng_float(rng) * (float)split, (float)(split - 1)) : 0;
         /* With highlights on, glossy(x) - glossy(next hit) - light is theirs (docs/design.md) when both
-         * lobes are highlight lobes. */
-        int lobes = at_camera && camera_terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b)
+         * lobes are highlight lobes: left to their estimator, or here split off into *highlights. */
+        int split_hl = at_camera && highlights;
+        int lobes = at_camera && !highlights && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b)
                         ? BSDF_NOT_HIGHLIGHT
                         : BSDF_ALL;
         vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1), next_sigma = sigma;
         surface_hit next;
         int have_next = 0, next_lobe = 0;
         for (int j = 0; traced && j < split; j++) {
-            vec3 t = v3(0, 0, 0), b, sg = sigma;
+            vec3 t = v3(0, 0, 0), t_hl = v3(0, 0, 0), b, sg = sigma;
             surface_hit h;
             vec3 wi;
             int lobe;
             float u_lobe = rng_float(rng);
-            int ok = glossy_direction(s, &x, traced, 0, beta, k, lobes, u_lobe, qmc_run_point(run, j), rng, st, &t, &b,
-                                      &h, &wi, &sg, &lobe);
-            if (at_camera && rec) pixel_record_add(rec, avg3(t));
+            int ok = glossy_direction(s, &x, traced, 0, beta, k, lobes, u_lobe, qmc_run_point(run, j), rng, st, &t,
+                                      split_hl ? &t_hl : NULL, &b, &h, &wi, &sg, &lobe);
+            if (at_camera && rec) pixel_record_add(rec, avg3(add3(t, t_hl)));
             if (!ok) continue;
             sum = madd3(sum, t, 1.0f / (float)split);
+            if (split_hl) *highlights = madd3(*highlights, t_hl, 1.0f / (float)split);
             if (j == chosen && !via_glass)
                 next_beta = b, next = h, next_wi = wi, next_sigma = sg, next_lobe = lobe, have_next = 1;
         }

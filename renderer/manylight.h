@@ -58,14 +58,14 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
                      rng_state *rng, render_stats *st);
 
 /* Indirect light at the camera hit x (scattering event 1 of at most max_depth), of the paths in
- * camera_terms there (m->terms, or VL_TERMS_ALL at a pixel whose highlights the virtual lights
- * take): gathered from the virtual lights, except through a glossy lobe sharper than trace_alpha,
+ * m->terms there; with highlights not NULL (a pixel whose highlights the virtual lights take), of
+ * every path, the highlights' own (pt.c's split) added to *highlights: gathered from the virtual lights, except through a glossy lobe sharper than trace_alpha,
  * where a handful of lights cannot represent the incoming light: that lobe is sampled, and the
  * path picks up the direct light at the next hit and gathers there (the same rule again). At the
  * camera hit the lobe is sampled in `split` directions, the first `split` points of seq (the
  * pixel's run); rec, when not NULL, records each one's light. */
-vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, vl_terms camera_terms,
-                        int max_depth, int split, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st);
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, vec3 *highlights, int max_depth,
+                        int split, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st);
 
 /* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
 shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);

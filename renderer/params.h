@@ -110,6 +110,9 @@ enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
  * those under 0.3% of their light (docs/benchmarks.md, 2026-11-28). */
 #define HL_DEFAULT_DIM_SHARE 0.01f
 #define HL_DIM_FRAMES 2 /* the frames a pixel's highlights are estimated before it is judged */
+/* A pixel judged bright (not dim) takes N times this many secondary rays, and twice the clusters
+ * (up to HL_MAX_CLUSTERS), from then on (docs/benchmarks.md, 2026-11-28). */
+#define HL_BRIGHT_RAY_FACTOR 2
 
 /* Zero means default for every field. */
 typedef struct {

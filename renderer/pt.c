@@ -20,10 +20,11 @@ static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
 
 /* Emission le reached at vertex `depth` (glass that shadow rays pass after the second scattering
  * event not counted) with MIS weight w: to its component, split into highlights for the paths
- * that reach the light at their third vertex. */
-static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int split_highlights, vec3 beta, vec3 beta_hl,
-                         vec3 le, float w) {
-    if (split_highlights && depth == 2 && events == 2)
+ * that reach the light at their third vertex (`before`: the scattering events before the ray's
+ * origin, 1 for a continuation, which the split counts). */
+static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int before, int split_highlights, vec3 beta,
+                         vec3 beta_hl, vec3 le, float w) {
+    if (split_highlights && depth + before == 2 && events + before == 2)
         add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
     else
         out[component_of(events)] = add3(out[component_of(events)], scale3(mul3(beta, le), w));
@@ -55,14 +56,16 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
  * of a path begun elsewhere: the emission it finds first belongs to that path's direct light and
  * is not counted. With split_highlights the paths camera - glossy - glossy - light go to
  * COMP_HIGHLIGHTS: the product of the two vertices' highlight lobes, out of the same samples (the
- * lobes add up to the BSDF). max_depth counts scattering events; transmissions are free (beyond
+ * lobes add up to the BSDF); a continuation then left the camera hit through its highlight lobe,
+ * and its first hit is the second vertex (its light's rest goes to COMP_INDIRECT). max_depth counts scattering events; transmissions are free (beyond
  * the depth only transmission carries on), up to PT_MAX_TRANSMISSIONS more vertices. */
 static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
                        rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
                        int split_highlights, int first_lobes, const qmc_run *first_run) {
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
-    vec3 beta_hl = v3s(0.0f); /* the throughput through glossy lobes only (depths 1 and 2) */
+    /* the throughput through highlight lobes only (of the first two scattering events) */
+    vec3 beta_hl = v3s(split_highlights && continuation ? 1.0f : 0.0f);
     /* The last scattering vertex (prev_p): the pdf of the BSDF sample that left it and whether
      * next-event estimation there could have found what the ray finds, also beyond glass that
      * shadow rays pass (material_pass_through), which leaves these as they are. */
@@ -87,7 +90,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (events > 0 || !continuation)) {
                 float w = prev_nee ? nee_emission_weight(s, prev_p, NULL, d, prev_pdf) : 1.0f;
-                add_emission(out, depth - passes, events, split_highlights,
+                add_emission(out, depth - passes, events, continuation, split_highlights,
                              mul3(beta, medium_transmittance(sigma, INFINITY)), beta_hl, le, w);
             }
             break;
@@ -98,7 +101,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
          * vertex it left (through glass too), which that path has. */
         if (!is_black3(le) && (events > 0 || !continuation)) {
             float w = prev_nee ? nee_emission_weight(s, prev_p, &h, d, prev_pdf) : 1.0f;
-            add_emission(out, depth - passes, events, split_highlights, beta, beta_hl, le, w);
+            add_emission(out, depth - passes, events, continuation, split_highlights, beta, beta_hl, le, w);
         }
         if (depth >= max_depth + PT_MAX_TRANSMISSIONS) break;
 
@@ -142,7 +145,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
                 nee_direct(s, h.p, h.ng, sigma, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
             if (!is_black3(arrival)) {
                 vec3 c = mul3(mul3(nee_beta, f), arrival);
-                if (split_highlights && depth == 1 && events == 1) {
+                if (split_highlights && depth + continuation == 1 && events + continuation == 1) {
                     vec3 wi = to_local(fr, ls.wi);
                     vec3 fg = scale3(bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b)), wi.z);
                     add_split(out, c, mul3(mul3(beta_hl, fg), arrival));
@@ -169,10 +172,10 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             else
                 beta = add3(beta, held), held = v3s(0.0f);
         }
-        if (split_highlights && depth <= 1) {
+        if (split_highlights && depth + continuation <= 1) {
             vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, bsdf_highlight_lobe(&b)), bs.wi.z / bs.pdf);
-            beta_hl = depth == 0 ? fg : mul3(beta_hl, fg);
-        } else if (passed && events == 2) {
+            beta_hl = depth + continuation == 0 ? fg : mul3(beta_hl, fg);
+        } else if (passed && events + continuation == 2) {
             beta_hl = mul3(beta_hl, weight);
             passes++;
         }
@@ -213,10 +216,11 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
 }
 
 int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, rng_state *rng, vec3 *direct,
-                        surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
+                        vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
     int hit = scene_intersect(s, o, d, INFINITY, first);
-    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, 0, lobes, NULL);
-    *direct = out[COMP_DIRECT];
+    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL, lobes, NULL);
+    *direct = add3(out[COMP_DIRECT], out[COMP_INDIRECT]); /* INDIRECT: the split's rest */
+    if (highlights) *highlights = out[COMP_HIGHLIGHTS];
     return hit;
 }

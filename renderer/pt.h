@@ -34,8 +34,10 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
  * light that reaches the hit directly from an emitter and is reflected back along the ray by the
  * hit's BSDF lobes in the mask (BSDF_ALL, or BSDF_NOT_HIGHLIGHT where the highlight lobe's share
  * belongs to the highlight estimator). For estimators that continue a path and must not count the emission
- * their direct light has. The ray travels in a medium of absorption sigma (0: air). */
+ * their direct light has. The ray travels in a medium of absorption sigma (0: air). With highlights
+ * not NULL the ray left the camera hit through its highlight lobe: the part of the light through
+ * the hit's highlight lobe goes there, the rest to *direct. */
 int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, rng_state *rng, vec3 *direct,
-                        surface_hit *first, uint64_t rays[RAY_KIND_COUNT]);
+                        vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]);
 
 #endif

@@ -203,6 +203,13 @@ static int probe_state(render_session *rs, render_stats *st, const camera_raster
     return hl_point_sharp(&rs->hl, &x) ? HL_PIXEL_SHARP : HL_PIXEL_BROAD;
 }
 
+/* Whether the pixels' highlights have been judged dim or bright (judge_dim_pixels), this frame
+ * or earlier. */
+static int dim_judged(const render_session *rs) {
+    return rs->adapt && rs->plan.highlights && rs->plan.virtual_lights && rs->plan.max_depth > 1 &&
+           rs->params.method != METHOD_PT && rs->hl.dim_share >= 0.0f && rs->frames >= HL_DIM_FRAMES;
+}
+
 /* The highlights of a pixel. A highlight is often smaller than the pixel (a curved mirror's image
  * of a lit speck), and there more positions in the pixel beat more rays from one: once the pixel
  * has met a sharp highlight lobe in an earlier frame or its probe (with --adapt), its secondary
@@ -215,6 +222,11 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
                              const surface_hit *first, rng_state *rng) {
     rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
     hl_setup setup = rs->hl;
+    if (dim_judged(rs)) { /* the pixel was kept: its highlights are bright */
+        int n = setup.secondary_rays * HL_BRIGHT_RAY_FACTOR;
+        setup.secondary_rays = n < HL_MAX_SECONDARY_RAYS ? n : HL_MAX_SECONDARY_RAYS;
+        setup.clusters = 2 * setup.clusters < HL_MAX_CLUSTERS ? 2 * setup.clusters : HL_MAX_CLUSTERS;
+    }
     int spread = rs->adapt && rs->hl_state[pixel] == HL_PIXEL_SHARP;
     int points = 1;
     if (spread) {
@@ -273,7 +285,7 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
             int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
             /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
             uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : next_frame_index(rs) * (uint64_t)split;
-            L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, dim ? VL_TERMS_ALL : rs->ml.terms, depth, split,
+            L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, dim ? &L[COMP_HIGHLIGHTS] : NULL, depth, split,
                                                   pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
                                                   rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
             uint64_t t2 = clock_ns();
@@ -302,17 +314,35 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     }
 }
 
-/* Whether a pixel's highlights in its earlier frames came to less than `share` of its light: then
- * the virtual lights' paths take them from now on (docs/design.md, "Where the samples go"). The
- * earlier frames decide, so each later frame's estimate stays unbiased. */
-static int highlights_dim(const film *f, int pixel, float share) {
+/* The share of a pixel's light its highlights took in the film so far (0 where it has none). */
+static double highlight_share(const film *f, int pixel) {
     double part = 0.0, all = 0.0;
     for (int c = 0; c < COMP_COUNT; c++) {
         const double *v = f->sum[c] + 3 * (size_t)pixel;
         all += v[0] + v[1] + v[2];
         if (c == COMP_HIGHLIGHTS) part = v[0] + v[1] + v[2];
     }
-    return !(part > (double)share * all);
+    return all > 0.0 && part > 0.0 ? part / all : 0.0;
+}
+
+/* Marks dim the pixels whose highlights, and their eight neighbours', came to at most `share` of
+ * their light in the earlier frames: the virtual lights' paths take them from now on (docs/design.md,
+ * "Where the samples go"). A neighbour's highlight keeps a pixel: a small sharp highlight its own
+ * first frames missed is seldom missed by all nine. The earlier frames decide, so each later
+ * frame's estimate stays unbiased. */
+static void judge_dim_pixels(render_session *rs, float share) {
+    int w = rs->params.width, h = rs->params.height;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            int dim = rs->hl_state[y * w + x] != HL_PIXEL_UNPROBED;
+            for (int dy = -1; dim && dy <= 1; dy++)
+                for (int dx = -1; dim && dx <= 1; dx++) {
+                    int qx = x + dx, qy = y + dy;
+                    if (qx >= 0 && qx < w && qy >= 0 && qy < h)
+                        dim = !(highlight_share(&rs->film, qy * w + qx) > (double)share);
+                }
+            if (dim) rs->hl_state[y * w + x] = HL_PIXEL_DIM;
+        }
 }
 
 /* The highlights of a packet's pixels whose camera hits have a broad highlight lobe, 2x2 blocks of
@@ -393,9 +423,6 @@ static void render_tile(void *ctx, int tile, int worker) {
             for (int i = 0; highlights && rs->adapt && i < n; i++) {
                 if (rs->hl_state[pixel[i]] == HL_PIXEL_UNPROBED)
                     rs->hl_state[pixel[i]] = (uint8_t)probe_state(rs, st, &raster, pixel[i]);
-                if (rs->frames == HL_DIM_FRAMES && rs->hl.dim_share >= 0.0f && rs->plan.virtual_lights &&
-                    highlights_dim(&rs->film, pixel[i], rs->hl.dim_share))
-                    rs->hl_state[pixel[i]] = HL_PIXEL_DIM;
             }
             vec3 shared[SCENE_PACKET];
             int has_shared[SCENE_PACKET] = {0};
@@ -435,6 +462,7 @@ int session_render_frame(render_session *rs) {
             return -1;
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
     }
+    if (dim_judged(rs) && rs->frames == HL_DIM_FRAMES) judge_dim_pixels(rs, rs->hl.dim_share);
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
     int aborted = rs->abort_flag && atomic_load(rs->abort_flag);
     if (!aborted) {
