@@ -35,7 +35,8 @@ typedef struct {
     int num_punctual;                        /* the scene's point, spot and directional lights (first in its list) */
     int area_lights;                         /* whether it has emissive triangles */
     int share;                               /* neighbouring pixels share their secondary hits */
-    float dim_share; /* with --adapt: pixels whose highlights were below this share leave them; < 0: never */
+    float dim_share;   /* with --adapt: pixels whose highlights were below this share leave them; < 0: never */
+    float check_share; /* merged: the share of frames checked against the trace (hl_estimate); <= 0: none */
 } hl_setup;
 
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */

@@ -43,6 +43,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_ON;
     if (vp->share == HL_SHARE_DEFAULT) r.share = HL_SHARE_OFF;
     r.dim_share = float_or(vp->dim_share, HL_DEFAULT_DIM_SHARE);
+    r.check_share = float_or(vp->check_share, HL_DEFAULT_CHECK_SHARE);
     return r;
 }
 
@@ -190,6 +191,13 @@ static const param_desc table[] = {
              "rays and 2K clusters; off: N and K everywhere",
      .label = "dim highlights below", .unit = "of the pixel's light", .panel_lo = 0, .panel_hi = 0.1,
      .panel_format = "%.3f", .panel_lo_text = "never"},
+    {.name = "check-merge", .type = PARAM_FLOAT, .group = PARAM_HIGHLIGHTS, .offset = F(check_share), .lo = 0,
+     .hi = 1, .off_word = "off", .zero_is_off = 1, .def = HL_DEFAULT_CHECK_SHARE, .def_text = "off", .value_name = "Q",
+     .help = "with --merge on: in a share Q of its frames a pixel's merged\n"
+             "lobes are checked against its hits lit through their own lobes,\n"
+             "adding (traced - merged) / Q: unbiased; off: never",
+     .label = "check the merge", .unit = "of the frames", .panel_lo = 0, .panel_hi = 1,
+     .panel_format = "%.2f", .panel_lo_text = "never"},
 };
 /* clang-format on */
 

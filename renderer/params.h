@@ -72,6 +72,9 @@ typedef struct {
     float dim_share;    /* with adapt: a pixel whose highlights were below this share of its light in
                          * its first HL_DIM_FRAMES frames leaves them to the virtual lights' paths
                          * from then on; < 0: never [HL_DEFAULT_DIM_SHARE] */
+    float check_share;  /* merged: the share of a pixel's frames whose merged lobes are checked against
+                         * the same hits lit through their own lobes (then unbiased); < 0: none
+                         * [HL_DEFAULT_CHECK_SHARE] */
 } vl_params;
 
 enum { VL_CLAMP_DEFAULT = 0, VL_CLAMP_ON, VL_CLAMP_OFF };
@@ -109,7 +112,8 @@ enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
  * the highlight pass reaches 42-53 k pixels a frame, of which 7-35 k get any highlight, many of
  * those under 0.3% of their light (docs/benchmarks.md, 2026-11-28). */
 #define HL_DEFAULT_DIM_SHARE 0.01f
-#define HL_DIM_FRAMES 2 /* the frames a pixel's highlights are estimated before it is judged */
+#define HL_DEFAULT_CHECK_SHARE -1.0f /* off: measured, not yet the default (docs/benchmarks.md, 2026-11-28) */
+#define HL_DIM_FRAMES 2              /* the frames a pixel's highlights are estimated before it is judged */
 /* A pixel judged bright (not dim) takes N times this many secondary rays, and twice the clusters
  * (up to HL_MAX_CLUSTERS), from then on (docs/benchmarks.md, 2026-11-28). */
 #define HL_BRIGHT_RAY_FACTOR 2
