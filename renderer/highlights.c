@@ -666,7 +666,8 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
     st->hl_points += (uint64_t)lit;
     /* In a share of the frames the merged lobes are checked: the same hits lit through their own
      * lobes (the trace, the path tracer's answer for these paths), and (traced - merged) / share
-     * added, so the estimate's expectation is the trace's (docs/design.md, "The highlight estimator"). */
+     * added, so the estimate's expectation is the trace's (docs/design.md, "The highlight
+     * estimator"). */
     int check = h->mode == HL_MERGED && h->check_share > 0.0f && rng_float(rng) < h->check_share;
     vec3 traced = v3(0, 0, 0);
     /* The N directions stratified over the lobes and over frames (each point's run), ray k from

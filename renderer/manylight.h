@@ -59,11 +59,12 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
 
 /* Indirect light at the camera hit x (scattering event 1 of at most max_depth), of the paths in
  * m->terms there; with highlights not NULL (a pixel whose highlights the virtual lights take), of
- * every path, the highlights' own (pt.c's split) added to *highlights: gathered from the virtual lights, except through a glossy lobe sharper than trace_alpha,
- * where a handful of lights cannot represent the incoming light: that lobe is sampled, and the
- * path picks up the direct light at the next hit and gathers there (the same rule again). At the
- * camera hit the lobe is sampled in `split` directions, the first `split` points of seq (the
- * pixel's run); rec, when not NULL, records each one's light. */
+ * every path, the highlights' own (pt.c's split) added to *highlights. Gathered from the virtual
+ * lights, except through a glossy lobe sharper than trace_alpha, where a handful of lights cannot
+ * represent the incoming light: that lobe is sampled, and the path picks up the direct light at
+ * the next hit and gathers there (the same rule again). At the camera hit the lobe is sampled in
+ * `split` directions, the first `split` points of seq (the pixel's run); rec, when not NULL,
+ * records each one's light. */
 vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, vec3 *highlights, int max_depth,
                         int split, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st);
 

@@ -57,8 +57,9 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
  * is not counted. With split_highlights the paths camera - glossy - glossy - light go to
  * COMP_HIGHLIGHTS: the product of the two vertices' highlight lobes, out of the same samples (the
  * lobes add up to the BSDF); a continuation then left the camera hit through its highlight lobe,
- * and its first hit is the second vertex (its light's rest goes to COMP_INDIRECT). max_depth counts scattering events; transmissions are free (beyond
- * the depth only transmission carries on), up to PT_MAX_TRANSMISSIONS more vertices. */
+ * and its first hit is the second vertex (its light's rest goes to COMP_INDIRECT). max_depth
+ * counts scattering events; transmissions are free (beyond the depth only transmission carries
+ * on), up to PT_MAX_TRANSMISSIONS more vertices. */
 static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
                        rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
                        int split_highlights, int first_lobes, const qmc_run *first_run) {

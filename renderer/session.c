@@ -35,7 +35,7 @@ typedef struct {
 #define HL_PIXEL_POINTS 8     /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
 #define HL_SHARP_RAY_FACTOR 4 /* ... and N times this many secondary rays (docs/benchmarks.md, 2026-11-28) */
 /* A pixel's highlight state with --adapt: not yet probed (reset), whether it has met a sharp
- * highlight lobe, or dim: its highlights left to the virtual lights (highlights_dim). */
+ * highlight lobe, or dim: its highlights left to the virtual lights (judge_dim_pixels). */
 enum { HL_PIXEL_UNPROBED = 0, HL_PIXEL_BROAD, HL_PIXEL_SHARP, HL_PIXEL_DIM };
 
 struct render_session {
