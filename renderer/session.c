@@ -329,20 +329,23 @@ static double highlight_share(const film *f, int pixel) {
  * their light in the earlier frames: the virtual lights' paths take them from now on (docs/design.md,
  * "Where the samples go"). A neighbour's highlight keeps a pixel: a small sharp highlight its own
  * first frames missed is seldom missed by all nine. The earlier frames decide, so each later
- * frame's estimate stays unbiased. */
+ * frame's estimate stays unbiased. Each pixel's share is read once: HL_PIXEL_BRIGHT marks the
+ * pixels above it while their neighbours are judged. */
+#define HL_PIXEL_BRIGHT 0x80
 static void judge_dim_pixels(render_session *rs, float share) {
     int w = rs->params.width, h = rs->params.height;
+    size_t n = (size_t)w * (size_t)h;
+    for (size_t i = 0; i < n; i++)
+        if (highlight_share(&rs->film, (int)i) > (double)share) rs->hl_state[i] |= HL_PIXEL_BRIGHT;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             int dim = rs->hl_state[y * w + x] != HL_PIXEL_UNPROBED;
-            for (int dy = -1; dim && dy <= 1; dy++)
-                for (int dx = -1; dim && dx <= 1; dx++) {
-                    int qx = x + dx, qy = y + dy;
-                    if (qx >= 0 && qx < w && qy >= 0 && qy < h)
-                        dim = !(highlight_share(&rs->film, qy * w + qx) > (double)share);
-                }
-            if (dim) rs->hl_state[y * w + x] = HL_PIXEL_DIM;
+            for (int qy = y > 0 ? y - 1 : 0; dim && qy <= y + 1 && qy < h; qy++)
+                for (int qx = x > 0 ? x - 1 : 0; dim && qx <= x + 1 && qx < w; qx++)
+                    dim = !(rs->hl_state[qy * w + qx] & HL_PIXEL_BRIGHT);
+            if (dim) rs->hl_state[y * w + x] = HL_PIXEL_DIM; /* never bright: its own share is a neighbour's */
         }
+    for (size_t i = 0; i < n; i++) rs->hl_state[i] &= (uint8_t)~HL_PIXEL_BRIGHT;
 }
 
 /* The highlights of a packet's pixels whose camera hits have a broad highlight lobe, 2x2 blocks of
