@@ -185,10 +185,11 @@ static const param_desc table[] = {
      .label = "share hits"},
     {.name = "dim-highlights", .type = PARAM_FLOAT, .group = PARAM_HIGHLIGHTS, .offset = F(dim_share), .lo = 0,
      .hi = 1, .off_word = "off", .zero_is_off = 1, .def = HL_DEFAULT_DIM_SHARE, .value_name = "S",
-     .help = "with --adapt on: a pixel whose highlights came to less than S of\n"
-             "its light in its first " STR(HL_DIM_FRAMES) " frames leaves them to the virtual lights\n"
-             "from then on (no secondary rays there), the others take " STR(HL_BRIGHT_RAY_FACTOR) "N\n"
-             "rays and 2K clusters; off: N and K everywhere",
+     .help = "with --adapt on: a pixel whose highlights, and theirs within " STR(HL_DIM_RADIUS) "\n"
+             "pixels, came to at most S of their light in its first " STR(HL_DIM_FRAMES) " frames\n"
+             "leaves them to the virtual lights (no secondary rays), judged\n"
+             "again as the frames double; the others take " STR(HL_BRIGHT_RAY_FACTOR) "N rays and 2K\n"
+             "clusters; off: N and K everywhere",
      .label = "dim highlights below", .unit = "of the pixel's light", .panel_lo = 0, .panel_hi = 0.1,
      .panel_format = "%.3f", .panel_lo_text = "never"},
     {.name = "check-merge", .type = PARAM_FLOAT, .group = PARAM_HIGHLIGHTS, .offset = F(check_share), .lo = 0,

@@ -69,9 +69,9 @@ typedef struct {
     int clusters;       /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
     int merge;          /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
     int share;          /* HL_SHARE_*: 2x2 blocks of pixels with broad lobes share their secondary hits [off] */
-    float dim_share;    /* with adapt: a pixel whose highlights were below this share of its light in
-                         * its first HL_DIM_FRAMES frames leaves them to the virtual lights' paths
-                         * from then on; < 0: never [HL_DEFAULT_DIM_SHARE] */
+    float dim_share;    /* with adapt: a pixel whose highlights, and its neighbours', were at most this
+                         * share of their light in its first HL_DIM_FRAMES frames leaves them to the
+                         * virtual lights' paths (hl_judge_dim); < 0: never [HL_DEFAULT_DIM_SHARE] */
     float check_share;  /* merged: the share of a pixel's frames whose merged lobes are checked against
                          * the same hits lit through their own lobes (then unbiased); < 0: none
                          * [HL_DEFAULT_CHECK_SHARE] */
@@ -114,6 +114,10 @@ enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
 #define HL_DEFAULT_DIM_SHARE 0.01f
 #define HL_DEFAULT_CHECK_SHARE -1.0f /* off: measured, not yet the default (docs/benchmarks.md, 2026-11-28) */
 #define HL_DIM_FRAMES 2              /* the frames a pixel's highlights are estimated before it is judged */
+/* A pixel stays bright when one within this many pixels is: a small sharp highlight (a curved
+ * mirror's image of a lit speck) that its own first frames missed is seldom missed by all 25
+ * (docs/benchmarks.md, 2026-11-28, ninth entry). */
+#define HL_DIM_RADIUS 2
 /* A pixel judged bright (not dim) takes N times this many secondary rays, and twice the clusters
  * (up to HL_MAX_CLUSTERS), from then on (docs/benchmarks.md, 2026-11-28). */
 #define HL_BRIGHT_RAY_FACTOR 2

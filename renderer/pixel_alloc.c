@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "params.h"
 #include "rng.h"
 
 /* Fewer single-direction samples than this: the pixel keeps the budget (its variance is not known). */
@@ -48,4 +49,29 @@ void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint6
         int n = (int)floor(want + (double)rng_float(&rng)); /* stochastic rounding: the mean is kept */
         a->samples[i] = (uint8_t)(n < 1 ? 1 : n > max ? max : n);
     }
+}
+
+void hl_judge_dim(uint8_t *state, int width, int height, int again) {
+    for (int y = 0; y < height; y++)
+        for (int x = 0; x < width; x++) {
+            uint8_t *st = &state[y * width + x];
+            uint8_t was = *st & (uint8_t)~HL_PIXEL_BRIGHT;
+            if (was == HL_PIXEL_UNPROBED || (again && was != HL_PIXEL_DIM)) continue;
+            int dim = 1;
+            for (int qy = y - HL_DIM_RADIUS; dim && qy <= y + HL_DIM_RADIUS; qy++)
+                for (int qx = x - HL_DIM_RADIUS; dim && qx <= x + HL_DIM_RADIUS; qx++)
+                    if (qy >= 0 && qy < height && qx >= 0 && qx < width)
+                        dim = !(state[qy * width + qx] & HL_PIXEL_BRIGHT);
+            /* a pixel turned dim was not bright itself, so no neighbour still to judge loses a mark */
+            if (dim)
+                *st = HL_PIXEL_DIM;
+            else if (again)
+                *st = (uint8_t)(HL_PIXEL_BROAD | (*st & HL_PIXEL_BRIGHT));
+        }
+    for (int i = 0; i < width * height; i++) state[i] &= (uint8_t)~HL_PIXEL_BRIGHT;
+}
+
+int hl_judge_due(long long frames) {
+    while (frames > HL_DIM_FRAMES && frames % 2 == 0) frames /= 2;
+    return frames == HL_DIM_FRAMES;
 }

@@ -25,6 +25,20 @@ void pixel_alloc_reset(pixel_alloc *a);
  * the others take the budget. The frame's own samples never decide its allocation, so each frame
  * stays unbiased. */
 void pixel_alloc_plan(pixel_alloc *a, int budget, int max, uint64_t frame, uint64_t seed);
+
+/* A pixel's highlight state with --adapt (session.c): not yet probed (reset), whether it has met a
+ * sharp highlight lobe, or dim: its highlights left to the virtual lights' paths. */
+enum { HL_PIXEL_UNPROBED = 0, HL_PIXEL_BROAD, HL_PIXEL_SHARP, HL_PIXEL_DIM };
+#define HL_PIXEL_BRIGHT 0x80 /* while judging: the pixel's highlights came to more than the dim share */
+/* Marks dim the probed pixels none of whose neighbours within HL_DIM_RADIUS (itself included) is
+ * marked HL_PIXEL_BRIGHT. Judged again (`again`), a dim pixel with a bright neighbour turns broad
+ * and the others keep their state: a dim pixel's highlights come from the virtual lights' paths,
+ * and a highlight its first frames missed shows there later. Clears the marks. */
+void hl_judge_dim(uint8_t *state, int width, int height, int again);
+/* Whether the pixels are judged after this many frames: at HL_DIM_FRAMES, then each time the
+ * frames double. */
+int hl_judge_due(long long frames);
+
 static inline void pixel_record_add(pixel_record *r, float v) {
     r->n += 1.0f;
     float d = v - r->mean;

@@ -34,9 +34,6 @@ typedef struct {
 #define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
 #define HL_PIXEL_POINTS 8     /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
 #define HL_SHARP_RAY_FACTOR 4 /* ... and N times this many secondary rays (docs/benchmarks.md, 2026-11-28) */
-/* A pixel's highlight state with --adapt: not yet probed (reset), whether it has met a sharp
- * highlight lobe, or dim: its highlights left to the virtual lights (judge_dim_pixels). */
-enum { HL_PIXEL_UNPROBED = 0, HL_PIXEL_BROAD, HL_PIXEL_SHARP, HL_PIXEL_DIM };
 
 struct render_session {
     const scene *scene;
@@ -325,27 +322,15 @@ static double highlight_share(const film *f, int pixel) {
     return all > 0.0 && part > 0.0 ? part / all : 0.0;
 }
 
-/* Marks dim the pixels whose highlights, and their eight neighbours', came to at most `share` of
- * their light in the earlier frames: the virtual lights' paths take them from now on (docs/design.md,
- * "Where the samples go"). A neighbour's highlight keeps a pixel: a small sharp highlight its own
- * first frames missed is seldom missed by all nine. The earlier frames decide, so each later
- * frame's estimate stays unbiased. Each pixel's share is read once: HL_PIXEL_BRIGHT marks the
- * pixels above it while their neighbours are judged. */
-#define HL_PIXEL_BRIGHT 0x80
+/* Judges which pixels' highlights are dim (hl_judge_dim): those whose highlights, and their
+ * neighbours', came to at most `share` of their light in the frames so far. The virtual lights'
+ * paths take a dim pixel's highlights (docs/design.md, "Where the samples go"). The earlier
+ * frames decide, so each later frame's estimate stays unbiased. */
 static void judge_dim_pixels(render_session *rs, float share) {
     int w = rs->params.width, h = rs->params.height;
-    size_t n = (size_t)w * (size_t)h;
-    for (size_t i = 0; i < n; i++)
-        if (highlight_share(&rs->film, (int)i) > (double)share) rs->hl_state[i] |= HL_PIXEL_BRIGHT;
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            int dim = rs->hl_state[y * w + x] != HL_PIXEL_UNPROBED;
-            for (int qy = y > 0 ? y - 1 : 0; dim && qy <= y + 1 && qy < h; qy++)
-                for (int qx = x > 0 ? x - 1 : 0; dim && qx <= x + 1 && qx < w; qx++)
-                    dim = !(rs->hl_state[qy * w + qx] & HL_PIXEL_BRIGHT);
-            if (dim) rs->hl_state[y * w + x] = HL_PIXEL_DIM; /* never bright: its own share is a neighbour's */
-        }
-    for (size_t i = 0; i < n; i++) rs->hl_state[i] &= (uint8_t)~HL_PIXEL_BRIGHT;
+    for (int i = 0; i < w * h; i++)
+        if (highlight_share(&rs->film, i) > (double)share) rs->hl_state[i] |= HL_PIXEL_BRIGHT;
+    hl_judge_dim(rs->hl_state, w, h, rs->frames > HL_DIM_FRAMES);
 }
 
 /* The highlights of a packet's pixels whose camera hits have a broad highlight lobe, 2x2 blocks of
@@ -465,7 +450,7 @@ int session_render_frame(render_session *rs) {
             return -1;
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
     }
-    if (dim_judged(rs) && rs->frames == HL_DIM_FRAMES) judge_dim_pixels(rs, rs->hl.dim_share);
+    if (dim_judged(rs) && hl_judge_due(rs->frames)) judge_dim_pixels(rs, rs->hl.dim_share);
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
     int aborted = rs->abort_flag && atomic_load(rs->abort_flag);
     if (!aborted) {

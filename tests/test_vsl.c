@@ -760,47 +760,6 @@ static void test_counts_beyond_the_frame(void) {
     scene_destroy(s);
 }
 
-/* The traced directions' allocation: a pixel whose record is too short keeps the budget; the others
- * get the budget in proportion to the spread of one direction's light there (stochastic rounding
- * keeps fractional shares on average), clamped to [1, max]. */
-static void test_pixel_alloc_plan(void) {
-    pixel_alloc a;
-    CHECK(pixel_alloc_init(&a, 5) == 0, "allocation");
-    /* pixel 0: constant light (spread 0); 1: spread 1; 2: spread 3; 3: unrecorded; 4: two samples */
-    for (int k = 0; k < 40; k++) {
-        pixel_record_add(&a.rec[0], 2.0f);
-        pixel_record_add(&a.rec[1], k % 2 ? 1.0f : -1.0f);
-        pixel_record_add(&a.rec[2], k % 2 ? 5.0f : -1.0f);
-    }
-    pixel_record_add(&a.rec[4], 0.0f);
-    pixel_record_add(&a.rec[4], 100.0f);
-    /* The sample spreads of +-1 and 2 +- 3 over 40 values: sqrt(40/39) and 3 sqrt(40/39); the mean
-     * over the three recorded pixels is 4/3 sqrt(40/39), so budget 4 wants 0, 3 and 9 directions. */
-    double sum[5] = {0};
-    int frames = 4000, over = 0;
-    for (int f = 0; f < frames; f++) {
-        pixel_alloc_plan(&a, 4, 8, (uint64_t)f, 7);
-        for (int i = 0; i < 5; i++) sum[i] += a.samples[i];
-        over |= a.samples[2] > 8;
-    }
-    CHECK(sum[0] == frames, "constant light: %.3f directions, expected 1 (the floor)", sum[0] / frames);
-    CHECK_NEAR(sum[1] / frames, 3.0, 0.05, "spread 1");
-    CHECK(sum[2] == 8.0 * frames && !over, "spread 3: %.3f directions, expected the cap 8", sum[2] / frames);
-    CHECK(sum[3] == 4.0 * frames && sum[4] == 4.0 * frames, "unknown spreads: %.3f and %.3f, expected the budget",
-          sum[3] / frames, sum[4] / frames);
-    /* A fractional share: budget 3 wants 2.25 directions at pixel 1, on average. */
-    sum[1] = 0.0;
-    for (int f = 0; f < frames; f++) {
-        pixel_alloc_plan(&a, 3, 8, (uint64_t)f, 7);
-        sum[1] += a.samples[1];
-    }
-    CHECK_NEAR(sum[1] / frames, 2.25, 0.03, "stochastic rounding");
-    pixel_alloc_reset(&a);
-    pixel_alloc_plan(&a, 4, 8, 0, 7);
-    CHECK(a.samples[1] == 4 && a.samples[2] == 4, "after a reset every pixel takes the budget");
-    pixel_alloc_free(&a);
-}
-
 int main(void) {
     test_integral_against_brute_force();
     test_diffuse_kernel();
@@ -813,7 +772,6 @@ int main(void) {
     test_glossy_box_energy();
     test_layered_box_against_pt();
     test_light_selection_unbiased();
-    test_pixel_alloc_plan();
     test_trace_glossy_matches_pt();
     test_no_leak_through_thin_walls();
     test_lights_touching_surfaces();
