@@ -2,7 +2,6 @@
  * allocation by one direction's spread, and which pixels' highlights are judged dim, checked
  * against hand-made records and brute force over the neighbourhood. */
 #include <stdlib.h>
-#include <string.h>
 
 #include "check.h"
 #include "params.h"
