@@ -112,7 +112,7 @@ enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
  * the highlight pass reaches 42-53 k pixels a frame, of which 7-35 k get any highlight, many of
  * those under 0.3% of their light (docs/benchmarks.md, 2026-11-28). */
 #define HL_DEFAULT_DIM_SHARE 0.01f
-#define HL_DEFAULT_CHECK_SHARE -1.0f /* off: measured, not yet the default (docs/benchmarks.md, 2026-11-28) */
+#define HL_DEFAULT_CHECK_SHARE -1.0f /* off (docs/benchmarks.md, 2026-11-28, ninth entry) */
 #define HL_DIM_FRAMES 2              /* the frames a pixel's highlights are estimated before it is judged */
 /* A pixel stays bright when one within this many pixels is: a small sharp highlight (a curved
  * mirror's image of a lit speck) that its own first frames missed is seldom missed by all 25
