@@ -65,7 +65,7 @@ static int parse_merge_options(int argc, char **argv, merge_options *o) {
     return 0;
 }
 
-/* Frames i, i + n, ... below total: shard i's share of a render of total spp. */
+/* Shard i's share of a render of total spp: as many frames as i, i + n, ... below total. */
 static long long shard_share(long long total, int i, int n) { return total > i ? (total - i + n - 1) / n : 0; }
 
 /* The descriptions of the parts, checked against the first and against each other: same render,

@@ -60,8 +60,9 @@ static void print_render_help(void) {
            "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers, and in its\n"
            "                       header the scene hash, camera, size, spp, noise: a reference\n"
            "                       for glint bench [none]\n"
-           "  --shard I/N          render shard I (from 0) of N: frames I, I+N, ... of the render\n"
-           "                       --spp asks for, with the moments glint merge needs, to --out\n"
+           "  --shard I/N          render shard I (from 0) of N: its share of the frames of the\n"
+           "                       render --spp asks for, in a row, with the moments glint merge\n"
+           "                       needs, to --out\n"
            "  --highlights-layer   camera-glossy-glossy-light paths (the highlight estimator's share)\n"
            "                       go to their own highlights.* layer, not indirect.*: pt, vsl+hl\n"
            "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
@@ -83,8 +84,9 @@ static int has_suffix(const char *name, const char *suffix) {
     return n > k && strcasecmp(name + n - k, suffix) == 0;
 }
 
-/* --shard I/N: the frames I, I + N, ... of the render --spp asks for, which is then the whole
- * render's; the shard renders its share. 0, or -1 after a usage error. */
+/* --shard I/N: shard I's share of the render --spp asks for, which is then the whole render's
+ * (as many frames as I, I + N, ... below it, in a row: shard_frame_index). 0, or -1 after a usage
+ * error. */
 static int parse_shard(render_options *o) {
     long long i, n;
     char first[32];
@@ -99,7 +101,8 @@ static int parse_shard(render_options *o) {
     o->params.shard_index = (int)i;
     o->params.shard_count = (int)n;
     o->spp_total = o->spp;
-    if (o->spp > 0) { /* frames i + k n below spp */
+    o->params.shard_spp_total = o->spp;
+    if (o->spp > 0) { /* as many frames as i + k n below spp */
         if (o->spp <= i) return cli_error("--shard %s: --spp %lld leaves shard %lld no frame", o->shard, o->spp, i), -1;
         o->spp = (o->spp - i + n - 1) / n;
     }

@@ -122,6 +122,21 @@ enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
  * (up to HL_MAX_CLUSTERS), from then on (docs/benchmarks.md, 2026-11-28). */
 #define HL_BRIGHT_RAY_FACTOR 2
 
+/* Frames a --time shard takes in a row before the other shards' runs (shard_frame_index). */
+#define SHARD_TIME_BLOCK 65536
+
+/* Frame k of shard index of count, in the whole render's sequence. Each shard's frames follow on
+ * without a gap: a pixel's low-discrepancy runs index their points by the frame, and every N-th
+ * point of a run is no run at all (every other point of the Sobol sequence covers half of its first
+ * dimension), so a shard taking frames i, i + N, ... converged, alone, to a wrong image. With --spp
+ * T the shards take consecutive blocks of T (shard i's share: the frames of i, i + N, ... below
+ * T); with --time (total 0), blocks of SHARD_TIME_BLOCK frames in turn. */
+static inline uint64_t shard_frame_index(long long total, int index, int count, uint64_t k) {
+    const uint64_t i = (uint64_t)index, n = (uint64_t)count, b = SHARD_TIME_BLOCK;
+    if (total > 0) return i * ((uint64_t)total / n) + (i < (uint64_t)total % n ? i : (uint64_t)total % n) + k;
+    return (k / b) * n * b + i * b + k % b;
+}
+
 /* Zero means default for every field. */
 typedef struct {
     int width, height; /* 0: DEFAULT_WIDTH x DEFAULT_HEIGHT */
@@ -134,10 +149,12 @@ typedef struct {
     unsigned only;     /* many-light methods: render only these film components (a mask of
                         * 1 << COMP_*), skipping the others' passes, to time one estimator alone;
                         * the path tracer renders whole paths regardless; 0: all */
-    /* A shard of a render split over machines: its frames are shard_index, shard_index +
-     * shard_count, ... of the whole render's sequence, so the shards' samples are disjoint and
-     * together those of one render; the film keeps the moments merging needs. 0: not a shard. */
+    /* A shard of a render split over machines: its frames are one run of the whole render's
+     * sequence (shard_frame_index), so the shards' samples are disjoint and together those of one
+     * render; the film keeps the moments merging needs. 0: not a shard. shard_spp_total: the
+     * whole render's frames (--spp), 0 with --time. */
     int shard_index, shard_count;
+    long long shard_spp_total;
     vl_params vl;
 } render_params;
 

@@ -125,12 +125,12 @@ void session_destroy(render_session *rs) {
     free(rs);
 }
 
-/* The index of the next frame in the sequence of the whole render: a shard takes every
- * shard_count-th frame from its own index, so the random numbers are the whole render's. */
+/* The index of the next frame in the sequence of the whole render: a shard's frames are a run of
+ * it (shard_frame_index), so the random numbers are the whole render's. */
 static uint64_t next_frame_index(const render_session *rs) {
     const render_params *p = &rs->params;
     if (p->shard_count <= 0) return (uint64_t)rs->frames;
-    return (uint64_t)p->shard_index + (uint64_t)rs->frames * (uint64_t)p->shard_count;
+    return shard_frame_index(p->shard_spp_total, p->shard_index, p->shard_count, (uint64_t)rs->frames);
 }
 
 /* n camera hits spread over a pixel: the frame's own first (NULL: none), then more at R2

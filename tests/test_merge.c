@@ -1,10 +1,11 @@
 /* glint render --shard and glint merge, run as a user would: four shards of one seed merged equal
  * the whole render to float rounding (they are its frames), means and variances both; a merge of
- * another seed agrees with a render of the same spp within the standard errors the two record,
- * and its noise estimate with the distance between them; a missing shard, a repeated one (the
- * same file twice, a copy, a merge holding it), parts of another seed, method, parameters,
- * size or total spp, and files that are no shard refused with one error line; --allow-partial
- * and a later merge of the rest; --shard's usage errors; the merged reference usable by bench.
+ * another seed, and one shard alone, agree with a render of the same spp within the standard
+ * errors the two record, and the merge's noise estimate with the distance between them; a missing
+ * shard, a repeated one (the same file twice, a copy, a merge holding it), parts of another seed,
+ * method, parameters, size or total spp, and files that are no shard refused with one error line;
+ * --allow-partial and a later merge of the rest; --shard's usage errors; the merged reference
+ * usable by bench.
  * Usage: test_merge PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -19,6 +20,7 @@
 #define SCENE "builtin:atelier --size 32x24 --max-depth 2 --threads 2 --quiet"
 /* Direct light only: noise light-tailed enough for 64 samples to judge each pixel's variance */
 #define DIRECT "builtin:doorway --size 32x24 --max-depth 1 --threads 2 --quiet"
+#define BOUNCE "builtin:doorway --size 32x24 --max-depth 2 --threads 2 --quiet"
 
 static int load(const char *name, exr_image *ex) {
     char p[1024], err[1024];
@@ -129,6 +131,15 @@ static void test_statistics(void) {
     snprintf(pb, sizeof pb, "%s/ts.exr", tmp);
     CHECK(merge_stats_compare(pa, pb, &st) == 0, "cannot compare tm.exr and ts.exr");
     CHECK(merge_stats_agree(&st), "the merge and a render of another seed disagree (above)");
+    /* A shard alone is a render too, here with a bounce: shards once took every N-th frame, whose
+     * Sobol points (every other one for N = 2) cover half of a dimension, and such a shard
+     * converged to another image (0.30 of |z| below 0.674). */
+    CHECK(run("render " BOUNCE " --spp 512 --seed 13 --shard 1/2 --out th.exr") == 0, "%s", err_text);
+    CHECK(run("render " BOUNCE " --spp 256 --seed 12 --shard 0/1 --out tw.exr") == 0, "%s", err_text);
+    snprintf(pa, sizeof pa, "%s/th.exr", tmp);
+    snprintf(pb, sizeof pb, "%s/tw.exr", tmp);
+    CHECK(merge_stats_compare(pa, pb, &st) == 0, "cannot compare th.exr and tw.exr");
+    CHECK(merge_stats_agree(&st), "one shard and a render of another seed disagree (above)");
     /* A merged reference is a reference: glint bench takes it (seed 11 + 1, as it would). */
     CHECK(run("bench " DIRECT " --reference tm.exr --methods pt --times 0.05 --out b") == 0, "bench: %s", err_text);
 }
