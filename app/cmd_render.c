@@ -246,13 +246,14 @@ static int write_stats(const char *path, const render_options *o, const render_s
         hl_setup hl = hl_setup_from(s, &p->vl, NULL);
         fprintf(f, ",\n  \"highlights\": {\"secondary_rays\": %d, \"clusters\": %d, \"merge\": %s, ", hl.secondary_rays,
                 hl.clusters,
-                hl.mode == HL_MERGED     ? "\"on\""
+                hl.mode == HL_MERGED     ? (hl.choose ? "\"auto\"" : "\"on\"")
                 : hl.mode == HL_UNMERGED ? "\"off\""
                                          : "\"trace\"");
         fprintf(f, "\"points\": %llu, \"secondary_rays_total\": %llu, \"lobes_lit\": %llu, \"merge_seconds\": %.6f, ",
                 (unsigned long long)st.hl_points, (unsigned long long)st.hl_secondary_rays,
                 (unsigned long long)st.hl_lobes, 1e-9 * (double)st.hl_merge_ns);
-        fprintf(f, "\"env_filter_bytes\": %llu}", (unsigned long long)st.env_filter_bytes);
+        fprintf(f, "\"traced_pixels\": %llu, \"env_filter_bytes\": %llu}", (unsigned long long)st.hl_traced_pixels,
+                (unsigned long long)st.env_filter_bytes);
     }
     /* The effect plan and what each pass cost: a skipped pass shows zero seconds. */
     const effect_plan *plan = session_plan(rs);

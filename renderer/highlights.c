@@ -21,6 +21,7 @@ hl_setup hl_setup_from(const scene *s, const vl_params *vp, const struct env_vmf
     }
     vl_params r = vl_params_resolve(vp);
     h.mode = r.merge == HL_MERGE_OFF ? HL_UNMERGED : r.merge == HL_MERGE_TRACE ? HL_TRACED : HL_MERGED;
+    h.choose = r.merge == HL_MERGE_AUTO;
     h.secondary_rays = r.secondary_rays;
     h.clusters = r.clusters;
     h.share = r.share == HL_SHARE_ON;
@@ -647,8 +648,9 @@ static int secondary_hit(const scene *s, const shading_point *x, vec2 u, render_
 }
 
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
-                 rng_state *rng, render_stats *st, int *sharp) {
+                 rng_state *rng, render_stats *st, int *sharp, vec3 *traced_out) {
     vec3 sum = v3(0, 0, 0);
+    if (traced_out) *traced_out = sum;
     int n = h->secondary_rays;
     if (points < 1) return sum;
     if (points > n) points = n;
@@ -669,6 +671,7 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
      * added, so the estimate's expectation is the trace's (docs/design.md, "The highlight
      * estimator"). */
     int check = h->mode == HL_MERGED && h->check_share > 0.0f && rng_float(rng) < h->check_share;
+    int trace_too = check || (traced_out && h->mode == HL_MERGED);
     vec3 traced = v3(0, 0, 0);
     /* The N directions stratified over the lobes and over frames (each point's run), ray k from
      * point k mod points, each point's rays weighted 1 / (points x its rays): the mean over the
@@ -684,7 +687,7 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
         vec3 weight = scale3(bs.f, bs.wi.z / (bs.pdf * (float)(hl_rays_of_point(n, points, j) * points)));
         if (member_record(h, s, &xs[j], &xl[j], &q, wi, bs.wi, hq.t, weight, &hits[count], rng, st, &sum)) {
             hit_point[count++] = j;
-            if (check) {
+            if (trace_too) {
                 lit_lobe l = {q.p, q.ng, NULL, &q, weight};
                 traced = add3(traced, light_lobe(h, s, &l, rng, st));
             }
@@ -699,6 +702,8 @@ vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int
             if (hit_point[i] == j) index[m++] = i;
         if (m > 0) merged = add3(merged, merge_and_light(h, s, hits, index, m, rng, st));
     }
+    /* sum holds so far what both estimates share (lobes lit through their own BSDF) */
+    if (traced_out) *traced_out = add3(sum, traced);
     sum = add3(sum, merged);
     if (check) sum = madd3(sum, sub3(traced, merged), 1.0f / h->check_share);
     return sum;

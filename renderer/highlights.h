@@ -37,6 +37,7 @@ typedef struct {
     int share;                               /* neighbouring pixels share their secondary hits */
     float dim_share;   /* with --adapt: pixels whose highlights were below this share leave them; < 0: never */
     float check_share; /* merged: the share of frames checked against the trace (hl_estimate); <= 0: none */
+    int choose;        /* merged: pixels may turn to the trace (--merge auto, hl_judge_trace) */
 } hl_setup;
 
 /* The highlight settings for scene s from the parameters (defaults filled in, ranges clamped). */
@@ -50,9 +51,10 @@ static inline int hl_rays_of_point(int n, int points, int j) { return n / points
  * secondary rays shared among them (ray k from point k mod points, its direction point k / points
  * of runs[k mod points], the point's run over frames); each point merges its own lobes. A point
  * without a glossy lobe adds zero. *sharp is set when some point's lobe is sharp (hl_point_sharp):
- * a pixel worth spreading over. Counts work into st. */
+ * a pixel worth spreading over. Merged, with traced non-NULL: the same hits are also lit through
+ * their own lobes, and *traced is the trace's estimate. Counts work into st. */
 vec3 hl_estimate(const hl_setup *h, const scene *s, const shading_point *xs, int points, const qmc_run *runs,
-                 rng_state *rng, render_stats *st, int *sharp);
+                 rng_state *rng, render_stats *st, int *sharp, vec3 *traced);
 
 /* Whether x has a highlight lobe sharp enough that its members take its image (every band of its
  * vMF fit narrow; docs/design.md, "Merging without the sample's spread"). */

@@ -40,7 +40,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     if (vp->adapt == VL_ADAPT_DEFAULT) r.adapt = VL_ADAPT_ON;
     r.secondary_rays = int_or(vp->secondary_rays, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_SECONDARY_RAYS);
     r.clusters = int_or(vp->clusters, HL_DEFAULT_CLUSTERS, HL_MAX_CLUSTERS);
-    if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_ON;
+    if (vp->merge == HL_MERGE_DEFAULT) r.merge = HL_MERGE_AUTO;
     if (vp->share == HL_SHARE_DEFAULT) r.share = HL_SHARE_OFF;
     r.dim_share = float_or(vp->dim_share, HL_DEFAULT_DIM_SHARE);
     r.check_share = float_or(vp->check_share, HL_DEFAULT_CHECK_SHARE);
@@ -82,7 +82,8 @@ static const param_choice selects[] = {{"power", VL_SELECT_POWER, "by power"}, {
 static const param_choice adapts[] = {{"on", VL_ADAPT_ON, "on"}, {"off", VL_ADAPT_OFF, "off"}};
 static const param_choice shares[] = {{"on", HL_SHARE_ON, "on"}, {"off", HL_SHARE_OFF, "off"}};
 static const param_choice merges[] = {{"on", HL_MERGE_ON, "on"}, {"off", HL_MERGE_OFF, "off"},
-                                      {"trace", HL_MERGE_TRACE, "trace"}};
+                                      {"trace", HL_MERGE_TRACE, "trace"},
+                                      {"auto", HL_MERGE_AUTO, "auto"}};
 
 /* In the help's order. Numbers' ranges are what the command line accepts; the panel's sliders span
  * the useful part of them. */
@@ -172,10 +173,13 @@ static const param_desc table[] = {
      .unit = "lobes per camera hit", .panel_lo = 1,
      .panel_hi = HL_MAX_CLUSTERS, .panel_format = "%d"},
     {.name = "merge", .type = PARAM_CHOICE, .group = PARAM_HIGHLIGHTS, .offset = F(merge), .choices = merges,
-     .num_choices = 3, .def = HL_MERGE_ON,
-     .help = "off: every secondary hit's own vMF lobe is lit by itself (the\n"
-             "paper's comparison); trace: no vMFs, each hit's true glossy lobe\n"
-             "(the path tracer's answer for the same paths)",
+     .num_choices = 4, .def = HL_MERGE_AUTO,
+     .help = "auto: merged, and with --adapt on a pixel takes the trace from\n"
+             "when the merge's bias there (against the trace at the same hits)\n"
+             "outweighs the trace's extra noise, judged as the frames double;\n"
+             "on: merged everywhere; off: every secondary hit's own vMF lobe\n"
+             "is lit by itself (the paper's comparison); trace: no vMFs, each\n"
+             "hit's true glossy lobe (the path tracer's answer for the paths)",
      .label = "merge"},
     {.name = "share", .type = PARAM_CHOICE, .group = PARAM_HIGHLIGHTS, .offset = F(share), .choices = shares,
      .num_choices = 2, .def = HL_SHARE_OFF,
@@ -194,7 +198,7 @@ static const param_desc table[] = {
      .panel_format = "%.3f", .panel_lo_text = "never"},
     {.name = "check-merge", .type = PARAM_FLOAT, .group = PARAM_HIGHLIGHTS, .offset = F(check_share), .lo = 0,
      .hi = 1, .off_word = "off", .zero_is_off = 1, .def = HL_DEFAULT_CHECK_SHARE, .def_text = "off", .value_name = "Q",
-     .help = "with --merge on: in a share Q of its frames a pixel's merged\n"
+     .help = "merged: in a share Q of its frames a pixel's merged\n"
              "lobes are checked against its hits lit through their own lobes,\n"
              "adding (traced - merged) / Q: unbiased; off: never",
      .label = "check the merge", .unit = "of the frames", .panel_lo = 0, .panel_hi = 1,

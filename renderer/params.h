@@ -67,7 +67,7 @@ typedef struct {
     /* vsl+hl: the highlight estimator (which owns the camera - glossy - glossy - light paths) */
     int secondary_rays; /* rays sampled from the camera hit's glossy lobe [HL_DEFAULT_SECONDARY_RAYS] */
     int clusters;       /* merged lobes per camera hit, 1..HL_MAX_CLUSTERS [HL_DEFAULT_CLUSTERS] */
-    int merge;          /* HL_MERGE_*: off lights every secondary hit's own vMF lobe instead [on] */
+    int merge;          /* HL_MERGE_*: merged, traced, either per pixel (auto), or each hit's own vMF [auto] */
     int share;          /* HL_SHARE_*: 2x2 blocks of pixels with broad lobes share their secondary hits [off] */
     float dim_share;    /* with adapt: a pixel whose highlights, and its neighbours', were at most this
                          * share of their light in its first HL_DIM_FRAMES frames leaves them to the
@@ -100,8 +100,10 @@ enum { VL_ADAPT_DEFAULT = 0, VL_ADAPT_ON, VL_ADAPT_OFF };
 #define VL_DEFAULT_GLOSSY_RAYS 4
 #define VL_MAX_GLOSSY_RAYS 64
 /* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the
- * path tracer's estimate of the same paths, to see what the approximation costs) */
-enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE };
+ * path tracer's estimate of the same paths, to see what the approximation costs). HL_MERGE_AUTO:
+ * the merge, and each pixel judged as the frames double (hl_judge_trace) takes the trace from then
+ * on where the merge's bias outweighs the trace's extra noise. */
+enum { HL_MERGE_DEFAULT = 0, HL_MERGE_ON, HL_MERGE_OFF, HL_MERGE_TRACE, HL_MERGE_AUTO };
 enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
 #define HL_DEFAULT_SECONDARY_RAYS 8
 #define HL_DEFAULT_CLUSTERS 4
@@ -182,6 +184,7 @@ typedef struct {
     uint64_t hl_secondary_rays; /* rays sampled from their glossy lobes */
     uint64_t hl_lobes;          /* lobes lit (merged, or one per secondary hit without merging) */
     uint64_t hl_merge_ns;       /* thread time spent clustering and merging (the paper's Table 1, C) */
+    uint64_t hl_traced_pixels;  /* --merge auto: pixels judged to take the trace, at the last judgement */
     uint64_t env_filter_bytes;  /* memory of the prefiltered environment map (vsl+hl under a map; 0: none) */
     uint64_t pass_ns[PASS_COUNT];
 } render_stats;

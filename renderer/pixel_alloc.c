@@ -75,3 +75,35 @@ int hl_judge_due(long long frames) {
     while (frames > HL_DIM_FRAMES && frames % 2 == 0) frames /= 2;
     return frames == HL_DIM_FRAMES;
 }
+
+/* The merge's squared bias less the trace's added variance of the mean, at one pixel (0 without two
+ * frames): positive where the trace would have erred less over the same frames. */
+static double trace_gain(const hl_merge_record *r) {
+    double n = r->n;
+    if (n < 2.0) return 0.0;
+    double md = (double)r->d / n, mm = (double)r->m / n, mt = mm + md;
+    double var_d = ((double)r->dd - n * md * md) / (n - 1.0);
+    double var_m = ((double)r->mm - n * mm * mm) / (n - 1.0);
+    double var_t = ((double)r->tt - n * mt * mt) / (n - 1.0);
+    return md * md - var_d / n - (var_t - var_m) / n;
+}
+
+int hl_judge_trace(hl_merge_record *rec, int width, int height) {
+    double *gain = malloc((size_t)width * (size_t)height * sizeof *gain);
+    if (!gain) return -1;
+    for (int i = 0; i < width * height; i++) gain[i] = trace_gain(&rec[i]);
+    for (int y = 0; y < height; y++)
+        for (int x = 0; x < width; x++) {
+            hl_merge_record *r = &rec[y * width + x];
+            if (r->traced || r->n < 2.0f) continue;
+            double sum = 0.0;
+            for (int qy = y - HL_DIM_RADIUS; qy <= y + HL_DIM_RADIUS; qy++)
+                for (int qx = x - HL_DIM_RADIUS; qx <= x + HL_DIM_RADIUS; qx++)
+                    if (qy >= 0 && qy < height && qx >= 0 && qx < width) sum += gain[qy * width + qx];
+            r->traced = sum > 0.0;
+        }
+    free(gain);
+    int traced = 0;
+    for (int i = 0; i < width * height; i++) traced += rec[i].traced;
+    return traced;
+}

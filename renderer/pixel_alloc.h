@@ -39,6 +39,25 @@ void hl_judge_dim(uint8_t *state, int width, int height, int again);
  * frames double. */
 int hl_judge_due(long long frames);
 
+/* A pixel's highlights, merged (m) and traced (t) at the same secondary hits, over the frames it
+ * took the merge with --merge auto (sums of their luminances, of squares and of the difference
+ * d = t - m), and whether it was judged to take the trace. */
+typedef struct {
+    float n, m, mm, d, dd, tt;
+    int traced;
+} hl_merge_record;
+/* Turns to the trace the pixels with a record where, summed over the pixels within HL_DIM_RADIUS,
+ * the merge's squared bias (d's squared mean less its variance) exceeds what the trace adds to the
+ * variance of the mean over the frames so far: the merge's error against the trace's. A pixel that
+ * took the trace keeps it. Judged when hl_judge_due. Returns the pixels taking the trace, or -1 when
+ * out of memory (nothing judged). */
+int hl_judge_trace(hl_merge_record *rec, int width, int height);
+
+static inline void hl_merge_record_add(hl_merge_record *r, float m, float t) {
+    float d = t - m;
+    r->n += 1.0f, r->m += m, r->mm += m * m, r->d += d, r->dd += d * d, r->tt += t * t;
+}
+
 static inline void pixel_record_add(pixel_record *r, float v) {
     r->n += 1.0f;
     float d = v - r->mean;

@@ -50,10 +50,11 @@ struct render_session {
      * samples, from the spread of one sample's light in earlier frames */
     int adapt;
     pixel_alloc glossy, direct;
-    uint8_t *hl_state;       /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
-    hl_setup hl;             /* vsl+hl: this frame's highlight settings */
-    env_vmf_filter *envf;    /* vsl+hl under a map: the map prefiltered, built on first use */
-    const env_map *envf_map; /* ... the map it was built from */
+    uint8_t *hl_state;         /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
+    hl_merge_record *hl_merge; /* per pixel with --merge auto: merge against trace; NULL until used */
+    hl_setup hl;               /* vsl+hl: this frame's highlight settings */
+    env_vmf_filter *envf;      /* vsl+hl under a map: the map prefiltered, built on first use */
+    const env_map *envf_map;   /* ... the map it was built from */
     scene_analysis analysis;
     effect_plan plan;
     const atomic_int *abort_flag; /* polled per tile; NULL: none */
@@ -118,6 +119,7 @@ void session_destroy(render_session *rs) {
     pixel_alloc_free(&rs->glossy);
     pixel_alloc_free(&rs->direct);
     free(rs->hl_state);
+    free(rs->hl_merge);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -234,6 +236,9 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     if (!first && points == 1) return v3(0, 0, 0);
     shading_point xs[HL_PIXEL_POINTS];
     pixel_points(rs, st, raster, pixel, d, first, xs, points);
+    /* --merge auto: a pixel judged to take the trace does; the others record the trace beside */
+    hl_merge_record *rec = rs->adapt && setup.choose ? &rs->hl_merge[pixel] : NULL;
+    if (rec && rec->traced) setup.mode = HL_TRACED, rec = NULL;
     int sharp = 0;
     /* Each point its own run (its rays' directions over frames); spread points get fresh ones. */
     qmc_run runs[HL_PIXEL_POINTS];
@@ -241,7 +246,9 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
         runs[j] = pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
                             next_frame_index(rs) * (uint64_t)hl_rays_of_point(setup.secondary_rays, points, j), 0);
     }
-    vec3 L = hl_estimate(&setup, rs->scene, xs, points, runs, &hl_rng, st, &sharp);
+    vec3 traced;
+    vec3 L = hl_estimate(&setup, rs->scene, xs, points, runs, &hl_rng, st, &sharp, rec ? &traced : NULL);
+    if (rec && is_finite3(L) && is_finite3(traced)) hl_merge_record_add(rec, avg3(L), avg3(traced));
     if (sharp) rs->hl_state[pixel] = HL_PIXEL_SHARP; /* read from the next frame on: one sample a pixel a frame */
     return L;
 }
@@ -442,6 +449,11 @@ int session_render_frame(render_session *rs) {
         }
         rs->totals.env_filter_bytes = rs->plan.env_prefilter ? env_vmf_filter_bytes(rs->envf) : 0;
         rs->hl = hl_setup_from(rs->scene, &rs->params.vl, rs->plan.env_prefilter ? rs->envf : NULL);
+        if (rs->adapt && rs->hl.choose && !rs->hl_merge &&
+            !(rs->hl_merge = calloc((size_t)p->width * (size_t)p->height, sizeof *rs->hl_merge))) {
+            snprintf(rs->error, sizeof rs->error, "out of memory for a %dx%d image", p->width, p->height);
+            return -1;
+        }
     }
     if (rs->plan.virtual_lights) {
         uint64_t t0 = clock_ns();
@@ -451,6 +463,10 @@ int session_render_frame(render_session *rs) {
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
     }
     if (dim_judged(rs) && hl_judge_due(rs->frames)) judge_dim_pixels(rs, rs->hl.dim_share);
+    if (rs->plan.highlights && rs->adapt && rs->hl.choose && hl_judge_due(rs->frames)) {
+        int traced = hl_judge_trace(rs->hl_merge, p->width, p->height); /* out of memory: judged next time */
+        if (traced >= 0) rs->totals.hl_traced_pixels = (uint64_t)traced;
+    }
     threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
     int aborted = rs->abort_flag && atomic_load(rs->abort_flag);
     if (!aborted) {
@@ -487,6 +503,8 @@ void session_reset(render_session *rs) {
     pixel_alloc_reset(&rs->glossy);
     pixel_alloc_reset(&rs->direct);
     memset(rs->hl_state, HL_PIXEL_UNPROBED, (size_t)rs->params.width * (size_t)rs->params.height);
+    if (rs->hl_merge)
+        memset(rs->hl_merge, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->hl_merge);
     rs->frames = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }

@@ -1,8 +1,9 @@
 /* The highlight estimator (vsl+hl) against the path tracer's highlights layer: the exact mode
  * (--merge trace) must agree with it statistically, the vMF modes within their approximation,
  * the VSL estimator must drop exactly the highlights' paths, the merged lobes must keep the reflection
- * of an edge dark (the paper's Fig. 6), the highlight's peak and shape must match path tracing's,
- * and hard cases stay finite. */
+ * of an edge dark (the paper's Fig. 6), the highlight's peak and shape must match path tracing's
+ * (with --merge auto, as the trace's within what its merged first frames leave), and hard cases
+ * stay finite. */
 #include <math.h>
 
 #include "check.h"
@@ -440,7 +441,7 @@ static void test_shared_hits_see_their_points(void) {
         boxed_max = fmax(boxed_max, (double)max_comp3(out[1]));
         qmc_run own = {(uint32_t)(f * 8), rng_next_u32(&rng), rng_next_u32(&rng)};
         int sharp = 0;
-        double b = (double)avg3(hl_estimate(&h, s, &xs[0], 1, &own, &rngs[0], &st, &sharp));
+        double b = (double)avg3(hl_estimate(&h, s, &xs[0], 1, &own, &rngs[0], &st, &sharp, NULL));
         alone += b, alone2 += b * b;
     }
     shared /= FRAMES, alone /= FRAMES;
@@ -471,6 +472,7 @@ static void test_peak_and_shape(void) {
                 {HL_MERGE_ON, 0, 24, HL_SHARE_OFF, "merged (defaults)"},
                 {HL_MERGE_ON, 0, 24, HL_SHARE_ON, "merged, hits shared"},
                 {HL_MERGE_ON, 1, 24, HL_SHARE_OFF, "merged, K=1"},
+                {HL_MERGE_AUTO, 0, 24, HL_SHARE_OFF, "merged or traced per pixel (auto)"},
                 {HL_MERGE_OFF, 0, 24, HL_SHARE_OFF, "no merging"}};
     for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
         render_params p = hl_params(runs[k].merge, runs[k].clusters, 0);
@@ -483,13 +485,15 @@ static void test_peak_and_shape(void) {
         printf("peak and shape, %s: peak %.3f +- %.3f, halo %.3f +- %.3f of path tracing's, shape error %.3f\n",
                runs[k].name, r.peak, r.peak_se, r.halo, r.halo_se, r.shape);
         /* The vMF lobes' own approximation (measured 2-8% at the peak, 0.05-0.1 in shape) plus
-         * four standard errors. */
-        double tol = runs[k].merge == HL_MERGE_TRACE ? 0.0 : 0.1;
+         * four standard errors; where each pixel may turn to the trace, only the merged first
+         * frames' share of it (measured: peak and halo +0.5% and +0.9%, merged +2.3% and +2.4%). */
+        int unbiased = runs[k].merge == HL_MERGE_TRACE || runs[k].merge == HL_MERGE_AUTO;
+        double tol = runs[k].merge == HL_MERGE_TRACE ? 0.0 : runs[k].merge == HL_MERGE_AUTO ? 0.01 : 0.1;
         CHECK(fabs(r.peak - 1.0) < tol + 4.0 * r.peak_se, "%s: peak %.3f of path tracing's (+- %.3f)", runs[k].name,
               r.peak, r.peak_se);
         CHECK(fabs(r.halo - 1.0) < tol + 4.0 * r.halo_se, "%s: halo %.3f of path tracing's (+- %.3f)", runs[k].name,
               r.halo, r.halo_se);
-        CHECK(r.shape < (runs[k].merge == HL_MERGE_TRACE ? 0.05 : 0.15), "%s: shape error %.3f", runs[k].name, r.shape);
+        CHECK(r.shape < (unbiased ? 0.05 : 0.15), "%s: shape error %.3f", runs[k].name, r.shape);
     }
     free(ref);
     free(img);

@@ -1,7 +1,10 @@
 /* Where a many-light frame's samples go, per pixel (pixel_alloc.h): the traced directions'
- * allocation by one direction's spread, and which pixels' highlights are judged dim, checked
- * against hand-made records and brute force over the neighbourhood. */
+ * allocation by one direction's spread, which pixels' highlights are judged dim, and which take the
+ * trace rather than the merge, checked against hand-made records and brute force over the
+ * neighbourhood. */
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "check.h"
 #include "params.h"
@@ -99,8 +102,94 @@ static void test_judge_dim(void) {
         CHECK(!hl_judge_due(not_due[k]), "the pixels must not be judged after %d frames", not_due[k]);
 }
 
+/* Sample variance of v[0..n), two passes. */
+static double sample_var(const double *v, int n) {
+    double mean = 0.0, ss = 0.0;
+    for (int i = 0; i < n; i++) mean += v[i] / n;
+    for (int i = 0; i < n; i++) ss += (v[i] - mean) * (v[i] - mean);
+    return ss / (n - 1);
+}
+
+enum { TW = 11, TH = 7, TMAX = 24 };
+
+/* Fills records from per-pixel samples: the merge m = base + bias + its noise, the trace t = base +
+ * its noise, the two sharing `base` (the same hits); returns in gain[] brute force's merge bias^2 -
+ * var(d) / n - (var(t) - var(m)) / n per pixel (0 below two frames). */
+static void judge_trace_case(hl_merge_record *rec, double *gain, rng_state *r, float bias, float sd_m, float sd_t,
+                             int random_n) {
+    for (int i = 0; i < TW * TH; i++) {
+        double m[TMAX], t[TMAX], d[TMAX];
+        int n = random_n ? (int)(rng_float(r) * TMAX) : TMAX;
+        float b = random_n ? bias * (rng_float(r) < 0.5f ? 0.0f : rng_float(r)) : bias;
+        memset(&rec[i], 0, sizeof rec[i]);
+        for (int k = 0; k < n; k++) {
+            float base = 1.0f + rng_float(r);
+            m[k] = base + b + sd_m * (2.0f * rng_float(r) - 1.0f);
+            t[k] = base + sd_t * (2.0f * rng_float(r) - 1.0f);
+            d[k] = t[k] - m[k];
+            hl_merge_record_add(&rec[i], (float)m[k], (float)t[k]);
+        }
+        double md = 0.0;
+        for (int k = 0; k < n; k++) md += d[k] / n;
+        gain[i] = n < 2 ? 0.0 : md * md - sample_var(d, n) / n - (sample_var(t, n) - sample_var(m, n)) / n;
+    }
+}
+
+/* The choice of the trace: against brute force over the neighbourhood (two-pass variances from the
+ * samples themselves, not the running sums), pixels judged before keeping the trace; and on uniform
+ * images, the merge kept where it is unbiased and less noisy, the trace taken where the merge is
+ * biased or where the trace is the less noisy (at nine pixels in ten). */
+static void test_judge_trace(void) {
+    hl_merge_record rec[TW * TH];
+    double gain[TW * TH];
+    rng_state r = rng_for(4, 5, 6);
+    int wrong = 0, traced = 0, merged = 0, close = 0;
+    for (int round = 0; round < 100; round++) {
+        judge_trace_case(rec, gain, &r, 0.3f, 0.2f, 0.6f, 1);
+        int before[TW * TH];
+        for (int i = 0; i < TW * TH; i++) rec[i].traced = before[i] = rng_float(&r) < 0.1f;
+        int count = hl_judge_trace(rec, TW, TH), counted = 0;
+        for (int i = 0; i < TW * TH; i++) counted += rec[i].traced;
+        CHECK(count == counted, "%d pixels counted as taking the trace, %d take it", count, counted);
+        for (int y = 0; y < TH; y++)
+            for (int x = 0; x < TW; x++) {
+                double sum = 0.0;
+                for (int qy = 0; qy < TH; qy++)
+                    for (int qx = 0; qx < TW; qx++)
+                        if (abs(qx - x) <= HL_DIM_RADIUS && abs(qy - y) <= HL_DIM_RADIUS) sum += gain[qy * TW + qx];
+                int i = y * TW + x, want = before[i] || (rec[i].n >= 2.0f && sum > 0.0);
+                if (fabs(sum) < 1e-4)
+                    close++; /* float sums may tip a tie either way */
+                else
+                    wrong += rec[i].traced != want;
+                traced += want && !before[i];
+                merged += !want;
+            }
+    }
+    CHECK(wrong == 0, "%d pixels chose otherwise than brute force (%d ties skipped)", wrong, close);
+    CHECK(traced > 100 && merged > 100, "the cases were not all met: %d turned to the trace, %d merged", traced,
+          merged);
+    struct {
+        float bias, sd_m, sd_t;
+        int want;
+        const char *what;
+    } uniform[] = {{0.0f, 0.1f, 0.5f, 0, "an unbiased merge, less noisy than the trace"},
+                   {0.5f, 0.1f, 0.5f, 1, "a merge biased by the trace's noise"},
+                   {0.0f, 0.5f, 0.1f, 1, "a merge noisier than the trace"}};
+    for (size_t c = 0; c < sizeof uniform / sizeof uniform[0]; c++) {
+        judge_trace_case(rec, gain, &r, uniform[c].bias, uniform[c].sd_m, uniform[c].sd_t, 0);
+        hl_judge_trace(rec, TW, TH);
+        int agree = 0;
+        for (int i = 0; i < TW * TH; i++) agree += rec[i].traced == uniform[c].want;
+        /* the estimated bias's own noise tips a few pixels (most at the edges, with fewer neighbours) */
+        CHECK(agree >= TW * TH * 9 / 10, "%s: %d of %d pixels %s", uniform[c].what, agree, TW * TH,
+              uniform[c].want ? "took the trace" : "kept the merge");
+    }
+}
+
 int main(void) {
     test_pixel_alloc_plan();
     test_judge_dim();
+    test_judge_trace();
     return check_exit("test_pixel_alloc");
 }

@@ -132,7 +132,7 @@ below 0 "$(field 2 cost_ms)" && below 0 "$(field 2 cost_before_ms)" ||
 [ "$(field 3 radius_mult)" = "4" ] || fail "a bad radius multiplier replaced the last good one"
 # stats lines 4 on: vsl+hl (with fewer secondary rays than the default 8, to save time), then shown
 # as highlights only, then N, K and merge changed
-[ "$(field 1 secondary_rays)" = "8" ] && [ "$(field 1 clusters)" = "4" ] && [ "$(field 1 merge)" = "on" ] ||
+[ "$(field 1 secondary_rays)" = "8" ] && [ "$(field 1 clusters)" = "4" ] && [ "$(field 1 merge)" = "auto" ] ||
   fail "highlight parameters do not start at their defaults: $(sed -n 1p stats.txt)"
 [ "$(field 4 method)" = "vsl+hl" ] && [ "$(field 4 secondary_rays)" = "6" ] || fail "vsl+hl not applied: $(sed -n 4p stats.txt)"
 [ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "switching to vsl+hl did not reset the accumulation"
