@@ -65,9 +65,6 @@ static int parse_merge_options(int argc, char **argv, merge_options *o) {
     return 0;
 }
 
-/* Shard i's share of a render of total spp: as many frames as i, i + n, ... below total. */
-static long long shard_share(long long total, int i, int n) { return total > i ? (total - i + n - 1) / n : 0; }
-
 /* The descriptions of the parts, checked against the first and against each other: same render,
  * no shard twice, each with the frames its shards own. The union of their shards into *all.
  * 0, or -1 after the error. */

@@ -102,9 +102,9 @@ static int parse_shard(render_options *o) {
     o->params.shard_count = (int)n;
     o->spp_total = o->spp;
     o->params.shard_spp_total = o->spp;
-    if (o->spp > 0) { /* as many frames as i + k n below spp */
+    if (o->spp > 0) {
         if (o->spp <= i) return cli_error("--shard %s: --spp %lld leaves shard %lld no frame", o->shard, o->spp, i), -1;
-        o->spp = (o->spp - i + n - 1) / n;
+        o->spp = shard_share(o->spp, (int)i, (int)n);
     }
     return 0;
 }

@@ -133,8 +133,14 @@ enum { HL_SHARE_DEFAULT = 0, HL_SHARE_ON, HL_SHARE_OFF };
  * dimension), so a shard taking frames i, i + N, ... converged, alone, to a wrong image. With --spp
  * T the shards take consecutive blocks of T (shard i's share: the frames of i, i + N, ... below
  * T); with --time (total 0), blocks of SHARD_TIME_BLOCK frames in turn. */
+/* Shard index's share of a render of total frames: as many frames as index, index + count, ...
+ * below total. */
+static inline long long shard_share(long long total, int index, int count) {
+    return total > index ? (total - index + count - 1) / count : 0;
+}
 static inline uint64_t shard_frame_index(long long total, int index, int count, uint64_t k) {
     const uint64_t i = (uint64_t)index, n = (uint64_t)count, b = SHARD_TIME_BLOCK;
+    /* after the shares of shards 0 .. index - 1: total / count each, one more for the first total % count */
     if (total > 0) return i * ((uint64_t)total / n) + (i < (uint64_t)total % n ? i : (uint64_t)total % n) + k;
     return (k / b) * n * b + i * b + k % b;
 }
