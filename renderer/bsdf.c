@@ -211,6 +211,19 @@ float bsdf_glossy_alpha(const bsdf *b) {
     return bsdf_has_base_glossy(b) ? fminf(base_glossy_alpha(b), coat) : coat;
 }
 
+void bsdf_regularize(bsdf *b, float alpha) {
+    if (!(alpha > 0.0f) || !is_black3(b->transmission) || !(bsdf_lobes(b) & BSDF_GLOSSY)) return;
+    if (b->coat > 0.0f) b->coat_alpha = fmaxf(b->coat_alpha, alpha);
+    if (!bsdf_has_base_glossy(b)) return;
+    if (b->model == GLOSSY_PHONG) {
+        float n = 0.5f * (1.0f / (alpha * alpha) - 1.0f); /* base_glossy_alpha's inverse */
+        b->exponent = fminf(b->exponent, fmaxf(n, 0.0f));
+    } else {
+        b->alpha_x = fmaxf(b->alpha_x, alpha);
+        b->alpha_y = fmaxf(b->alpha_y, alpha);
+    }
+}
+
 /* ---- GGX ------------------------------------------------------------------------------------ */
 
 static float ggx_d(const bsdf *b, vec3 h) {

@@ -156,6 +156,11 @@ static inline int bsdf_glossy_is_single(const bsdf *b) { return !(b->coat > 0.0f
  * Phong through its equivalent exponent); the sharper of the base's and the coat's; 0 without a
  * glossy lobe. */
 float bsdf_glossy_alpha(const bsdf *b);
+/* Widens every glossy lobe of b sharper than roughness alpha to alpha (Phong through its
+ * equivalent exponent), keeping its colour and Fresnel: path-space regularisation (Kaplanyan and
+ * Dachsbacher 2013) of a near-specular vertex. Lobes that transmit are left as they are (shadow
+ * rays pass smooth glass). alpha <= 0: nothing. */
+void bsdf_regularize(bsdf *b, float alpha);
 /* BSDF_GLOSSY when b's glossy lobe is sharper than BSDF_HIGHLIGHT_ALPHA, else 0. */
 int bsdf_highlight_lobe(const bsdf *b);
 /* How anisotropic the glossy lobe is: its larger roughness over its smaller (GGX, Ward); 1 for an

@@ -36,6 +36,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     r.candidates = int_or(vp->candidates, VL_DEFAULT_CANDIDATES, VL_MAX_CANDIDATES);
     if (vp->select == VL_SELECT_DEFAULT) r.select = VL_SELECT_POWER;
     r.trace_glossy = float_or(vp->trace_glossy, VL_DEFAULT_TRACE_GLOSSY);
+    r.regularize = float_or(vp->regularize, VL_DEFAULT_REGULARIZE);
     r.glossy_rays = int_or(vp->glossy_rays, VL_DEFAULT_GLOSSY_RAYS, VL_MAX_GLOSSY_RAYS);
     if (vp->adapt == VL_ADAPT_DEFAULT) r.adapt = VL_ADAPT_ON;
     r.secondary_rays = int_or(vp->secondary_rays, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_SECONDARY_RAYS);
@@ -155,6 +156,12 @@ static const param_desc table[] = {
      .help = "directions traced through such a lobe at the camera hit, 1.." STR(VL_MAX_GLOSSY_RAYS),
      .label = "glossy rays", .unit = "rays per camera hit", .panel_lo = 1, .panel_hi = VL_MAX_GLOSSY_RAYS,
      .panel_format = "%d"},
+    {.name = "regularize", .type = PARAM_FLOAT, .offset = F(regularize), .lo = 0, .hi = 1, .off_word = "off",
+     .zero_is_off = 1, .def = VL_DEFAULT_REGULARIZE, .value_name = "A",
+     .help = "past two traced lobes, the next hit's lobes sharper than\n"
+             "alpha A are widened to A for its direct light; A shrinks as M",
+     .label = "regularize below", .unit = "roughness alpha", .panel_lo = 0, .panel_hi = 1,
+     .panel_format = "alpha %.2f", .panel_lo_text = "never"},
     {.name = "adapt", .type = PARAM_CHOICE, .offset = F(adapt), .choices = adapts, .num_choices = 2,
      .def = VL_ADAPT_ON,
      .help = "on: each pixel's glossy rays (N on average) and direct-light\n"

@@ -59,6 +59,10 @@ typedef struct {
                           * gathered from the lights: the camera path goes on through it (BSDF
                           * sampling, direct light at the next hit, gathering there); < 0: never
                           * [VL_DEFAULT_TRACE_GLOSSY] */
+    float regularize;    /* where a traced path has gone through two such lobes or more, the glossy
+                          * lobes at the next hit, whose direct light it takes, are widened to this
+                          * roughness alpha at least, shrinking as the VSL radius does; < 0: never
+                          * [VL_DEFAULT_REGULARIZE] */
     int glossy_rays;     /* directions traced through such a lobe at the camera hit, each taking the
                           * direct light at its next hit, one carrying the path on; with
                           * adapt, their mean over the pixels [VL_DEFAULT_GLOSSY_RAYS] */
@@ -97,6 +101,7 @@ enum { VL_ADAPT_DEFAULT = 0, VL_ADAPT_ON, VL_ADAPT_OFF };
 #define VL_DEFAULT_CANDIDATES 32
 #define VL_MAX_CANDIDATES 256 /* they live on the stack */
 #define VL_DEFAULT_TRACE_GLOSSY 0.35f
+#define VL_DEFAULT_REGULARIZE 0.15f
 #define VL_DEFAULT_GLOSSY_RAYS 4
 #define VL_MAX_GLOSSY_RAYS 64
 /* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the

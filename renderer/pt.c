@@ -59,10 +59,11 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
  * lobes add up to the BSDF); a continuation then left the camera hit through its highlight lobe,
  * and its first hit is the second vertex (its light's rest goes to COMP_INDIRECT). max_depth
  * counts scattering events; transmissions are free (beyond the depth only transmission carries
- * on), up to PT_MAX_TRANSMISSIONS more vertices. */
+ * on), up to PT_MAX_TRANSMISSIONS more vertices. Glossy lobes sharper than min_alpha are widened to it
+ * (bsdf_regularize; 0: none). */
 static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
                        rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
-                       int split_highlights, int first_lobes, const qmc_run *first_run) {
+                       int split_highlights, int first_lobes, const qmc_run *first_run, float min_alpha) {
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     /* the throughput through highlight lobes only (of the first two scattering events) */
@@ -108,6 +109,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
         frame3 fr;
         bsdf b = material_bsdf(s, &h, &fr);
+        if (min_alpha > 0.0f) bsdf_regularize(&b, min_alpha);
         vec3 wo = to_local(fr, neg3(d));
         int capped = events >= max_depth;
         int hold =
@@ -199,7 +201,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
                  qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL, &run);
+    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL, &run, 0.0f);
 }
 
 vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
@@ -208,7 +210,7 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     uint64_t camera_rays = rays[RAY_CAMERA];
     int n = first && samples > 1 ? samples : 1; /* an escaping ray has nothing to sample */
     for (int k = 0; k < n; k++) {
-        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL, NULL);
+        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL, NULL, 0.0f);
         sum = add3(sum, out[COMP_DIRECT]);
         if (rec && first) pixel_record_add(rec, avg3(out[COMP_DIRECT]));
     }
@@ -216,11 +218,11 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     return scale3(sum, 1.0f / (float)n);
 }
 
-int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, rng_state *rng, vec3 *direct,
-                        vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, float min_alpha, rng_state *rng,
+                        vec3 *direct, vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
     int hit = scene_intersect(s, o, d, INFINITY, first);
-    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL, lobes, NULL);
+    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL, lobes, NULL, min_alpha);
     *direct = add3(out[COMP_DIRECT], out[COMP_INDIRECT]); /* INDIRECT: the split's rest */
     if (highlights) *highlights = out[COMP_HIGHLIGHTS];
     return hit;

@@ -36,8 +36,9 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
  * belongs to the highlight estimator). For estimators that continue a path and must not count the emission
  * their direct light has. The ray travels in a medium of absorption sigma (0: air). With highlights
  * not NULL the ray left the camera hit through its highlight lobe: the part of the light through
- * the hit's highlight lobe goes there, the rest to *direct. */
-int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, rng_state *rng, vec3 *direct,
-                        vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]);
+ * the hit's highlight lobe goes there, the rest to *direct. Glossy lobes at the hit sharper than
+ * min_alpha are widened to it (bsdf_regularize; 0: as they are). */
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, float min_alpha, rng_state *rng,
+                        vec3 *direct, vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]);
 
 #endif

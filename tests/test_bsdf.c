@@ -3,6 +3,7 @@
  * masks add up, the GGX lobe matches an independent double-precision implementation, and the
  * traps (grazing, razor-sharp, below the horizon) stay finite. */
 #include <stdlib.h>
+#include <string.h>
 
 #include "bsdf.h"
 #include "bsdf_sampler.h"
@@ -597,6 +598,56 @@ static void test_glossy_alpha_scale(void) {
     CHECK(bsdf_glossy_alpha(&lambert) == 0.0f, "a lobe-less bsdf has a glossy alpha");
 }
 
+/* bsdf_regularize: a sharp lobe widened to alpha is the lobe the same material has at that
+ * roughness, built from scratch (values and pdfs at directions around the peak and off it); a
+ * lobe already as wide, a transmitting one and alpha 0 are left bit for bit. */
+static void test_regularize(void) {
+    const float alpha = 0.2f;
+    struct {
+        const char *name;
+        bsdf sharp, wide;
+    } cases[] = {
+        {"ggx metal", make_bsdf_gltf(v3(1.0f, 0.8f, 0.6f), 1.0f, 0.15f, 0.0f),
+         make_bsdf_gltf(v3(1.0f, 0.8f, 0.6f), 1.0f, sqrtf(alpha), 0.0f)},
+        {"ggx dielectric", make_bsdf_gltf(v3(0.9f, 0.2f, 0.2f), 0.0f, 0.1f, 0.0f),
+         make_bsdf_gltf(v3(0.9f, 0.2f, 0.2f), 0.0f, sqrtf(alpha), 0.0f)},
+        {"phong n1000", make_bsdf_phong(v3s(0.2f), v3s(0.8f), 1000.0f),
+         make_bsdf_phong(v3s(0.2f), v3s(0.8f), 0.5f * (1.0f / (alpha * alpha) - 1.0f))},
+        {"ward 0.02x0.3", make_bsdf_ward(v3s(0.3f), v3s(0.7f), 0.02f, 0.3f),
+         make_bsdf_ward(v3s(0.3f), v3s(0.7f), alpha, 0.3f)},
+    };
+    for (int c = 0; c < (int)(sizeof cases / sizeof cases[0]); c++) {
+        bsdf b = cases[c].sharp;
+        bsdf_regularize(&b, alpha);
+        CHECK(fabsf(bsdf_glossy_alpha(&b) - bsdf_glossy_alpha(&cases[c].wide)) < 1e-5f, "%s: alpha %g, expected %g",
+              cases[c].name, (double)bsdf_glossy_alpha(&b), (double)bsdf_glossy_alpha(&cases[c].wide));
+        vec3 wo = dir_from_angles(35.0, 20.0);
+        for (int k = 0; k < 24; k++) {
+            vec3 wi = dir_from_angles(35.0 + 2.5 * (k % 6), 200.0 + 4.0 * (k / 6)); /* around the peak */
+            vec3 f = bsdf_eval(&b, wo, wi, BSDF_ALL), g = bsdf_eval(&cases[c].wide, wo, wi, BSDF_ALL);
+            float pf = bsdf_pdf(&b, wo, wi, BSDF_ALL), pg = bsdf_pdf(&cases[c].wide, wo, wi, BSDF_ALL);
+            CHECK(fabsf(f.x - g.x) <= 1e-5f * g.x + 1e-7f && fabsf(f.z - g.z) <= 1e-5f * g.z + 1e-7f &&
+                      fabsf(pf - pg) <= 1e-5f * pg + 1e-7f,
+                  "%s at %d: f %g, pdf %g; rebuilt %g, %g", cases[c].name, k, (double)f.x, (double)pf, (double)g.x,
+                  (double)pg);
+        }
+    }
+    bsdf keep[] = {make_bsdf_gltf(v3s(1.0f), 1.0f, 0.6f, 0.5f), make_bsdf_lambert(v3s(0.5f)),
+                   make_bsdf_phong(v3s(0.3f), v3s(0.7f), 5.0f)};
+    for (int k = 0; k < 3; k++) {
+        bsdf b = keep[k];
+        bsdf_regularize(&b, alpha);
+        CHECK(memcmp(&b, &keep[k], sizeof b) == 0, "a lobe wider than alpha %g changed (case %d)", (double)alpha, k);
+    }
+    bsdf glass = make_bsdf_gltf(v3s(1.0f), 0.0f, 0.0f, 0.0f), b = glass;
+    glass.transmission = v3s(1.0f), glass.eta = 1.5f, b = glass;
+    bsdf_regularize(&b, alpha);
+    CHECK(memcmp(&b, &glass, sizeof b) == 0, "a transmitting lobe was widened");
+    b = keep[0] = make_bsdf_gltf(v3s(1.0f), 1.0f, 0.1f, 0.0f);
+    bsdf_regularize(&b, 0.0f);
+    CHECK(memcmp(&b, &keep[0], sizeof b) == 0, "alpha 0 changed a lobe");
+}
+
 /* The tabulated glossy albedo against a Monte Carlo estimate from independent random samples of
  * the lobe (whose sampling the tests above check against the pdf and quadrature): every model,
  * widths between and on the table's nodes, normal to grazing incidence, coloured F0, and
@@ -723,5 +774,6 @@ int main(void) {
     test_furnace();
     test_traps();
     test_glossy_alpha_scale();
+    test_regularize();
     return check_exit("test_bsdf");
 }
