@@ -248,16 +248,16 @@ static int traced_lobes(const manylight *m, const bsdf *b) {
 
 /* One direction (u_lobe, u) through x's traced lobes (x is scattering event k, reached with weight
  * beta in a medium of absorption *sigma): the direct light at the next hit, weighted (*t), its
- * glossy lobes widened to min_alpha (bsdf_regularize; 0: as they are), and
- * what carrying the path on needs (*b, *h, *wi, *sigma, *lobe). Through a transmission *t is 0
- * unless through_direct: a transmission is no scattering event, and the direct estimator that
- * reached x (its paths carry on through x's transmission) has the next hit's direct light; glass
- * reached by a gathered lobe's direction (glass_direction) had no such estimator before it, so
- * there the next hit's direct light is taken. Returns 0 when the direction ends there (sampled on
- * the wrong side of the surface, Russian roulette, a miss). */
+ * glossy lobes widened by reg (pt_regularize), and what carrying the path on needs (*b, *h, *wi,
+ * *sigma, *lobe). Through a transmission *t is 0 unless through_direct: a transmission is no
+ * scattering event, and the direct estimator that reached x (its paths carry on through x's
+ * transmission) has the next hit's direct light; glass reached by a gathered lobe's direction
+ * (glass_direction) had no such estimator before it, so there the next hit's direct light is taken.
+ * Returns 0 when the direction ends there (sampled on the wrong side of the surface, Russian
+ * roulette, a miss). */
 static int glossy_direction(const scene *s, const shading_point *x, int traced, int through_direct, vec3 beta, int k,
-                            int lobes, float min_alpha, float u_lobe, vec2 u, rng_state *rng, render_stats *st, vec3 *t,
-                            vec3 *t_hl, vec3 *b, surface_hit *h, vec3 *wi, vec3 *sigma, int *lobe) {
+                            int lobes, pt_regularize reg, float u_lobe, vec2 u, rng_state *rng, render_stats *st,
+                            vec3 *t, vec3 *t_hl, vec3 *b, surface_hit *h, vec3 *wi, vec3 *sigma, int *lobe) {
     bsdf_sample_result bs;
     if (!bsdf_sample(&x->b, x->wo, traced, u_lobe, u, &bs) || !(bs.pdf > 0.0f)) return 0;
     *wi = to_world(x->frame, bs.wi);
@@ -279,8 +279,7 @@ static int glossy_direction(const scene *s, const shading_point *x, int traced, 
          * t_hl, the part through both hits' highlight lobes goes there (pt.c's split). */
         int hl = t_hl ? bsdf_highlight_lobe(&x->b) : 0;
         vec3 direct, direct_hl;
-        if (!pt_reflected_direct(s, o, *wi, *sigma, lobes, min_alpha, rng, &direct, hl ? &direct_hl : NULL, h,
-                                 st->rays))
+        if (!pt_reflected_direct(s, o, *wi, *sigma, lobes, reg, rng, &direct, hl ? &direct_hl : NULL, h, st->rays))
             return 0;
         *t = mul3(*b, direct);
         if (hl) {
@@ -315,8 +314,8 @@ static int glass_direction(const scene *s, const shading_point *x, vec3 beta, in
     beta = mul3(beta, scale3(bs.f, fabsf(bs.wi.z) / bs.pdf));
     beta = mul3(beta, medium_transmittance(*sigma, g.t));
     int lobe;
-    return glossy_direction(s, &gp, BSDF_TRANSMIT, 1, beta, k + 1, BSDF_ALL, 0.0f, 0.0f, rng_vec2(rng), rng, st, t,
-                            NULL, b, h, wi, sigma, &lobe);
+    return glossy_direction(s, &gp, BSDF_TRANSMIT, 1, beta, k + 1, BSDF_ALL, (pt_regularize){0}, 0.0f, rng_vec2(rng),
+                            rng, st, t, NULL, b, h, wi, sigma, &lobe);
 }
 
 /* The camera hit's gather. With highlights, the paths in every term, the highlights' own to
@@ -371,12 +370,12 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         int lobes = at_camera && !highlights && m->terms == VL_TERMS_NO_HIGHLIGHTS && bsdf_highlight_lobe(&x.b)
                         ? BSDF_NOT_HIGHLIGHT
                         : BSDF_ALL;
-        /* A chain of two traced lobes or more regularises the near-specular lobes at the hit whose
-         * direct light it takes: there a point light's reflection in a mirror seen in another is a
-         * rare direction worth thousands of times the pixel (docs/design.md, "Regularised
-         * chains"). The camera hit's own directions keep every lobe sharp: their highlights are
-         * seen. */
-        float min_alpha = k >= 2 ? m->reg_alpha : 0.0f;
+        /* The hit a traced direction reaches sees a light through lobes widened so that the
+         * light's image there is no narrower than a share of x's lobe (docs/design.md,
+         * "Regularised images"), and a chain of two traced lobes or more widens them to a floor
+         * besides: there a point light's reflection in a mirror seen in another is a rare
+         * direction worth thousands of times the pixel ("Regularised chains"). */
+        pt_regularize reg = {k >= 2 ? m->reg_alpha : 0.0f, m->reg_image * bsdf_glossy_alpha(&x.b)};
         vec3 next_beta = v3(0, 0, 0), next_wi = v3(0, 0, 1), next_sigma = sigma;
         surface_hit next;
         int have_next = 0, next_lobe = 0;
@@ -386,8 +385,8 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
             vec3 wi;
             int lobe;
             float u_lobe = rng_float(rng);
-            int ok = glossy_direction(s, &x, traced, 0, beta, k, lobes, min_alpha, u_lobe, qmc_run_point(run, j), rng,
-                                      st, &t, split_hl ? &t_hl : NULL, &b, &h, &wi, &sg, &lobe);
+            int ok = glossy_direction(s, &x, traced, 0, beta, k, lobes, reg, u_lobe, qmc_run_point(run, j), rng, st, &t,
+                                      split_hl ? &t_hl : NULL, &b, &h, &wi, &sg, &lobe);
             if (at_camera && rec) pixel_record_add(rec, avg3(add3(t, t_hl)));
             if (!ok) continue;
             sum = madd3(sum, t, 1.0f / (float)split);
@@ -435,6 +434,7 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     m->radius_mult = vsl_radius_mult_at(vp->radius_mult, shrink, i);
     /* The VSLs' schedule: the chains' blur shrinks as the spheres do, so both converge together. */
     m->reg_alpha = vp->regularize > 0.0f ? vsl_radius_mult_at(vp->regularize, shrink, i) : 0.0f;
+    m->reg_image = vp->reg_image > 0.0f ? vsl_radius_mult_at(vp->reg_image, shrink, i) : 0.0f;
     m->num_entries = 0;
     m->clustered = 0;
     m->use_tree = 0;

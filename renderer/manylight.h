@@ -32,6 +32,7 @@ typedef struct {
     int candidates_beyond; /* ... and at a path's later hits */
     float trace_alpha;     /* glossy lobes sharper than this are traced through, not gathered */
     float reg_alpha;       /* this frame's roughness floor at hits lit through two traced lobes or more (0: off) */
+    float reg_image;       /* this frame's factor on the sending lobe's roughness at a traced hit (0: off) */
     int glossy_split;      /* directions traced through such a lobe at the camera hit (the mean with adapt) */
     int glass;             /* the scene has transmissive materials: gathered paths are also traced through them */
     vlight_set set;

@@ -37,6 +37,7 @@ vl_params vl_params_resolve(const vl_params *vp) {
     if (vp->select == VL_SELECT_DEFAULT) r.select = VL_SELECT_POWER;
     r.trace_glossy = float_or(vp->trace_glossy, VL_DEFAULT_TRACE_GLOSSY);
     r.regularize = float_or(vp->regularize, VL_DEFAULT_REGULARIZE);
+    r.reg_image = float_or(vp->reg_image, VL_DEFAULT_REGULARIZE_IMAGE);
     r.glossy_rays = int_or(vp->glossy_rays, VL_DEFAULT_GLOSSY_RAYS, VL_MAX_GLOSSY_RAYS);
     if (vp->adapt == VL_ADAPT_DEFAULT) r.adapt = VL_ADAPT_ON;
     r.secondary_rays = int_or(vp->secondary_rays, HL_DEFAULT_SECONDARY_RAYS, HL_MAX_SECONDARY_RAYS);
@@ -162,6 +163,13 @@ static const param_desc table[] = {
              "alpha A are widened to A for its direct light; A shrinks as M",
      .label = "regularize below", .unit = "roughness alpha", .panel_lo = 0, .panel_hi = 1,
      .panel_format = "alpha %.2f", .panel_lo_text = "never"},
+    {.name = "regularize-image", .type = PARAM_FLOAT, .offset = F(reg_image), .lo = 0, .hi = 2,
+     .off_word = "off", .zero_is_off = 1, .def = VL_DEFAULT_REGULARIZE_IMAGE, .value_name = "C",
+     .help = "a traced direction's hit sees lights through lobes at least C x\n"
+             "the sending lobe's roughness wide, a point or spot light at d\n"
+             "through C x that x (1 + t / d), t the ray's length; C shrinks as M",
+     .label = "regularize images", .unit = "x the sending lobe", .panel_lo = 0, .panel_hi = 2,
+     .panel_format = "%.2f", .panel_lo_text = "never"},
     {.name = "adapt", .type = PARAM_CHOICE, .offset = F(adapt), .choices = adapts, .num_choices = 2,
      .def = VL_ADAPT_ON,
      .help = "on: each pixel's glossy rays (N on average) and direct-light\n"

@@ -63,6 +63,10 @@ typedef struct {
                           * lobes at the next hit, whose direct light it takes, are widened to this
                           * roughness alpha at least, shrinking as the VSL radius does; < 0: never
                           * [VL_DEFAULT_REGULARIZE] */
+    float reg_image;     /* --regularize-image: at a hit a traced direction reaches, a light's image
+                          * in the glossy lobes is made at least this share of the sending lobe's
+                          * width (docs/design.md, "Regularised images"), shrinking as the VSL
+                          * radius does; < 0: never [VL_DEFAULT_REGULARIZE_IMAGE] */
     int glossy_rays;     /* directions traced through such a lobe at the camera hit, each taking the
                           * direct light at its next hit, one carrying the path on; with
                           * adapt, their mean over the pixels [VL_DEFAULT_GLOSSY_RAYS] */
@@ -102,6 +106,7 @@ enum { VL_ADAPT_DEFAULT = 0, VL_ADAPT_ON, VL_ADAPT_OFF };
 #define VL_MAX_CANDIDATES 256 /* they live on the stack */
 #define VL_DEFAULT_TRACE_GLOSSY 0.35f
 #define VL_DEFAULT_REGULARIZE 0.15f
+#define VL_DEFAULT_REGULARIZE_IMAGE 0.25f
 #define VL_DEFAULT_GLOSSY_RAYS 4
 #define VL_MAX_GLOSSY_RAYS 64
 /* HL_MERGE_TRACE: no vMF at all, every secondary hit lit through its own glossy BSDF lobe (the

@@ -32,19 +32,33 @@ static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int before
 
 /* A BSDF's lobes as next-event estimation sees them: their value, and the pdf of the lobes the
  * vertex samples its continuation from (pdf_lobes); for lights above the surface, or with below
- * those beyond it (its transmission). */
+ * those beyond it (its transmission). With image_alpha > 0 the vertex is a regularised one
+ * (docs/design.md, "Regularised images"): a point or spot light at distance d sees its glossy
+ * lobes widened to image_alpha (1 + near_t / d), near_t the distance the ray came. */
 typedef struct {
     const bsdf *b;
     frame3 fr;
     vec3 wo;
     int lobes, pdf_lobes, below;
+    float image_alpha, near_t;
 } bsdf_lobe;
+
+/* The BSDF that light sample ls sees at l: l's own, or for a delta light at a regularised vertex
+ * a copy in *store widened so that the light's image is as wide there as from afar. */
+static const bsdf *bsdf_lobe_for(const bsdf_lobe *l, const light_sample *ls, bsdf *store) {
+    if (!(l->image_alpha > 0.0f) || !ls->delta) return l->b;
+    float near = ls->dist > 0.0f ? l->near_t / ls->dist : INFINITY; /* 0 for a directional light */
+    *store = *l->b;
+    bsdf_regularize(store, fminf(l->image_alpha * (1.0f + near), BSDF_HIGHLIGHT_ALPHA));
+    return store;
+}
 
 static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lobe_pdf) {
     const bsdf_lobe *l = ctx;
     vec3 wi = to_local(l->fr, ls->wi);
     if (!(l->below ? wi.z < 0.0f : wi.z > 0.0f)) return v3(0, 0, 0);
-    vec3 f = bsdf_eval(l->b, l->wo, wi, l->lobes);
+    bsdf store;
+    vec3 f = bsdf_eval(bsdf_lobe_for(l, ls, &store), l->wo, wi, l->lobes);
     /* A delta light's weight needs no lobe pdf: skip evaluating it (point and spot lights are
      * common, and this runs at every vertex). */
     if (!ls->delta && !is_black3(f)) *lobe_pdf = bsdf_pdf(l->b, l->wo, wi, l->pdf_lobes);
@@ -59,11 +73,11 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
  * lobes add up to the BSDF); a continuation then left the camera hit through its highlight lobe,
  * and its first hit is the second vertex (its light's rest goes to COMP_INDIRECT). max_depth
  * counts scattering events; transmissions are free (beyond the depth only transmission carries
- * on), up to PT_MAX_TRANSMISSIONS more vertices. Glossy lobes sharper than min_alpha are widened to it
- * (bsdf_regularize; 0: none). */
+ * on), up to PT_MAX_TRANSMISSIONS more vertices. reg widens glossy lobes (pt_regularize; zero:
+ * none). */
 static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
                        rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
-                       int split_highlights, int first_lobes, const qmc_run *first_run, float min_alpha) {
+                       int split_highlights, int first_lobes, const qmc_run *first_run, pt_regularize reg) {
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     /* the throughput through highlight lobes only (of the first two scattering events) */
@@ -109,14 +123,16 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
         frame3 fr;
         bsdf b = material_bsdf(s, &h, &fr);
-        if (min_alpha > 0.0f) bsdf_regularize(&b, min_alpha);
+        int hl_mask = bsdf_highlight_lobe(&b); /* the path-space split goes by the lobes as they are */
+        float image_alpha = depth == 0 && continuation ? reg.image_alpha : 0.0f;
+        float floor_alpha = fmaxf(reg.min_alpha, image_alpha);
+        if (floor_alpha > 0.0f) bsdf_regularize(&b, floor_alpha);
         vec3 wo = to_local(fr, neg3(d));
         int capped = events >= max_depth;
-        int hold =
-            !capped && depth == 0 && first_lobes == BSDF_NOT_HIGHLIGHT && s->has_glass ? bsdf_highlight_lobe(&b) : 0;
+        int hold = !capped && depth == 0 && first_lobes == BSDF_NOT_HIGHLIGHT && s->has_glass ? hl_mask : 0;
         int lobes = capped                              ? BSDF_TRANSMIT
                     : depth > 0 || hold                 ? BSDF_ALL
-                    : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~bsdf_highlight_lobe(&b)
+                    : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~hl_mask
                                                         : first_lobes;
         if (!(bsdf_lobes(&b) & lobes)) break;
 
@@ -129,7 +145,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         if (through) {
             float u_sel = rng_float(rng);
             vec2 u_light = rng_vec2(rng);
-            bsdf_lobe lobe = {&b, fr, wo, BSDF_TRANSMIT, lobes, 1};
+            bsdf_lobe lobe = {&b, fr, wo, BSDF_TRANSMIT, lobes, 1, 0.0f, 0.0f};
             vec3 beyond = material_medium_after(&s->materials[h.material], h.backface, BSDF_TRANSMIT, sigma);
             light_sample ls;
             vec3 f;
@@ -141,7 +157,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         if (!capped) {
             float u_sel = rng_float(rng);
             vec2 u_light = rng_vec2(rng);
-            bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes, 0};
+            bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes, 0, image_alpha, h.t};
             light_sample ls;
             vec3 f;
             vec3 arrival =
@@ -150,7 +166,8 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
                 vec3 c = mul3(mul3(nee_beta, f), arrival);
                 if (split_highlights && depth + continuation == 1 && events + continuation == 1) {
                     vec3 wi = to_local(fr, ls.wi);
-                    vec3 fg = scale3(bsdf_eval(&b, wo, wi, bsdf_highlight_lobe(&b)), wi.z);
+                    bsdf store;
+                    vec3 fg = scale3(bsdf_eval(bsdf_lobe_for(&lobe, &ls, &store), wo, wi, hl_mask), wi.z);
                     add_split(out, c, mul3(mul3(beta_hl, fg), arrival));
                 } else {
                     out[component_of(events + 1)] = add3(out[component_of(events + 1)], c);
@@ -176,7 +193,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
                 beta = add3(beta, held), held = v3s(0.0f);
         }
         if (split_highlights && depth + continuation <= 1) {
-            vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, bsdf_highlight_lobe(&b)), bs.wi.z / bs.pdf);
+            vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, hl_mask), bs.wi.z / bs.pdf);
             beta_hl = depth + continuation == 0 ? fg : mul3(beta_hl, fg);
         } else if (passed && events + continuation == 2) {
             beta_hl = mul3(beta_hl, weight);
@@ -201,7 +218,8 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
                  qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL, &run, 0.0f);
+    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL, &run,
+               (pt_regularize){0});
 }
 
 vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
@@ -210,7 +228,7 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     uint64_t camera_rays = rays[RAY_CAMERA];
     int n = first && samples > 1 ? samples : 1; /* an escaping ray has nothing to sample */
     for (int k = 0; k < n; k++) {
-        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL, NULL, 0.0f);
+        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL, NULL, (pt_regularize){0});
         sum = add3(sum, out[COMP_DIRECT]);
         if (rec && first) pixel_record_add(rec, avg3(out[COMP_DIRECT]));
     }
@@ -218,11 +236,11 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int sam
     return scale3(sum, 1.0f / (float)n);
 }
 
-int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, float min_alpha, rng_state *rng,
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, pt_regularize reg, rng_state *rng,
                         vec3 *direct, vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
     int hit = scene_intersect(s, o, d, INFINITY, first);
-    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL, lobes, NULL, min_alpha);
+    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL, lobes, NULL, reg);
     *direct = add3(out[COMP_DIRECT], out[COMP_INDIRECT]); /* INDIRECT: the split's rest */
     if (highlights) *highlights = out[COMP_HIGHLIGHTS];
     return hit;

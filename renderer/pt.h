@@ -30,15 +30,24 @@ void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, ve
 vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
                uint64_t rays[RAY_KIND_COUNT]);
 
+/* How a many-light estimator's traced path widens the glossy lobes of the hit whose direct light it
+ * takes (bsdf_regularize; docs/design.md, "Regularised chains" and "Regularised images"): to
+ * min_alpha for every light, and to image_alpha (1 + t / d) for a point or spot light at distance d
+ * when the ray came t to the hit (image_alpha: its factor times the roughness of the lobe that sent
+ * it). Zero: the lobes as they are. */
+typedef struct {
+    float min_alpha, image_alpha;
+} pt_regularize;
+
 /* The same without the emission at the hit (nor the environment when the ray escapes): only
  * light that reaches the hit directly from an emitter and is reflected back along the ray by the
  * hit's BSDF lobes in the mask (BSDF_ALL, or BSDF_NOT_HIGHLIGHT where the highlight lobe's share
  * belongs to the highlight estimator). For estimators that continue a path and must not count the emission
  * their direct light has. The ray travels in a medium of absorption sigma (0: air). With highlights
  * not NULL the ray left the camera hit through its highlight lobe: the part of the light through
- * the hit's highlight lobe goes there, the rest to *direct. Glossy lobes at the hit sharper than
- * min_alpha are widened to it (bsdf_regularize; 0: as they are). */
-int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, float min_alpha, rng_state *rng,
+ * the hit's highlight lobe goes there, the rest to *direct. reg widens the hit's glossy lobes for
+ * its direct light (pt_regularize). */
+int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, pt_regularize reg, rng_state *rng,
                         vec3 *direct, vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]);
 
 #endif

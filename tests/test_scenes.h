@@ -120,6 +120,16 @@ static inline void ts_finalize(scene *s) {
     }
 }
 
+/* A white point light of intensity 1 at position. */
+static inline void ts_point_light(scene *s, vec3 position) {
+    light l;
+    memset(&l, 0, sizeof l);
+    l.type = LIGHT_POINT;
+    l.color = v3s(1.0f);
+    l.position = position;
+    scene_add_light(s, &l);
+}
+
 /* A constant sky of radiance value (a 4x2 image). */
 static inline void ts_constant_env(scene *s, float value) {
     image_rgb img = {4, 2, malloc(sizeof(float) * 3 * 8)};

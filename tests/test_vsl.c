@@ -378,12 +378,7 @@ static scene *closed_box(material m, vec3 light_pos) {
     scene *s = ts_new("closed box");
     int mat = ts_material(s, m);
     ts_box(s, v3(-1, -1, -1), v3(1, 1, 1), 1, mat);
-    light l;
-    memset(&l, 0, sizeof l);
-    l.type = LIGHT_POINT;
-    l.color = v3s(1.0f);
-    l.position = light_pos;
-    scene_add_light(s, &l);
+    ts_point_light(s, light_pos);
     ts_finalize(s);
     return s;
 }
@@ -616,6 +611,7 @@ static void test_trace_glossy_matches_pt(void) {
         p.max_depth = depths[k];
         p.vl.trace_glossy = 0.3f;
         p.vl.regularize = -1.0f; /* exactly the path tracer's paths */
+        p.vl.reg_image = -1.0f;
         char err[256];
         render_session *rs = session_create(s, &cam, &p, err, sizeof err);
         for (int f = 0; f < frames; f++) session_render_frame(rs);
@@ -674,6 +670,7 @@ static void test_regularize_past_two_lobes(void) {
             p.max_depth = depth;
             p.vl.trace_glossy = 0.3f;
             p.vl.regularize = k ? 0.5f : -1.0f;
+            p.vl.reg_image = -1.0f;     /* the chains' floor alone */
             p.vl.radius_shrink = -1.0f; /* the floor stays at 0.5 */
             char err[256];
             render_session *rs = session_create(s, &cam, &p, err, sizeof err);
@@ -710,12 +707,7 @@ static void test_no_leak_through_thin_walls(void) {
     ts_box(s, v3(-1, -1, -1), v3(1, 1, 1), 1, mat);
     /* the divider: one quad, lit on its upper side, seen on its lower side */
     ts_quad(s, v3(-1, 0, -1), v3(1, 0, -1), v3(1, 0, 1), v3(-1, 0, 1), mat);
-    light l;
-    memset(&l, 0, sizeof l);
-    l.type = LIGHT_POINT;
-    l.color = v3s(1.0f);
-    l.position = v3(0.2f, 0.5f, 0.1f);
-    scene_add_light(s, &l);
+    ts_point_light(s, v3(0.2f, 0.5f, 0.1f));
     ts_finalize(s);
     camera cam = camera_look_at(v3(0.3f, -0.8f, 0.8f), v3(-0.5f, 0.0f, -0.5f), v3(0, 1, 0), 1.3f);
     for (int method = METHOD_VPL; method <= METHOD_VSL; method++) {
