@@ -44,7 +44,7 @@ typedef struct {
 } bsdf_lobe;
 
 /* The BSDF that light sample ls sees at l: l's own, or for a delta light at a regularised vertex
- * a copy in *store widened so that the light's image is as wide there as from afar. */
+ * a copy in *store widened to image_alpha (1 + near_t / d). */
 static const bsdf *bsdf_lobe_for(const bsdf_lobe *l, const light_sample *ls, bsdf *store) {
     if (!(l->image_alpha > 0.0f) || !ls->delta) return l->b;
     float near = ls->dist > 0.0f ? l->near_t / ls->dist : INFINITY; /* 0 for a directional light */
