@@ -123,7 +123,11 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
         frame3 fr;
         bsdf b = material_bsdf(s, &h, &fr);
-        int hl_mask = bsdf_highlight_lobe(&b); /* the path-space split goes by the lobes as they are */
+        /* The path-space split goes by the lobes as they are, before any widening; only the first
+         * vertices ask. */
+        int split_vertex =
+            (split_highlights && depth + continuation <= 1) || (depth == 0 && first_lobes == BSDF_NOT_HIGHLIGHT);
+        int hl_mask = split_vertex ? bsdf_highlight_lobe(&b) : 0;
         float image_alpha = depth == 0 && continuation ? reg.image_alpha : 0.0f;
         float floor_alpha = fmaxf(reg.min_alpha, image_alpha);
         if (floor_alpha > 0.0f) bsdf_regularize(&b, floor_alpha);
