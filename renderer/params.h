@@ -195,7 +195,7 @@ typedef struct {
     uint64_t vsl_samples;       /* integration samples of the VSL integrals */
     uint64_t clamped;           /* contributions the clamp cut down */
     uint64_t glossy_bounces;    /* camera paths continued through a sharp glossy lobe (--trace-glossy) */
-    uint64_t pixel_points;      /* camera rays past a pixel's one a frame: its highlight points (--adapt) */
+    uint64_t pixel_points;      /* camera rays past a pixel's one a frame: its direct and highlight points */
     uint64_t hl_points;         /* camera hits the highlight estimator worked at */
     uint64_t hl_secondary_rays; /* rays sampled from their glossy lobes */
     uint64_t hl_lobes;          /* lobes lit (merged, or one per secondary hit without merging) */

@@ -65,6 +65,15 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
     return scale3(f, fabsf(wi.z));
 }
 
+/* What a caller fixes at a path's first vertex: the lobes it may leave by (BSDF_NOT_HIGHLIGHT: see
+ * trace_path), the run whose point 0 its bounce takes (NULL: drawn), and the number that selects the
+ * light of its next-event estimation (< 0: drawn). */
+typedef struct {
+    int lobes;
+    const qmc_run *run;
+    float u_select;
+} first_vertex;
+
 /* The path tracer, for a ray (o, d) whose closest hit the caller has traced: *first, or NULL when
  * the ray escaped; the ray travels in a medium of absorption sigma. A continuation ray is a bounce
  * of a path begun elsewhere: the emission it finds first belongs to that path's direct light and
@@ -74,10 +83,10 @@ static vec3 bsdf_lobe_toward(const void *ctx, const light_sample *ls, float *lob
  * and its first hit is the second vertex (its light's rest goes to COMP_INDIRECT). max_depth
  * counts scattering events; transmissions are free (beyond the depth only transmission carries
  * on), up to PT_MAX_TRANSMISSIONS more vertices. reg widens glossy lobes (pt_regularize; zero:
- * none). */
+ * none); fv fixes what first_vertex says. */
 static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
                        rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
-                       int split_highlights, int first_lobes, const qmc_run *first_run, pt_regularize reg) {
+                       int split_highlights, first_vertex fv, pt_regularize reg) {
     for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
     vec3 beta = v3s(1.0f);
     /* the throughput through highlight lobes only (of the first two scattering events) */
@@ -89,7 +98,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
     int prev_nee = 0;
     vec3 prev_p = o;
     int passes = 0; /* such glass passed after the second scattering event (the highlight split) */
-    /* With first_lobes BSDF_NOT_HIGHLIGHT: the share of the path that left the first vertex by its
+    /* With fv.lobes BSDF_NOT_HIGHLIGHT: the share of the path that left the first vertex by its
      * highlight lobe. Its light is the highlight estimator's while only glass that shadow rays
      * pass lies between; at the first other vertex it joins the path (docs/design.md). Only in
      * scenes with glass: without, it could only be lost. */
@@ -126,18 +135,18 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         /* The path-space split goes by the lobes as they are, before any widening; only the first
          * vertices ask. */
         int split_vertex =
-            (split_highlights && depth + continuation <= 1) || (depth == 0 && first_lobes == BSDF_NOT_HIGHLIGHT);
+            (split_highlights && depth + continuation <= 1) || (depth == 0 && fv.lobes == BSDF_NOT_HIGHLIGHT);
         int hl_mask = split_vertex ? bsdf_highlight_lobe(&b) : 0;
         float image_alpha = depth == 0 && continuation ? reg.image_alpha : 0.0f;
         float floor_alpha = fmaxf(reg.min_alpha, image_alpha);
         if (floor_alpha > 0.0f) bsdf_regularize(&b, floor_alpha);
         vec3 wo = to_local(fr, neg3(d));
         int capped = events >= max_depth;
-        int hold = !capped && depth == 0 && first_lobes == BSDF_NOT_HIGHLIGHT && s->has_glass ? hl_mask : 0;
-        int lobes = capped                              ? BSDF_TRANSMIT
-                    : depth > 0 || hold                 ? BSDF_ALL
-                    : first_lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~hl_mask
-                                                        : first_lobes;
+        int hold = !capped && depth == 0 && fv.lobes == BSDF_NOT_HIGHLIGHT && s->has_glass ? hl_mask : 0;
+        int lobes = capped                           ? BSDF_TRANSMIT
+                    : depth > 0 || hold              ? BSDF_ALL
+                    : fv.lobes == BSDF_NOT_HIGHLIGHT ? BSDF_ALL & ~hl_mask
+                                                     : fv.lobes;
         if (!(bsdf_lobes(&b) & lobes)) break;
 
         /* Next-event estimation: lights above the surface through the reflecting lobes (shadow rays
@@ -159,7 +168,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
                 out[component_of(events)] = add3(out[component_of(events)], mul3(mul3(nee_beta, f), arrival));
         }
         if (!capped) {
-            float u_sel = rng_float(rng);
+            float u_sel = depth == 0 && fv.u_select >= 0.0f ? fv.u_select : rng_float(rng);
             vec2 u_light = rng_vec2(rng);
             bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes, 0, image_alpha, h.t};
             light_sample ls;
@@ -181,7 +190,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
         /* Continue the path by sampling the BSDF. */
         float u_lobe = rng_float(rng);
-        vec2 u_dir = depth == 0 && first_run ? qmc_run_point(*first_run, 0) : rng_vec2(rng);
+        vec2 u_dir = depth == 0 && fv.run ? qmc_run_point(*fv.run, 0) : rng_vec2(rng);
         bsdf_sample_result bs;
         if (!bsdf_sample(&b, wo, lobes, u_lobe, u_dir, &bs) || !(bs.pdf > 0.0f)) break;
         vec3 wi = to_world(fr, bs.wi);
@@ -222,29 +231,24 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
 
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
                  qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights, BSDF_ALL, &run,
-               (pt_regularize){0});
+    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights,
+               (first_vertex){BSDF_ALL, &run, -1.0f}, (pt_regularize){0});
 }
 
-vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u_select, rng_state *rng,
                uint64_t rays[RAY_KIND_COUNT]) {
-    vec3 out[COMP_COUNT], sum = v3(0, 0, 0);
-    uint64_t camera_rays = rays[RAY_CAMERA];
-    int n = first && samples > 1 ? samples : 1; /* an escaping ray has nothing to sample */
-    for (int k = 0; k < n; k++) {
-        trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, BSDF_ALL, NULL, (pt_regularize){0});
-        sum = add3(sum, out[COMP_DIRECT]);
-        if (rec && first) pixel_record_add(rec, avg3(out[COMP_DIRECT]));
-    }
-    rays[RAY_CAMERA] = camera_rays + 1; /* the samples share one camera ray */
-    return scale3(sum, 1.0f / (float)n);
+    vec3 out[COMP_COUNT];
+    trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, (first_vertex){BSDF_ALL, NULL, u_select},
+               (pt_regularize){0});
+    return out[COMP_DIRECT];
 }
 
 int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, pt_regularize reg, rng_state *rng,
                         vec3 *direct, vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
     int hit = scene_intersect(s, o, d, INFINITY, first);
-    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL, lobes, NULL, reg);
+    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL,
+               (first_vertex){lobes, NULL, -1.0f}, reg);
     *direct = add3(out[COMP_DIRECT], out[COMP_INDIRECT]); /* INDIRECT: the split's rest */
     if (highlights) *highlights = out[COMP_HIGHLIGHTS];
     return hit;

@@ -6,7 +6,6 @@
 
 #include "film.h"
 #include "params.h"
-#include "pixel_alloc.h"
 #include "rng.h"
 #include "sampling.h"
 #include "scene.h"
@@ -25,9 +24,10 @@ void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, ve
 #define PT_MAX_TRANSMISSIONS 32
 
 /* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
- * max depth 1, so every method shares one direct estimator), the mean of `samples` estimates at
- * that hit; first as for pt_radiance. rec, when not NULL and there is a hit, records each one. */
-vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, int samples, pixel_record *rec, rng_state *rng,
+ * max depth 1, so every method shares one direct estimator): one estimate, whose next-event
+ * estimation selects its light by u_select in [0, 1) (< 0: drawn), so that a caller taking several
+ * can stratify the choice; first as for pt_radiance. Counts one camera ray. */
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u_select, rng_state *rng,
                uint64_t rays[RAY_KIND_COUNT]);
 
 /* How a many-light estimator's traced path widens the glossy lobes of the hit whose direct light it

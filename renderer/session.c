@@ -50,6 +50,7 @@ struct render_session {
      * samples, from the spread of one sample's light in earlier frames */
     int adapt;
     pixel_alloc glossy, direct;
+    uint32_t *direct_taken;    /* per pixel: the points of its direct samples' run taken so far */
     uint8_t *hl_state;         /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
     hl_merge_record *hl_merge; /* per pixel with --merge auto: merge against trace; NULL until used */
     hl_setup hl;               /* vsl+hl: this frame's highlight settings */
@@ -102,7 +103,8 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
     }
     if (pixel_alloc_init(&rs->glossy, p->width * p->height) != 0 ||
         pixel_alloc_init(&rs->direct, p->width * p->height) != 0 ||
-        !(rs->hl_state = calloc((size_t)p->width * (size_t)p->height, 1))) {
+        !(rs->hl_state = calloc((size_t)p->width * (size_t)p->height, 1)) ||
+        !(rs->direct_taken = calloc((size_t)p->width * (size_t)p->height, sizeof *rs->direct_taken))) {
         session_destroy(rs);
         return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
     }
@@ -119,6 +121,7 @@ void session_destroy(render_session *rs) {
     pixel_alloc_free(&rs->glossy);
     pixel_alloc_free(&rs->direct);
     free(rs->hl_state);
+    free(rs->direct_taken);
     free(rs->hl_merge);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
@@ -175,6 +178,7 @@ enum {
     RUN_HIGHLIGHTS = 1,
     RUN_HIGHLIGHT_POINTS = 2,
     RUN_HIGHLIGHT_BLOCK = 2 + HL_PIXEL_POINTS,
+    RUN_DIRECT_POINTS,
     RUN_STREAMS = 16
 };
 static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken, int own_count) {
@@ -183,6 +187,41 @@ static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, u
     rng_state start = rng_for((uint64_t)pixel, UINT64_MAX - 2 - (shard * RUN_STREAMS + stream), p->seed);
     uint32_t sx = rng_next_u32(&start);
     return (qmc_run){(uint32_t)taken, sx, rng_next_u32(&start)};
+}
+
+/* The direct light at a pixel, the mean of `samples` estimates. The first is at the frame's own
+ * camera hit (first; NULL: none), the others each at a camera hit of its own, at the next points of
+ * the pixel's run of them (its count of them kept in direct_taken: a run's points taken in a row
+ * cover the pixel evenly, and with gaps, as a count of all samples would leave, they do not).
+ * Sample k selects its light by (k + u) / samples: the samples' choice among the lights is
+ * stratified. A light's reflection smaller than the pixel (a spot seen in a glossy sphere) varies
+ * with the position, and where several lights shine a sample varies with the light it picks; more
+ * samples at one hit, each picking at random, repeated the same shadow ray (docs/design.md, "Where
+ * the samples go"). rec, when not NULL, records each one. */
+static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                         const surface_hit *first, int samples, pixel_record *rec, rng_state *rng) {
+    const scene *s = rs->scene;
+    const render_params *p = &rs->params;
+    qmc_run run = pixel_run(rs, pixel, RUN_DIRECT_POINTS, rs->direct_taken[pixel], 1);
+    rs->direct_taken[pixel] += (uint32_t)(samples - 1);
+    float u_select = rng_float(rng);
+    vec3 sum = v3(0, 0, 0);
+    for (int k = 0; k < samples; k++) {
+        vec3 dir = d;
+        surface_hit hit;
+        const surface_hit *h = first;
+        if (k > 0) {
+            vec2 u = qmc_run_point(run, (uint32_t)(k - 1));
+            dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
+            h = scene_intersect(s, rs->cam.position, dir, INFINITY, &hit) ? &hit : NULL;
+            st->pixel_points++;
+        }
+        float u = fminf(((float)k + u_select) / (float)samples, 0x1.fffffep-1f);
+        vec3 L = pt_direct(s, rs->cam.position, dir, h, u, rng, st->rays);
+        if (rec) pixel_record_add(rec, avg3(L));
+        sum = add3(sum, L);
+    }
+    return scale3(sum, 1.0f / (float)samples);
 }
 
 /* A pixel's first highlight state: whether a camera hit at a position of its own in the pixel has
@@ -262,7 +301,9 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     /* render_tile probed the pixel's highlight state */
     int spread = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_SHARP;
     int dim = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_DIM;
-    if (!first && !s->env && !spread) { /* into the void: every component is zero, nothing to add */
+    int direct_samples = p->method == METHOD_PT ? 1 : rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES;
+    /* into the void (and its other points too): every component is zero, nothing to add */
+    if (!first && !s->env && !spread && direct_samples == 1) {
         st->rays[RAY_CAMERA]++;
         return;
     }
@@ -277,9 +318,8 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
         for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
         uint64_t t0 = clock_ns();
         if (!p->only || p->only & (1u << COMP_DIRECT))
-            L[COMP_DIRECT] = pt_direct(s, rs->cam.position, d, first,
-                                       rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES,
-                                       rs->adapt ? &rs->direct.rec[pixel] : NULL, rng, st->rays);
+            L[COMP_DIRECT] = pixel_direct(rs, st, raster, pixel, d, first, direct_samples,
+                                          rs->adapt ? &rs->direct.rec[pixel] : NULL, rng);
         else
             st->rays[RAY_CAMERA]++;
         uint64_t t1 = clock_ns();
@@ -503,6 +543,7 @@ void session_reset(render_session *rs) {
     pixel_alloc_reset(&rs->glossy);
     pixel_alloc_reset(&rs->direct);
     memset(rs->hl_state, HL_PIXEL_UNPROBED, (size_t)rs->params.width * (size_t)rs->params.height);
+    memset(rs->direct_taken, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->direct_taken);
     if (rs->hl_merge)
         memset(rs->hl_merge, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->hl_merge);
     rs->frames = 0;

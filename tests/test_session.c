@@ -4,9 +4,14 @@
  * count the frames since the last reset (the viewer's rays per second and virtual lights); a scene
  * edit re-analyses the scene and restarts. And the frames' positions inside a pixel cover it evenly:
  * an emitter's straight edge seen directly converges faster than independent positions would.
- * render_params.only: the components left out stay exactly zero and their passes never run. */
+ * render_params.only: the components left out stay exactly zero and their passes never run. The
+ * many-light methods' direct samples of a frame: spread over the pixel (the same edge after 16
+ * frames of 4 nearer than 64 independent positions) and their lights' choice stratified (two
+ * lights: a frame's value hardly varies, where choosing at random would). */
 #include <float.h>
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "check.h"
 #include "test_scenes.h"
@@ -15,18 +20,20 @@
 #define H 12
 
 /* A pixel's mean over N frames against the exact share of it an emitter's edge covers (on the
- * plane z = -1 the emitter is x < 0.1 + 0.3 y; the share counted on a 64 x 64 grid of rays).
- * Independent positions leave an RMS error of sqrt(c (1 - c) / N), about 0.05 at N = 64 for
- * c near 1/2; positions that cover the pixel evenly leave far less. */
-static void check_edge_coverage(void) {
-    enum { EW = 64, EH = 40, N = 64, G = 32 };
+ * plane z = -1 the emitter is x < 0.1 + 0.3 y; the share counted on a 32 x 32 grid of rays).
+ * Independent positions leave an RMS error of sqrt(c (1 - c) / n), about 0.05 at n = 64 for
+ * c near 1/2; positions that cover the pixel evenly leave far less. pt takes one position a frame,
+ * vsl (--adapt off, only the direct light) 4 a frame: 64 positions each. */
+static void check_edge_coverage(render_method method, int frames, int positions) {
+    enum { EW = 64, EH = 40, G = 32 };
     scene *s = ts_new("edge");
     ts_quad(s, v3(-5, -5, -1), v3(-1.4f, -5, -1), v3(1.6f, 5, -1), v3(-5, 5, -1),
             ts_lambert(s, v3s(0.0f), v3s(1.0f), 0));
     ts_finalize(s);
     camera cam = camera_look_at(v3(0, 0, 0), v3(0, 0, -1), v3(0, 1, 0), 0.6f);
-    render_params p = {.width = EW, .height = EH, .max_depth = 1, .seed = 11};
-    float *img = ts_render_with(s, &cam, &p, N, ~0u);
+    render_params p = {.width = EW, .height = EH, .method = method, .max_depth = 1, .seed = 11};
+    p.vl.adapt = VL_ADAPT_OFF;
+    float *img = ts_render_with(s, &cam, &p, frames, ~0u);
     camera_raster r = camera_raster_make(&cam, EW, EH);
     double err2 = 0.0, indep2 = 0.0;
     int edge = 0;
@@ -44,17 +51,76 @@ static void check_edge_coverage(void) {
             if (c < 0.05 || c > 0.95) continue;
             edge++;
             err2 += (v - c) * (v - c);
-            indep2 += c * (1.0 - c) / N;
+            indep2 += c * (1.0 - c) / positions;
         }
     }
     CHECK(edge >= 20, "the edge must cross pixels (%d)", edge);
     double rms = sqrt(err2 / edge), indep = sqrt(indep2 / edge);
     CHECK(rms < 0.5 * indep,
-          "pixels along an edge after %d frames: RMS error %.4f, independent positions would "
+          "%s, pixels along an edge after %d frames: RMS error %.4f, %d independent positions would "
           "leave %.4f",
-          N, rms, indep);
+          method_name(method), frames, rms, positions, indep);
     free(img);
     scene_destroy(s);
+}
+
+/* A session of p over n frames: their mean to mean and, when frames is not NULL, each frame's own
+ * image (from the running means) to frames[f]. */
+static void session_frames_of(const scene *s, const camera *cam, const render_params *p, int n, float *mean,
+                              float **frames) {
+    char err[256];
+    int len = 3 * p->width * p->height;
+    render_session *rs = session_create(s, cam, p, err, sizeof err);
+    CHECK(rs != NULL, "session: %s", err);
+    float *prev = calloc((size_t)len, sizeof *prev);
+    for (int f = 0; rs && f < n; f++) {
+        CHECK(session_render_frame(rs) == 0, "frame %d: %s", f, session_error(rs));
+        film_resolve(session_film(rs), ~0u, mean);
+        for (int i = 0; frames && i < len; i++) frames[f][i] = (float)((f + 1.0) * mean[i] - f * (double)prev[i]);
+        memcpy(prev, mean, sizeof(float) * (size_t)len);
+    }
+    free(prev);
+    session_destroy(rs);
+}
+
+/* A Lambert floor under two point lights of equal power, far apart, seen by vsl's 4 direct samples a
+ * frame (--adapt off): their mean over the frames is the sum of the lights' images rendered apart,
+ * and a frame's value varies far less than choosing each sample's light at random would make it
+ * ((f1 - f2)^2 / 4 at a pixel the lights light f1 and f2). */
+static void check_direct_light_choice(void) {
+    enum { N = 24, LEN = 3 * W * H };
+    const vec3 lights[2] = {v3(-1.0f, 2.0f, -1.0f), v3(1.0f, 1.5f, -1.0f)};
+    camera cam = camera_look_at(v3(0, 2.5f, 0.0f), v3(0, 0, -1), v3(0, 1, 0), 0.8f);
+    render_params p = {.width = W, .height = H, .method = METHOD_VSL, .max_depth = 1, .seed = 7};
+    p.vl.adapt = VL_ADAPT_OFF;
+    float alone[2][LEN], both[LEN];
+    float *frames[N];
+    for (int f = 0; f < N; f++) frames[f] = malloc(sizeof(float) * LEN);
+    for (int k = 0; k <= 2; k++) {
+        scene *s = ts_new("two lights");
+        ts_quad(s, v3(-4, 0, 2), v3(4, 0, 2), v3(4, 0, -6), v3(-4, 0, -6), ts_lambert(s, v3s(0.8f), v3s(0), 0));
+        for (int l = 0; l < 2; l++)
+            if (k == 2 || k == l) ts_point_light(s, lights[l]);
+        ts_finalize(s);
+        session_frames_of(s, &cam, &p, N, k < 2 ? alone[k] : both, k < 2 ? NULL : frames);
+        scene_destroy(s);
+    }
+    double sum = 0.0, expect = 0.0, var = 0.0, random_choice = 0.0;
+    for (int i = 0; i < LEN; i++) {
+        double f1 = alone[0][i], f2 = alone[1][i], m = 0.0, m2 = 0.0;
+        sum += both[i];
+        expect += f1 + f2;
+        for (int f = 0; f < N; f++) m += frames[f][i], m2 += (double)frames[f][i] * frames[f][i];
+        m /= N;
+        var += (m2 - N * m * m) / (N - 1);
+        random_choice += (f1 - f2) * (f1 - f2) / 4.0;
+    }
+    CHECK(expect > 0.0 && fabs(sum / expect - 1.0) < 0.01, "two lights: mean %.5f of the lights' images apart",
+          sum / expect);
+    CHECK(var < 0.05 * random_choice,
+          "two lights: a frame's variance %.4g, against %.4g were each sample's light chosen at random", var,
+          random_choice);
+    for (int f = 0; f < N; f++) free(frames[f]);
 }
 
 /* Sums of each component's film after two frames of p, and the statistics. */
@@ -100,11 +166,13 @@ static void check_only(void) {
         for (int c = 0; c < COMP_COUNT; c++)
             CHECK((rendered >> c & 1u) ? sum[c] > 0.0 && isfinite(sum[c]) : sum[c] == 0.0,
                   "only %#x: component %d sums to %g", masks[k], c, sum[c]);
-        /* One camera ray a pixel a frame, and those of the pixels' extra highlight points (--adapt) */
+        /* One camera ray a pixel a frame, and those of the pixels' extra direct and highlight points */
         CHECK(st.rays[RAY_CAMERA] == (uint64_t)(2 * W * H) + st.pixel_points,
               "only %#x: %llu camera rays for %d + %llu", masks[k], (unsigned long long)st.rays[RAY_CAMERA], 2 * W * H,
               (unsigned long long)st.pixel_points);
-        CHECK(st.pixel_points < (uint64_t)(2 * W * H * 8), "only %#x: %llu extra points", masks[k],
+        /* a pixel's probe, and a frame's 3 more direct samples (4 a pixel before the records decide)
+         * and 7 more highlight points at most */
+        CHECK(st.pixel_points <= (uint64_t)(W * H * (1 + 2 * (3 + 7))), "only %#x: %llu extra points", masks[k],
               (unsigned long long)st.pixel_points);
         CHECK((rendered & I) ? st.virtual_lights > 0 : st.virtual_lights == 0 && st.pass_ns[PASS_GATHER] == 0,
               "only %#x: %llu virtual lights", masks[k], (unsigned long long)st.virtual_lights);
@@ -158,7 +226,9 @@ static void check_huge_sky(void) {
 }
 
 int main(void) {
-    check_edge_coverage();
+    check_edge_coverage(METHOD_PT, 64, 64);
+    check_edge_coverage(METHOD_VSL, 16, 64);
+    check_direct_light_choice();
     check_huge_sky();
     check_only();
     scene *s = ts_new("box");
