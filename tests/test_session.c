@@ -86,7 +86,7 @@ static void session_frames_of(const scene *s, const camera *cam, const render_pa
 /* A Lambert floor under two point lights of equal power, far apart, seen by vsl's 4 direct samples a
  * frame (--adapt off): their mean over the frames is the sum of the lights' images rendered apart,
  * and a frame's value varies far less than choosing each sample's light at random would make it
- * ((f1 - f2)^2 / 4 at a pixel the lights light f1 and f2). */
+ * ((f1 - f2)^2 / 4 at a pixel where the lights alone give f1 and f2). */
 static void check_direct_light_choice(void) {
     enum { N = 24, LEN = 3 * W * H };
     const vec3 lights[2] = {v3(-1.0f, 2.0f, -1.0f), v3(1.0f, 1.5f, -1.0f)};
