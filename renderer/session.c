@@ -138,6 +138,16 @@ static uint64_t next_frame_index(const render_session *rs) {
     return shard_frame_index(p->shard_spp_total, p->shard_index, p->shard_count, (uint64_t)rs->frames);
 }
 
+/* The camera ray through position u ([0,1)^2) of a pixel past the frame's own: its direction to
+ * *dir, its hit to *hit, returned (NULL: none). Counts the point; its camera ray is the caller's. */
+static const surface_hit *pixel_hit(const render_session *rs, render_stats *st, const camera_raster *raster, int pixel,
+                                    vec2 u, vec3 *dir, surface_hit *hit) {
+    int w = rs->params.width;
+    *dir = camera_raster_dir(raster, (float)(pixel % w) + u.x, (float)(pixel / w) + u.y);
+    st->pixel_points++;
+    return scene_intersect(rs->scene, rs->cam.position, *dir, INFINITY, hit) ? hit : NULL;
+}
+
 /* n camera hits spread over a pixel: the frame's own first (NULL: none), then more at R2
  * positions over the pixel. */
 static void pixel_points(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
@@ -152,11 +162,8 @@ static void pixel_points(render_session *rs, render_stats *st, const camera_rast
         vec3 dir = d;
         if (j > 0) {
             int index = (int)((next_frame_index(rs) * (HL_PIXEL_POINTS - 1) + (uint64_t)j) & 0x3fffffff);
-            vec2 u = sample_r2(index, shift);
-            dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
             st->rays[RAY_CAMERA]++;
-            st->pixel_points++;
-            h = scene_intersect(s, rs->cam.position, dir, INFINITY, &hit) ? &hit : NULL;
+            h = pixel_hit(rs, st, raster, pixel, sample_r2(index, shift), &dir, &hit);
         }
         if (h) {
             xs[j] = shading_point_at(s, h, dir);
@@ -201,7 +208,6 @@ static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, u
 static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
                          const surface_hit *first, int samples, pixel_record *rec, rng_state *rng) {
     const scene *s = rs->scene;
-    const render_params *p = &rs->params;
     qmc_run run = pixel_run(rs, pixel, RUN_DIRECT_POINTS, rs->direct_taken[pixel], 1);
     rs->direct_taken[pixel] += (uint32_t)(samples - 1);
     float u_select = rng_float(rng);
@@ -211,10 +217,7 @@ static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_rast
         surface_hit hit;
         const surface_hit *h = first;
         if (k > 0) {
-            vec2 u = qmc_run_point(run, (uint32_t)(k - 1));
-            dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
-            h = scene_intersect(s, rs->cam.position, dir, INFINITY, &hit) ? &hit : NULL;
-            st->pixel_points++;
+            h = pixel_hit(rs, st, raster, pixel, qmc_run_point(run, (uint32_t)(k - 1)), &dir, &hit);
         }
         float u = fminf(((float)k + u_select) / (float)samples, 0x1.fffffep-1f);
         vec3 L = pt_direct(s, rs->cam.position, dir, h, u, rng, st->rays);
@@ -231,12 +234,10 @@ static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_rast
 static int probe_state(render_session *rs, render_stats *st, const camera_raster *raster, int pixel) {
     const render_params *p = &rs->params;
     rng_state r = rng_for((uint64_t)pixel, UINT64_MAX >> 1, p->seed); /* no frame's stream */
-    vec2 u = rng_vec2(&r);
-    vec3 dir = camera_raster_dir(raster, (float)(pixel % p->width) + u.x, (float)(pixel / p->width) + u.y);
-    st->rays[RAY_CAMERA]++;
-    st->pixel_points++;
+    vec3 dir;
     surface_hit h;
-    if (!scene_intersect(rs->scene, rs->cam.position, dir, INFINITY, &h)) return HL_PIXEL_BROAD;
+    st->rays[RAY_CAMERA]++;
+    if (!pixel_hit(rs, st, raster, pixel, rng_vec2(&r), &dir, &h)) return HL_PIXEL_BROAD;
     shading_point x = shading_point_at(rs->scene, &h, dir);
     return hl_point_sharp(&rs->hl, &x) ? HL_PIXEL_SHARP : HL_PIXEL_BROAD;
 }
