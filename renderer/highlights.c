@@ -442,7 +442,7 @@ static vec3 light_lobe(const hl_setup *h, const scene *s, const lit_lobe *l, rng
         float u_sel = rng_float(rng);
         vec2 u = rng_vec2(rng);
         lobe_nee ctx = {l, s, env_by_sampling};
-        vec3 f_light, arrival = nee_direct(s, l->origin, l->n, v3s(0.0f), u_sel, u, lobe_toward, &ctx,
+        vec3 f_light, arrival = nee_direct(s, l->origin, l->n, v3s(0.0f), u_sel, u, rng, lobe_toward, &ctx,
                                            &st->rays[RAY_SHADOW], &f_light, NULL);
         sum = add3(sum, mul3(f_light, arrival));
         vec3 wi;

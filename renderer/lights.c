@@ -1,6 +1,7 @@
 /* Lights: building the list, sampling for next-event estimation, pdfs for MIS, the environment. */
 #include "lights.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -95,11 +96,16 @@ int scene_build_lights(scene *s, char *err, size_t errlen) {
         if (s->env_light < 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
     }
     dist1d_deinit(&s->light_dist);
+    dist1d_deinit(&s->nee_dist);
+    s->nee_each = kept <= NEE_EACH_MAX ? kept : 0;
+    s->nee_draws = s->num_lights > s->nee_each;
     if (s->num_lights > 0) {
         float *power = malloc(sizeof(float) * (size_t)s->num_lights);
         if (!power) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
         for (int i = 0; i < s->num_lights; i++) power[i] = s->lights[i].power;
         int status = dist1d_init(&s->light_dist, power, s->num_lights);
+        for (int i = 0; i < s->nee_each; i++) power[i] = 0.0f;
+        if (status == 0 && s->nee_draws) status = dist1d_init(&s->nee_dist, power, s->num_lights);
         free(power);
         if (status != 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
     }
@@ -140,9 +146,9 @@ static surface_hit triangle_point(const scene *s, int t, vec2 u, vec3 *q, vec3 *
 static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light_sample *out);
 
 int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out) {
-    if (s->num_lights == 0) return 0;
+    if (!s->nee_draws) return 0;
     float pmf;
-    int li = dist1d_sample_discrete(&s->light_dist, u_select, &pmf, NULL);
+    int li = dist1d_sample_discrete(&s->nee_dist, u_select, &pmf, NULL);
     if (!(pmf > 0.0f)) return 0;
     return sample_light(s, li, pmf, p, u, out);
 }
@@ -246,7 +252,7 @@ float light_pdf_triangle(const scene *s, int li, vec3 p, const surface_hit *h) {
     float d2 = length_sq3(d);
     float cos_l = fabsf(dot3(h->ng, d)) / sqrtf(d2);
     if (!(cos_l > 0.0f) || !(area > 0.0f)) return 0.0f;
-    return dist1d_pmf(&s->light_dist, li) * d2 / (cos_l * area);
+    return dist1d_pmf(&s->nee_dist, li) * d2 / (cos_l * area);
 }
 
 float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, float lobe_pdf) {
@@ -255,17 +261,44 @@ float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, 
     return mis_power(lobe_pdf, li >= 0 ? light_pdf_triangle(s, li, p, h) : 0.0f);
 }
 
-vec3 nee_direct(const scene *s, vec3 p, vec3 ng, vec3 sigma, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
-                uint64_t *shadow_rays, vec3 *f, light_sample *out) {
+/* One candidate of next-event estimation: its sample, the lobe toward it, its MIS weight over its
+ * pdf, and what it would bring before its shadow ray, the luminance of f Le w / pdf. */
+typedef struct {
     light_sample ls;
+    vec3 f;
+    float w_pdf, w;
+} nee_candidate;
+
+vec3 nee_direct(const scene *s, vec3 p, vec3 ng, vec3 sigma, float u_select, vec2 u, rng_state *rng, nee_lobe_fn lobe,
+                const void *ctx, uint64_t *shadow_rays, vec3 *f, light_sample *out) {
+    nee_candidate c[NEE_EACH_MAX + 1];
+    int m = 0;
+    float sum = 0.0f;
     *f = v3(0, 0, 0);
-    if (!light_sample_direct(s, p, u_select, u, &ls) || !(dot3(ls.wi, ng) > 0.0f)) return v3(0, 0, 0);
-    if (out) *out = ls;
-    float lobe_pdf = 0.0f;
-    *f = lobe(ctx, &ls, &lobe_pdf);
-    if (is_black3(*f)) return v3(0, 0, 0);
-    vec3 tr = light_sample_visible(s, p, ng, &ls, sigma, shadow_rays);
-    return is_black3(tr) ? tr : mul3(tr, scale3(ls.radiance, nee_light_weight(&ls, lobe_pdf) / ls.pdf));
+    for (int j = 0; j <= s->nee_each; j++) {
+        nee_candidate *cj = &c[m];
+        if (j < s->nee_each ? !light_sample_one(s, j, p, u, &cj->ls) : !light_sample_direct(s, p, u_select, u, &cj->ls))
+            continue;
+        if (!(dot3(cj->ls.wi, ng) > 0.0f)) continue;
+        float lobe_pdf = 0.0f;
+        cj->f = lobe(ctx, &cj->ls, &lobe_pdf);
+        cj->w_pdf = nee_light_weight(&cj->ls, lobe_pdf) / cj->ls.pdf;
+        cj->w = luminance3(mul3(cj->f, cj->ls.radiance)) * cj->w_pdf;
+        if (!(cj->w > 0.0f) || !(cj->w < INFINITY)) continue;
+        sum += cj->w;
+        m++;
+    }
+    if (m == 0) return v3(0, 0, 0);
+    int k = 0;
+    if (m > 1) { /* one in proportion to what it brings */
+        float x = rng_float(rng) * sum;
+        while (k < m - 1 && x >= c[k].w) x -= c[k++].w;
+    }
+    if (out) *out = c[k].ls;
+    *f = c[k].f;
+    vec3 tr = light_sample_visible(s, p, ng, &c[k].ls, sigma, shadow_rays);
+    /* Resampled: the pick's own estimate times the candidates' sum over its share of it. */
+    return is_black3(tr) ? tr : mul3(tr, scale3(c[k].ls.radiance, c[k].w_pdf * (sum / c[k].w)));
 }
 
 float light_pdf_env(const scene *s, vec3 d) {
@@ -273,7 +306,7 @@ float light_pdf_env(const scene *s, vec3 d) {
     vec2 uv = env_uv(s->env, d);
     float st = sinf(PI_F * uv.y);
     if (!(st > 0.0f)) return 0.0f;
-    return dist1d_pmf(&s->light_dist, s->env_light) * dist2d_pdf(&s->env->dist, uv) / (2.0f * PI_F * PI_F * st);
+    return dist1d_pmf(&s->nee_dist, s->env_light) * dist2d_pdf(&s->env->dist, uv) / (2.0f * PI_F * PI_F * st);
 }
 
 /* ---- emission (light tracing) -------------------------------------------------------------- */

@@ -1,8 +1,10 @@
-/* glint — lights: selection by power, sampling a light from a shading point (next-event
- * estimation), the matching pdfs for multiple importance sampling, and the environment map. */
+/* glint — lights: next-event estimation's candidates and the light it keeps, sampling a light from
+ * a shading point, the matching pdfs for multiple importance sampling, selection by power for
+ * emission, and the environment map. */
 #ifndef GLINT_LIGHTS_H
 #define GLINT_LIGHTS_H
 
+#include "rng.h"
 #include "scene.h"
 
 typedef struct {
@@ -18,9 +20,9 @@ typedef struct {
     int delta;     /* a point, spot or directional light: no MIS possible */
 } light_sample;
 
-/* Picks a light by power (u_select) and a point or direction on it (u) as seen from p.
- * Returns 0 when the sample carries nothing (no lights, back of a single-sided emitter, outside
- * a spot cone, zero pdf). */
+/* Picks a light by power (u_select) among those next-event estimation draws rather than takes each,
+ * and a point or direction on it (u) as seen from p. Returns 0 when the sample carries nothing (no
+ * such lights, back of a single-sided emitter, outside a spot cone, zero pdf). */
 int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sample *out);
 
 /* The same for one given light (index into scene.lights), as if it were always chosen: the pdf
@@ -69,13 +71,19 @@ float nee_emission_weight(const scene *s, vec3 p, const surface_hit *h, vec3 d, 
  * sampling finds that direction. Black means no shadow ray. */
 typedef vec3 (*nee_lobe_fn)(const void *lobe, const light_sample *ls, float *lobe_pdf);
 
-/* Next-event estimation, the one routine: picks a light from p (u_select, u), keeps it only above
- * the geometric surface (ng), asks the lobe for its value *f and traces one shadow ray when that is
- * not black (through smooth unbent glass, from a medium of absorption sigma:
- * light_sample_visible). Returns the light's weighted arrival Le T w / pdf (black when nothing
- * arrives); the contribution is *f times it. *ls (optional) receives the sample. */
-vec3 nee_direct(const scene *s, vec3 p, vec3 ng, vec3 sigma, float u_select, vec2 u, nee_lobe_fn lobe, const void *ctx,
-                uint64_t *shadow_rays, vec3 *f, light_sample *ls);
+/* Next-event estimation, the one routine. Its candidates: each punctual light (up to NEE_EACH_MAX
+ * of them; more are drawn with the rest) and one light drawn by power from the rest (u_select, a
+ * point on it by u), each kept only above the geometric surface (ng) and valued by the lobe (*f
+ * for the one kept). Of several it keeps one in proportion to what each would bring before its
+ * shadow ray (resampled importance sampling over candidates of disjoint kinds, the pick from rng):
+ * a spot of little power in the sharp lobe that faces it, which a draw by power mostly missed, is
+ * nearly always the one (docs/design.md, "Which light a sample takes"). The MIS weights keep the
+ * draw's density. One shadow ray (through smooth unbent glass, from a medium of absorption sigma:
+ * light_sample_visible). Returns the kept light's weighted arrival (black when nothing arrives);
+ * the contribution is *f times it. *ls (optional) receives its sample. */
+#define NEE_EACH_MAX 8
+vec3 nee_direct(const scene *s, vec3 p, vec3 ng, vec3 sigma, float u_select, vec2 u, rng_state *rng, nee_lobe_fn lobe,
+                const void *ctx, uint64_t *shadow_rays, vec3 *f, light_sample *ls);
 
 /* Rebuilds the light list after geometry, materials or the environment changed: keeps the
  * punctual lights, re-derives emissive triangles and the environment light, powers and the

@@ -162,7 +162,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             vec3 beyond = material_medium_after(&s->materials[h.material], h.backface, BSDF_TRANSMIT, sigma);
             light_sample ls;
             vec3 f;
-            vec3 arrival = nee_direct(s, h.p, neg3(h.ng), beyond, u_sel, u_light, bsdf_lobe_toward, &lobe,
+            vec3 arrival = nee_direct(s, h.p, neg3(h.ng), beyond, u_sel, u_light, rng, bsdf_lobe_toward, &lobe,
                                       &rays[RAY_SHADOW], &f, &ls);
             if (!is_black3(arrival))
                 out[component_of(events)] = add3(out[component_of(events)], mul3(mul3(nee_beta, f), arrival));
@@ -173,8 +173,8 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             bsdf_lobe lobe = {&b, fr, wo, lobes & ~hold, lobes, 0, image_alpha, h.t};
             light_sample ls;
             vec3 f;
-            vec3 arrival =
-                nee_direct(s, h.p, h.ng, sigma, u_sel, u_light, bsdf_lobe_toward, &lobe, &rays[RAY_SHADOW], &f, &ls);
+            vec3 arrival = nee_direct(s, h.p, h.ng, sigma, u_sel, u_light, rng, bsdf_lobe_toward, &lobe,
+                                      &rays[RAY_SHADOW], &f, &ls);
             if (!is_black3(arrival)) {
                 vec3 c = mul3(mul3(nee_beta, f), arrival);
                 if (split_highlights && depth + continuation == 1 && events + continuation == 1) {

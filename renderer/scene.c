@@ -84,6 +84,7 @@ void scene_destroy(scene *s) {
     free(s->cameras);
     env_map_destroy(s->env);
     dist1d_deinit(&s->light_dist);
+    dist1d_deinit(&s->nee_dist);
     free(((scene_box *)s)->gains);
     free(((scene_box *)s)->gain_bases);
     free((scene_box *)s);

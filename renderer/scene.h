@@ -175,7 +175,10 @@ typedef struct scene {
     env_map *env;  /* NULL without one */
     int env_light; /* index into lights, or -1 */
 
-    dist1d light_dist; /* light selection by power */
+    dist1d light_dist; /* light selection by power (emission: virtual lights) */
+    dist1d nee_dist;   /* next-event estimation's draw by power among the lights it does not take each */
+    int nee_each;      /* the punctual lights [0, nee_each) next-event estimation takes each (lights.h) */
+    int nee_draws;     /* whether it draws a light from nee_dist too */
 
     bounds3 bounds;
     float diag;    /* bounding-box diagonal: the scene's size */

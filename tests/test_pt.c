@@ -248,6 +248,112 @@ static void test_area_light(void) {
     scene_destroy(s);
 }
 
+/* ---- several lights at once: next-event estimation's candidates ------------------------------ */
+
+typedef struct {
+    area_setup as;
+    plane_light point, spot;
+} mixed_setup;
+
+static float mixed_radiance(vec3 p, const void *ctx) {
+    const mixed_setup *ms = ctx;
+    return area_radiance(p, &ms->as) + punctual_radiance(p, &ms->point) + punctual_radiance(p, &ms->spot);
+}
+
+static light mixed_spot(void) {
+    return (light){.type = LIGHT_SPOT,
+                   .color = v3s(2.0f),
+                   .position = v3(-1.0f, 1.2f, 0.5f),
+                   .direction = normalize3(v3(0.5f, -1, -0.2f)),
+                   .cos_inner = cosf(0.3f),
+                   .cos_outer = cosf(0.7f)};
+}
+
+/* A point light, a spot and the square area light over the Lambert plane, direct light only: the
+ * image is the sum of the three closed forms. Next-event estimation takes the punctual lights and
+ * a draw among the area lights as candidates and keeps one by what it brings; the mean must stay
+ * the sum (and the MIS weights of the emitter found by BSDF sampling must match the draw's). */
+static void test_mixed_lights(void) {
+    mixed_setup ms = {{{v3(-0.5f, 1, -0.5f), v3(0.5f, 1, -0.5f), v3(0.5f, 1, 0.5f), v3(-0.5f, 1, 0.5f)}, 4.0f, 0.5f},
+                      {{.type = LIGHT_POINT, .color = v3s(1.5f), .position = v3(1.2f, 0.8f, 0.6f)}, 0.5f},
+                      {mixed_spot(), 0.5f}};
+    scene *s = ts_new("mixed-lights");
+    int plane = ts_lambert(s, v3s(0.5f), v3s(0), 0);
+    int emitter = ts_lambert(s, v3s(0), v3s(ms.as.le), 0);
+    ts_quad(s, v3(-20, 0, 20), v3(20, 0, 20), v3(20, 0, -20), v3(-20, 0, -20), plane);
+    ts_quad(s, ms.as.corners[0], ms.as.corners[1], ms.as.corners[2], ms.as.corners[3], emitter);
+    scene_add_light(s, &ms.point.l);
+    scene_add_light(s, &ms.spot.l);
+    ts_finalize(s);
+    CHECK(s->nee_each == 2 && s->nee_draws, "mixed lights: %d punctual lights taken each", s->nee_each);
+    camera cam = camera_look_at(v3(0.2f, 3.0f, 2.0f), v3(0, 0, 0), v3(0, 1, 0), 1.0f);
+    const int w = 32, h = 24, n = w * h;
+    float *img = ts_render(s, &cam, w, h, 64, 1, 9, ALL);
+    float *e = plane_expected(&cam, w, h, mixed_radiance, &ms);
+    for (int i = 0; i < n; i++) { /* the emitter's unlit back, which plane_expected does not know */
+        vec3 d = camera_ray_dir(&cam, (float)w / (float)h, ((float)(i % w) + 0.5f) / (float)w,
+                                ((float)(i / w) + 0.5f) / (float)h);
+        surface_hit hit;
+        if (scene_intersect(s, cam.position, d, INFINITY, &hit) && hit.p.y > 0.5f)
+            for (int c = 0; c < 3; c++) img[3 * i + c] = e[3 * i + c] = 0.0f;
+    }
+    double mean, sem, mean_e, sem_e;
+    ts_stats(e, n, &mean_e, &sem_e);
+    diff_stats(img, e, n, &mean, &sem);
+    CHECK_NEAR(mean, 0.0, 4.0 * sem + 2e-3 * mean_e, "mixed lights: mean error (expected mean %g)", mean_e);
+    diff_stats(img, e, n / 2, &mean, &sem);
+    CHECK_NEAR(mean, 0.0, 4.0 * sem + 2e-3 * mean_e, "mixed lights: far half");
+    diff_stats(img + 3 * (n / 2), e + 3 * (n / 2), n - n / 2, &mean, &sem);
+    CHECK_NEAR(mean, 0.0, 4.0 * sem + 2e-3 * mean_e, "mixed lights: near half");
+    free(img);
+    free(e);
+    scene_destroy(s);
+}
+
+/* A spot of a tenth of the scene's power, seen in a glossy metal plane, beside a bright panel the
+ * plane's lobe does not face there: at the spot's highlight one sample picking its light by power
+ * varies by at least E^2 (1 - p) / p (E the spot's share, p its power's); keeping the candidate
+ * that brings the most leaves a small part of that. */
+static void test_weak_light_in_lobe(void) {
+    scene *s = ts_new("weak-light");
+    material metal = material_default();
+    metal.base_color = v3s(0.9f);
+    metal.metallic = 1.0f;
+    metal.roughness = 0.3f;
+    int plane = ts_material(s, metal);
+    int emitter = ts_lambert(s, v3s(0), v3s(6.0f), 0);
+    ts_quad(s, v3(-20, 0, 20), v3(20, 0, 20), v3(20, 0, -20), v3(-20, 0, -20), plane);
+    ts_quad(s, v3(3, 3, -1), v3(5, 3, -1), v3(5, 3, 1), v3(3, 3, 1), emitter); /* facing down */
+    light spot = {.type = LIGHT_SPOT,
+                  .color = v3s(3.0f),
+                  .position = v3(0, 1.5f, -2.0f),
+                  .direction = normalize3(v3(0, -1.5f, 2.0f)),
+                  .cos_inner = cosf(0.4f),
+                  .cos_outer = cosf(0.8f)};
+    scene_add_light(s, &spot);
+    ts_finalize(s);
+    float p = dist1d_pmf(&s->light_dist, 0); /* punctual lights come first */
+    CHECK(p > 0.02f && p < 0.2f, "weak light: the spot's share of the power is %g", p);
+    camera cam = camera_look_at(v3(0, 1.5f, 2.0f), v3(0, 0, 0), v3(0, 1, 0), 0.5f);
+    const int w = 16, h = 12, n = w * h, runs = 200;
+    double *sum = calloc((size_t)n, sizeof *sum), *sum2 = calloc((size_t)n, sizeof *sum2);
+    for (int r = 0; r < runs; r++) {
+        float *img = ts_render(s, &cam, w, h, 1, 1, (uint64_t)(100 + r), ALL);
+        for (int i = 0; i < n; i++) sum[i] += img[3 * i], sum2[i] += (double)img[3 * i] * img[3 * i];
+        free(img);
+    }
+    int peak = 0;
+    for (int i = 1; i < n; i++)
+        if (sum[i] > sum[peak]) peak = i;
+    double e = sum[peak] / runs, var = sum2[peak] / runs - e * e, by_power = e * e * (1.0 - p) / p;
+    CHECK(e > 0.1, "weak light: its highlight is dark (%g)", e);
+    CHECK(var < 0.05 * by_power, "weak light: variance %g at its highlight (%g), picking by power %g", var, e,
+          by_power);
+    free(sum);
+    free(sum2);
+    scene_destroy(s);
+}
+
 /* ---- glossy reflection of an area light: brute-force quadrature over the light ---------------- */
 
 typedef struct {
@@ -498,6 +604,8 @@ int main(void) {
     test_punctual("directional", sun);
 
     test_area_light();
+    test_mixed_lights();
+    test_weak_light_in_lobe();
 
     test_glossy_area("glossy-phong", glossy_material(MATERIAL_PHONG));
     test_glossy_area("glossy-ward", glossy_material(MATERIAL_WARD));
