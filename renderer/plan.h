@@ -60,7 +60,7 @@ typedef struct {
     int highlights;         /* vsl+hl: the highlight pass (else the VSL gather keeps those paths) */
     int env_prefilter;      /* vsl+hl: the vMF-prefiltered environment */
     /* why, one line each */
-    char why_depth[160], why_virtual[160], why_kernel[160], why_highlights[160], why_env[160], why_direct[200];
+    char why_depth[160], why_virtual[160], why_kernel[160], why_highlights[160], why_env[160], why_direct[256];
 } effect_plan;
 
 /* The plan for method `method` (render_method), asked max_depth, PLAN_AUTO or PLAN_FULL. */

@@ -76,17 +76,21 @@ static inline int merge_stats_compare(const char *a_path, const char *b_path, me
     return status;
 }
 
-/* The verdict: the median |z| where normal errors put it (robust to the few pixels whose variance
- * a handful of samples misjudges; a wrong weight or a shard counted twice moves it far: two
- * sigma of it is about 0.04 with a thousand pixel channels), the distance what the noise estimates
- * predict, the two estimates alike. Prints what fails; 1 when all hold. */
+/* The verdict: the median |z| no further out than normal errors put it (robust to the few pixels
+ * whose variance a handful of samples misjudges; a wrong weight or a shard counted twice moves it
+ * far: two sigma of it is about 0.04 with a thousand pixel channels), the distance no more than
+ * the noise estimates predict, the two estimates alike. Only the upper sides tell a fault: the
+ * estimates take the frames as independent, and the frames' positions in the pixel follow one
+ * Sobol run, whose mean errs less than that (doorway's direct light, where next-event estimation
+ * leaves little but the position's variance, at edges: 0.3 of the distance they predict).
+ * Prints what fails; 1 when all hold. */
 static inline int merge_stats_agree(const merge_stats *st) {
     int ok = 1;
     if (st->compared * 2 < st->pixels / 2)
         ok = 0, fprintf(stderr, "only %zu of %zu pixel channels have a variance\n", st->compared, st->pixels);
-    if (!(st->below > 0.42 && st->below < 0.58))
-        ok = 0, fprintf(stderr, "%.3f of |z| below 0.674 (expected 0.5)\n", st->below);
-    if (!(st->measured > 0.7 * st->predicted && st->measured < 1.4 * st->predicted))
+    if (!(st->below > 0.42))
+        ok = 0, fprintf(stderr, "%.3f of |z| below 0.674 (expected 0.5, more with stratified frames)\n", st->below);
+    if (!(st->measured < 1.4 * st->predicted))
         ok = 0,
         fprintf(stderr, "relative L2 %.4g between them, their noise predicts %.4g\n", st->measured, st->predicted);
     if (!(st->noise_a > 0.8 * st->noise_b && st->noise_a < 1.25 * st->noise_b))
