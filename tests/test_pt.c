@@ -310,10 +310,10 @@ static void test_mixed_lights(void) {
     scene_destroy(s);
 }
 
-/* A spot of a tenth of the scene's power, seen in a glossy metal plane, beside a bright panel the
- * plane's lobe does not face there: at the spot's highlight one sample picking its light by power
- * varies by at least E^2 (1 - p) / p (E the spot's share, p its power's); keeping the candidate
- * that brings the most leaves a small part of that. */
+/* A spot of a twentieth of the scene's power, seen in a glossy metal plane, beside a bright panel
+ * the plane's lobe does not face there: at the spot's highlight one sample picking its light by
+ * power varies by at least E^2 (1 - p) / p (E the spot's share, p its power's); keeping a
+ * candidate by what it brings leaves a small part of that. */
 static void test_weak_light_in_lobe(void) {
     scene *s = ts_new("weak-light");
     material metal = material_default();
