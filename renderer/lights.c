@@ -97,7 +97,7 @@ int scene_build_lights(scene *s, char *err, size_t errlen) {
     }
     dist1d_deinit(&s->light_dist);
     dist1d_deinit(&s->nee_dist);
-    s->nee_each = kept <= NEE_EACH_MAX ? kept : 0;
+    s->nee_each = nee_each_count(kept);
     s->nee_draws = s->num_lights > s->nee_each;
     if (s->num_lights > 0) {
         float *power = malloc(sizeof(float) * (size_t)s->num_lights);

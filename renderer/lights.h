@@ -82,6 +82,9 @@ typedef vec3 (*nee_lobe_fn)(const void *lobe, const light_sample *ls, float *lob
  * light_sample_visible). Returns the kept light's weighted arrival (black when nothing arrives);
  * the contribution is *f times it. *ls (optional) receives its sample. */
 #define NEE_EACH_MAX 8
+/* How many of a scene's punctual lights next-event estimation takes each: all, up to NEE_EACH_MAX;
+ * past that none (they are drawn with the rest). It draws as well when other lights remain. */
+static inline int nee_each_count(int punctual) { return punctual <= NEE_EACH_MAX ? punctual : 0; }
 vec3 nee_direct(const scene *s, vec3 p, vec3 ng, vec3 sigma, float u_select, vec2 u, rng_state *rng, nee_lobe_fn lobe,
                 const void *ctx, uint64_t *shadow_rays, vec3 *f, light_sample *ls);
 

@@ -193,9 +193,7 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
     int many = method == METHOD_VPL || method == METHOD_VSL || method == METHOD_VSL_HL;
     int vsl = method == METHOD_VSL || method == METHOD_VSL_HL;
     int emitters = a->punctual + a->area + a->env;
-    /* next-event estimation's candidates (lights.h) */
-    int candidates =
-        (a->punctual <= NEE_EACH_MAX ? a->punctual : 0) + (a->area + a->env > 0 || a->punctual > NEE_EACH_MAX);
+    int each = nee_each_count(a->punctual), candidates = each + (emitters > each); /* lights.h */
     snprintf(p.why_direct, sizeof p.why_direct, "%s%s%s%s%s%s%s", emitters ? "" : "none: no emitters",
              a->punctual ? "punctual lights by one shadow ray each" : "", a->punctual && a->area + a->env ? "; " : "",
              a->area ? "area lights by light and BSDF sampling (MIS)" : "", a->area && a->env ? "; " : "",
