@@ -42,6 +42,7 @@ SHADE_Y, SHADE_H = 1.72, 0.16
 SPOT_POS = add(LAMP, (0.0, SHADE_Y + SHADE_H + 0.01, 0.0))
 
 CAMERA_EYE, CAMERA_TARGET = (2.65, 1.35, 1.75), (-1.3, 0.35, -1.6)
+CAMERA2_EYE, CAMERA2_TARGET = (-2.6, 1.6, 1.85), (1.4, 0.6, -1.2)
 
 # The reflector: three polished brass leaves hung under the ceiling in the beam, each turned to
 # throw the spot's light somewhere else. The first throws it to where the camera sees the leaf in
@@ -130,6 +131,8 @@ def build():
         s.mesh("rod %d" % i, "black metal", cylinder(0.006, 0.006, H - LEAF_Y, 8, caps=False), translation=centre)
     s.add_meshes(OBJECTS)
     s.camera(CAMERA_EYE, CAMERA_TARGET, yfov=1.15)
+    # A second view, from the front-left corner towards the sideboard: the viewer's camera jumps.
+    s.camera(CAMERA2_EYE, CAMERA2_TARGET, yfov=1.0, name="camera 1")
     # A wide beam straight up at the ceiling: 55 degrees to the edge of the cone.
     s.light(spot("torchiere", (1.0, 0.86, 0.68), 8000.0, inner=0.75, outer=0.96), SPOT_POS, add(SPOT_POS, (0, 1, 0)))
     return s.document("glint atelier", "glint assets/scenes/make_atelier.py")

@@ -42,6 +42,7 @@ DX0, DX1, DH = -1.3, -0.3, 2.1
 TILE = 0.625
 
 CAMERA_EYE, CAMERA_TARGET = (1.6, 1.5, 4.3), (-1.0, 0.7, -0.3)
+CAMERA2_EYE, CAMERA2_TARGET = (-1.6, 1.6, 4.3), (0.6, 0.9, -1.5)
 PANEL_LIGHT = (-0.8, 0.0, -1.3)  # centre of the ceiling panel, over the back room's floor
 SPOT_POS = (1.45, 2.15, -1.55)   # in the back room, right of the door
 PANEL_X = -W + 0.02              # the steel panel's plane, on the left wall
@@ -157,6 +158,8 @@ def build():
     s.add_meshes(ROOM)
     s.add_meshes(OBJECTS)
     s.camera(CAMERA_EYE, CAMERA_TARGET, yfov=0.95)
+    # A second view, from the front room's left side through the door: the viewer's camera jumps.
+    s.camera(CAMERA2_EYE, CAMERA2_TARGET, yfov=0.95, name="camera 1")
     s.light(spot("spot", (1.0, 0.9, 0.75), 3000.0, inner=0.2, outer=0.3), SPOT_POS, double_mirror()[1])
     return s.document("glint doorway", "glint assets/scenes/make_doorway.py")
 

@@ -1,0 +1,41 @@
+/* glint — a geometry buffer: the first hit of each pixel's centre ray (position, normal, depth,
+ * material, albedo, how glossy it is). The display pipeline (display.h) reprojects history and
+ * guides its filter with it; the estimators never read it, so it changes no estimate. */
+#ifndef GLINT_GBUFFER_H
+#define GLINT_GBUFFER_H
+
+#include <stdint.h>
+
+#include "scene.h"
+#include "threadpool.h"
+
+/* Structure of arrays, one entry per pixel, row-major, top row first. */
+typedef struct {
+    int width, height;
+    camera cam;        /* the camera it was traced from */
+    float *pos;        /* 3 a pixel: the hit's world position */
+    float *normal;     /* 3: the shading normal, turned to face the camera */
+    float *depth;      /* distance from the camera along the ray; 0 where the ray escapes */
+    float *albedo;     /* 3: the light a pixel reflects per unit light arriving (diffuse + glossy +
+                        * transmitted directional albedo at this view), floored at GBUFFER_MIN_ALBEDO:
+                        * the display divides the light by it to filter (display.h) */
+    float *gloss;      /* the glossy lobe's share of that albedo at this view, 0..1 */
+    float *alpha;      /* the glossy lobe's width (microfacet alpha); 1 without a glossy lobe */
+    int32_t *material; /* the material's index; -1 where the ray escapes */
+} gbuffer;
+
+/* Below this albedo a channel is not divided any further: a black surface keeps its light. */
+#define GBUFFER_MIN_ALBEDO 0.02f
+
+/* Caller's memory: 0, or -1 out of memory (g left empty). */
+int gbuffer_init(gbuffer *g, int width, int height);
+void gbuffer_deinit(gbuffer *g);
+/* Traces every pixel's centre ray of cam (pixel (x, y) at x + 0.5, y + 0.5, as the film's pixels
+ * are) on pool's threads (NULL: the calling thread). */
+void gbuffer_trace(gbuffer *g, const scene *s, const camera *cam, threadpool *pool);
+
+/* Where world point p lands in g's camera: image coordinates (pixel (x, y) spans [x, x + 1)), or 0
+ * when p is behind the camera. */
+int gbuffer_project(const gbuffer *g, vec3 p, float *x, float *y);
+
+#endif
