@@ -65,8 +65,9 @@ static void fill_pixel(gbuffer *g, const scene *s, size_t i, vec3 d, const surfa
     put3(g->pos, i, h->p);
     put3(g->normal, i, f.n);
     g->depth[i] = h->t;
-    put3(g->albedo, i,
-         v3(fmaxf(total.x, GBUFFER_MIN_ALBEDO), fmaxf(total.y, GBUFFER_MIN_ALBEDO), fmaxf(total.z, GBUFFER_MIN_ALBEDO)));
+    put3(
+        g->albedo, i,
+        v3(fmaxf(total.x, GBUFFER_MIN_ALBEDO), fmaxf(total.y, GBUFFER_MIN_ALBEDO), fmaxf(total.z, GBUFFER_MIN_ALBEDO)));
     g->gloss[i] = all > 0.0f ? clampf(luminance3(glossy) / all, 0.0f, 1.0f) : 0.0f;
     float a = bsdf_glossy_alpha(&b);
     g->alpha[i] = a > 0.0f ? a : 1.0f;
