@@ -35,6 +35,15 @@ typedef struct {
 #define HL_PIXEL_POINTS 8     /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
 #define HL_SHARP_RAY_FACTOR 4 /* ... and N times this many secondary rays (docs/benchmarks.md, 2026-11-28) */
 
+/* One part of a frame: the packets (x + a i, y + b j) of a lattice cell, cols of them a row, row
+ * major, handed out `chunk` at a time. */
+typedef struct {
+    part_cell cell;
+    int cols, packets, chunk;
+} part_job;
+#define PART_CHUNK 16          /* packets at most a task: the atomic counter is read once per chunk */
+#define PART_CHUNKS_A_THREAD 8 /* ... and at least this many chunks a thread where the part has them */
+
 struct render_session {
     const scene *scene;
     camera cam;
@@ -58,7 +67,12 @@ struct render_session {
     const env_map *envf_map;   /* ... the map it was built from */
     scene_analysis analysis;
     effect_plan plan;
-    const atomic_int *abort_flag; /* polled per tile; NULL: none */
+    const atomic_int *abort_flag; /* polled per tile or chunk; NULL: none */
+    const sample_sink *sink;      /* NULL: none */
+    /* A frame in parts (session_render_part): its count (0: no frame under way), the parts done and
+     * the rank of its first; the rank after the last part begun, which session_reset keeps. */
+    int frame_parts, parts_done, first_part, next_part;
+    part_job part; /* the part being rendered */
     char error[256];
 };
 
@@ -293,6 +307,12 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     return L;
 }
 
+/* The sample the film took at a pixel, to the sink. */
+static void sink_put(const sample_sink *k, int pixel, const float sample[COMP_COUNT][3]) {
+    for (int c = 0; c < COMP_COUNT; c++) memcpy(k->rgb[c] + 3 * (size_t)pixel, sample[c], sizeof sample[c]);
+    k->stamp[pixel] = k->serial;
+}
+
 /* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL; its
  * highlights, when its block shared them, in shared_hl. */
 static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
@@ -306,6 +326,8 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     /* into the void (and its other points too): every component is zero, nothing to add */
     if (!first && !s->env && !spread && direct_samples == 1) {
         st->rays[RAY_CAMERA]++;
+        static const float zero[COMP_COUNT][3];
+        if (rs->sink) sink_put(rs->sink, pixel, zero); /* a sample all the same */
         return;
     }
     vec3 L[COMP_COUNT];
@@ -353,6 +375,7 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     /* A NaN or Inf never reaches the film: the sample is dropped and counted. */
     if (finite) {
         film_add(&rs->film, pixel, (const float(*)[3])sample);
+        if (rs->sink) sink_put(rs->sink, pixel, (const float(*)[3])sample);
     } else {
         film_reject(&rs->film, pixel);
         st->rejected_samples++;
@@ -417,6 +440,54 @@ static void block_highlights(render_session *rs, render_stats *st, const int *pi
     st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t0;
 }
 
+/* The packet of pixels from (bx, by), PACKET_W x PACKET_H of them where the image has them. Camera
+ * rays go in packets: neighbours share most of their BVH traversal. A pixel's sample depends on the
+ * frame, the pixel and its state (its 2x2 block's: inside the packet), which only begin_frame reads
+ * across pixels, never on the packets rendered before it: a frame takes the same samples in any
+ * order, whole or in parts (docs/design.md, "What a frame is"). */
+static void render_packet(render_session *rs, render_stats *st, const camera_raster *raster, uint64_t frame, int bx,
+                          int by) {
+    const render_params *p = &rs->params;
+    int x1 = bx + PACKET_W < p->width ? bx + PACKET_W : p->width;
+    int y1 = by + PACKET_H < p->height ? by + PACKET_H : p->height;
+    int pixel[SCENE_PACKET], n = 0;
+    rng_state rng[SCENE_PACKET];
+    vec3 d[SCENE_PACKET];
+    surface_hit hit[SCENE_PACKET];
+    for (int y = by; y < y1; y++) {
+        for (int x = bx; x < x1; x++, n++) {
+            pixel[n] = y * p->width + x;
+            rng[n] = rng_for((uint64_t)pixel[n], frame, p->seed);
+            /* A pixel's positions over frames follow the R2 sequence from a random start: any run
+             * of frames covers the pixel evenly, so a small bright feature inside it (a highlight
+             * seen in a curved mirror) converges faster than with independent positions, and each
+             * frame's position is still uniform. */
+            rng_state start = rng_for((uint64_t)pixel[n], UINT64_MAX, p->seed);
+            vec2 j = sample_r2((int)(frame & 0x3fffffff), rng_vec2(&start));
+            d[n] = camera_raster_dir(raster, (float)x + j.x, (float)y + j.y);
+        }
+    }
+    int timed = p->method != METHOD_PT; /* camera rays belong to the direct pass */
+    uint64_t t0 = timed ? clock_ns() : 0;
+    unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
+    if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
+    /* Each pixel's highlight state before any pixel's highlights: a block shares only among pixels
+     * that are not spread. */
+    int highlights = p->method != METHOD_PT && rs->plan.highlights && rs->plan.max_depth > 1;
+    for (int i = 0; highlights && rs->adapt && i < n; i++) {
+        if (rs->hl_state[pixel[i]] == HL_PIXEL_UNPROBED)
+            rs->hl_state[pixel[i]] = (uint8_t)probe_state(rs, st, raster, pixel[i]);
+    }
+    vec3 shared[SCENE_PACKET];
+    int has_shared[SCENE_PACKET] = {0};
+    if (highlights && rs->hl.share && rs->hl.secondary_rays <= HL_SHARE_MAX_RAYS)
+        block_highlights(rs, st, pixel, d, hit, hits, n, shared, has_shared);
+    for (int i = 0; i < n; i++)
+        render_sample(rs, st, raster, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i],
+                      has_shared[i] ? &shared[i] : NULL);
+}
+
+/* A whole frame's task: a TILE x TILE tile, its packets in turn. */
 static void render_tile(void *ctx, int tile, int worker) {
     render_session *rs = ctx;
     const render_params *p = &rs->params;
@@ -428,51 +499,32 @@ static void render_tile(void *ctx, int tile, int worker) {
     camera_raster raster = camera_raster_make(&rs->cam, p->width, p->height);
     const uint64_t frame = next_frame_index(rs);
     uint64_t tile_start = clock_ns();
-    /* Camera rays go in packets of PACKET_W x PACKET_H pixels: neighbours share most of their
-     * BVH traversal. */
-    for (int by = y0; by < y1; by += PACKET_H) {
-        for (int bx = x0; bx < x1; bx += PACKET_W) {
-            int pixel[SCENE_PACKET], n = 0;
-            rng_state rng[SCENE_PACKET];
-            vec3 d[SCENE_PACKET];
-            surface_hit hit[SCENE_PACKET];
-            for (int y = by; y < by + PACKET_H && y < y1; y++) {
-                for (int x = bx; x < bx + PACKET_W && x < x1; x++, n++) {
-                    pixel[n] = y * p->width + x;
-                    rng[n] = rng_for((uint64_t)pixel[n], frame, p->seed);
-                    /* A pixel's positions over frames follow the R2 sequence from a random start:
-                     * any run of frames covers the pixel evenly, so a small bright feature inside
-                     * it (a highlight seen in a curved mirror) converges faster than with
-                     * independent positions, and each frame's position is still uniform. */
-                    rng_state start = rng_for((uint64_t)pixel[n], UINT64_MAX, p->seed);
-                    vec2 j = sample_r2((int)(frame & 0x3fffffff), rng_vec2(&start));
-                    d[n] = camera_raster_dir(&raster, (float)x + j.x, (float)y + j.y);
-                }
-            }
-            int timed = p->method != METHOD_PT; /* camera rays belong to the direct pass */
-            uint64_t t0 = timed ? clock_ns() : 0;
-            unsigned hits = scene_intersect_packet(rs->scene, rs->cam.position, d, n, hit);
-            if (timed) st->pass_ns[PASS_DIRECT] += clock_ns() - t0;
-            /* Each pixel's highlight state before any pixel's highlights: a block shares only
-             * among pixels that are not spread. */
-            int highlights = p->method != METHOD_PT && rs->plan.highlights && rs->plan.max_depth > 1;
-            for (int i = 0; highlights && rs->adapt && i < n; i++) {
-                if (rs->hl_state[pixel[i]] == HL_PIXEL_UNPROBED)
-                    rs->hl_state[pixel[i]] = (uint8_t)probe_state(rs, st, &raster, pixel[i]);
-            }
-            vec3 shared[SCENE_PACKET];
-            int has_shared[SCENE_PACKET] = {0};
-            if (highlights && rs->hl.share && rs->hl.secondary_rays <= HL_SHARE_MAX_RAYS)
-                block_highlights(rs, st, pixel, d, hit, hits, n, shared, has_shared);
-            for (int i = 0; i < n; i++)
-                render_sample(rs, st, &raster, pixel[i], d[i], (hits >> i & 1u) ? &hit[i] : NULL, &rng[i],
-                              has_shared[i] ? &shared[i] : NULL);
-        }
-    }
+    for (int by = y0; by < y1; by += PACKET_H)
+        for (int bx = x0; bx < x1; bx += PACKET_W) render_packet(rs, st, &raster, frame, bx, by);
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - tile_start;
 }
 
-int session_render_frame(render_session *rs) {
+/* A part's task: a chunk of its packets. */
+static void render_chunk(void *ctx, int chunk, int worker) {
+    render_session *rs = ctx;
+    const render_params *p = &rs->params;
+    const part_job *job = &rs->part;
+    render_stats *st = &rs->workers[worker].st;
+    if (rs->abort_flag && atomic_load_explicit(rs->abort_flag, memory_order_relaxed)) return;
+    camera_raster raster = camera_raster_make(&rs->cam, p->width, p->height);
+    const uint64_t frame = next_frame_index(rs);
+    uint64_t chunk_start = clock_ns();
+    int end = (chunk + 1) * job->chunk < job->packets ? (chunk + 1) * job->chunk : job->packets;
+    for (int k = chunk * job->chunk; k < end; k++) {
+        int i = job->cell.x + job->cell.a * (k % job->cols), j = job->cell.y + job->cell.b * (k / job->cols);
+        render_packet(rs, st, &raster, frame, PACKET_W * i, PACKET_H * j);
+    }
+    if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - chunk_start;
+}
+
+/* A frame's work before its pixels (allocation plans, the prefiltered map, the highlight settings,
+ * the virtual lights, the judgements): 0, or -1 with rs->error set. */
+static int begin_frame(render_session *rs) {
     const render_params *p = &rs->params;
     const uint64_t frame = next_frame_index(rs);
     rs->adapt = p->method != METHOD_PT && vl_params_resolve(&p->vl).adapt == VL_ADAPT_ON;
@@ -508,12 +560,11 @@ int session_render_frame(render_session *rs) {
         int traced = hl_judge_trace(rs->hl_merge, p->width, p->height); /* out of memory: judged next time */
         if (traced >= 0) rs->totals.hl_traced_pixels = (uint64_t)traced;
     }
-    threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
-    int aborted = rs->abort_flag && atomic_load(rs->abort_flag);
-    if (!aborted) {
-        film_end_pass(&rs->film);
-        rs->frames++;
-    }
+    return 0;
+}
+
+/* The workers' counters into the totals, and cleared. */
+static void gather_stats(render_session *rs) {
     int n = threadpool_size(rs->pool);
     for (int w = 0; w < n; w++) {
         render_stats *st = &rs->workers[w].st;
@@ -532,8 +583,88 @@ int session_render_frame(render_session *rs) {
         for (int k = 0; k < PASS_COUNT; k++) t->pass_ns[k] += st->pass_ns[k];
         memset(st, 0, sizeof *st);
     }
-    return aborted;
 }
+
+/* parts clamped to a power of two in [1, SESSION_MAX_PARTS], the nearest below. */
+static int allowed_parts(int parts) {
+    int k = 1;
+    while (k < SESSION_MAX_PARTS && 2 * k <= parts) k *= 2;
+    return k;
+}
+
+part_cell session_part_cell(int parts, int rank) {
+    parts = allowed_parts(parts);
+    int k = 0;
+    while (1 << k < parts) k++;
+    int bits_x = (k + 1) / 2, bits_y = k / 2;
+    part_cell c = {1 << bits_x, 1 << bits_y, 0, 0};
+    /* The rank's bits from the lowest name the cell's from the highest: consecutive ranks land far
+     * apart. An odd k's extra x bit first (the two halves of a 2:1 lattice are square), then pairs as
+     * in Bayer's matrix [[0, 2], [3, 1]]: the first bit of a pair moves x and y (the diagonal), the
+     * second x. */
+    unsigned r = (unsigned)rank & (unsigned)(parts - 1);
+    int bx = bits_x - 1, by = bits_y - 1;
+    if (k & 1) {
+        c.x |= (int)(r & 1u) << bx--;
+        r >>= 1;
+    }
+    for (; by >= 0; bx--, by--, r >>= 2) {
+        c.x |= (int)((r ^ r >> 1) & 1u) << bx;
+        c.y |= (int)(r & 1u) << by;
+    }
+    return c;
+}
+
+int session_render_part(render_session *rs, int parts, int *frame_done) {
+    if (frame_done) *frame_done = 0;
+    if (!rs->frame_parts) {
+        if (begin_frame(rs) != 0) return -1;
+        rs->frame_parts = allowed_parts(parts);
+        rs->parts_done = 0;
+        rs->first_part = rs->next_part % rs->frame_parts;
+    }
+    int rank = (rs->first_part + rs->parts_done) % rs->frame_parts;
+    rs->next_part = rank + 1; /* begun, whatever comes of it: the rotation never depends on timing */
+    if (rs->frame_parts == 1) {
+        threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
+    } else {
+        part_job *job = &rs->part;
+        int packets_x = (rs->params.width + PACKET_W - 1) / PACKET_W;
+        int packets_y = (rs->params.height + PACKET_H - 1) / PACKET_H;
+        job->cell = session_part_cell(rs->frame_parts, rank);
+        /* cell.x < a: 0 where the image is too small for the cell (an empty part) */
+        job->cols = (packets_x - job->cell.x + job->cell.a - 1) / job->cell.a;
+        job->packets = job->cols * ((packets_y - job->cell.y + job->cell.b - 1) / job->cell.b);
+        int chunks = PART_CHUNKS_A_THREAD * threadpool_size(rs->pool);
+        job->chunk = (job->packets + chunks - 1) / chunks;
+        job->chunk = job->chunk < 1 ? 1 : job->chunk > PART_CHUNK ? PART_CHUNK : job->chunk;
+        threadpool_run(rs->pool, render_chunk, rs, (job->packets + job->chunk - 1) / job->chunk);
+    }
+    gather_stats(rs);
+    if (rs->abort_flag && atomic_load(rs->abort_flag)) {
+        rs->frame_parts = 0; /* abandoned: the caller resets */
+        return 1;
+    }
+    if (++rs->parts_done == rs->frame_parts) {
+        film_end_pass(&rs->film);
+        rs->frames++;
+        rs->frame_parts = 0;
+        if (frame_done) *frame_done = 1;
+    }
+    return 0;
+}
+
+int session_render_frame(render_session *rs) {
+    int done = 0, status;
+    do status = session_render_part(rs, 1, &done);
+    while (status == 0 && !done);
+    return status;
+}
+
+int session_frame_parts(const render_session *rs) { return rs->frame_parts; }
+int session_frame_parts_done(const render_session *rs) { return rs->frame_parts ? rs->parts_done : 0; }
+
+void session_set_sink(render_session *rs, const sample_sink *sink) { rs->sink = sink; }
 
 void session_set_abort_flag(render_session *rs, const atomic_int *flag) { rs->abort_flag = flag; }
 
@@ -548,6 +679,7 @@ void session_reset(render_session *rs) {
     if (rs->hl_merge)
         memset(rs->hl_merge, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->hl_merge);
     rs->frames = 0;
+    rs->frame_parts = 0; /* a frame under way is abandoned; next_part stays, so the next part differs */
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }
 

@@ -1,11 +1,13 @@
 /* glint — a render session: the scene (read-only), a camera, the parameters, the film and the
  * statistics. Each frame is one pass of fresh samples over the image (one camera sample per
- * pixel); the image is the running mean. */
+ * pixel); the image is the running mean. A frame renders whole or in interleaved parts, with the
+ * same samples either way (docs/design.md, "What a frame is"). */
 #ifndef GLINT_SESSION_H
 #define GLINT_SESSION_H
 
 #include <stdatomic.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "film.h"
 #include "params.h"
@@ -20,16 +22,62 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
                                size_t errlen);
 void session_destroy(render_session *rs);
 
-/* Renders one frame (all threads; returns when done). Returns 0, or -1 with the reason in
- * session_error() when a frame could not be prepared (out of memory; the film is unchanged), or 1
- * when the abort flag stopped it: the frame is not counted, but the tiles rendered before the
- * stop are in the film, so the caller must reset the accumulation. */
+/* Renders one frame (all threads; returns when done), or the rest of a frame under way in parts
+ * (session_render_part). Returns 0, or -1 with the reason in session_error() when a frame could
+ * not be prepared (out of memory; the film is unchanged), or 1 when the abort flag stopped it: the
+ * frame is not counted, but the tiles rendered before the stop are in the film, so the caller must
+ * reset the accumulation. */
 int session_render_frame(render_session *rs);
-/* A flag the session polls before each tile: while it is non-zero, frames stop early (above).
- * For interactive use, where the change that sets it resets the accumulation anyway. NULL: none. */
+/* Renders the next part of the frame under way, beginning a frame (in `parts` parts) when none is:
+ * the image's 4x4-pixel packets in `parts` interleaved parts, each call one part. Packet (i, j) lies
+ * in cell (i mod a, j mod b) of a lattice of a x b = parts cells (session_part_cell), and part p of a
+ * frame is the packets of the cell of rank p. A frame begins at the part after the last one begun
+ * (in whatever frame, stopped or not, mod the new frame's count; session_reset does not forget it),
+ * so a caller who resets before every call still renders a different part each time; it ends after
+ * its last part: *frame_done is then 1 (0 otherwise; frame_done may be NULL). The film after a frame
+ * is the same, bit for bit, in whatever parts the frame was rendered; between parts it holds the
+ * parts so far, so its mean is a frame's only once the frame ends. `parts` is read when a frame
+ * begins: a power of two, 1 .. SESSION_MAX_PARTS, others clamped to the nearest allowed value below
+ * (1 below 1); a frame under way keeps its own count. Returns as session_render_frame: 0 (a part
+ * rendered), -1 (the frame could not begin: nothing rendered), or 1 when the abort flag stopped it
+ * (the frame is abandoned, uncounted; the caller must reset). The statistics count every part. */
+#define SESSION_MAX_PARTS 256
+int session_render_part(render_session *rs, int parts, int *frame_done);
+/* The frame under way: its part count (0: none, between frames) and the parts of it done. */
+int session_frame_parts(const render_session *rs);
+int session_frame_parts_done(const render_session *rs);
+/* The lattice of `parts` parts (clamped as session_render_part does) and the cell of rank `rank`
+ * (taken mod parts): a = 2^ceil(k/2) by b = 2^floor(k/2) cells for parts = 2^k, ranked in ordered-
+ * dither (Bayer) order: every aligned run of 2^m ranks puts one cell in each block of
+ * (a >> ceil(m/2)) x (b >> floor(m/2)) cells, and on a square lattice also in each block of
+ * (a >> floor(m/2)) x (b >> ceil(m/2)): the frame's first parts spread evenly over the image. */
+typedef struct {
+    int a, b; /* the lattice's size, in packets */
+    int x, y; /* the cell: packets (x + a i, y + b j) */
+} part_cell;
+part_cell session_part_cell(int parts, int rank);
+
+/* Where every sample the film takes also goes (whole frames or parts), for a display that reads
+ * each part's fresh samples: per film component the sample's 3 floats at the pixel (zeros included;
+ * arrays of the image's size), and the pixel's stamp set to serial. A sample the film drops (NaN or
+ * Inf) writes nothing. The caller owns the memory and keeps the struct alive while it is set: the
+ * render threads read it and write the arrays while a call renders, so the caller sets serial (and
+ * reads the arrays) between calls. */
+typedef struct {
+    float *rgb[COMP_COUNT]; /* 3 floats a pixel each: the pixel's sample, per film component */
+    uint32_t *stamp;        /* one a pixel: set to serial where the pixel took a sample */
+    uint32_t serial;
+} sample_sink;
+/* NULL: none (the default). */
+void session_set_sink(render_session *rs, const sample_sink *sink);
+
+/* A flag the session polls before each tile (in a part, each chunk of its packets): while it is
+ * non-zero, frames stop early (above). For interactive use, where the change that sets it resets
+ * the accumulation anyway. NULL: none. */
 void session_set_abort_flag(render_session *rs, const atomic_int *flag);
 const char *session_error(const render_session *rs);
-/* Clears the accumulation (the next frame starts a new mean) and the statistics with it. */
+/* Clears the accumulation (the next frame starts a new mean) and the statistics with it, and
+ * abandons a frame under way in parts (nothing of it counted). */
 void session_reset(render_session *rs);
 void session_set_camera(render_session *rs, const camera *cam);
 /* The scene changed (a light moved or dimmed, another environment map): analyses it again,
