@@ -40,8 +40,9 @@ typedef struct {
 
 typedef struct denoiser denoiser;
 
-/* Scratch for width x height images (about 2.2 MB per plane, 6 + 12 per component touched).
- * NULL when out of memory or the size is not positive. */
+/* Scratch for width x height images: 6 planes of geometry and 12 per component used, each of
+ * (width rounded up to 128, + 64) x (height + 64) floats (79 MB for two components at 960x540).
+ * NULL when out of memory or the size is not in 1..65536. */
 denoiser *denoiser_create(int width, int height);
 void denoiser_destroy(denoiser *d); /* NULL is fine */
 
