@@ -26,8 +26,10 @@ typedef struct {
     const float *count[COMP_COUNT];    /* per pixel: samples behind that mean (fractional when history is
                                         * kept in part); 0 (or not finite): no sample, a hole to fill */
     const float *variance[COMP_COUNT]; /* per pixel: the variance of ONE sample's luminance (of the light
-                                        * over the albedo), unbiased; the mean's is variance / count. NULL:
-                                        * unknown (0), estimated from the neighbours where count < 4 */
+                                        * over the albedo), unbiased (n / (n - 1) times film's); the mean's
+                                        * is variance / count. Below 4 samples it is pooled with an estimate
+                                        * from the neighbours; from 4 on it is trusted, and 0 (or NULL) says
+                                        * the mean is exact: the pixel keeps its value */
     const gbuffer *g;                  /* the geometry (depth, normal) of the same pixels */
 } denoise_input;
 
@@ -47,9 +49,9 @@ denoiser *denoiser_create(int width, int height);
 void denoiser_destroy(denoiser *d); /* NULL is fine */
 
 /* Filters in's components into out with p (NULL: all defaults, so no pass) on pool's threads (NULL:
- * the calling thread). Every value written is finite, whatever the input. Returns 0, or -1 when
- * in's G-buffer is not the denoiser's size or components is outside 1..COMP_COUNT (nothing
- * written). */
+ * the calling thread); one run at a time per denoiser. Every value written is finite, whatever the
+ * input. Returns 0, or -1 when in's G-buffer is not the denoiser's size, components is outside
+ * 1..COMP_COUNT or a component's light, count or output is NULL (nothing written). */
 int denoise_run(denoiser *d, const denoise_input *in, const denoise_params *p, const denoise_output *out,
                 threadpool *pool);
 
