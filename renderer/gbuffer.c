@@ -58,9 +58,12 @@ static void fill_pixel(gbuffer *g, const scene *s, size_t i, vec3 d, const surfa
     }
     frame3 f;
     bsdf b = material_bsdf(s, h, &f);
-    vec3 wo = to_local(f, neg3(d));
-    vec3 glossy = bsdf_glossy_albedo(&b, wo);
-    vec3 total = add3(add3(bsdf_diffuse_albedo(&b, wo), glossy), b.transmission);
+    /* The lobes' own colours, not their directional albedos: a point's albedo must not change as
+     * the view turns, or light divided by it at one view and multiplied at another would (the
+     * display's history follows points across views). */
+    vec3 spec = v3(fminf(b.specular.x, 1.0f), fminf(b.specular.y, 1.0f), fminf(b.specular.z, 1.0f));
+    if (!(bsdf_lobes(&b) & BSDF_GLOSSY)) spec = v3(0, 0, 0);
+    vec3 total = add3(add3(b.diffuse, spec), b.transmission);
     float all = luminance3(total);
     put3(g->pos, i, h->p);
     put3(g->normal, i, f.n);
@@ -68,7 +71,7 @@ static void fill_pixel(gbuffer *g, const scene *s, size_t i, vec3 d, const surfa
     put3(
         g->albedo, i,
         v3(fmaxf(total.x, GBUFFER_MIN_ALBEDO), fmaxf(total.y, GBUFFER_MIN_ALBEDO), fmaxf(total.z, GBUFFER_MIN_ALBEDO)));
-    g->gloss[i] = all > 0.0f ? clampf(luminance3(glossy) / all, 0.0f, 1.0f) : 0.0f;
+    g->gloss[i] = all > 0.0f ? clampf(luminance3(spec) / all, 0.0f, 1.0f) : 0.0f;
     float a = bsdf_glossy_alpha(&b);
     g->alpha[i] = a > 0.0f ? a : 1.0f;
     g->material[i] = h->material;

@@ -1,0 +1,518 @@
+#define _POSIX_C_SOURCE 200809L
+#include "display.h"
+
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "clock.h"
+#include "denoise.h"
+#include "threadpool.h"
+
+/* One pixel's history, per film component: the mean of its samples divided by the pixel's albedo,
+ * how many samples it stands for (fractional once part of it was let go), and the mean of their
+ * squared luminance (the spread the filter needs). One cache line: reprojection reads four. */
+typedef struct {
+    struct {
+        float mean[3], count, m2;
+    } c[COMP_COUNT];
+    float pad[16 - 5 * COMP_COUNT];
+} pixel_history;
+
+/* History a camera move carries over is capped at this many samples: each reprojection resamples
+ * (blurs) it a little, and a cap lets new samples take over at a steady pace while moving. */
+#define DISPLAY_MAX_CARRIED 64.0f
+/* A light change sets the history aside (stale) until new samples show, tile by tile, whether
+ * the light there changed: a tile of TILE_PX x TILE_PX pixels is judged once it has
+ * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "Light moves"). Until then
+ * stale history counts as STALE_WEIGHT samples where a pixel has no new one: it fills holes, and
+ * any new sample near it outweighs it. */
+#define TILE_PX 16
+#define JUDGE_MIN_SAMPLES 16
+#define JUDGE_MAX_SAMPLES 64
+#define STALE_WEIGHT 0.25f
+/* Reprojection's tests: a surface point's old pixel is the same point if its normal is within
+ * this cosine and it lies within this many pixel footprints of the old point's plane. */
+#define REPROJECT_MIN_COS 0.9f
+#define REPROJECT_PLANE_PIXELS 2.0f
+#define DENOISE_LEVELS DENOISE_MAX_LEVELS
+
+/* A tile's evidence since the last light change: new samples' luminance (every component, divided
+ * by the albedo) less the stale history's at the same pixels, its variance, the stale total. */
+enum { TILE_UNKNOWN = 0, TILE_SAME, TILE_CHANGED };
+typedef struct {
+    double diff, var, base;
+    int n, state;
+} light_tile;
+
+struct display {
+    int width, height;
+    threadpool *pool;
+    gbuffer g[2];        /* g[cur] the view shown, the other the one before */
+    pixel_history *h[2]; /* h[cur] the view shown, the other the one before */
+    int cur;
+    int have_view;
+    sample_sink sink;
+    /* resolve's scratch: the filter's input per component (demodulated mean, samples, one sample's
+     * luminance variance) and its output */
+    float *light[COMP_COUNT], *count[COMP_COUNT], *variance[COMP_COUNT], *out[COMP_COUNT];
+    denoiser *dn;
+    int active[COMP_COUNT]; /* a component had a sample other than zero since the last restart */
+    /* after a light change: the history before it, and per tile what new samples say of it */
+    pixel_history *stale;
+    int judging;
+    int tiles_x, tiles_y;
+    light_tile *tiles;
+    display_stats st;
+};
+
+display *display_create(int width, int height, int threads, char *err, size_t errlen) {
+    display *d = calloc(1, sizeof *d);
+    if (!d) return snprintf(err, errlen, "out of memory"), NULL;
+    size_t n = (size_t)width * (size_t)height;
+    d->width = width;
+    d->height = height;
+    int ok = gbuffer_init(&d->g[0], width, height) == 0 && gbuffer_init(&d->g[1], width, height) == 0;
+    for (int k = 0; ok && k < 2; k++) ok = (d->h[k] = calloc(n, sizeof(pixel_history))) != NULL;
+    d->tiles_x = (width + TILE_PX - 1) / TILE_PX;
+    d->tiles_y = (height + TILE_PX - 1) / TILE_PX;
+    if (ok) ok = (d->stale = calloc(n, sizeof(pixel_history))) != NULL;
+    if (ok) ok = (d->tiles = calloc((size_t)d->tiles_x * (size_t)d->tiles_y, sizeof(light_tile))) != NULL;
+    for (int c = 0; ok && c < COMP_COUNT; c++) {
+        d->sink.rgb[c] = malloc(sizeof(float) * 3 * n);
+        d->light[c] = malloc(sizeof(float) * 3 * n);
+        d->count[c] = malloc(sizeof(float) * n);
+        d->variance[c] = malloc(sizeof(float) * n);
+        d->out[c] = malloc(sizeof(float) * 3 * n);
+        ok = d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c];
+    }
+    if (ok) ok = (d->sink.stamp = calloc(n, sizeof(uint32_t))) != NULL;
+    if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
+    if (!ok) {
+        display_destroy(d);
+        return snprintf(err, errlen, "out of memory for a %dx%d display", width, height), NULL;
+    }
+    d->sink.serial = 1; /* stamps start at 0: no pixel is taken before its first sample */
+    if (!(d->pool = threadpool_create(threads))) {
+        display_destroy(d);
+        return snprintf(err, errlen, "cannot start the display's threads"), NULL;
+    }
+    return d;
+}
+
+void display_destroy(display *d) {
+    if (!d) return;
+    threadpool_destroy(d->pool);
+    denoiser_destroy(d->dn);
+    for (int k = 0; k < 2; k++) {
+        gbuffer_deinit(&d->g[k]);
+        free(d->h[k]);
+    }
+    free(d->stale);
+    free(d->tiles);
+    for (int c = 0; c < COMP_COUNT; c++) {
+        free(d->sink.rgb[c]);
+        free(d->light[c]);
+        free(d->count[c]);
+        free(d->variance[c]);
+        free(d->out[c]);
+    }
+    free(d->sink.stamp);
+    free(d);
+}
+
+const sample_sink *display_sink(const display *d) { return &d->sink; }
+display_stats display_get_stats(const display *d) { return d->st; }
+const gbuffer *display_gbuffer(const display *d) { return &d->g[d->cur]; }
+
+static vec3 get3(const float *a, size_t i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
+
+/* ---- carrying history over a change of view ------------------------------------------------ */
+
+typedef struct {
+    display *d;
+    const gbuffer *from, *to;
+    const pixel_history *old;
+    pixel_history *now;
+    unsigned change;
+    int same_camera;
+    float footprint; /* a pixel's width per unit distance in the new view */
+    atomic_llong carried, lost;
+} carry_job;
+
+/* How much of a glossy lobe's share of a point's history survives the view turning by an angle
+ * whose cosine is cos_turn: the reflected lobe turns about twice as far as the view, and its
+ * width is about its microfacet alpha, so history falls off as a Gaussian in the turn over the
+ * lobe (turn^2 taken as 2 (1 - cos), within 3% up to 40 degrees, beyond which nothing is kept). */
+static float glossy_keep(float cos_turn, float alpha) {
+    float w = 2.0f * fmaxf(alpha, 1e-3f);
+    return expf(-2.0f * (1.0f - cos_turn) / (w * w));
+}
+
+/* Whether old pixel q shows the surface point of new pixel i (positions, normals, materials). */
+static int same_point(const carry_job *j, size_t i, size_t q) {
+    const gbuffer *a = j->to, *b = j->from;
+    if (a->material[i] != b->material[q]) return 0;
+    vec3 na = get3(a->normal, i), nb = get3(b->normal, q);
+    if (a->material[i] < 0) return dot3(na, nb) > 0.99999f; /* the sky: the same direction */
+    if (dot3(na, nb) < REPROJECT_MIN_COS) return 0;
+    float tol = REPROJECT_PLANE_PIXELS * j->footprint * a->depth[i];
+    return fabsf(dot3(sub3(get3(a->pos, i), get3(b->pos, q)), nb)) <= tol;
+}
+
+/* The old pixels around where new pixel i's point was seen, bilinear taps, each kept only if it
+ * shows the same point. Returns how many (weights normalised), 0 when none does. */
+static int find_taps(const carry_job *j, int x, int y, size_t taps[4], float weights[4]) {
+    int w = j->d->width, h = j->d->height;
+    size_t i = (size_t)y * (size_t)w + (size_t)x;
+    int n = 0;
+    float ox, oy;
+    if (j->same_camera) {
+        taps[0] = i, weights[0] = 1.0f, n = 1;
+    } else if (gbuffer_project(j->from, get3(j->to->pos, i), &ox, &oy)) {
+        float fx = ox - 0.5f, fy = oy - 0.5f;
+        int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+        float ax = fx - (float)x0, ay = fy - (float)y0;
+        for (int k = 0; k < 4; k++) {
+            int tx = x0 + (k & 1), ty = y0 + (k >> 1);
+            if (tx < 0 || ty < 0 || tx >= w || ty >= h) continue;
+            taps[n] = (size_t)ty * (size_t)w + (size_t)tx;
+            weights[n] = ((k & 1) ? ax : 1.0f - ax) * ((k >> 1) ? ay : 1.0f - ay);
+            n++;
+        }
+    }
+    int kept = 0;
+    float total = 0.0f;
+    for (int k = 0; k < n; k++) {
+        if (weights[k] > 0.0f && same_point(j, i, taps[k])) {
+            taps[kept] = taps[k], weights[kept] = weights[k], kept++;
+            total += weights[k];
+        }
+    }
+    if (total < 1e-3f) return 0;
+    for (int k = 0; k < kept; k++) weights[k] /= total;
+    return kept;
+}
+
+static void carry_row(void *ctx, int y, int worker) {
+    (void)worker;
+    carry_job *j = ctx;
+    const gbuffer *to = j->to;
+    int w = j->d->width;
+    long long carried = 0, lost = 0;
+    float cap = DISPLAY_MAX_CARRIED;
+    for (int x = 0; x < w; x++) {
+        size_t i = (size_t)y * (size_t)w + (size_t)x;
+        pixel_history *now = &j->now[i];
+        memset(now, 0, sizeof *now);
+        if (j->change & DISPLAY_RESTART) continue;
+        size_t taps[4];
+        float weights[4];
+        int kept = find_taps(j, x, y, taps, weights);
+        if (!kept) {
+            lost++;
+            continue;
+        }
+        carried++;
+        /* What survives of each component: all of its diffuse share, of its glossy share what the
+         * lobe and the view's turn there allow (the highlights are all glossy). */
+        float glossy = 1.0f;
+        if (!j->same_camera && to->material[i] >= 0) {
+            vec3 p = get3(to->pos, i);
+            vec3 a = normalize3(sub3(j->from->cam.position, p)), b = normalize3(sub3(to->cam.position, p));
+            glossy = glossy_keep(dot3(a, b), to->alpha[i]);
+        }
+        float diffuse = (1.0f - to->gloss[i]) + to->gloss[i] * glossy;
+        for (int c = 0; c < COMP_COUNT; c++) {
+            if (!j->d->active[c]) continue;
+            float count = 0.0f, m2 = 0.0f, m[3] = {0.0f, 0.0f, 0.0f};
+            for (int k = 0; k < kept; k++) {
+                const pixel_history *o = &j->old[taps[k]];
+                float wk = weights[k];
+                count += wk * o->c[c].count;
+                m2 += wk * o->c[c].m2;
+                for (int e = 0; e < 3; e++) m[e] += wk * o->c[c].mean[e];
+            }
+            count = fminf(count * (c == COMP_HIGHLIGHTS ? glossy : diffuse), cap);
+            if (!(count > 0.0f)) continue;
+            now->c[c].count = count;
+            now->c[c].m2 = m2;
+            for (int e = 0; e < 3; e++) now->c[c].mean[e] = m[e];
+        }
+    }
+    atomic_fetch_add(&j->carried, carried);
+    atomic_fetch_add(&j->lost, lost);
+}
+
+/* ---- light changes ------------------------------------------------------------------------- */
+
+/* Adds b's samples to a's, per component, b's counted at most cap each. */
+static void history_merge(pixel_history *a, const pixel_history *b, float cap) {
+    for (int c = 0; c < COMP_COUNT; c++) {
+        float nb = fminf(b->c[c].count, cap), na = a->c[c].count, n = na + nb;
+        if (!(nb > 0.0f)) continue;
+        for (int e = 0; e < 3; e++) a->c[c].mean[e] = (na * a->c[c].mean[e] + nb * b->c[c].mean[e]) / n;
+        a->c[c].m2 = (na * a->c[c].m2 + nb * b->c[c].m2) / n;
+        a->c[c].count = n;
+    }
+}
+
+static int tile_of(const display *d, size_t i) {
+    int x = (int)(i % (size_t)d->width), y = (int)(i / (size_t)d->width);
+    return (y / TILE_PX) * d->tiles_x + x / TILE_PX;
+}
+
+/* A tile's verdict: where the light did not change its stale history comes back (counted in full),
+ * where it did the stale history goes. */
+static void settle_tile(display *d, int t, int state) {
+    d->tiles[t].state = state;
+    int x0 = (t % d->tiles_x) * TILE_PX, y0 = (t / d->tiles_x) * TILE_PX;
+    pixel_history *h = d->h[d->cur];
+    for (int y = y0; y < y0 + TILE_PX && y < d->height; y++)
+        for (int x = x0; x < x0 + TILE_PX && x < d->width; x++) {
+            size_t i = (size_t)y * (size_t)d->width + (size_t)x;
+            if (state == TILE_SAME) history_merge(&h[i], &d->stale[i], INFINITY);
+            memset(&d->stale[i], 0, sizeof d->stale[i]);
+        }
+}
+
+/* The light changed: what the history says is set aside, to come back where new samples agree with
+ * it. During a drag each step adds what came since the last one to what is set aside. */
+static void begin_judging(display *d) {
+    size_t n = (size_t)d->width * (size_t)d->height;
+    pixel_history *h = d->h[d->cur];
+    if (d->judging) {
+        for (size_t i = 0; i < n; i++) history_merge(&d->stale[i], &h[i], INFINITY);
+        memset(h, 0, n * sizeof *h);
+    } else {
+        d->h[d->cur] = d->stale;
+        d->stale = h;
+        memset(d->h[d->cur], 0, n * sizeof *h);
+    }
+    memset(d->tiles, 0, sizeof(light_tile) * (size_t)d->tiles_x * (size_t)d->tiles_y);
+    d->judging = 1;
+}
+
+/* The camera moves before every tile was judged: the stale history of tiles not judged changed
+ * comes back as one sample's worth (it may be wrong), and the judgement ends. */
+static void end_judging(display *d, pixel_history *h) {
+    size_t n = (size_t)d->width * (size_t)d->height;
+    for (size_t i = 0; i < n; i++)
+        if (d->tiles[tile_of(d, i)].state != TILE_CHANGED) history_merge(&h[i], &d->stale[i], 1.0f);
+    memset(d->stale, 0, n * sizeof *d->stale);
+    d->judging = 0;
+}
+
+/* Each tile with enough new samples beside stale history: changed when their difference stands
+ * well out of the noise and is a tenth of the light or more; the same when it does not. */
+static void judge_tiles(display *d) {
+    int nt = d->tiles_x * d->tiles_y, open = 0;
+    for (int t = 0; t < nt; t++) {
+        light_tile *k = &d->tiles[t];
+        if (k->state != TILE_UNKNOWN) continue;
+        open++;
+        if (k->n < JUDGE_MIN_SAMPLES) continue;
+        double z = fabs(k->diff) / sqrt(k->var + 1e-30), r = fabs(k->diff) / (k->base + 1e-30);
+        if (z > 3.0 && r > 0.1)
+            settle_tile(d, t, TILE_CHANGED), open--;
+        else if (z < 2.0 || r < 0.05 || k->n >= JUDGE_MAX_SAMPLES)
+            settle_tile(d, t, r > 0.1 ? TILE_CHANGED : TILE_SAME), open--;
+    }
+    if (!open) d->judging = 0;
+}
+
+/* Luminance of every component of a history entry, summed, and its samples' variance. */
+static float total_luminance(const pixel_history *p, float *variance) {
+    float l = 0.0f, v = 0.0f;
+    for (int c = 0; c < COMP_COUNT; c++) {
+        float lc = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2]));
+        l += lc;
+        v += fmaxf(p->c[c].m2 - lc * lc, 0.0f);
+    }
+    *variance = v;
+    return l;
+}
+
+/* A new sample e (each component's, divided by the albedo) at pixel i, as evidence for its tile. */
+static void gather_evidence(display *d, size_t i, const vec3 *e) {
+    const pixel_history *st = &d->stale[i];
+    if (!(st->c[COMP_DIRECT].count > 0.0f || st->c[COMP_INDIRECT].count > 0.0f)) return;
+    light_tile *k = &d->tiles[tile_of(d, i)];
+    if (k->state != TILE_UNKNOWN) return;
+    float var, old = total_luminance(st, &var), x = 0.0f;
+    for (int c = 0; c < COMP_COUNT; c++) x += luminance3(e[c]);
+    k->diff += (double)(x - old);
+    k->var += (double)var;
+    k->base += (double)old;
+    k->n++;
+}
+
+void display_change_view(display *d, const scene *s, const camera *cam, unsigned change) {
+    uint64_t t0 = clock_ns();
+    int prev = d->cur, next = 1 - d->cur;
+    gbuffer_trace(&d->g[next], s, cam, d->pool);
+    if (!d->have_view) change |= DISPLAY_RESTART;
+    if (d->judging && (change & DISPLAY_RESTART)) {
+        memset(d->stale, 0, (size_t)d->width * (size_t)d->height * sizeof *d->stale);
+        d->judging = 0;
+    } else if (d->judging && memcmp(&d->g[prev].cam, cam, sizeof *cam) != 0) {
+        end_judging(d, d->h[prev]);
+    }
+    carry_job j = {.d = d,
+                   .from = &d->g[prev],
+                   .to = &d->g[next],
+                   .old = d->h[prev],
+                   .now = d->h[next],
+                   .change = change,
+                   .same_camera = memcmp(&d->g[prev].cam, cam, sizeof *cam) == 0,
+                   .footprint = 2.0f * tanf(0.5f * cam->yfov) / (float)d->height};
+    threadpool_run(d->pool, carry_row, &j, d->height);
+    d->cur = next;
+    d->have_view = 1;
+    if ((change & DISPLAY_LIGHTS) && !(change & DISPLAY_RESTART)) begin_judging(d);
+    d->st.carried = atomic_load(&j.carried);
+    d->st.lost = atomic_load(&j.lost);
+    if (change & DISPLAY_RESTART) memset(d->active, 0, sizeof d->active);
+    /* samples written for the old view are not for this one */
+    d->sink.serial++;
+    d->st.view_ms = 1e-6 * (double)(clock_ns() - t0);
+}
+
+/* ---- samples in, the image out ------------------------------------------------------------- */
+
+long long display_take_samples(display *d) {
+    const gbuffer *g = &d->g[d->cur];
+    pixel_history *h = d->h[d->cur];
+    size_t n = (size_t)d->width * (size_t)d->height;
+    uint32_t serial = d->sink.serial;
+    long long taken = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (d->sink.stamp[i] != serial) continue;
+        taken++;
+        vec3 a = get3(g->albedo, i), e[COMP_COUNT];
+        for (int c = 0; c < COMP_COUNT; c++) e[c] = div3(get3(d->sink.rgb[c], i), a);
+        if (d->judging) gather_evidence(d, i, e);
+        for (int c = 0; c < COMP_COUNT; c++) {
+            d->active[c] |= !is_black3(e[c]);
+            float l = luminance3(e[c]);
+            float k = h[i].c[c].count + 1.0f, *m = h[i].c[c].mean;
+            m[0] += (e[c].x - m[0]) / k;
+            m[1] += (e[c].y - m[1]) / k;
+            m[2] += (e[c].z - m[2]) / k;
+            h[i].c[c].m2 += (l * l - h[i].c[c].m2) / k;
+            h[i].c[c].count = k;
+        }
+    }
+    if (d->judging) judge_tiles(d);
+    d->sink.serial++;
+    if (d->sink.serial == 0) { /* wrapped: no stale stamp may match again */
+        memset(d->sink.stamp, 0, sizeof(uint32_t) * n);
+        d->sink.serial = 1;
+    }
+    if (taken) d->st.updates++;
+    d->st.samples += (uint64_t)taken;
+    return taken;
+}
+
+typedef struct {
+    display *d;
+    unsigned mask; /* the components shown that have light */
+    int filtered;
+    float *rgb;
+    atomic_llong samples; /* the direct light's, over all pixels: how young the image is */
+} resolve_job;
+
+/* Component c of pixel i's history as shown: its own, or, while a light change is judged and the
+ * pixel has none of its own since, the stale history's counted as STALE_WEIGHT samples (where its
+ * tile was not judged changed). NULL when there is nothing. */
+static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2) {
+    const pixel_history *p = &d->h[d->cur][i];
+    if (!(p->c[c].count > 0.0f) && d->judging && d->stale[i].c[c].count > 0.0f) {
+        p = &d->stale[i];
+        *count = fminf(p->c[c].count, STALE_WEIGHT);
+    } else if (p->c[c].count > 0.0f) {
+        *count = p->c[c].count;
+    } else {
+        return NULL;
+    }
+    *m2 = p->c[c].m2;
+    return p->c[c].mean;
+}
+
+/* The filter's input: each component's history as planes, its variance from the moments. */
+static void split_row(void *ctx, int y, int worker) {
+    (void)worker;
+    resolve_job *j = ctx;
+    display *d = j->d;
+    double samples = 0.0;
+    for (int x = 0; x < d->width; x++) {
+        size_t i = (size_t)y * (size_t)d->width + (size_t)x;
+        samples += (double)d->h[d->cur][i].c[COMP_DIRECT].count;
+        for (int c = 0; c < COMP_COUNT; c++) {
+            if (!(j->mask >> c & 1u)) continue;
+            float count = 0.0f, m2 = 0.0f;
+            const float *m = shown_history(d, i, c, &count, &m2);
+            static const float none[3] = {0.0f, 0.0f, 0.0f};
+            if (!m) m = none;
+            float l = luminance3(v3(m[0], m[1], m[2]));
+            for (int e = 0; e < 3; e++) d->light[c][3 * i + (size_t)e] = m[e];
+            d->count[c][i] = count;
+            /* the moments give the population variance; the filter wants the unbiased one */
+            d->variance[c][i] = count > 1.0f ? fmaxf(m2 - l * l, 0.0f) * count / (count - 1.0f) : 0.0f;
+        }
+    }
+    atomic_fetch_add(&j->samples, (long long)samples);
+}
+
+static void modulate_row(void *ctx, int y, int worker) {
+    (void)worker;
+    resolve_job *j = ctx;
+    display *d = j->d;
+    const gbuffer *g = &d->g[d->cur];
+    for (int x = 0; x < d->width; x++) {
+        size_t i = (size_t)y * (size_t)d->width + (size_t)x;
+        vec3 sum = v3(0, 0, 0);
+        for (int c = 0; c < COMP_COUNT; c++) {
+            if (!(j->mask >> c & 1u)) continue;
+            float count, m2;
+            const float *m;
+            if (j->filtered)
+                sum = add3(sum, get3(d->out[c], i));
+            else if ((m = shown_history(d, i, c, &count, &m2)))
+                sum = add3(sum, v3(m[0], m[1], m[2]));
+        }
+        vec3 v = mul3(sum, get3(g->albedo, i));
+        if (!is_finite3(v)) v = v3(0, 0, 0);
+        j->rgb[3 * i] = v.x;
+        j->rgb[3 * i + 1] = v.y;
+        j->rgb[3 * i + 2] = v.z;
+    }
+}
+
+void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
+    uint64_t t0 = clock_ns();
+    resolve_job j = {.d = d, .filtered = denoise, .rgb = rgb};
+    for (int c = 0; c < COMP_COUNT; c++)
+        if (mask >> c & 1u && d->active[c]) j.mask |= 1u << c;
+    d->st.levels = 0;
+    if (denoise) {
+        threadpool_run(d->pool, split_row, &j, d->height);
+        d->st.mean_count = (double)atomic_load(&j.samples) / ((double)d->width * (double)d->height);
+        /* each component shown that has light, filtered on its own */
+        denoise_input in = {.g = &d->g[d->cur]};
+        denoise_output out = {.light = {NULL}};
+        for (int c = 0; c < COMP_COUNT; c++) {
+            if (!(j.mask >> c & 1u)) continue;
+            int k = in.components++;
+            in.light[k] = d->light[c];
+            in.count[k] = d->count[c];
+            in.variance[k] = d->variance[c];
+            out.light[k] = d->out[c];
+        }
+        denoise_params p = {.levels = DENOISE_LEVELS};
+        if (in.components) denoise_run(d->dn, &in, &p, &out, d->pool);
+        d->st.levels = DENOISE_LEVELS;
+    }
+    threadpool_run(d->pool, modulate_row, &j, d->height);
+    d->st.resolve_ms = 1e-6 * (double)(clock_ns() - t0);
+}

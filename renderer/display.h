@@ -1,0 +1,64 @@
+/* glint — what the viewer shows while the estimate refines (docs/design.md, "The display while
+ * things move"): a view of the film's samples, never the film. Each pixel keeps a history of the
+ * samples that landed on its surface point, per film component, divided by the point's albedo;
+ * when the camera moves, the history follows the point to where it lands in the new view
+ * (reprojection through a G-buffer of the pixels' centre rays), keeping of a glossy lobe's share
+ * less the sharper the lobe and the more the view turned; new samples blend in; the image shown
+ * is the history, filtered while it is young (denoise.h). Exports, references and glint bench
+ * read the session's film, which this never touches. */
+#ifndef GLINT_DISPLAY_H
+#define GLINT_DISPLAY_H
+
+#include <stdint.h>
+
+#include "film.h"
+#include "gbuffer.h"
+#include "session.h"
+
+/* Why the view changed (display_change_view), a mask. */
+enum {
+    DISPLAY_CAMERA = 1,  /* the camera moved: each point's history follows it */
+    DISPLAY_LIGHTS = 2,  /* a light moved or changed: what it lit changed, history is kept briefly */
+    DISPLAY_RESTART = 4, /* another scene, estimator or size: nothing carries over */
+};
+
+typedef struct {
+    uint64_t updates;  /* display_take_samples calls that brought samples */
+    uint64_t samples;  /* samples taken in all */
+    long long carried; /* pixels whose history the last view change carried over... */
+    long long lost;    /* ...and those it lost (disocclusions, another surface) */
+    double mean_count; /* samples behind the average pixel's light at the last resolve */
+    int levels;        /* the filter's passes at the last resolve (0: not filtered) */
+    double view_ms;    /* the last view change: G-buffer and reprojection */
+    double resolve_ms; /* the last resolve: filter and modulation */
+} display_stats;
+
+typedef struct display display;
+
+/* A display for width x height images, on threads threads (0: one per core). Returns NULL with err
+ * set (out of memory, no threads). Its history starts empty. */
+display *display_create(int width, int height, int threads, char *err, size_t errlen);
+void display_destroy(display *d);
+
+/* Where the session writes each update's samples (session_set_sink): the display reads the pixels
+ * stamped with the sink's serial at display_take_samples. */
+const sample_sink *display_sink(const display *d);
+
+/* The view changed for the reasons in `change` (DISPLAY_*): the G-buffer is traced for cam, and
+ * each pixel's history carried over from the last view as far as the change leaves it right. The
+ * first call (and DISPLAY_RESTART) starts from nothing. s must be the scene the samples render. */
+void display_change_view(display *d, const scene *s, const camera *cam, unsigned change);
+
+/* Blends in the samples the session wrote into the sink since the last call, and opens the sink
+ * for the next update. Returns how many it took. */
+long long display_take_samples(display *d);
+
+/* The image shown, of the components in mask (bit c = film component c), into rgb (3 floats a
+ * pixel, width x height): the history times the albedo, filtered when denoise is set (its
+ * strength follows each pixel's noise: a converged pixel comes back as it is). Finite. */
+void display_resolve(display *d, unsigned mask, int denoise, float *rgb);
+
+display_stats display_get_stats(const display *d);
+const gbuffer *display_gbuffer(const display *d);
+
+#endif

@@ -1,0 +1,373 @@
+/* The display pipeline's temporal part (display.h), against answers known exactly: samples taken
+ * at one view average as the film averages them; a camera move carries each surface point's
+ * history to where the point lands (a light linear in position comes back exactly, since bilinear
+ * taps of a linear function are exact); what the move reveals starts empty and never takes another
+ * surface's light; a glossy lobe's share keeps what its width and the view's turn leave, a diffuse
+ * point all of it; a light change keeps little, a restart nothing; samples written for an old
+ * view are not taken for a new one; the image shown is finite whatever the samples. The G-buffer's
+ * projection is checked against its own centre rays. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "display.h"
+#include "test_scenes.h"
+
+#define W 64
+#define H 40
+
+/* A grey Lambert plane z = 0 (facing +z), and in front of it a small quad at z = 1 of another
+ * material; or a glossy plane (Phong, exponent n) when n > 0. */
+static scene *plane_scene(int with_quad, float phong_n) {
+    scene *s = ts_new("display");
+    int plane = phong_n > 0.0f ? ts_material(s, ts_phong(v3s(0.3f), v3s(0.3f), phong_n))
+                               : ts_lambert(s, v3s(0.5f), v3s(0.0f), 0);
+    ts_quad(s, v3(-50, -50, 0), v3(50, -50, 0), v3(50, 50, 0), v3(-50, 50, 0), plane);
+    if (with_quad) {
+        int q = ts_lambert(s, v3(0.8f, 0.2f, 0.1f), v3s(0.0f), 0);
+        ts_quad(s, v3(-0.3f, -0.3f, 1), v3(0.3f, -0.3f, 1), v3(0.3f, 0.3f, 1), v3(-0.3f, 0.3f, 1), q);
+    }
+    ts_point_light(s, v3(0, 0, 10));
+    ts_finalize(s);
+    return s;
+}
+
+static camera view_from(vec3 eye, vec3 target) { return camera_look_at(eye, target, v3(0, 1, 0), 0.7f); }
+
+/* The light a test writes for a surface point: linear in its position, per component. */
+static vec3 light_at(vec3 p, int c) { return v3(2.0f + p.x + 0.1f * c, 3.0f + p.y, 1.0f + 0.5f * p.x - 0.25f * p.y); }
+
+/* Writes one sample into every pixel of the sink: the light at the pixel's G-buffer point times
+ * its albedo (so the demodulated history holds light_at), scaled by gain, or `value` when the
+ * pixel shows material `mat` (>= 0). */
+static void write_samples(display *d, float gain, int mat, float value) {
+    const sample_sink *sk = display_sink(d);
+    const gbuffer *g = display_gbuffer(d);
+    for (int i = 0; i < W * H; i++) {
+        vec3 p = v3(g->pos[3 * i], g->pos[3 * i + 1], g->pos[3 * i + 2]);
+        vec3 a = v3(g->albedo[3 * i], g->albedo[3 * i + 1], g->albedo[3 * i + 2]);
+        for (int c = 0; c < COMP_COUNT; c++) {
+            vec3 l = mat >= 0 && g->material[i] == mat ? v3s(value) : scale3(light_at(p, c), gain);
+            vec3 x = mul3(l, a);
+            sk->rgb[c][3 * i] = x.x, sk->rgb[c][3 * i + 1] = x.y, sk->rgb[c][3 * i + 2] = x.z;
+        }
+        sk->stamp[i] = sk->serial;
+    }
+}
+
+static void check_projection(void) {
+    scene *s = plane_scene(0, 0.0f);
+    gbuffer g;
+    CHECK(gbuffer_init(&g, W, H) == 0, "gbuffer_init");
+    camera cam = view_from(v3(0.4f, -0.3f, 5), v3(0.1f, 0.2f, 0));
+    gbuffer_trace(&g, s, &cam, NULL);
+    double worst = 0.0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            int i = y * W + x;
+            float px, py;
+            vec3 p = v3(g.pos[3 * i], g.pos[3 * i + 1], g.pos[3 * i + 2]);
+            CHECK(g.material[i] >= 0 && g.depth[i] > 0.0f, "pixel %d sees the plane", i);
+            if (!gbuffer_project(&g, p, &px, &py)) continue;
+            worst = fmax(worst, fmax(fabs(px - (x + 0.5)), fabs(py - (y + 0.5))));
+            CHECK_NEAR(g.normal[3 * i + 2], 1.0, 1e-5, "the plane's normal faces the camera");
+        }
+    CHECK(worst < 2e-3, "a centre ray's hit projects back to the pixel's centre (worst %g pixels)", worst);
+    gbuffer_deinit(&g);
+    scene_destroy(s);
+}
+
+/* Samples at one view: the history is their mean, as the film's is. */
+static void check_static_mean(void) {
+    scene *s = plane_scene(0, 0.0f);
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    CHECK(d != NULL, "display_create: %s", err);
+    if (!d) return;
+    camera cam = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    display_change_view(d, s, &cam, DISPLAY_CAMERA);
+    const float gains[4] = {1.0f, 3.0f, 0.5f, 2.5f};
+    for (int k = 0; k < 4; k++) {
+        write_samples(d, gains[k], -1, 0.0f);
+        CHECK(display_take_samples(d) == W * H, "every pixel's sample taken");
+    }
+    CHECK(display_take_samples(d) == 0, "a sample is taken once");
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_INDIRECT, 0, img);
+    const gbuffer *g = display_gbuffer(d);
+    double worst = 0.0;
+    for (int i = 0; i < W * H; i++) {
+        vec3 p = v3(g->pos[3 * i], g->pos[3 * i + 1], g->pos[3 * i + 2]);
+        vec3 want = mul3(scale3(light_at(p, COMP_INDIRECT), 7.0f / 4.0f), v3(g->albedo[3 * i], 0, 0));
+        worst = fmax(worst, fabs(img[3 * i] - want.x) / want.x);
+    }
+    CHECK(worst < 1e-5, "the mean of four samples (worst relative difference %g)", worst);
+    free(img);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
+/* Moves the camera from a to b after n samples at a; returns the display (caller destroys). */
+static display *moved(const scene *s, camera a, camera b, int n, unsigned change, int mat, float value) {
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    if (!d) return NULL;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    for (int k = 0; k < n; k++) {
+        write_samples(d, 1.0f, mat, value);
+        display_take_samples(d);
+    }
+    display_change_view(d, s, &b, change);
+    return d;
+}
+
+/* The history that comes with a pixel: its mean light (component c) and count, read back through
+ * a resolve without the filter (the mean times the albedo) and the stats. */
+static void check_reprojection(void) {
+    scene *s = plane_scene(0, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    camera b = view_from(v3(0.37f, 0.11f, 5), v3(0.37f, 0.11f, 0)); /* a slide of a fraction of pixels */
+    display *d = moved(s, a, b, 3, DISPLAY_CAMERA, -1, 0.0f);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    display_stats st = display_get_stats(d);
+    const gbuffer *g = display_gbuffer(d);
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_DIRECT, 0, img);
+    gbuffer ga;
+    gbuffer_init(&ga, W, H);
+    gbuffer_trace(&ga, s, &a, NULL);
+    double worst = 0.0;
+    long long inside = 0, empty_outside = 0, outside = 0;
+    for (int i = 0; i < W * H; i++) {
+        vec3 p = v3(g->pos[3 * i], g->pos[3 * i + 1], g->pos[3 * i + 2]);
+        float ox, oy;
+        gbuffer_project(&ga, p, &ox, &oy);
+        /* inside: all four bilinear taps were in the old image */
+        if (ox >= 0.5f && oy >= 0.5f && ox <= W - 0.5f && oy <= H - 0.5f) {
+            inside++;
+            vec3 want = mul3(light_at(p, COMP_DIRECT), v3(g->albedo[3 * i], g->albedo[3 * i + 1], 0));
+            worst = fmax(worst, fmax(fabs(img[3 * i] - want.x) / want.x, fabs(img[3 * i + 1] - want.y) / want.y));
+        } else if (ox < -0.5f || oy < -0.5f || ox > W + 0.5f || oy > H + 0.5f) {
+            outside++;
+            empty_outside += img[3 * i] == 0.0f;
+        }
+    }
+    CHECK(inside > W * H / 2, "most pixels were seen before (%lld)", inside);
+    CHECK(worst < 1e-4, "a linear light comes back exactly where its point lands (worst relative %g)", worst);
+    CHECK(outside > 0 && empty_outside == outside, "what the move reveals starts empty: %lld of %lld", empty_outside,
+          outside);
+    CHECK(st.carried >= inside && st.lost >= outside, "stats: carried %lld, lost %lld", st.carried, st.lost);
+    gbuffer_deinit(&ga);
+    free(img);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
+/* A quad in front of the plane, the camera slides: plane pixels that saw the quad before start
+ * empty; no plane pixel takes the quad's light. */
+static void check_disocclusion(void) {
+    scene *s = plane_scene(1, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    camera b = view_from(v3(0.8f, 0, 5), v3(0.8f, 0, 0));
+    int quad_material = 1;
+    display *d = moved(s, a, b, 2, DISPLAY_CAMERA, quad_material, 100.0f);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_DIRECT, 0, img);
+    const gbuffer *g = display_gbuffer(d);
+    gbuffer ga;
+    gbuffer_init(&ga, W, H);
+    gbuffer_trace(&ga, s, &a, NULL);
+    long long revealed = 0, revealed_empty = 0, leaks = 0, quad_kept = 0, quad = 0;
+    for (int i = 0; i < W * H; i++) {
+        float ox, oy;
+        vec3 p = v3(g->pos[3 * i], g->pos[3 * i + 1], g->pos[3 * i + 2]);
+        if (!gbuffer_project(&ga, p, &ox, &oy)) continue;
+        int tx = (int)ox, ty = (int)oy;
+        if (tx < 1 || ty < 1 || tx >= W - 1 || ty >= H - 1) continue;
+        float v = img[3 * i] / g->albedo[3 * i];
+        if (g->material[i] == quad_material) {
+            quad++;
+            quad_kept += fabsf(v - 100.0f) < 1e-3f;
+            continue;
+        }
+        leaks += v > 50.0f;
+        /* the old pixel there showed the quad: the point was hidden */
+        if (ga.material[ty * W + tx] == quad_material) {
+            revealed++;
+            revealed_empty += v == 0.0f;
+        }
+    }
+    CHECK(revealed > 10 && revealed_empty == revealed, "revealed plane pixels start empty: %lld of %lld",
+          revealed_empty, revealed);
+    CHECK(leaks == 0, "%lld plane pixels took the quad's light", leaks);
+    CHECK(quad > 10 && quad_kept * 10 >= quad * 9, "the quad keeps its own light: %lld of %lld", quad_kept, quad);
+    gbuffer_deinit(&ga);
+    free(img);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
+/* The history's sample count after a turn of the view, read from the stats' mean count (every
+ * pixel sees the plane): diffuse keeps all (up to the cap), glossy what its lobe allows. */
+static double count_after_orbit(float phong_n, float degrees, unsigned mask_component, int n) {
+    scene *s = plane_scene(0, phong_n);
+    float r = 5.0f, t = degrees * PI_F / 180.0f;
+    camera a = view_from(v3(0, 0, r), v3(0, 0, 0));
+    camera b = view_from(v3(r * sinf(t), 0, r * cosf(t)), v3(0, 0, 0));
+    display *d = moved(s, a, b, n, DISPLAY_CAMERA, -1, 0.0f);
+    double sum = 0.0;
+    int m = 0;
+    if (d) {
+        /* one more sample everywhere: its weight in the mean tells the count that was carried */
+        const gbuffer *g = display_gbuffer(d);
+        write_samples(d, 0.0f, -1, 0.0f); /* zero light: mean' = mean * count / (count + 1) */
+        float *before = malloc(sizeof(float) * 3 * W * H), *after = malloc(sizeof(float) * 3 * W * H);
+        display_resolve(d, mask_component, 0, before);
+        display_take_samples(d);
+        display_resolve(d, mask_component, 0, after);
+        for (int i = W * H / 4; i < 3 * W * H / 4; i++) {
+            if (g->material[i] < 0 || !(before[3 * i] > 0.0f)) continue;
+            double q = after[3 * i] / before[3 * i]; /* count / (count + 1) */
+            sum += q / (1.0 - q);
+            m++;
+        }
+        free(before);
+        free(after);
+        display_destroy(d);
+    }
+    scene_destroy(s);
+    return m ? sum / m : 0.0;
+}
+
+static void check_glossy_history(void) {
+    double diffuse = count_after_orbit(0.0f, 10.0f, 1u << COMP_DIRECT, 8);
+    CHECK_NEAR(diffuse, 8.0, 0.01, "a diffuse plane keeps its whole history through a 10 degree orbit");
+    /* Phong 400: alpha = sqrt(2 / 402) = 0.0705; the view turns 10 degrees at the centre */
+    double glossy_direct = count_after_orbit(400.0f, 10.0f, 1u << COMP_DIRECT, 8);
+    double glossy_hl = count_after_orbit(400.0f, 10.0f, 1u << COMP_HIGHLIGHTS, 8);
+    double small_turn = count_after_orbit(400.0f, 0.5f, 1u << COMP_HIGHLIGHTS, 8);
+    CHECK(glossy_hl < 0.5 * 8.0, "a sharp lobe's highlights lose most of their history in 10 degrees: %g", glossy_hl);
+    CHECK(glossy_direct > glossy_hl + 0.5 && glossy_direct < 8.0 - 0.5,
+          "the direct light of a glossy plane keeps its diffuse share: %g (highlights %g)", glossy_direct, glossy_hl);
+    CHECK(small_turn > 0.9 * 8.0, "half a degree leaves a sharp lobe's history nearly whole: %g", small_turn);
+}
+
+/* Light edits keep little, a restart nothing; samples stamped before a change are not taken. */
+static void check_changes(void) {
+    scene *s = plane_scene(0, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    char err[256];
+    display *d = display_create(W, H, 1, err, sizeof err);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    for (int k = 0; k < 5; k++) {
+        write_samples(d, 1.0f, -1, 0.0f);
+        display_take_samples(d);
+    }
+    write_samples(d, 50.0f, -1, 0.0f); /* written for this view, but the view changes first */
+    display_change_view(d, s, &a, DISPLAY_LIGHTS);
+    CHECK(display_take_samples(d) == 0, "samples of the view before a change are not taken");
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_DIRECT, 0, img);
+    float kept = img[3 * (H / 2 * W + W / 2)];
+    write_samples(d, 0.0f, -1, 0.0f);
+    display_take_samples(d);
+    float *after = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_DIRECT, 0, after);
+    CHECK(kept > 0.0f && after[3 * (H / 2 * W + W / 2)] <= 0.51f * kept,
+          "a light change keeps at most one sample's weight: %g -> %g", kept, after[3 * (H / 2 * W + W / 2)]);
+    display_change_view(d, s, &a, DISPLAY_RESTART);
+    display_resolve(d, COMP_MASK_ALL, 0, img);
+    double sum = 0.0;
+    for (int i = 0; i < 3 * W * H; i++) sum += fabs(img[i]);
+    CHECK(sum == 0.0, "a restart keeps nothing");
+    /* hostile samples: the image shown stays finite */
+    const sample_sink *sk = display_sink(d);
+    for (int i = 0; i < W * H; i++) {
+        for (int c = 0; c < COMP_COUNT; c++)
+            sk->rgb[c][3 * i] = sk->rgb[c][3 * i + 1] = sk->rgb[c][3 * i + 2] = FLT_MAX;
+        sk->stamp[i] = sk->serial;
+    }
+    display_take_samples(d);
+    for (int denoise = 0; denoise < 2; denoise++) {
+        display_resolve(d, COMP_MASK_ALL, denoise, img);
+        int finite = 1;
+        for (int i = 0; i < 3 * W * H; i++) finite &= isfinite(img[i]);
+        CHECK(finite, "huge samples give a finite image (denoise %d)", denoise);
+    }
+    free(img);
+    free(after);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
+/* A light change, judged tile by tile from new samples: where they agree with the history (the
+ * left half, noisy samples about the same mean) it comes back in full; where the light tripled
+ * (the right half) it goes; tiles without new samples show it meanwhile. */
+static void check_light_judgement(void) {
+    scene *s = plane_scene(0, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    const sample_sink *sk = display_sink(d);
+    const gbuffer *g = display_gbuffer(d);
+    rng_state rng = rng_for(7, 0, 0);
+    /* noisy samples: 1 +- 0.5 times the light, 8 of them before the change */
+    for (int k = 0; k < 9; k++) {
+        if (k == 8) display_change_view(d, s, &a, DISPLAY_LIGHTS);
+        for (int i = 0; i < W * H; i++) {
+            int x = i % W, y = i / W;
+            /* after the change: the right half's light triples; the bottom rows get no sample */
+            if (k == 8 && y >= 32) continue;
+            float gain = (k == 8 && x >= W / 2 ? 3.0f : 1.0f) * (0.5f + rng_float(&rng));
+            for (int c = 0; c < COMP_COUNT; c++)
+                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = gain * g->albedo[3 * i + e];
+            sk->stamp[i] = sk->serial;
+        }
+        display_take_samples(d);
+    }
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_DIRECT, 0, img);
+    double left = 0.0, left2 = 0.0, right = 0.0, unjudged = 0.0;
+    int nl = 0, nr = 0, nu = 0;
+    for (int i = 0; i < W * H; i++) {
+        int x = i % W, y = i / W;
+        double v = img[3 * i] / g->albedo[3 * i];
+        if (y >= 32)
+            unjudged += v, nu++;
+        else if (x < W / 2)
+            left += v, left2 += (v - 1.0) * (v - 1.0), nl++;
+        else
+            right += v, nr++;
+    }
+    left /= nl, right /= nr, unjudged /= nu;
+    /* the left keeps 9 samples' mean (about 1 +- 0.1), the right shows its one new sample (about 3) */
+    /* one sample's spread is 0.29; nine samples' a third of it */
+    CHECK(fabs(left - 1.0) < 0.05 && sqrt(left2 / nl) < 0.15, "unchanged light keeps its history: mean %g, RMS %g",
+          left, sqrt(left2 / nl));
+    CHECK(fabs(right - 3.0) < 0.15, "changed light shows the new samples alone: mean %g", right);
+    CHECK(fabs(unjudged - 1.0) < 0.05, "tiles without new samples show the old light meanwhile: %g", unjudged);
+    free(img);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
+int main(void) {
+    check_projection();
+    check_static_mean();
+    check_reprojection();
+    check_disocclusion();
+    check_glossy_history();
+    check_changes();
+    check_light_judgement();
+    return check_exit("test_display");
+}
