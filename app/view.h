@@ -318,8 +318,6 @@ void frame_scene(ui_thread *u);
 int open_reference(ui_thread *u, const char *path);
 /* Back to the reference's camera; -1 (message set) without one. */
 int reference_view(ui_thread *u);
-/* Whether two cameras are the same view (scale: the scene's size). */
-int same_view(const camera *a, const camera *b, float scale);
 /* Refreshes u->status and its notes (every UI frame). */
 void update_status(ui_thread *u);
 

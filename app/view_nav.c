@@ -175,11 +175,6 @@ int reference_view(ui_thread *u) {
     return 0;
 }
 
-int same_view(const camera *a, const camera *b, float scale) {
-    return length3(sub3(a->position, b->position)) <= 1e-4f * scale && dot3(a->forward, b->forward) >= 1.0f - 1e-5f &&
-           dot3(a->up, b->up) >= 1.0f - 1e-5f && fabsf(a->yfov - b->yfov) <= 1e-4f;
-}
-
 /* ---- standing notes -------------------------------------------------------------------------- */
 
 void update_status(ui_thread *u) {
@@ -197,7 +192,7 @@ void update_status(ui_thread *u) {
         }
     }
     camera now = ctl_camera(&u->cam);
-    int paused = u->reference.rgb && u->reference_cam_valid && !same_view(&now, &u->reference_cam, u->info.diag);
+    int paused = u->reference.rgb && u->reference_cam_valid && !camera_same_view(&now, &u->reference_cam, u->info.diag);
     if (paused && len < (int)sizeof u->status)
         snprintf(u->status + len, sizeof u->status - (size_t)len,
                  "%serror plot paused: away from the reference's "

@@ -480,7 +480,7 @@ static void *render_main(void *arg) {
         render_params params = sh->params;
         int preview = seconds_since(sh->changed_at) < PREVIEW_HOLD_SECONDS;
         /* Measured against the reference only from its camera (when its description names one). */
-        int measure = !sh->reference_cam_valid || same_view(&cam, &sh->reference_cam, rt->scene->diag);
+        int measure = !sh->reference_cam_valid || camera_same_view(&cam, &sh->reference_cam, rt->scene->diag);
         int rw = sh->render_w, rh = sh->render_h;
         /* Light requests made for a scene since replaced are stale: the new one starts as loaded. */
         int edit_lights = gen != applied && sh->lights_scene == sh->info_serial;
