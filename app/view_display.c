@@ -142,6 +142,9 @@ int fetch_published(ui_thread *u) {
         if (u->step_ms < 0.0 && u->front.generation == u->sent_generation) /* the change's first image */
             u->step_ms = 1e3 * seconds_since(u->sent_at);
         if (u->front.preview) u->preview_w = u->front.width, u->preview_h = u->front.height;
+        u->images_shown++;
+        u->images_full += !u->front.preview;
+        u->image_pixels += (unsigned long long)u->front.width * (unsigned long long)u->front.height;
     }
     int new_error = sh->stats.rel_error_serial != u->stats.rel_error_serial;
     u->stats = sh->stats;
@@ -235,6 +238,91 @@ void take_screenshot(ui_thread *u, const char *name) {
     if (png_save_rgb8(path, u->front.width, u->front.height, u->pixels, WRITE_NO_REPLACE, err, sizeof err) != 0) {
         snprintf(u->message, sizeof u->message, "%s", err);
         cli_error("%s", err);
+        return;
+    }
+    snprintf(u->message, sizeof u->message, "wrote %s", path);
+    printf("glint: wrote %s\n", path);
+    fflush(stdout);
+}
+
+/* src (w x h, RGB) magnified to out (W x H) as the window draws it: a GL_LINEAR texture with
+ * clamp-to-edge, texel centres at (i + 0.5) / w, stretched over the image. */
+static void magnify_bilinear(const float *src, int w, int h, float *out, int W, int H) {
+    for (int Y = 0; Y < H; Y++) {
+        float v = ((float)Y + 0.5f) * (float)h / (float)H - 0.5f;
+        int y0 = (int)floorf(v);
+        float fy = v - (float)y0;
+        int ya = y0 < 0 ? 0 : y0 >= h ? h - 1 : y0, yb = y0 + 1 < 0 ? 0 : y0 + 1 >= h ? h - 1 : y0 + 1;
+        for (int X = 0; X < W; X++) {
+            float x = ((float)X + 0.5f) * (float)w / (float)W - 0.5f;
+            int x0 = (int)floorf(x);
+            float fx = x - (float)x0;
+            int xa = x0 < 0 ? 0 : x0 >= w ? w - 1 : x0, xb = x0 + 1 < 0 ? 0 : x0 + 1 >= w ? w - 1 : x0 + 1;
+            const float *p00 = src + 3 * ((size_t)ya * (size_t)w + (size_t)xa),
+                        *p01 = src + 3 * ((size_t)ya * (size_t)w + (size_t)xb),
+                        *p10 = src + 3 * ((size_t)yb * (size_t)w + (size_t)xa),
+                        *p11 = src + 3 * ((size_t)yb * (size_t)w + (size_t)xb);
+            float *o = out + 3 * ((size_t)Y * (size_t)W + (size_t)X);
+            for (int k = 0; k < 3; k++)
+                o[k] = (1.0f - fy) * ((1.0f - fx) * p00[k] + fx * p01[k]) + fy * ((1.0f - fx) * p10[k] + fx * p11[k]);
+        }
+    }
+}
+
+void capture_image(ui_thread *u, const char *name) {
+    char path[1024], err[1200];
+    const image_buf *im = &u->front;
+    int W = im->full_w, H = im->full_h;
+    float *magnified = NULL;
+    reference_info info;
+    int written = 0;
+    if (!im->rgb || W <= 0 || H <= 0) {
+        snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
+    } else if (unique_path(name, path, sizeof path) != 0) {
+        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
+    } else if ((im->width != W || im->height != H) &&
+               !(magnified = malloc(sizeof(float) * 3 * (size_t)W * (size_t)H))) {
+        snprintf(u->message, sizeof u->message, "%s: out of memory", name);
+    } else if (describe_view(u, &info, W, H, &im->lights, err, sizeof err) != 0) {
+        snprintf(u->message, sizeof u->message, "%s", err);
+    } else {
+        if (magnified) magnify_bilinear(im->rgb, im->width, im->height, magnified, W, H);
+        /* The image's own camera: one of the scene's when it is that view, else a free camera. */
+        info.cam = im->cam;
+        info.camera_index = -1;
+        for (int i = 0; i < u->info.num_cameras && info.camera_index < 0; i++)
+            if (camera_same_view(&im->cam, &u->info.cameras[i], u->info.diag)) info.camera_index = i;
+        const render_params *p = &u->ctl.params;
+        snprintf(info.method, sizeof info.method, "%s", method_name(p->method));
+        reference_params_text(p, info.params, sizeof info.params);
+        info.max_depth = p->max_depth > 0 ? p->max_depth : DEFAULT_MAX_DEPTH;
+        info.seed = p->seed;
+        info.threads = p->threads;
+        info.spp = im->frames;
+        double now = cli_now();
+        info.capture = 1;
+        info.since_change = now - u->sent_at;
+        info.seconds = info.since_change;
+        info.since_start = now - u->started_at;
+        info.image_age = now - im->published_at;
+        info.preview = im->preview;
+        info.image_width = im->width;
+        info.image_height = im->height;
+        info.latest = im->generation == u->sent_generation;
+        char *json = reference_json(&info);
+        exr_layer layer = {"", magnified ? magnified : im->rgb};
+        exr_text_attr attr = {REFERENCE_ATTR, json};
+        if (!json)
+            snprintf(u->message, sizeof u->message, "%s: out of memory", path);
+        else if (exr_save_layers_attrs(path, W, H, &layer, 1, &attr, 1, WRITE_NO_REPLACE, err, sizeof err) != 0)
+            snprintf(u->message, sizeof u->message, "%s", err);
+        else
+            written = 1;
+        free(json);
+    }
+    free(magnified);
+    if (!written) {
+        cli_error("%s", u->message);
         return;
     }
     snprintf(u->message, sizeof u->message, "wrote %s", path);
