@@ -39,6 +39,7 @@
 #define MAX_CURVES 6         /* error curves kept for comparison */
 #define MAX_VIEW_VARIANTS 64 /* material variants the panel lists */
 #define MAX_CURVE_POINTS 512 /* per curve; halved (every other point) when full */
+#define MAX_CAPTURES 8       /* captures written at once */
 
 static inline double seconds_since(double t) { return cli_now() - t; }
 
@@ -246,8 +247,11 @@ typedef struct {
     /* the reference's camera, from its description (view_nav.c) */
     int reference_cam_valid;
     camera reference_cam;
-    char reference_lights[4096]; /* its light edits */
-    int error_paused_shown;      /* the note about the paused error plot is up */
+    char reference_lights[4096];            /* its light edits */
+    int error_paused_shown;                 /* the note about the paused error plot is up */
+    pthread_t captures[MAX_CAPTURES];       /* the script's captures being written... */
+    char capture_names[MAX_CAPTURES][1024]; /* ...as the script named them */
+    int num_captures;
     /* images taken from the render thread: all, those at full resolution, and their pixels */
     unsigned long long images_shown, images_full, image_pixels;
     char status[600];     /* what the panel should say about the view: pauses, an unlit scene */
@@ -347,8 +351,10 @@ int load_reference(ui_thread *u, const char *path);
 void tonemap_and_upload(ui_thread *u);
 void take_screenshot(ui_thread *u, const char *name);
 /* Saves the image shown, linear and at the render's size (a preview magnified as the window
- * draws it), as an EXR with its description (numbered, never overwriting). */
+ * draws it), as an EXR with its description (numbered, never overwriting), written by a thread
+ * of its own; capture_finish waits for those under way (before the viewer exits). */
 void capture_image(ui_thread *u, const char *name);
+void capture_finish(ui_thread *u);
 void capture_window(ui_thread *u, int w, int h);
 void draw_image_and_panel(ui_thread *u);
 

@@ -269,65 +269,112 @@ static void magnify_bilinear(const float *src, int w, int h, float *out, int W, 
     }
 }
 
-void capture_image(ui_thread *u, const char *name) {
-    char path[1024], err[1200];
-    const image_buf *im = &u->front;
-    int W = im->full_w, H = im->full_h;
-    float *magnified = NULL;
+/* A capture on its way to its file: the image as taken, magnified and written by a thread of its
+ * own, so that taking it costs the window (and what it measures) a copy, not a compression. */
+typedef struct {
+    char path[1024];
+    float *rgb; /* w x h, magnified to W x H when they differ */
+    int w, h, W, H;
+    char *json;
+} capture_job;
+
+static void *capture_main(void *arg) {
+    capture_job *j = arg;
+    char err[1200];
+    float *full = j->rgb;
+    if (j->w != j->W || j->h != j->H) {
+        full = malloc(sizeof(float) * 3 * (size_t)j->W * (size_t)j->H);
+        if (full) magnify_bilinear(j->rgb, j->w, j->h, full, j->W, j->H);
+    }
+    exr_layer layer = {"", full};
+    exr_text_attr attr = {REFERENCE_ATTR, j->json};
+    if (!full)
+        cli_error("%s: out of memory", j->path);
+    else if (exr_save_layers_attrs(j->path, j->W, j->H, &layer, 1, &attr, 1, WRITE_NO_REPLACE, err, sizeof err) != 0)
+        cli_error("%s", err);
+    else
+        printf("glint: wrote %s\n", j->path), fflush(stdout);
+    if (full != j->rgb) free(full);
+    free(j->rgb);
+    free(j->json);
+    free(j);
+    return NULL;
+}
+
+void capture_finish(ui_thread *u) {
+    for (int i = 0; i < u->num_captures; i++) pthread_join(u->captures[i], NULL);
+    u->num_captures = 0;
+}
+
+/* The description of the image shown (im), taken now: its own camera and lights, when. NULL
+ * with the message set. */
+static char *describe_capture(ui_thread *u, const image_buf *im) {
     reference_info info;
-    int written = 0;
-    if (!im->rgb || W <= 0 || H <= 0) {
-        snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
-    } else if (unique_path(name, path, sizeof path) != 0) {
-        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
-    } else if ((im->width != W || im->height != H) &&
-               !(magnified = malloc(sizeof(float) * 3 * (size_t)W * (size_t)H))) {
-        snprintf(u->message, sizeof u->message, "%s: out of memory", name);
-    } else if (describe_view(u, &info, W, H, &im->lights, err, sizeof err) != 0) {
+    char err[1200];
+    if (describe_view(u, &info, im->full_w, im->full_h, &im->lights, err, sizeof err) != 0) {
         snprintf(u->message, sizeof u->message, "%s", err);
-    } else {
-        if (magnified) magnify_bilinear(im->rgb, im->width, im->height, magnified, W, H);
-        /* The image's own camera: one of the scene's when it is that view, else a free camera. */
-        info.cam = im->cam;
-        info.camera_index = -1;
-        for (int i = 0; i < u->info.num_cameras && info.camera_index < 0; i++)
-            if (camera_same_view(&im->cam, &u->info.cameras[i], u->info.diag)) info.camera_index = i;
-        const render_params *p = &u->ctl.params;
-        snprintf(info.method, sizeof info.method, "%s", method_name(p->method));
-        reference_params_text(p, info.params, sizeof info.params);
-        info.max_depth = p->max_depth > 0 ? p->max_depth : DEFAULT_MAX_DEPTH;
-        info.seed = p->seed;
-        info.threads = p->threads;
-        info.spp = im->frames;
-        double now = cli_now();
-        info.capture = 1;
-        info.since_change = now - u->sent_at;
-        info.seconds = info.since_change;
-        info.since_start = now - u->started_at;
-        info.image_age = now - im->published_at;
-        info.preview = im->preview;
-        info.image_width = im->width;
-        info.image_height = im->height;
-        info.latest = im->generation == u->sent_generation;
-        char *json = reference_json(&info);
-        exr_layer layer = {"", magnified ? magnified : im->rgb};
-        exr_text_attr attr = {REFERENCE_ATTR, json};
-        if (!json)
-            snprintf(u->message, sizeof u->message, "%s: out of memory", path);
-        else if (exr_save_layers_attrs(path, W, H, &layer, 1, &attr, 1, WRITE_NO_REPLACE, err, sizeof err) != 0)
-            snprintf(u->message, sizeof u->message, "%s", err);
-        else
-            written = 1;
-        free(json);
+        return NULL;
     }
-    free(magnified);
-    if (!written) {
-        cli_error("%s", u->message);
-        return;
+    /* One of the scene's cameras when it is that view, else a free camera. */
+    info.cam = im->cam;
+    info.camera_index = -1;
+    for (int i = 0; i < u->info.num_cameras && info.camera_index < 0; i++)
+        if (camera_same_view(&im->cam, &u->info.cameras[i], u->info.diag)) info.camera_index = i;
+    const render_params *p = &u->ctl.params;
+    snprintf(info.method, sizeof info.method, "%s", method_name(p->method));
+    reference_params_text(p, info.params, sizeof info.params);
+    info.max_depth = p->max_depth > 0 ? p->max_depth : DEFAULT_MAX_DEPTH;
+    info.seed = p->seed;
+    info.threads = p->threads;
+    info.spp = im->frames;
+    double now = cli_now();
+    info.capture = 1;
+    info.since_change = now - u->sent_at;
+    info.seconds = info.since_change;
+    info.since_start = now - u->started_at;
+    info.image_age = now - im->published_at;
+    info.preview = im->preview;
+    info.image_width = im->width;
+    info.image_height = im->height;
+    info.latest = im->generation == u->sent_generation;
+    char *json = reference_json(&info);
+    if (!json) snprintf(u->message, sizeof u->message, "out of memory");
+    return json;
+}
+
+void capture_image(ui_thread *u, const char *name) {
+    const image_buf *im = &u->front;
+    size_t bytes = sizeof(float) * 3 * (size_t)im->width * (size_t)im->height;
+    /* A file of this name on its way would be given the same free name: wait for it first. The
+     * same for a backlog. */
+    for (int i = 0; i < u->num_captures; i++)
+        if (strcmp(u->capture_names[i], name) == 0) capture_finish(u);
+    if (u->num_captures == MAX_CAPTURES) capture_finish(u);
+    capture_job *j = calloc(1, sizeof *j);
+    if (!im->rgb || im->full_w <= 0 || im->full_h <= 0) {
+        snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
+    } else if (!j || !(j->rgb = malloc(bytes))) {
+        snprintf(u->message, sizeof u->message, "%s: out of memory", name);
+    } else if (unique_path(name, j->path, sizeof j->path) != 0) {
+        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
+    } else if ((j->json = describe_capture(u, im)) != NULL) {
+        memcpy(j->rgb, im->rgb, bytes);
+        j->w = im->width;
+        j->h = im->height;
+        j->W = im->full_w;
+        j->H = im->full_h;
+        snprintf(u->capture_names[u->num_captures], sizeof u->capture_names[0], "%s", name);
+        if (pthread_create(&u->captures[u->num_captures], NULL, capture_main, j) == 0) {
+            u->num_captures++;
+            snprintf(u->message, sizeof u->message, "capturing %s", j->path);
+            return;
+        }
+        snprintf(u->message, sizeof u->message, "%s: cannot start a thread to write it", name);
+        free(j->json);
     }
-    snprintf(u->message, sizeof u->message, "wrote %s", path);
-    printf("glint: wrote %s\n", path);
-    fflush(stdout);
+    cli_error("%s", u->message);
+    if (j) free(j->rgb);
+    free(j);
 }
 
 /* Saves the window's back buffer as drawn (panel included). */
