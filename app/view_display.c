@@ -273,14 +273,24 @@ static void magnify_bilinear(const float *src, int w, int h, float *out, int W, 
  * own, so that taking it costs the window (and what it measures) a copy, not a compression. */
 typedef struct {
     char path[1024];
-    float *rgb; /* w x h, magnified to W x H when they differ */
+    float *rgb; /* the image shown: w x h, magnified to W x H when they differ, with json... */
     int w, h, W, H;
     char *json;
+    unsigned char *png; /* ...or the window, w x h, as a PNG */
 } capture_job;
 
 static void *capture_main(void *arg) {
     capture_job *j = arg;
     char err[1200];
+    if (j->png) {
+        if (png_save_rgb8(j->path, j->w, j->h, j->png, WRITE_NO_REPLACE, err, sizeof err) != 0)
+            cli_error("%s", err);
+        else
+            printf("glint: wrote %s\n", j->path), fflush(stdout);
+        free(j->png);
+        free(j);
+        return NULL;
+    }
     float *full = j->rgb;
     if (j->w != j->W || j->h != j->H) {
         full = malloc(sizeof(float) * 3 * (size_t)j->W * (size_t)j->H);
@@ -342,14 +352,28 @@ static char *describe_capture(ui_thread *u, const image_buf *im) {
     return json;
 }
 
-void capture_image(ui_thread *u, const char *name) {
-    const image_buf *im = &u->front;
-    size_t bytes = sizeof(float) * 3 * (size_t)im->width * (size_t)im->height;
-    /* A file of this name on its way would be given the same free name: wait for it first. The
-     * same for a backlog. */
+/* Before a capture named name: a file of that name on its way would be given the same free name,
+ * so it is waited for; so is a backlog. */
+static void make_room(ui_thread *u, const char *name) {
     for (int i = 0; i < u->num_captures; i++)
         if (strcmp(u->capture_names[i], name) == 0) capture_finish(u);
     if (u->num_captures == MAX_CAPTURES) capture_finish(u);
+}
+
+/* Starts the thread that writes j (after make_room). 0, or -1 with the message set. */
+static int start_capture(ui_thread *u, capture_job *j, const char *name) {
+    snprintf(u->capture_names[u->num_captures], sizeof u->capture_names[0], "%s", name);
+    if (pthread_create(&u->captures[u->num_captures], NULL, capture_main, j) != 0)
+        return snprintf(u->message, sizeof u->message, "%s: cannot start a thread to write it", name), -1;
+    u->num_captures++;
+    snprintf(u->message, sizeof u->message, "capturing %s", j->path);
+    return 0;
+}
+
+void capture_image(ui_thread *u, const char *name) {
+    const image_buf *im = &u->front;
+    size_t bytes = sizeof(float) * 3 * (size_t)im->width * (size_t)im->height;
+    make_room(u, name);
     capture_job *j = calloc(1, sizeof *j);
     if (!im->rgb || im->full_w <= 0 || im->full_h <= 0) {
         snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
@@ -363,13 +387,7 @@ void capture_image(ui_thread *u, const char *name) {
         j->h = im->height;
         j->W = im->full_w;
         j->H = im->full_h;
-        snprintf(u->capture_names[u->num_captures], sizeof u->capture_names[0], "%s", name);
-        if (pthread_create(&u->captures[u->num_captures], NULL, capture_main, j) == 0) {
-            u->num_captures++;
-            snprintf(u->message, sizeof u->message, "capturing %s", j->path);
-            return;
-        }
-        snprintf(u->message, sizeof u->message, "%s: cannot start a thread to write it", name);
+        if (start_capture(u, j, name) == 0) return;
         free(j->json);
     }
     cli_error("%s", u->message);
@@ -377,11 +395,12 @@ void capture_image(ui_thread *u, const char *name) {
     free(j);
 }
 
-/* Saves the window's back buffer as drawn (panel included). */
+/* Saves the window's back buffer as drawn (panel included); the PNG is written as captures are. */
 void capture_window(ui_thread *u, int w, int h) {
-    char path[1024], err[1200];
+    make_room(u, u->window_shot);
+    capture_job *j = calloc(1, sizeof *j);
     unsigned char *px = malloc(3 * (size_t)w * (size_t)h), *row = malloc(3 * (size_t)w);
-    if (!px || !row || unique_path(u->window_shot, path, sizeof path) != 0) {
+    if (!j || !px || !row || unique_path(u->window_shot, j->path, sizeof j->path) != 0) {
         cli_error("%s: cannot capture the window", u->window_shot);
     } else {
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -391,11 +410,15 @@ void capture_window(ui_thread *u, int w, int h) {
             memcpy(px + 3 * (size_t)w * (size_t)y, px + 3 * (size_t)w * (size_t)(h - 1 - y), 3 * (size_t)w);
             memcpy(px + 3 * (size_t)w * (size_t)(h - 1 - y), row, 3 * (size_t)w);
         }
-        if (png_save_rgb8(path, w, h, px, WRITE_NO_REPLACE, err, sizeof err) != 0)
-            cli_error("%s", err);
+        j->png = px;
+        j->w = w;
+        j->h = h;
+        if (start_capture(u, j, u->window_shot) == 0)
+            px = NULL, j = NULL; /* the thread's now */
         else
-            printf("glint: wrote %s\n", path);
+            cli_error("%s", u->message);
     }
+    free(j);
     free(px);
     free(row);
     u->window_shot[0] = 0;

@@ -47,14 +47,15 @@ def exr_description(path):
 
 
 def captures(root):
-    """(path, scene, method, scenario, name) of every capture under root/SCENE/METHOD/SCENARIO/."""
+    """(path, scene, method, scenario, name) of every capture under root/SCENE/METHOD/SCENARIO/:
+    opened-T, during-N and after-T.exr."""
     found = []
     for dirpath, _, files in os.walk(root):
         rel = os.path.relpath(dirpath, root).split(os.sep)
         if len(rel) != 3:
             continue
         for name in sorted(files):
-            if name.endswith(".exr") and (name.startswith("during-") or name.startswith("after-")):
+            if name.endswith(".exr") and name.split("-")[0] in ("opened", "during", "after"):
                 found.append((os.path.join(dirpath, name), rel[0], rel[1], rel[2], name[:-4]))
     return sorted(found)
 
@@ -200,7 +201,7 @@ def cmd_table(root, refs, glint, out):
         i = find_pose(poses, pose_of(desc))
         ref = ref_path(refs, i, poses[i]) if i >= 0 else None
         row = {"scene": scene, "method": method, "scenario": scenario,
-               "when": "during" if name.startswith("during-") else name[len("after-"):],
+               "when": name[len("after-"):] if name.startswith("after-") else name,
                "capture": name, "since_change": desc["capture"]["since_change"],
                "preview": desc["capture"]["preview"], "image": "%dx%d" % tuple(desc["capture"]["image_size"]),
                "latest": desc["capture"]["latest"], "frames": desc["spp"], "pose": i,
@@ -220,9 +221,12 @@ def cmd_table(root, refs, glint, out):
                             "pixel_share": "%.3f" % rates["pixel_share"], "orbit_s": "%.2f" % rates["seconds"],
                             "last_preview": rates["last_preview"]})
         rows.append(row)
-    order = {"during": -1}
-    rows.sort(key=lambda r: (r["scene"], r["method"], r["scenario"], order.get(r["when"], 0),
-                             float(r["when"]) if r["when"] != "during" else 0, r["capture"]))
+    def when_key(w):  # at rest after opening, the orbit's steps, then seconds after the stop
+        if w.startswith("opened-"):
+            return (0, float(w[len("opened-"):]))
+        return (1, int(w[len("during-"):])) if w.startswith("during-") else (2, float(w))
+
+    rows.sort(key=lambda r: (r["scene"], r["method"], r["scenario"], when_key(r["when"])))
     fields = ["scene", "method", "scenario", "when", "capture", "since_change", "preview", "image", "latest", "frames",
               "pose", "ref_spp", "rel_l2", "ref_noise", "net", "updates_per_s", "full_per_s", "pixel_share", "orbit_s",
               "last_preview"]
@@ -232,7 +236,10 @@ def cmd_table(root, refs, glint, out):
         w.writerows(rows)
     with open(out + ".md", "w") as f:
         f.write("Displayed error (relative L2 against path-traced references, the references' noise taken out) "
-                "by scene, method and scenario; `when`: seconds after the stop, or during the motion.\n\n")
+                "by scene, method and scenario; `when`: seconds after the stop, during-N: after the orbit's step N of 10, opened-10: 10 s after "
+                "opening, before the orbit (plain accumulation at rest); "
+                "`s after change`: when the capture was taken, after the last change (a step); `stale`: the image shown "
+                "was not yet of the last change (its own pose is the one measured).\n\n")
         f.write("| scene | method | scenario | when | s after change | shown | net error | ref noise |\n"
                 "|---|---|---|---|---|---|---|---|\n")
         for r in rows:

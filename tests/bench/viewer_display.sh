@@ -4,7 +4,8 @@
 # through the script language (capture, stats), so it measures any viewer that speaks it.
 #
 # For each scene (builtin:NAME) and method, at 960x540 under Xvfb (1920x1080), three sessions:
-#   orbit  sleep 10; 10 x (orbit 1.5 0; sleep 0.1), 15 degrees at 15 degrees a second, capturing
+#   orbit  sleep 10 and a capture (opened-10.exr: 10 s at rest, the moonshot's plain
+#          accumulation); 10 x (orbit 1.5 0; sleep 0.1), 15 degrees at 15 degrees a second, capturing
 #          after steps 3, 6 and 9 (during-3/6/9.exr) and stats before and after the orbit (updates
 #          a second, those at full resolution, their mean size); then captures 0.25, 1, 3, 5 and
 #          10 s after the last step (after-T.exr); window shots (panel included, for the docs)
@@ -87,6 +88,7 @@ script() {
   case $1 in
   orbit)
     echo "sleep 10"
+    echo "capture opened-10.exr"
     echo "stats"
     for i in 1 2 3 4 5 6 7 8 9 10; do
       echo "orbit 1.5 0"
