@@ -135,7 +135,8 @@ run_captures() {
         (cd "$dir" && timeout 300 "$glint" view "builtin:$scene" --size $size --method "$method" \
           --script script.txt >stdout.txt 2>stderr.txt) ||
           { echo "$scene $method $scenario: the viewer failed: $(tail -n 3 "$dir/stderr.txt")"; exit 1; }
-        echo "  $scene $method $scenario: $(grep -c '^glint: wrote .*\.exr' "$dir/stdout.txt") captures"
+        cut -d' ' -f1-3 /proc/loadavg >"$dir/load.txt" # a busy machine slows the viewer: say how busy
+        echo "  $scene $method $scenario: $(grep -c '^glint: wrote .*\.exr' "$dir/stdout.txt") captures, load $(cat "$dir/load.txt")"
       done
     done
   done
