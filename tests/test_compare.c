@@ -141,6 +141,18 @@ static void test_refusals(void) {
     compare("old.exr a.exr", v);
     CHECK(v[0] == 0.0, "an older description, the same image: %g", v[0]);
     expect_failure("compare old.exr moved.exr", 1, "as loaded");
+    /* A malformed edit list is a malformed description, whoever reads it. */
+    static const char *const bad[] = {"0:1,0,0", "0:1,0,0*1;", "x:1,0,0*1", "0:1,0,0*1;0:2,0,0*1", "0:1,0,0*0"};
+    for (int i = 0; i < (int)(sizeof bad / sizeof bad[0]); i++) {
+        char edited[65600], *field = NULL;
+        read_reference("a.exr", desc, sizeof desc);
+        field = strstr(desc, "\"lights\": \"\"");
+        if (!field) break;
+        snprintf(edited, sizeof edited, "%.*s\"lights\": \"%s\"%s", (int)(field - desc), desc, bad[i],
+                 field + strlen("\"lights\": \"\""));
+        CHECK(write_reference("a.exr", "bad-lights.exr", edited, 0) == 0, "bad-lights.exr written");
+        expect_failure("compare a.exr bad-lights.exr", 1, "bad \"lights\"");
+    }
 }
 
 static void test_render_poses(void) {
