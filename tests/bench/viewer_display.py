@@ -236,7 +236,7 @@ def cmd_table(root, refs, glint, out):
         w.writerows(rows)
     with open(out + ".md", "w") as f:
         f.write("Displayed error (relative L2 against path-traced references, the references' noise taken out) "
-                "by scene, method and scenario; `when`: seconds after the stop, during-N: after the orbit's step N of 10, opened-10: 10 s after "
+                "by scene, method and scenario; `when`: seconds after the stop, during-N: at the end of the orbit's step N of 10 (0.1 s after it), opened-10: 10 s after "
                 "opening, before the orbit (plain accumulation at rest); "
                 "`s after change`: when the capture was taken, after the last change (a step); `stale`: the image shown "
                 "was not yet of the last change (its own pose is the one measured).\n\n")

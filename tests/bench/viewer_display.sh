@@ -6,7 +6,8 @@
 # For each scene (builtin:NAME) and method, at 960x540 under Xvfb (1920x1080), three sessions:
 #   orbit  sleep 10 and a capture (opened-10.exr: 10 s at rest, the moonshot's plain
 #          accumulation); 10 x (orbit 1.5 0; sleep 0.1), 15 degrees at 15 degrees a second, capturing
-#          after steps 3, 6 and 9 (during-3/6/9.exr) and stats before and after the orbit (updates
+#          at the end of steps 3, 6 and 9, just before the next (during-3/6/9.exr: what the step
+#          left on screen, measured at its own pose), and stats before and after the orbit (updates
 #          a second, those at full resolution, their mean size); then captures 0.25, 1, 3, 5 and
 #          10 s after the last step (after-T.exr); window shots (panel included, for the docs)
 #          during the orbit (after step 9) and 1 s after it (window-during.png, window-after-1.png).
@@ -92,9 +93,9 @@ script() {
     echo "stats"
     for i in 1 2 3 4 5 6 7 8 9 10; do
       echo "orbit 1.5 0"
-      case $i in 3 | 6 | 9) echo "capture during-$i.exr" ;; esac
-      [ $i != 9 ] || echo "window-shot window-during.png"
       [ $i = 10 ] || echo "sleep 0.1"
+      case $i in 3 | 6 | 9) echo "capture during-$i.exr" ;; esac # what step i left on screen
+      [ $i != 9 ] || echo "window-shot window-during.png"
     done
     echo "stats"
     shots=1 rest_captures 0.25 1 3 5 10
