@@ -375,7 +375,7 @@ static double frame_error(render_thread *rt, const film *f, unsigned mask, const
  * The film is resolved with the components shown now, not when the frame started: a frame after a
  * display change shows that change. */
 static void publish(render_thread *rt, render_session *rs, int preview, int measure, double frame_ms,
-                    const render_stats *before, uint64_t resets_seen, uint64_t gen, const camera *cam) {
+                    const render_stats *before, uint64_t resets_seen, uint64_t gen) {
     shared_state *sh = rt->sh;
     const film *f = session_film(rs);
     if (rt->back.width != f->width || rt->back.height != f->height) {
@@ -393,7 +393,7 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
     rt->back.full_w = session_film(rt->full)->width;
     rt->back.full_h = session_film(rt->full)->height;
     rt->back.generation = gen;
-    rt->back.cam = *cam;
+    rt->back.cam = *session_camera(rs); /* what its frames were rendered from, whatever asked since */
     rt->back.lights = rt->lights_applied;
     rt->back.frames = preview ? 0 : session_frames(rs);
     rt->back.published_at = cli_now();
@@ -552,7 +552,7 @@ static void *render_main(void *arg) {
         }
         if (rs == rt->full) rt->full_film_partial = 0;
         double ms = 1e3 * seconds_since(t0);
-        publish(rt, rs, preview, measure, ms, &before, resets_seen, gen, &cam);
+        publish(rt, rs, preview, measure, ms, &before, resets_seen, gen);
         if (preview)
             adapt_preview(rt, ms, &cam, &params);
         else if (session_frames(rt->full) == 1)
