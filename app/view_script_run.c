@@ -27,6 +27,8 @@ static void print_stats(ui_thread *u) {
     for (int i = 1; i <= 9; i++)
         if (u->bookmark_set[i]) marks[nb++] = (char)('0' + i);
     marks[nb] = 0;
+    /* One line, whole: a capture's thread says "glint: wrote" on stdout too. */
+    flockfile(stdout);
     printf(
         "stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
         "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
@@ -67,6 +69,7 @@ static void print_stats(ui_thread *u) {
     }
     printf("\n");
     fflush(stdout);
+    funlockfile(stdout);
 }
 
 /* A live parameter by its command-line name. Returns 0, or -1 with a message. */

@@ -333,6 +333,14 @@ i1=$(field 1 images) i4=$(field 4 images) f4=$(field 4 images_full)
 [ "${f4:-0}" -ge 2 ] && [ "$f4" -le "$i4" ] || fail "full-resolution images $f4 of $i4"
 [ "$(field 1 render_size)" = 160x90 ] || fail "render_size $(field 1 render_size)"
 
+# A reference rendered with a light moved is not of the scene as loaded: refused with the reason.
+"$glint" render --size 64x36 --spp 1 --quiet --move-light 0,0.5,0,0 --out ref-moved.exr ||
+  fail "render with a light moved failed"
+printf 'quit\n' >quit.txt
+view --size 64x36 --reference ref-moved.exr --script quit.txt
+grep -q "rendered with lights edited '0:0.5,0,0\*1', not the lights as loaded; reference not used" err.txt ||
+  fail "a reference with a light moved was not refused: $(cat err.txt)"
+
 printf 'wait 1\nfrobnicate 3\n' >bad.txt
 view --script bad.txt
 rc=$?
