@@ -32,23 +32,6 @@ static void ref_free(bench_ref *r) {
     memset(r, 0, sizeof *r);
 }
 
-/* Interleaves the EXR layer with the given prefix ("" for R,G,B); NULL when absent. */
-static float *ref_layer(const exr_image *ex, const char *prefix) {
-    const float *c[3];
-    const char *ch[3] = {"R", "G", "B"};
-    for (int k = 0; k < 3; k++) {
-        char name[64];
-        snprintf(name, sizeof name, "%s%s%s", prefix, prefix[0] ? "." : "", ch[k]);
-        if (!(c[k] = exr_image_channel(ex, name))) return NULL;
-    }
-    size_t n = (size_t)ex->width * (size_t)ex->height;
-    float *rgb = malloc(sizeof(float) * 3 * n);
-    if (!rgb) return NULL;
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++) rgb[3 * i + (size_t)k] = c[k][i];
-    return rgb;
-}
-
 static int ref_load(const bench_options *o, bench_ref *r) {
     memset(r, 0, sizeof *r);
     char err[1200];
@@ -56,10 +39,10 @@ static int ref_load(const bench_options *o, bench_ref *r) {
     if (exr_image_load(o->ref_path, &ex, err, sizeof err) != 0) return cli_error("%s", err), -1;
     r->width = ex.width;
     r->height = ex.height;
-    r->layer[ERR_ALL] = ref_layer(&ex, "");
-    r->layer[ERR_DIRECT] = ref_layer(&ex, "direct");
-    r->layer[ERR_INDIRECT] = ref_layer(&ex, "indirect");
-    r->layer[ERR_HIGHLIGHTS] = ref_layer(&ex, "highlights");
+    r->layer[ERR_ALL] = exr_image_layer_rgb(&ex, "");
+    r->layer[ERR_DIRECT] = exr_image_layer_rgb(&ex, "direct");
+    r->layer[ERR_INDIRECT] = exr_image_layer_rgb(&ex, "indirect");
+    r->layer[ERR_HIGHLIGHTS] = exr_image_layer_rgb(&ex, "highlights");
     exr_image_free(&ex);
     if (!r->layer[ERR_ALL]) {
         ref_free(r);

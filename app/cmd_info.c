@@ -132,6 +132,16 @@ int cmd_info(int argc, char **argv) {
     printf("lights:     %d point, %d spot, %d directional, %d emissive triangles, %s\n", by_type[LIGHT_POINT],
            by_type[LIGHT_SPOT], by_type[LIGHT_DIRECTIONAL], by_type[LIGHT_TRIANGLE],
            s->env ? "an environment map" : "no environment map");
+    /* The numbers glint render's --move-light and --light-gain and the viewer's panel take. */
+    light_group groups[16];
+    int num_groups = scene_light_groups(s, groups, 16);
+    if (num_groups > 0) {
+        printf("            by number (glint render --move-light, the viewer's panel): ");
+        for (int i = 0; i < num_groups && i < 16; i++)
+            printf("%s%d '%s' at %.4g %.4g %.4g", i ? ", " : "", i, groups[i].name, (double)groups[i].center.x,
+                   (double)groups[i].center.y, (double)groups[i].center.z);
+        printf("%s\n", num_groups > 16 ? ", ..." : "");
+    }
     if (scene_num_variants(s) > 0) {
         printf("variants:   %d (", scene_num_variants(s));
         for (int i = 0; i < scene_num_variants(s); i++) printf("%s'%s'", i ? ", " : "", scene_variant_name(s, i));

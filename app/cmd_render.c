@@ -25,6 +25,10 @@ typedef struct {
     double env_rotation_deg;
     const char *variant; /* NULL: the file's default materials */
     long long camera_index;
+    const char *camera_from;                      /* --camera-from: a glint EXR whose description gives the camera */
+    light_edit lights[REFERENCE_MAX_LIGHT_EDITS]; /* --move-light, --light-gain: one per group */
+    int gain_given[REFERENCE_MAX_LIGHT_EDITS];
+    int num_lights;
     const char *out_exr, *out_png, *out_stats;
     const char *shard;   /* --shard I/N as given; its numbers are in params */
     long long spp_total; /* a shard's: the whole render's --spp (spp is the shard's share) */
@@ -55,6 +59,11 @@ static void print_render_help(void) {
            "  --variant NAME       the scene's material variant NAME (KHR_materials_variants;\n"
            "                       glint info lists them) [the file's default materials]\n"
            "  --camera INDEX       glTF camera to render from [0; a framing view without cameras]\n"
+           "  --camera-from FILE.exr  the camera recorded in a glint EXR's description (a\n"
+           "                       reference, a merge, a viewer's capture) of this scene\n"
+           "  --move-light G,DX,DY,DZ  move light G (as glint info numbers them) by a world-space\n"
+           "                       offset, as the viewer does; repeatable, moves add up\n"
+           "  --light-gain G,X     light G's intensity times X (as the viewer's panel sets it)\n"
            "  --seed S             random seed; runs with the same seed reproduce [0]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
            "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers, and in its\n"
@@ -109,6 +118,55 @@ static int parse_shard(render_options *o) {
     return 0;
 }
 
+/* The edit of light group g, added when new; NULL (reported) when there are too many. */
+static light_edit *light_edit_for(render_options *o, int g) {
+    for (int i = 0; i < o->num_lights; i++)
+        if (o->lights[i].group == g) return &o->lights[i];
+    if (o->num_lights == REFERENCE_MAX_LIGHT_EDITS)
+        return cli_error("more than %d lights edited", REFERENCE_MAX_LIGHT_EDITS), NULL;
+    o->gain_given[o->num_lights] = 0;
+    o->lights[o->num_lights] = (light_edit){g, v3(0, 0, 0), 1.0f};
+    return &o->lights[o->num_lights++];
+}
+
+/* n numbers separated by commas, nothing else. 0, or -1. */
+static int parse_numbers(const char *text, double *v, int n) {
+    const char *p = text;
+    for (int k = 0; k < n; k++) {
+        char *end;
+        v[k] = strtod(p, &end);
+        if (end == p || !isfinite(v[k]) || *end != (k < n - 1 ? ',' : '\0')) return -1;
+        p = end + 1;
+    }
+    return 0;
+}
+
+/* --move-light G,DX,DY,DZ (moves of one light add up) and --light-gain G,X (once a light). 0, or
+ * -1 after a usage error. */
+static int parse_light_option(render_options *o, const char *option, const char *value) {
+    int gain = strcmp(option, "--light-gain") == 0;
+    double v[4];
+    if (parse_numbers(value, v, gain ? 2 : 4) != 0)
+        return cli_error("%s: '%s' is not %s", option, value,
+                         gain ? "G,X (a light and a factor)" : "G,DX,DY,DZ (a light and an offset)"),
+               -1;
+    if (v[0] < 0 || v[0] >= 1e6 || v[0] != floor(v[0]))
+        return cli_error("%s: '%s': the light is a whole number from 0 (glint info lists them)", option, value), -1;
+    if (gain && !(v[1] >= 1e-6 && v[1] <= 1e6))
+        return cli_error("%s: '%s': the factor is 1e-6 to 1e6", option, value), -1;
+    light_edit *e = light_edit_for(o, (int)v[0]);
+    if (!e) return -1;
+    if (!gain) {
+        e->offset = add3(e->offset, v3((float)v[1], (float)v[2], (float)v[3]));
+        return 0;
+    }
+    int *given = &o->gain_given[e - o->lights];
+    if (*given) return cli_error("%s: light %d given twice", option, e->group), -1;
+    *given = 1;
+    e->gain = (float)v[1];
+    return 0;
+}
+
 /* Returns 0 to render, 1 when --help was shown, -1 on a usage error (already reported). */
 static int parse_render_options(int argc, char **argv, render_options *o) {
     memset(o, 0, sizeof *o);
@@ -136,12 +194,16 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--stats", .kind = CLI_TEXT, .out = &o->out_stats},
         {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -50.0, .hi = 50.0},
         {.name = "--shard", .kind = CLI_TEXT, .out = &o->shard},
+        {.name = "--camera-from", .kind = CLI_TEXT, .out = &o->camera_from},
     };
     for (int i = 0; i < argc; i++) {
         int r;
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             print_render_help();
             return 1;
+        } else if (strcmp(argv[i], "--move-light") == 0 || strcmp(argv[i], "--light-gain") == 0) {
+            const char *option = argv[i], *value = cli_value(argc, argv, &i);
+            if (!value || parse_light_option(o, option, value) != 0) return -1;
         } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0 ||
                    (r = cli_vl_option(argc, argv, &i, &p->vl)) != 0) {
             if (r < 0) return -1;
@@ -150,6 +212,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         }
     }
     if (spp_given && time_given) return cli_error("--spp and --time exclude each other"), -1;
+    if (o->camera_from && o->camera_index >= 0) return cli_error("--camera and --camera-from exclude each other"), -1;
     if (o->params.pt_highlights && o->params.method != METHOD_PT && o->params.method != METHOD_VSL_HL)
         return cli_error("--highlights-layer: only pt and vsl+hl split highlights off (vpl and vsl count them "
                          "as indirect)"),
@@ -277,15 +340,22 @@ static int write_stats(const char *path, const render_options *o, const render_s
 }
 
 /* What makes the EXR a reference (reference.h), as JSON for its header; glint bench checks a
- * reference by it. NULL after printing the error. */
-static char *describe_reference(const render_options *o, const render_session *rs, const scene *s, double seconds,
-                                reference_noise *rn) {
+ * reference by it. cam, cam_index: the camera rendered from (--camera-from's may be a free one,
+ * -1). NULL after printing the error. */
+static char *describe_reference(const render_options *o, const render_session *rs, const scene *s, const camera *cam,
+                                int cam_index, double seconds, reference_noise *rn) {
     char err[1024];
     reference_info info;
     const render_params *p = session_params(rs);
-    if (reference_describe(&info, o->scene_path, o->env_path, o->env_rotation_deg, s, (int)o->camera_index, p, err,
-                           sizeof err) != 0)
+    if (reference_describe(&info, o->scene_path, o->env_path, o->env_rotation_deg, s, cam_index, p, err, sizeof err) !=
+        0)
         return cli_error("%s", err), NULL;
+    if (o->camera_from) {
+        info.cam = *cam;
+        info.camera_index = cam_index;
+    }
+    if (reference_lights_text(o->lights, o->num_lights, info.lights, sizeof info.lights) != 0)
+        return cli_error("%s: too many light edits to describe", o->out_exr), NULL;
     info.spp = session_frames(rs);
     info.spp_total = o->spp_total;
     info.seconds = seconds;
@@ -296,12 +366,12 @@ static char *describe_reference(const render_options *o, const render_session *r
 }
 
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, const camera *cam,
-                         double seconds, reference_noise *rn, size_t clamped) {
+                         int cam_index, double seconds, reference_noise *rn, size_t clamped) {
     const film *fm = session_film(rs);
     char err[1024];
     const unsigned layers = exr_layers(o);
     if (o->out_exr) {
-        char *json = describe_reference(o, rs, s, seconds, rn);
+        char *json = describe_reference(o, rs, s, cam, cam_index, seconds, rn);
         if (!json) return -1;
         exr_text_attr attr = {REFERENCE_ATTR, json};
         int st = film_save_exr_attrs(fm, layers, o->out_exr, &attr, 1, WRITE_REPLACE, err, sizeof err);
@@ -350,13 +420,55 @@ scene *load_scene_or_default(const char *path, const char *env_path, float env_r
     return s;
 }
 
+/* --camera-from: the camera FILE's description records, a view of scene s; *index the scene's
+ * camera it is, else -1 (a free camera). 0, or -1 after printing the error. */
+static int camera_from(const render_options *o, const scene *s, camera *cam, int *index) {
+    reference_info r;
+    char err[1200], hash[64];
+    int st = reference_load(o->camera_from, &r, err, sizeof err);
+    if (st < 0) return cli_error("%s", err), -1;
+    if (st > 0)
+        return cli_error("%s: --camera-from: no glint description in its header, so no camera to take", o->camera_from),
+               -1;
+    const char *scene_path = o->scene_path ? o->scene_path : s->path;
+    if (reference_hash_file(scene_path, hash, err, sizeof err) != 0) return cli_error("%s", err), -1;
+    if (strcmp(hash, r.scene_hash) != 0)
+        return cli_error("%s: --camera-from: a view of another scene ('%s', %s), not '%s' (%s)", o->camera_from,
+                         r.scene, r.scene_hash, scene_path, hash),
+               -1;
+    *cam = r.cam;
+    *index = -1;
+    for (int i = 0; i < s->num_cameras && *index < 0; i++)
+        if (camera_same_view(cam, &s->cameras[i], s->diag)) *index = i;
+    return 0;
+}
+
+/* --move-light and --light-gain on s, as the viewer edits its lights. 0, or -1 after printing the
+ * error. */
+static int edit_lights(const render_options *o, scene *s) {
+    char err[512];
+    int groups = scene_light_groups(s, NULL, 0);
+    for (int i = 0; i < o->num_lights; i++) {
+        const light_edit *e = &o->lights[i];
+        if (e->group >= groups)
+            return cli_error("%s: no light %d to edit (the scene has %d; glint info lists them)", s->path, e->group,
+                             groups),
+                   -1;
+        if ((!is_black3(e->offset) && scene_move_light(s, e->group, e->offset, err, sizeof err) != 0) ||
+            (e->gain != 1.0f && scene_set_light_gain(s, e->group, e->gain, err, sizeof err) != 0))
+            return cli_error("%s: %s", s->path, err), -1;
+    }
+    return 0;
+}
+
 int cmd_render(int argc, char **argv) {
     render_options o;
     int parsed = parse_render_options(argc, argv, &o);
     if (parsed != 0) return parsed > 0 ? EXIT_OK : EXIT_USAGE;
     const cli_file outputs[] = {{"--out", o.out_exr}, {"--png", o.out_png}, {"--stats", o.out_stats}};
-    const cli_file inputs[] = {{"the scene", o.scene_path}, {"the environment map (--env)", o.env_path}};
-    if (cli_check_roles(outputs, 3, inputs, 2) != 0) return EXIT_USAGE;
+    const cli_file inputs[] = {
+        {"the scene", o.scene_path}, {"the environment map (--env)", o.env_path}, {"--camera-from", o.camera_from}};
+    if (cli_check_roles(outputs, 3, inputs, 3) != 0) return EXIT_USAGE;
     if ((o.out_exr && cli_check_output_dir("--out", o.out_exr)) ||
         (o.out_png && cli_check_output_dir("--png", o.out_png)) ||
         (o.out_stats && cli_check_output_dir("--stats", o.out_stats)))
@@ -373,6 +485,15 @@ int cmd_render(int argc, char **argv) {
     }
     render_params p = render_params_resolve_frame(&o.params);
     camera cam = scene_camera(s, (int)o.camera_index, (float)p.width / (float)p.height);
+    int cam_index = (int)o.camera_index;
+    if (edit_lights(&o, s) != 0) {
+        scene_destroy(s);
+        return EXIT_USAGE;
+    }
+    if (o.camera_from && camera_from(&o, s, &cam, &cam_index) != 0) {
+        scene_destroy(s);
+        return EXIT_FAILURE_;
+    }
     char err[1024];
     render_session *rs = session_create(s, &cam, &p, err, sizeof err);
     if (!rs) {
@@ -408,7 +529,7 @@ int cmd_render(int argc, char **argv) {
     size_t clamped = film_count_clamped(session_film(rs), exr_layers(&o));
     if (clamped) cli_warning("%zu pixel values beyond float's range were written as the largest float", clamped);
 
-    int status = write_outputs(&o, rs, s, &cam, elapsed, &rn, clamped);
+    int status = write_outputs(&o, rs, s, &cam, cam_index, elapsed, &rn, clamped);
     reference_noise_deinit(&rn);
     session_destroy(rs);
     scene_destroy(s);

@@ -245,6 +245,7 @@ int cmd_view(int argc, char **argv) {
     }
 
     render_thread_stop(rt);
+    capture_finish(&u);
     if (u.texture) {
         GLuint t = u.texture;
         glDeleteTextures(1, &t);

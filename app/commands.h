@@ -11,6 +11,8 @@ int cmd_info(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
 /* Shards of one render combined into one reference (cmd_merge.c). */
 int cmd_merge(int argc, char **argv);
+/* One image's error against a reference (cmd_compare.c). */
+int cmd_compare(int argc, char **argv);
 /* The interactive viewer. */
 int cmd_view(int argc, char **argv);
 

@@ -17,6 +17,8 @@ static void print_help(void) {
            "                                   combine the shards of a render (glint render --shard)\n"
            "  glint bench [SCENE] --reference REF.exr [options]\n"
            "                                   error against time per method (see glint bench --help)\n"
+           "  glint compare IMAGE.exr REFERENCE.exr [--layer NAME]\n"
+           "                                   one image's error against a reference (a viewer's capture)\n"
            "  glint --help | --version\n"
            "\n",
            GLINT_VERSION);
@@ -37,6 +39,7 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "info") == 0) return cmd_info(argc - 2, argv + 2);
     if (strcmp(argv[1], "bench") == 0) return cmd_bench(argc - 2, argv + 2);
     if (strcmp(argv[1], "merge") == 0) return cmd_merge(argc - 2, argv + 2);
+    if (strcmp(argv[1], "compare") == 0) return cmd_compare(argc - 2, argv + 2);
     if (strcmp(argv[1], "view") == 0) return cmd_view(argc - 2, argv + 2);
     /* `glint SCENE [options]` and `glint --option ...` open the viewer too. */
     struct stat st;

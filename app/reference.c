@@ -93,6 +93,7 @@ int reference_describe(reference_info *r, const char *scene_path, const char *en
     /* -1 renders the first camera when there is one: record that, so both spellings match. */
     r->camera_index = camera_index < 0 && s->num_cameras > 0 ? 0 : camera_index;
     r->cam = scene_camera(s, camera_index, (float)p->width / (float)p->height);
+    r->scene_diag = s->diag;
     r->width = p->width;
     r->height = p->height;
     r->max_depth = p->max_depth > 0 ? p->max_depth : DEFAULT_MAX_DEPTH;
@@ -192,6 +193,10 @@ char *reference_json(const reference_info *r) {
     fputs(", ", f);
     json_vec3(f, "forward", r->cam.forward);
     fprintf(f, ", \"yfov\": %.9g},\n", (double)r->cam.yfov);
+    if (r->scene_diag > 0.0f) fprintf(f, "  \"scene_diagonal\": %.9g,\n", (double)r->scene_diag);
+    fputs("  \"lights\": ", f);
+    reference_json_string(f, r->lights);
+    fputs(",\n", f);
     fprintf(f, "  \"width\": %d,\n  \"height\": %d,\n  \"method\": ", r->width, r->height);
     reference_json_string(f, r->method);
     fprintf(f, ",\n  \"highlights_layer\": %s,\n", r->highlights_layer ? "true" : "false");
@@ -207,6 +212,12 @@ char *reference_json(const reference_info *r) {
             if (reference_has_shard(r, i)) fprintf(f, "%s%d", first ? "" : ", ", i), first = 0;
         fputs("]},\n", f);
     }
+    if (r->capture)
+        fprintf(f,
+                "  \"capture\": {\"since_change\": %.6f, \"since_start\": %.6f, \"image_age\": %.6f, "
+                "\"preview\": %s, \"image_size\": [%d, %d], \"latest\": %s},\n",
+                r->since_change, r->since_start, r->image_age, r->preview ? "true" : "false", r->image_width,
+                r->image_height, r->latest ? "true" : "false");
     if (r->has_noise)
         fprintf(f,
                 "  \"variance\": {\"mean_pixel_variance\": %.9g, \"rel_l2_noise\": %.9g, "
@@ -314,6 +325,27 @@ static int parse_shards(const cJSON *obj, reference_info *r) {
     return 0;
 }
 
+/* "capture": {"since_change": S, "since_start": S, "image_age": S, "preview": B, "image_size": [W, H],
+ * "latest": B}. */
+static int parse_capture(const cJSON *obj, reference_info *r) {
+    const cJSON *size = cJSON_GetObjectItemCaseSensitive(obj, "image_size");
+    const cJSON *preview = cJSON_GetObjectItemCaseSensitive(obj, "preview");
+    const cJSON *latest = cJSON_GetObjectItemCaseSensitive(obj, "latest");
+    double w, h;
+    if (!cJSON_IsObject(obj) || json_number(obj, "since_change", &r->since_change) ||
+        json_number(obj, "since_start", &r->since_start) || json_number(obj, "image_age", &r->image_age) ||
+        !cJSON_IsBool(preview) || !cJSON_IsBool(latest) || !cJSON_IsArray(size) || cJSON_GetArraySize(size) != 2 ||
+        finite_number(cJSON_GetArrayItem(size, 0), &w) || finite_number(cJSON_GetArrayItem(size, 1), &h) ||
+        w != floor(w) || h != floor(h) || w < 1 || h < 1 || w > 16384 || h > 16384)
+        return -1;
+    r->capture = 1;
+    r->preview = cJSON_IsTrue(preview);
+    r->latest = cJSON_IsTrue(latest);
+    r->image_width = (int)w;
+    r->image_height = (int)h;
+    return 0;
+}
+
 /* A description is small; this bounds what a damaged or hostile file can make the parser do. */
 enum { MAX_DESCRIPTION = 1 << 20 };
 
@@ -380,6 +412,17 @@ int reference_parse(const char *text, size_t n, const char *label, reference_inf
     NEED(!cJSON_GetObjectItemCaseSensitive(root, "params") ||
              json_str(root, "params", r->params, sizeof r->params) == 0,
          "params");
+    /* Newer fields, absent from older descriptions: no scale known, no light edits, not a capture. */
+    const cJSON *diag = cJSON_GetObjectItemCaseSensitive(root, "scene_diagonal");
+    NEED(!diag || (json_float(diag, &r->scene_diag) == 0 && r->scene_diag > 0.0f), "scene_diagonal");
+    light_edit edits[REFERENCE_MAX_LIGHT_EDITS];
+    char why[256];
+    NEED(!cJSON_GetObjectItemCaseSensitive(root, "lights") ||
+             (json_str(root, "lights", r->lights, sizeof r->lights) == 0 &&
+              reference_lights_parse(r->lights, edits, REFERENCE_MAX_LIGHT_EDITS, why, sizeof why) >= 0),
+         "lights");
+    const cJSON *capture = cJSON_GetObjectItemCaseSensitive(root, "capture");
+    NEED(!capture || parse_capture(capture, r) == 0, "capture");
     const cJSON *shards = cJSON_GetObjectItemCaseSensitive(root, "shards");
     NEED(!shards || parse_shards(shards, r) == 0, "shards");
     /* "variance": null when the reference rendered a single frame. */
@@ -519,10 +562,88 @@ void reference_noise_finish(reference_noise *rn, const render_session *rs, refer
     info->has_noise = 1;
 }
 
-/* ---- matching -------------------------------------------------------------------------------- */
+/* ---- light edits ----------------------------------------------------------------------------- */
+
+static int by_group(const void *a, const void *b) {
+    int x = ((const light_edit *)a)->group, y = ((const light_edit *)b)->group;
+    return (x > y) - (x < y);
+}
+
+static int unedited(const light_edit *e) { return is_black3(e->offset) && e->gain == 1.0f; }
+
+int reference_lights_text(const light_edit *edits, int n, char *out, size_t outlen) {
+    light_edit sorted[REFERENCE_MAX_LIGHT_EDITS];
+    int m = 0;
+    for (int i = 0; i < n; i++)
+        if (!unedited(&edits[i])) {
+            if (m == REFERENCE_MAX_LIGHT_EDITS) return -1;
+            sorted[m++] = edits[i];
+        }
+    qsort(sorted, (size_t)m, sizeof sorted[0], by_group);
+    size_t len = 0;
+    if (outlen) out[0] = 0;
+    for (int i = 0; i < m; i++) {
+        /* + 0.0f: a -0 offset prints as 0, so equal edits have one text; %.9g reads back exactly */
+        const light_edit *e = &sorted[i];
+        int k = snprintf(out + len, outlen - len, "%s%d:%.9g,%.9g,%.9g*%.9g", i ? ";" : "", e->group,
+                         (double)(e->offset.x + 0.0f), (double)(e->offset.y + 0.0f), (double)(e->offset.z + 0.0f),
+                         (double)e->gain);
+        if (k < 0 || (size_t)k >= outlen - len) return -1;
+        len += (size_t)k;
+    }
+    return 0;
+}
+
+int reference_lights_parse(const char *text, light_edit *out, int max, char *err, size_t errlen) {
+    int n = 0;
+    for (const char *p = text; *p;) {
+        const char *end = strchr(p, ';');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        char item[160], tail;
+        if (len >= sizeof item) return fail(err, errlen, "light edit '%.40s...' too long", p);
+        memcpy(item, p, len);
+        item[len] = 0;
+        int g;
+        float x, y, z, gain;
+        if (sscanf(item, "%d:%f,%f,%f*%f%c", &g, &x, &y, &z, &gain, &tail) != 5 || g < 0 || g >= 1000000 ||
+            !isfinite(x) || !isfinite(y) || !isfinite(z) || !(gain >= 1e-6f && gain <= 1e6f))
+            return fail(err, errlen, "light edit '%s' is not GROUP:DX,DY,DZ*GAIN", item);
+        for (int i = 0; i < n; i++)
+            if (out[i].group == g) return fail(err, errlen, "light %d edited twice", g);
+        if (n == max) return fail(err, errlen, "more than %d light edits", max);
+        out[n++] = (light_edit){g, v3(x, y, z), gain};
+        p += len + (end ? 1 : 0);
+        if (end && !*p) return fail(err, errlen, "a light edit list ends in ';'");
+    }
+    return n;
+}
 
 static int near(float a, float b) { return fabsf(a - b) <= 1e-5f * (1.0f + fmaxf(fabsf(a), fabsf(b))); }
 static int near3(vec3 a, vec3 b) { return near(a.x, b.x) && near(a.y, b.y) && near(a.z, b.z); }
+
+/* The edit of group g among n (unedited when absent). */
+static light_edit edit_of(const light_edit *e, int n, int g) {
+    for (int i = 0; i < n; i++)
+        if (e[i].group == g) return e[i];
+    return (light_edit){g, v3(0, 0, 0), 1.0f};
+}
+
+int reference_lights_same(const char *a, const char *b) {
+    light_edit ea[REFERENCE_MAX_LIGHT_EDITS], eb[REFERENCE_MAX_LIGHT_EDITS];
+    char why[256];
+    int na = reference_lights_parse(a, ea, REFERENCE_MAX_LIGHT_EDITS, why, sizeof why);
+    int nb = reference_lights_parse(b, eb, REFERENCE_MAX_LIGHT_EDITS, why, sizeof why);
+    if (na < 0 || nb < 0) return 0;
+    for (int pass = 0; pass < 2; pass++) /* every group either edits, against the other's */
+        for (int i = 0; i < (pass ? nb : na); i++) {
+            int g = pass ? eb[i].group : ea[i].group;
+            light_edit x = edit_of(ea, na, g), y = edit_of(eb, nb, g);
+            if (!near3(x.offset, y.offset) || !near(x.gain, y.gain)) return 0;
+        }
+    return 1;
+}
+
+/* ---- matching -------------------------------------------------------------------------------- */
 
 int reference_check(const char *ref, const reference_info *have, const reference_info *want, char *err, size_t errlen) {
     if (strcmp(have->model, want->model) != 0)
@@ -547,6 +668,11 @@ int reference_check(const char *ref, const reference_info *have, const reference
                     have->variant[0] ? have->variant : "the default materials", have->variant[0] ? "'" : "",
                     want->variant[0] ? "material variant '" : "",
                     want->variant[0] ? want->variant : "the default materials", want->variant[0] ? "'" : "");
+    if (!reference_lights_same(have->lights, want->lights))
+        return fail(err, errlen, "%s: rendered with %s%s%s, not %s%s%s", ref,
+                    have->lights[0] ? "lights edited '" : "the lights as loaded", have->lights,
+                    have->lights[0] ? "'" : "", want->lights[0] ? "lights edited '" : "the lights as loaded",
+                    want->lights, want->lights[0] ? "'" : "");
     if (have->width != want->width || have->height != want->height)
         return fail(err, errlen, "%s: rendered at %dx%d, not %dx%d", ref, have->width, have->height, want->width,
                     want->height);

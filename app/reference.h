@@ -11,7 +11,8 @@
 
 #include "session.h"
 
-#define REFERENCE_MAX_SHARDS 4096 /* far above a cluster's job array (Slurm's default limit: 1001) */
+#define REFERENCE_MAX_SHARDS 4096     /* far above a cluster's job array (Slurm's default limit: 1001) */
+#define REFERENCE_MAX_LIGHT_EDITS 256 /* lights moved or dimmed in one description */
 
 typedef struct {
     char model[64];      /* BSDF_MODEL_STAMP of the glint that rendered it; "" in older references */
@@ -21,8 +22,13 @@ typedef struct {
     char env_hash[64];
     double env_rotation; /* degrees */
     char variant[64];    /* the material variant rendered, "" for the file's default materials */
-    int camera_index;    /* -1: the scene's first camera or the framing view */
+    int camera_index;    /* -1: the scene's first camera or the framing view; a free camera (the
+                          * viewer's, --camera-from's) */
     camera cam;          /* the camera actually rendered from */
+    float scene_diag;    /* the scene's diagonal, the scale of camera_same_view; 0 in older ones */
+    /* The lights moved or dimmed against the scene as loaded, as reference_lights_text writes
+     * them ("" for none, and in older references that have no such field). */
+    char lights[4096];
     int width, height;
     char method[16];
     int highlights_layer; /* the EXR has a highlights.* layer */
@@ -44,7 +50,34 @@ typedef struct {
     int has_noise;
     double mean_variance; /* mean over pixels and channels of the variance of the pixel mean */
     double rel_l2_noise;  /* expected relative L2 error of the reference against the truth */
+    /* A capture of what the viewer showed (its script's `capture`): spp is then the view's
+     * full-resolution frames, and these say when it was taken and what the image was. */
+    int capture;
+    double since_change;           /* seconds since the last change the viewer was asked for (a stop) */
+    double since_start;            /* seconds since the viewer started */
+    double image_age;              /* seconds since the image shown was published */
+    int preview;                   /* it was a reduced-resolution preview, magnified to width x height */
+    int image_width, image_height; /* its own size */
+    int latest;                    /* it showed the last change asked for */
 } reference_info;
+
+/* A light's edit: group (as scene_light_groups, glint info and the viewer's panel number them)
+ * moved by offset and its intensity gain times the loaded one. */
+typedef struct {
+    int group;
+    vec3 offset;
+    float gain;
+} light_edit;
+
+/* The canonical text of n edits (distinct groups, any order): "G:DX,DY,DZ*GAIN" for each group
+ * moved or dimmed, by group, joined by ';' ("0:0.5,0,-1*1;2:0,0,0*0.5"); "" when none is. Returns
+ * 0, or -1 when out is too small. */
+int reference_lights_text(const light_edit *edits, int n, char *out, size_t outlen);
+/* Parses such a text into at most max edits. Returns their count, or -1 with err = "problem". */
+int reference_lights_parse(const char *text, light_edit *out, int max, char *err, size_t errlen);
+/* Whether two texts are the same edits, offsets and gains within float noise (a group absent from
+ * one is unedited there). A malformed text matches nothing. */
+int reference_lights_same(const char *a, const char *b);
 
 /* The content hash of a scene or environment file (FNV-1a 64 of its bytes; for builtin:NAME,
  * of the built-in scene's). Returns 0, or -1 with err = "PATH: problem". */
@@ -108,7 +141,7 @@ void reference_noise_from_variance(const float *const mean[3], const float *cons
 
 /* Compares what a bench renders (want) with a reference's description (have), field by field: the
  * material model (a reference of another is stale: re-render it), scene and environment hashes,
- * material variant, camera index and parameters, size. Returns 0 when they match, else -1
+ * material variant, light edits, camera index and parameters, size. Returns 0 when they match, else -1
  * with err naming the first difference ("REF.exr: ..."). */
 int reference_check(const char *ref_path, const reference_info *have, const reference_info *want, char *err,
                     size_t errlen);

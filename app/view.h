@@ -29,6 +29,7 @@
 
 #include "camera.h"
 #include "cli.h"
+#include "reference.h"
 #include "session.h"
 #include "ui.h"
 #include "view_script.h"
@@ -38,17 +39,30 @@
 #define MAX_CURVES 6         /* error curves kept for comparison */
 #define MAX_VIEW_VARIANTS 64 /* material variants the panel lists */
 #define MAX_CURVE_POINTS 512 /* per curve; halved (every other point) when full */
+#define MAX_CAPTURES 8       /* captures written at once */
 
 static inline double seconds_since(double t) { return cli_now() - t; }
 
 /* ---- shared state (view_render.c) ------------------------------------------------------------ */
 
+/* Light edits: the offset and intensity multiplier of every light, against the scene as loaded. */
+typedef struct {
+    vec3 offset[MAX_LIGHT_GROUPS];
+    float gain[MAX_LIGHT_GROUPS];
+} light_edits;
+
+/* A published image and what it shows: the camera and lights it was rendered with travel with it,
+ * as the UI's may have moved on since. */
 typedef struct {
     float *rgb;
     int width, height;
     int preview;
     int full_w, full_h;  /* the render size it belongs to (a preview's is larger than its own) */
     uint64_t generation; /* the request generation it shows */
+    camera cam;
+    light_edits lights;
+    long long frames;    /* full-resolution frames in it (0 for a preview) */
+    double published_at; /* cli_now() */
 } image_buf;
 
 typedef struct {
@@ -65,12 +79,6 @@ typedef struct {
     char variant_names[MAX_VIEW_VARIANTS][64];
     int kept_view; /* it replaced the last scene to show another variant: the view stays */
 } scene_info;
-
-/* Light edits: the offset and intensity multiplier of every light, against the scene as loaded. */
-typedef struct {
-    vec3 offset[MAX_LIGHT_GROUPS];
-    float gain[MAX_LIGHT_GROUPS];
-} light_edits;
 
 /* What the render thread reports about its frames. It writes them under the lock; the UI thread
  * copies them as a whole with each image it takes. */
@@ -125,6 +133,7 @@ typedef struct {
      * measured against it, so the error plot pauses while the view is away. */
     int reference_cam_valid;
     camera reference_cam;
+    char reference_lights[4096]; /* its light edits (reference_lights_text), when it has a camera */
     /* Loads (load_kind, load_path) are read by a thread of their own while frames go on and
      * applied between frames; a failed one changes nothing. A script waits for loads_done. */
     uint64_t load_requests, loads_done;
@@ -166,6 +175,8 @@ void shared_state_deinit(shared_state *sh);
 void fill_scene_info(scene_info *info, const scene *s);
 /* The scene as loaded: no light edits. */
 void clear_light_edits(light_edits *e);
+/* The edits as a description gives them (reference_lights_text); "" when none. */
+void light_edits_text(const light_edits *e, char *out, size_t n);
 /* Creates the sessions for s at sh's requested size, camera and parameters and starts the thread,
  * which then owns s. Returns the thread (free with render_thread_stop), or NULL with the error in
  * sh->message; s is then still the caller's. */
@@ -236,9 +247,15 @@ typedef struct {
     /* the reference's camera, from its description (view_nav.c) */
     int reference_cam_valid;
     camera reference_cam;
-    int error_paused_shown; /* the note about the paused error plot is up */
-    char status[600];       /* what the panel should say about the view: pauses, an unlit scene */
-    uint64_t unlit_noted;   /* 1 + the info_serial of the last unlit scene reported */
+    char reference_lights[4096];            /* its light edits */
+    int error_paused_shown;                 /* the note about the paused error plot is up */
+    pthread_t captures[MAX_CAPTURES];       /* the script's captures being written... */
+    char capture_names[MAX_CAPTURES][1024]; /* ...as the script named them */
+    int num_captures;
+    /* images taken from the render thread: all, those at full resolution, and their pixels */
+    unsigned long long images_shown, images_full, image_pixels;
+    char status[600];     /* what the panel should say about the view: pauses, an unlit scene */
+    uint64_t unlit_noted; /* 1 + the info_serial of the last unlit scene reported */
     uint64_t script_load_target;
     /* a scripted continuous orbit */
     double spin_rate, spin_until; /* degrees per second, until when */
@@ -313,13 +330,15 @@ void nav_pan(ui_thread *u, float dx, float dy);
 void nav_fly(ui_thread *u, vec3 dir, double dt);
 /* A view of the whole scene, lit when possible. */
 void frame_scene(ui_thread *u);
-/* Loads a reference after checking its description against the viewer's scene, environment and
- * size; returns 0 or -1 (refused, message shown). */
+/* What the viewer renders, as a description has it (reference.h): material model, scene and its
+ * hash, environment, variant, the scene's size, w x h, and the light edits lights. 0, or -1 with
+ * err set (a file unreadable for hashing). */
+int describe_view(ui_thread *u, reference_info *out, int w, int h, const light_edits *lights, char *err, size_t errlen);
+/* Loads a reference after checking its description against the viewer's scene, environment,
+ * size and light edits; returns 0 or -1 (refused, message shown). */
 int open_reference(ui_thread *u, const char *path);
 /* Back to the reference's camera; -1 (message set) without one. */
 int reference_view(ui_thread *u);
-/* Whether two cameras are the same view (scale: the scene's size). */
-int same_view(const camera *a, const camera *b, float scale);
 /* Refreshes u->status and its notes (every UI frame). */
 void update_status(ui_thread *u);
 
@@ -331,6 +350,11 @@ int fetch_published(ui_thread *u);
 int load_reference(ui_thread *u, const char *path);
 void tonemap_and_upload(ui_thread *u);
 void take_screenshot(ui_thread *u, const char *name);
+/* Saves the image shown, linear and at the render's size (a preview magnified as the window
+ * draws it), as an EXR with its description (numbered, never overwriting), written by a thread
+ * of its own; capture_finish waits for those under way (before the viewer exits). */
+void capture_image(ui_thread *u, const char *name);
+void capture_finish(ui_thread *u);
 void capture_window(ui_thread *u, int w, int h);
 void draw_image_and_panel(ui_thread *u);
 

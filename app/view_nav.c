@@ -120,30 +120,42 @@ static int refuse(ui_thread *u, const char *why) {
     return -1;
 }
 
+int describe_view(ui_thread *u, reference_info *out, int w, int h, const light_edits *lights, char *err,
+                  size_t errlen) {
+    shared_state *sh = u->sh;
+    char env[1024];
+    memset(out, 0, sizeof *out);
+    snprintf(out->model, sizeof out->model, "%s", BSDF_MODEL_STAMP);
+    pthread_mutex_lock(&sh->lock);
+    snprintf(env, sizeof env, "%s", sh->env_now);
+    pthread_mutex_unlock(&sh->lock);
+    out->width = w;
+    out->height = h;
+    snprintf(out->scene, sizeof out->scene, "%s", u->info.name);
+    if (reference_hash_file(out->scene, out->scene_hash, err, errlen) != 0) return -1;
+    if (strcmp(env, ENV_SKY) == 0) { /* no file renders it */
+        snprintf(out->env, sizeof out->env, "the uniform sky");
+        snprintf(out->env_hash, sizeof out->env_hash, "uniform-sky");
+    } else if (env[0]) {
+        snprintf(out->env, sizeof out->env, "%s", env);
+        if (reference_hash_file(env, out->env_hash, err, errlen) != 0) return -1;
+    }
+    if (u->info.variant >= 0) snprintf(out->variant, sizeof out->variant, "%s", u->info.variant_names[u->info.variant]);
+    out->scene_diag = u->info.diag;
+    light_edits_text(lights, out->lights, sizeof out->lights);
+    return 0;
+}
+
 int open_reference(ui_thread *u, const char *path) {
     reference_info have, want;
     char err[1200];
     int described = reference_load(path, &have, err, sizeof err);
     if (described < 0) return refuse(u, err);
     if (described == 0) { /* what this view renders, against what the reference was rendered from */
-        shared_state *sh = u->sh;
-        char env[1024];
-        memset(&want, 0, sizeof want);
-        snprintf(want.model, sizeof want.model, "%s", BSDF_MODEL_STAMP);
-        pthread_mutex_lock(&sh->lock);
-        snprintf(env, sizeof env, "%s", sh->env_now);
-        want.width = sh->render_w;
-        want.height = sh->render_h;
-        pthread_mutex_unlock(&sh->lock);
-        snprintf(want.scene, sizeof want.scene, "%s", u->info.name);
-        if (reference_hash_file(want.scene, want.scene_hash, err, sizeof err) != 0) return refuse(u, err);
-        if (strcmp(env, ENV_SKY) == 0) { /* no file renders it */
-            snprintf(want.env, sizeof want.env, "the uniform sky");
-            snprintf(want.env_hash, sizeof want.env_hash, "uniform-sky");
-        } else if (env[0]) {
-            snprintf(want.env, sizeof want.env, "%s", env);
-            if (reference_hash_file(env, want.env_hash, err, sizeof err) != 0) return refuse(u, err);
-        }
+        pthread_mutex_lock(&u->sh->lock);
+        int w = u->sh->render_w, h = u->sh->render_h;
+        pthread_mutex_unlock(&u->sh->lock);
+        if (describe_view(u, &want, w, h, &u->lights, err, sizeof err) != 0) return refuse(u, err);
         /* The view may be anywhere: the reference's camera is where the error is measured. */
         want.camera_index = have.camera_index;
         want.cam = have.cam;
@@ -152,9 +164,11 @@ int open_reference(ui_thread *u, const char *path) {
     if (load_reference(u, path) != 0) return -1;
     u->reference_cam_valid = described == 0;
     if (described == 0) u->reference_cam = have.cam;
+    snprintf(u->reference_lights, sizeof u->reference_lights, "%s", described == 0 ? have.lights : "");
     pthread_mutex_lock(&u->sh->lock);
     u->sh->reference_cam_valid = u->reference_cam_valid;
     u->sh->reference_cam = u->reference_cam;
+    snprintf(u->sh->reference_lights, sizeof u->sh->reference_lights, "%s", u->reference_lights);
     pthread_mutex_unlock(&u->sh->lock);
     u->error_paused_shown = 0;
     if (described == 1) {
@@ -175,11 +189,6 @@ int reference_view(ui_thread *u) {
     return 0;
 }
 
-int same_view(const camera *a, const camera *b, float scale) {
-    return length3(sub3(a->position, b->position)) <= 1e-4f * scale && dot3(a->forward, b->forward) >= 1.0f - 1e-5f &&
-           dot3(a->up, b->up) >= 1.0f - 1e-5f && fabsf(a->yfov - b->yfov) <= 1e-4f;
-}
-
 /* ---- standing notes -------------------------------------------------------------------------- */
 
 void update_status(ui_thread *u) {
@@ -197,16 +206,20 @@ void update_status(ui_thread *u) {
         }
     }
     camera now = ctl_camera(&u->cam);
-    int paused = u->reference.rgb && u->reference_cam_valid && !same_view(&now, &u->reference_cam, u->info.diag);
+    char lights[sizeof u->reference_lights];
+    light_edits_text(&u->lights, lights, sizeof lights);
+    int described = u->reference.rgb && u->reference_cam_valid;
+    int away = described && !camera_same_view(&now, &u->reference_cam, u->info.diag);
+    int relit = described && !reference_lights_same(lights, u->reference_lights); /* lights unlike its */
+    int paused = away || relit;
     if (paused && len < (int)sizeof u->status)
-        snprintf(u->status + len, sizeof u->status - (size_t)len,
-                 "%serror plot paused: away from the reference's "
-                 "camera (C returns)",
-                 len ? "; " : "");
+        snprintf(u->status + len, sizeof u->status - (size_t)len, "%serror plot paused: %s", len ? "; " : "",
+                 away ? "away from the reference's camera (C returns)" : "lights edited unlike the reference's");
     if (paused != u->error_paused_shown) { /* the message line says it when it happens */
         snprintf(u->message, sizeof u->message, "%s",
-                 paused ? "error plot paused: the view left the reference's camera (C returns to it)"
-                        : "error plot resumed: the reference's camera");
+                 !paused ? "error plot resumed: the reference's camera"
+                 : away  ? "error plot paused: the view left the reference's camera (C returns to it)"
+                         : "error plot paused: the lights differ from the reference's");
         u->error_paused_shown = paused;
     }
 }

@@ -95,6 +95,12 @@ void clear_light_edits(light_edits *e) {
     }
 }
 
+void light_edits_text(const light_edits *e, char *out, size_t n) {
+    light_edit list[MAX_LIGHT_GROUPS];
+    for (int g = 0; g < MAX_LIGHT_GROUPS; g++) list[g] = (light_edit){g, e->offset[g], e->gain[g]};
+    if (reference_lights_text(list, MAX_LIGHT_GROUPS, out, n) != 0 && n) out[0] = 0; /* n too small: none said */
+}
+
 static void set_message(render_thread *rt, const char *fmt, const char *a, const char *b) {
     shared_state *sh = rt->sh;
     pthread_mutex_lock(&sh->lock);
@@ -387,6 +393,10 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
     rt->back.full_w = session_film(rt->full)->width;
     rt->back.full_h = session_film(rt->full)->height;
     rt->back.generation = gen;
+    rt->back.cam = *session_camera(rs); /* what its frames were rendered from, whatever asked since */
+    rt->back.lights = rt->lights_applied;
+    rt->back.frames = preview ? 0 : session_frames(rs);
+    rt->back.published_at = cli_now();
     double rel_error = preview || !measure ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
@@ -480,7 +490,10 @@ static void *render_main(void *arg) {
         render_params params = sh->params;
         int preview = seconds_since(sh->changed_at) < PREVIEW_HOLD_SECONDS;
         /* Measured against the reference only from its camera (when its description names one). */
-        int measure = !sh->reference_cam_valid || same_view(&cam, &sh->reference_cam, rt->scene->diag);
+        int measure = !sh->reference_cam_valid || camera_same_view(&cam, &sh->reference_cam, rt->scene->diag);
+        int lights_measured = sh->reference_cam_valid; /* a described reference: its lights too */
+        char reference_lights[sizeof sh->reference_lights];
+        snprintf(reference_lights, sizeof reference_lights, "%s", sh->reference_lights);
         int rw = sh->render_w, rh = sh->render_h;
         /* Light requests made for a scene since replaced are stale: the new one starts as loaded. */
         int edit_lights = gen != applied && sh->lights_scene == sh->info_serial;
@@ -507,6 +520,12 @@ static void *render_main(void *arg) {
         }
 
         if (edit_lights) apply_light_edits(rt, &lights);
+        /* ...and with the lights it was rendered with */
+        if (measure && lights_measured) {
+            char now[sizeof reference_lights];
+            light_edits_text(&rt->lights_applied, now, sizeof now);
+            measure = reference_lights_same(now, reference_lights);
+        }
         /* The scene's analysis follows light edits once they settle, not at every step of a drag. */
         if (rt->scene_edited && !preview) {
             if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0)

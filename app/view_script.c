@@ -78,6 +78,7 @@ int view_script_parse_line(const char *line, script_action *out, char *err, size
         {"buttons", ACT_BUTTONS, 0, 0, 0},
         {"wheel", ACT_WHEEL, 3, 3, 0},
         {"variant", ACT_VARIANT, 1, 0, 1},
+        {"capture", ACT_CAPTURE, 1, 0, 1},
     };
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
         if (strcmp(w[0], commands[i].name) != 0) continue;

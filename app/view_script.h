@@ -11,6 +11,7 @@
  *   quit                      pause                  resume
  *   sleep SECONDS             wait-file FILE         buttons
  *   wheel X Y STEPS           variant NAME|default   wait-held
+ *   capture FILE.exr
  *
  * `window-shot` captures the window as drawn, panel included (for documentation); the actions
  * after it wait for the capture. `wait` waits for FRAMES new full-resolution frames; `stats`
@@ -28,7 +29,12 @@
  * `move-light` moves light INDEX (as the panel lists them) by a world-space offset and selects it;
  * `spin` orbits continuously, a little every drawn frame, as a held mouse drag would. `variant`
  * shows the scene's material variant NAME (`default`: the file's materials), as the panel's choice
- * does, and waits until the scene is reloaded. */
+ * does, and waits until the scene is reloaded. `capture` saves the image the window shows, linear
+ * (before tone mapping) and at the render's size (a preview magnified as the window draws it), as
+ * an EXR (numbered, never overwriting) whose glint.reference header attribute describes it:
+ * scene, environment, variant, the camera and light edits it was rendered with, and when it was
+ * taken (seconds since the last change and since the start, its full-resolution frames, whether
+ * a preview); glint compare measures it against a reference. */
 #ifndef GLINT_VIEW_SCRIPT_H
 #define GLINT_VIEW_SCRIPT_H
 
@@ -64,6 +70,7 @@ typedef enum {
     ACT_BUTTONS,   /* where the panel's buttons are */
     ACT_WHEEL,     /* the cursor moved and the wheel turned at once */
     ACT_VARIANT,
+    ACT_CAPTURE, /* the image shown, linear, with its description */
 } script_action_kind;
 
 typedef struct {
@@ -71,7 +78,7 @@ typedef struct {
     int line;
     double a, b, c, d; /* numbers: frames, degrees, offsets, factor, light index and offset */
     char name[64];     /* set: parameter; key: key name */
-    char text[1024];   /* set: value; screenshot, export, load, env, window-shot, reference, wait-file: path */
+    char text[1024];   /* set: value; screenshot, export, capture, load, env, window-shot, reference, wait-file: path */
 } script_action;
 
 typedef struct {

@@ -27,6 +27,8 @@ static void print_stats(ui_thread *u) {
     for (int i = 1; i <= 9; i++)
         if (u->bookmark_set[i]) marks[nb++] = (char)('0' + i);
     marks[nb] = 0;
+    /* One line, whole: a capture's thread says "glint: wrote" on stdout too. */
+    flockfile(stdout);
     printf(
         "stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
         "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
@@ -50,6 +52,10 @@ static void print_stats(ui_thread *u) {
            env, strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->stats.error_paused,
            (unsigned long long)u->stats.rel_error_serial, u->step_ms, u->stats.frame_ms, view_cost_ms(u),
            u->cost_before_ms);
+    /* Images taken from the render thread (what the window showed), those at full resolution, their
+     * pixels in all, and the size they render at: updates a second and their resolution. */
+    printf(" images=%llu images_full=%llu image_pixels=%llu render_size=%dx%d", u->images_shown, u->images_full,
+           u->image_pixels, u->front.full_w, u->front.full_h);
     print_panel_stats(u);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
@@ -63,6 +69,7 @@ static void print_stats(ui_thread *u) {
     }
     printf("\n");
     fflush(stdout);
+    funlockfile(stdout);
 }
 
 /* A live parameter by its command-line name. Returns 0, or -1 with a message. */
@@ -245,6 +252,7 @@ void run_script(ui_thread *u) {
             break;
         case ACT_SCREENSHOT: take_screenshot(u, a->text); break;
         case ACT_EXPORT: request_export(u, a->text); break;
+        case ACT_CAPTURE: capture_image(u, a->text); break;
         case ACT_LOAD:
         case ACT_ENV:
         case ACT_SKY:

@@ -31,3 +31,8 @@ camera scene_camera(const scene *s, int index, float aspect) {
     if (s->num_cameras > 0) return s->cameras[index >= 0 && index < s->num_cameras ? index : 0];
     return camera_frame_bounds(s->bounds, 0.8f, aspect);
 }
+
+int camera_same_view(const camera *a, const camera *b, float scale) {
+    return length3(sub3(a->position, b->position)) <= 1e-4f * scale && dot3(a->forward, b->forward) >= 1.0f - 1e-5f &&
+           dot3(a->up, b->up) >= 1.0f - 1e-5f && fabsf(a->yfov - b->yfov) <= 1e-4f;
+}

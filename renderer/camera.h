@@ -11,6 +11,10 @@ camera camera_look_at(vec3 eye, vec3 target, vec3 up, float yfov);
 camera camera_frame_bounds(bounds3 b, float yfov, float aspect);
 /* The scene's camera `index` (-1 or out of range: the first one, or the framing default). */
 camera scene_camera(const scene *s, int index, float aspect);
+/* Whether two cameras are the same view: positions within 1e-4 scale (scale: the scene's size,
+ * its diagonal), directions and field of view within float noise. The viewer measures against a
+ * reference only from its view, and glint compare refuses images of two views, by this test. */
+int camera_same_view(const camera *a, const camera *b, float scale);
 
 /* Unit direction through image position (x, y) in [0,1)^2, y downward, for width/height aspect. */
 static inline vec3 camera_ray_dir(const camera *c, float aspect, float x, float y) {

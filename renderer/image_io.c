@@ -150,6 +150,21 @@ const float *exr_image_channel(const exr_image *img, const char *name) {
     return NULL;
 }
 
+float *exr_image_layer_rgb(const exr_image *img, const char *prefix) {
+    const float *c[3];
+    for (int k = 0; k < 3; k++) {
+        char name[256];
+        snprintf(name, sizeof name, "%s%s%c", prefix, prefix[0] ? "." : "", "RGB"[k]);
+        if (!(c[k] = exr_image_channel(img, name))) return NULL;
+    }
+    size_t n = (size_t)img->width * (size_t)img->height;
+    float *rgb = malloc(sizeof(float) * 3 * n);
+    if (!rgb) return NULL;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) rgb[3 * i + (size_t)k] = c[k][i];
+    return rgb;
+}
+
 int exr_header_string(const char *path, const char *name, char **value, size_t *len, char *err, size_t errlen) {
     *value = NULL;
     *len = 0;

@@ -41,6 +41,9 @@ int exr_image_load(const char *path, exr_image *out, char *err, size_t errlen);
 void exr_image_free(exr_image *img);
 /* The plane of the named channel, or NULL. */
 const float *exr_image_channel(const exr_image *img, const char *name);
+/* The layer prefix.R, .G, .B ("" for R, G, B) interleaved, 3 floats a pixel (malloc'ed: free it),
+ * or NULL when a channel is missing or out of memory. */
+float *exr_image_layer_rgb(const exr_image *img, const char *prefix);
 
 /* One RGB layer to write: prefix "" writes R,G,B; prefix "direct" writes direct.R, direct.G, direct.B. */
 typedef struct {

@@ -135,3 +135,7 @@ double metric_loglog_reach(const double *x, const double *y, int n, double y0) {
     }
     return (double)NAN;
 }
+
+double metric_without_noise(double rel_l2, double ref_noise) {
+    return ref_noise > 0.0 ? sqrt(fmax(rel_l2 * rel_l2 - ref_noise * ref_noise, 0.0)) : rel_l2;
+}

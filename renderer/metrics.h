@@ -10,6 +10,10 @@
  * the image is zero too, else INFINITY: there is no relative scale to measure against. */
 double metric_rel_l2(const float *img, const float *ref, size_t n);
 
+/* An error with a reference's own relative noise taken out in quadrature, as the bias of
+ * metric_noise_bias takes it: sqrt(max(0, rel_l2^2 - ref_noise^2)); rel_l2 itself for ref_noise 0. */
+double metric_without_noise(double rel_l2, double ref_noise);
+
 /* Relative mean squared error: mean of (I - R)^2 / (R^2 + METRIC_RELMSE_EPS). The epsilon keeps
  * black reference pixels from dominating. n = 0 gives 0. */
 #define METRIC_RELMSE_EPS 1e-2

@@ -702,6 +702,8 @@ void session_set_camera(render_session *rs, const camera *cam) {
     session_reset(rs);
 }
 
+const camera *session_camera(const render_session *rs) { return &rs->cam; }
+
 void session_set_params(render_session *rs, const render_params *params) {
     render_params p = *params;
     p.width = rs->params.width;

@@ -80,6 +80,8 @@ const char *session_error(const render_session *rs);
  * abandons a frame under way in parts (nothing of it counted). */
 void session_reset(render_session *rs);
 void session_set_camera(render_session *rs, const camera *cam);
+/* The camera its frames are rendered from. */
+const camera *session_camera(const render_session *rs);
 /* The scene changed (a light moved or dimmed, another environment map): analyses it again,
  * re-makes the plan, drops what was derived from the old map and resets.
  * Returns 0, or -1 with session_error() set (out of memory; the old analysis stays). */

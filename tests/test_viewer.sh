@@ -7,7 +7,8 @@
 # running, a bad script line or value is reported with its line number.
 # Lights move and dim live, camera bookmarks round-trip through their file (a malformed one is
 # reported and ignored), tone mappers switch without a reset, a reference image gives the error
-# and its false-colour view (one of another size is refused).
+# and its false-colour view (one of another size is refused). Captures are the image shown, at the
+# render's size, with the camera it was rendered from; the stats count the images shown.
 # Usage: test_viewer.sh GLINT TMPDIR [KEEP_MODULES_LIB]
 set -u
 glint=$1
@@ -273,6 +274,73 @@ grep -q 'highlights.exr: the reference is 48x27 but the render is 96x54' err.txt
 [ "$(field 3 frames)" -gt "$(field 2 frames)" ] || fail "the viewer stopped after a reference of another size"
 
 # A bad script line is reported with its line number, before any window opens.
+# ---- captures: the image shown, linear, at the render's size, with its own camera -----------
+# At rest and paused, a capture is the full-resolution image, the same pixels as an export. An
+# orbit and a capture in one UI frame: the image shown is still the one before the orbit, and the
+# capture says so (its camera, not the new one; not the latest). Soon after, a preview: magnified
+# to the render's size. The stats count the images the window took.
+cat >capture.txt <<'EOF'
+wait 1
+pause
+wait-held
+stats
+capture still.exr
+export still-export.exr
+resume
+orbit 20 0
+capture moved.exr
+stats
+sleep 0.1
+capture preview.exr
+stats
+wait 1
+pause
+wait-held
+capture moved-rest.exr
+stats
+quit
+EOF
+rm -f still*.exr moved*.exr preview*.exr
+view --size 160x90 --script capture.txt
+rc=$?
+[ $rc -eq 0 ] || fail "capture script exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+for f in still.exr moved.exr preview.exr moved-rest.exr; do
+  grep -q "^glint: wrote $f\$" out.txt || fail "capture $f not reported: $(cat out.txt err.txt)"
+done
+desc() { exrheader "$1" 2>/dev/null | tr -d '\n'; } # the header, its description on one line
+if command -v exrheader >/dev/null; then
+  case $(desc still.exr) in *'"width": 160,  "height": 90'*'"preview": false'*'"latest": true'*) ;;
+  *) fail "still.exr: not a full-resolution capture of the latest state: $(desc still.exr)" ;; esac
+  "$glint" compare still.exr still-export.exr >cmp.txt 2>&1 || fail "compare still: $(cat cmp.txt)"
+  grep -q '^rel_l2=0 ' cmp.txt || fail "the paused capture is not the exported image: $(cat cmp.txt)"
+  case $(desc moved.exr) in *'"latest": false'*) ;; *) fail "moved.exr claims the orbit's image" ;; esac
+  # Its camera is the one before the orbit: compare takes it against the still capture, and
+  # refuses it against the capture at rest after the orbit.
+  "$glint" compare moved.exr still.exr >cmp.txt 2>&1 || fail "moved vs still: $(cat cmp.txt)"
+  "$glint" compare moved.exr moved-rest.exr >cmp.txt 2>&1 && fail "moved.exr has the new camera"
+  grep -q 'seen from' cmp.txt || fail "moved vs moved-rest: $(cat cmp.txt)"
+  case $(desc preview.exr) in
+  *'"preview": true'*)
+    case $(desc preview.exr) in *'"width": 160,  "height": 90'*) ;; *) fail "preview capture not at the render's size" ;; esac
+    [ "$(field 3 preview)" = 1 ] || fail "the capture was a preview, the stats say preview=$(field 3 preview)" ;;
+  *'"preview": false'*) echo "no preview on screen 0.1 s after the orbit: the preview capture not checked" ;;
+  *) fail "preview.exr: no description: $(desc preview.exr)" ;;
+  esac
+fi
+i1=$(field 1 images) i4=$(field 4 images) f4=$(field 4 images_full)
+[ "${i1:-0}" -ge 1 ] && [ "${i4:-0}" -gt "$i1" ] || fail "images counted $i1 then $i4"
+[ "${f4:-0}" -ge 2 ] && [ "$f4" -le "$i4" ] || fail "full-resolution images $f4 of $i4"
+[ "$(field 1 render_size)" = 160x90 ] || fail "render_size $(field 1 render_size)"
+
+# A reference rendered with a light moved is not of the scene as loaded: refused with the reason.
+"$glint" render --size 64x36 --spp 1 --quiet --move-light 0,0.5,0,0 --out ref-moved.exr ||
+  fail "render with a light moved failed"
+printf 'quit\n' >quit.txt
+view --size 64x36 --reference ref-moved.exr --script quit.txt
+grep -q "rendered with lights edited '0:0.5,0,0\*1', not the lights as loaded; reference not used" err.txt ||
+  fail "a reference with a light moved was not refused: $(cat err.txt)"
+
 printf 'wait 1\nfrobnicate 3\n' >bad.txt
 view --script bad.txt
 rc=$?

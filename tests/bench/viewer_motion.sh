@@ -18,19 +18,11 @@ seconds=${2:-10}
 methods=${3:-pt vpl vsl vsl+hl}
 [ -x "$glint" ] || { echo "no glint at $glint (build it: tests/bench/run.sh builds build/)"; exit 1; }
 glint=$(cd "$(dirname "$glint")" && pwd)/$(basename "$glint") # the viewer runs in a scratch directory
-command -v Xvfb >/dev/null || { echo "Xvfb not installed"; exit 1; }
 command -v xdotool >/dev/null || { echo "xdotool not installed"; exit 1; }
 work=$(mktemp -d)
-Xvfb -displayfd 3 -screen 0 1920x1080x24 -nolisten tcp 3>"$work/display.txt" 2>"$work/xvfb.log" &
-xvfb=$!
-trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null; rm -rf "$work"' EXIT
-tries=0
-until [ -s "$work/display.txt" ]; do
-  tries=$((tries + 1))
-  [ $tries -le 300 ] || { echo "Xvfb did not start"; exit 1; }
-  sleep 0.1
-done
-export DISPLAY=":$(head -n 1 "$work/display.txt")"
+. "$root/tests/bench/xvfb.sh"
+xvfb_remove_dir=1
+xvfb_start "$work" || exit 1
 cd "$work"
 {
   echo "sleep 3"

@@ -1,0 +1,209 @@
+/* glint compare, and the poses of glint render it compares: the error of an image against a
+ * reference, checked against the same sum done here and against images made to a known error;
+ * the reference's noise taken out in quadrature; the refusals (size, scene, camera, light edits;
+ * glint bench's of a reference with a light moved);
+ * glint render's --camera-from (the camera of another file's description, refused without one or
+ * of another scene) and --move-light / --light-gain (the edits applied, recorded, compared).
+ * Usage: test_compare PATH_TO_GLINT */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "cli_harness.h"
+#include "image_io.h"
+
+/* Exit code `code`, and stderr exactly one "glint: error: ..." line containing `needle`. */
+static void expect_failure(const char *args, int code, const char *needle) {
+    int rc = run(args);
+    CHECK(rc == code, "'%s': exit %d, expected %d (stderr: %s)", args, rc, code, err_text);
+    const char *nl = strchr(err_text, '\n');
+    CHECK(strncmp(err_text, "glint: error: ", 14) == 0 && nl && !nl[1], "'%s': stderr is not one error line: '%s'",
+          args, err_text);
+    CHECK(strstr(err_text, needle), "'%s': error '%s' lacks '%s'", args, err_text, needle);
+}
+
+/* Runs glint compare ARGS, which must succeed; its three numbers into v. */
+static void compare(const char *args, double v[3]) {
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "compare %s", args);
+    int rc = run(cmd);
+    v[0] = v[1] = v[2] = NAN;
+    CHECK(rc == 0, "'%s': exit %d (%s)", cmd, rc, err_text);
+    CHECK(sscanf(out_text, "rel_l2=%lf ref_noise=%lf net=%lf", &v[0], &v[1], &v[2]) == 3 && !strchr(out_text, '\n')[1],
+          "'%s': output '%s'", cmd, out_text);
+}
+
+static int render(const char *args) {
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "render builtin:atelier --size 32x18 --quiet %s", args);
+    int rc = run(cmd);
+    CHECK(rc == 0, "'%s': exit %d (%s)", cmd, rc, err_text);
+    return rc;
+}
+
+/* The layer `prefix` of EXR `name` (in tmp), interleaved; NULL when unreadable. */
+static float *layer(const char *name, const char *prefix, int *w, int *h) {
+    char p[1024], err[1024];
+    snprintf(p, sizeof p, "%s/%s", tmp, name);
+    exr_image ex;
+    if (exr_image_load(p, &ex, err, sizeof err) != 0) return NULL;
+    float *rgb = exr_image_layer_rgb(&ex, prefix);
+    *w = ex.width;
+    *h = ex.height;
+    exr_image_free(&ex);
+    return rgb;
+}
+
+/* ||a - b|| / ||b|| summed here, in double. */
+static double rel_l2_here(const char *a, const char *b, const char *prefix) {
+    int w, h, w2, h2;
+    float *x = layer(a, prefix, &w, &h), *y = layer(b, prefix, &w2, &h2);
+    double d = 0.0, n = 0.0;
+    for (size_t i = 0; x && y && i < 3 * (size_t)w * (size_t)h; i++) {
+        d += ((double)x[i] - y[i]) * ((double)x[i] - y[i]);
+        n += (double)y[i] * y[i];
+    }
+    free(x);
+    free(y);
+    return x && y ? sqrt(d / n) : NAN;
+}
+
+/* A w x h image of value v * (1 + pixel index / 100) in every channel, no description. */
+static void write_ramp(const char *name, int w, int h, float v) {
+    char p[1024], err[1024];
+    float *rgb = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
+    for (int i = 0; i < w * h; i++)
+        for (int k = 0; k < 3; k++) rgb[3 * i + k] = v * (1.0f + (float)i / 100.0f);
+    snprintf(p, sizeof p, "%s/%s", tmp, name);
+    exr_layer l = {"", rgb};
+    CHECK(exr_save_layers(p, w, h, &l, 1, WRITE_REPLACE, err, sizeof err) == 0, "%s", err);
+    free(rgb);
+}
+
+static void test_numbers(void) {
+    double v[3];
+    /* Made to a known error: 1.1 times the reference everywhere is 0.1 off. */
+    write_ramp("ramp.exr", 8, 4, 2.0f);
+    write_ramp("ramp-more.exr", 8, 4, 2.2f);
+    compare("ramp-more.exr ramp.exr", v);
+    CHECK_NEAR(v[0], 0.1, 1e-5, "1.1 times the reference");
+    CHECK(v[1] == 0.0 && v[2] == v[0], "no description: no noise to take out (%g, %g)", v[1], v[2]);
+    compare("ramp.exr ramp.exr", v);
+    CHECK(v[0] == 0.0 && v[2] == 0.0, "an image against itself: %g %g", v[0], v[2]);
+    /* Two renders: the sum done here, and the reference's noise (its description's) taken out. */
+    if (render("--method pt --spp 2 --seed 1 --out a.exr") || render("--method pt --spp 16 --seed 2 --out b.exr"))
+        return;
+    char desc[65536];
+    read_reference("b.exr", desc, sizeof desc);
+    const char *noise_at = strstr(desc, "\"rel_l2_noise\": ");
+    double noise = noise_at ? atof(noise_at + 16) : NAN;
+    CHECK(noise > 0.0, "b.exr has its noise in its description");
+    compare("a.exr b.exr", v);
+    CHECK_NEAR(v[0], rel_l2_here("a.exr", "b.exr", ""), 1e-5 * v[0], "against the sum done here");
+    CHECK_NEAR(v[1], noise, 1e-5 * noise, "the reference's noise");
+    CHECK_NEAR(v[2], sqrt(fmax(v[0] * v[0] - noise * noise, 0.0)), 1e-5, "net: the noise out in quadrature");
+    CHECK(v[2] < v[0], "net %g below rel_l2 %g", v[2], v[0]);
+    /* A layer: its own error, and no noise known for it. */
+    compare("a.exr b.exr --layer direct", v);
+    CHECK_NEAR(v[0], rel_l2_here("a.exr", "b.exr", "direct"), 1e-5 * v[0], "the direct layer");
+    CHECK(v[1] == 0.0 && v[2] == v[0], "a layer's noise is unknown: %g %g", v[1], v[2]);
+    expect_failure("compare a.exr b.exr --layer nosuch", 1, "nosuch.R,G,B");
+    expect_failure("compare a.exr", 2, "IMAGE.exr REFERENCE.exr");
+    expect_failure("compare a.exr b.exr ramp.exr", 2, "ramp.exr");
+    expect_failure("compare a.exr missing.exr", 1, "missing.exr");
+}
+
+static void test_refusals(void) {
+    if (render("--method pt --spp 2 --seed 1 --out a.exr")) return;
+    run("render builtin:atelier --size 16x9 --spp 1 --quiet --out small.exr");
+    expect_failure("compare a.exr small.exr", 1, "32x18, but small.exr is 16x9");
+    expect_failure("compare ramp.exr a.exr", 1, "8x4, but a.exr is 32x18");
+    run("render builtin:doorway --size 32x18 --spp 1 --quiet --out doorway.exr");
+    expect_failure("compare a.exr doorway.exr", 1, "builtin:doorway");
+    if (render("--spp 1 --camera 1 --out cam1.exr")) return;
+    expect_failure("compare a.exr cam1.exr", 1, "seen from");
+    if (render("--spp 1 --move-light 0,0.5,0,0 --out moved.exr")) return;
+    expect_failure("compare a.exr moved.exr", 1, "edited '0:0.5,0,0*1'");
+    expect_failure("compare moved.exr a.exr", 1, "as loaded");
+    /* glint bench renders the scene as loaded: a reference with a light moved is not of it. */
+    expect_failure("bench builtin:atelier --reference moved.exr --methods pt --times 0.05 --quiet", 1,
+                   "rendered with lights edited '0:0.5,0,0*1', not the lights as loaded");
+    /* An older description, without the lights field: as loaded. */
+    char desc[65536];
+    read_reference("a.exr", desc, sizeof desc);
+    char *at = strstr(desc, "  \"lights\": \"\",\n");
+    CHECK(at != NULL, "a.exr's description has an empty lights field: %s", desc);
+    if (at) memmove(at, at + strlen("  \"lights\": \"\",\n"), strlen(at + strlen("  \"lights\": \"\",\n")) + 1);
+    CHECK(write_reference("a.exr", "old.exr", desc, 0) == 0, "old.exr written");
+    double v[3];
+    compare("old.exr a.exr", v);
+    CHECK(v[0] == 0.0, "an older description, the same image: %g", v[0]);
+    expect_failure("compare old.exr moved.exr", 1, "as loaded");
+    /* A malformed edit list is a malformed description, whoever reads it. */
+    static const char *const bad[] = {"0:1,0,0", "0:1,0,0*1;", "x:1,0,0*1", "0:1,0,0*1;0:2,0,0*1", "0:1,0,0*0"};
+    for (int i = 0; i < (int)(sizeof bad / sizeof bad[0]); i++) {
+        char edited[65600], *field = NULL;
+        read_reference("a.exr", desc, sizeof desc);
+        field = strstr(desc, "\"lights\": \"\"");
+        if (!field) break;
+        snprintf(edited, sizeof edited, "%.*s\"lights\": \"%s\"%s", (int)(field - desc), desc, bad[i],
+                 field + strlen("\"lights\": \"\""));
+        CHECK(write_reference("a.exr", "bad-lights.exr", edited, 0) == 0, "bad-lights.exr written");
+        expect_failure("compare a.exr bad-lights.exr", 1, "bad \"lights\"");
+    }
+}
+
+static void test_render_poses(void) {
+    double v[3];
+    /* Two moves of one light add up to one move; the recorded edit is the same, the image too. */
+    if (render("--spp 2 --seed 3 --move-light 0,0.25,0,0 --move-light 0,0.25,0,0 --out twice.exr") ||
+        render("--spp 2 --seed 3 --move-light 0,0.5,0,0 --out once.exr") || render("--spp 2 --seed 3 --out still.exr"))
+        return;
+    compare("twice.exr once.exr", v);
+    CHECK(v[0] < 1e-6, "two moves and their sum: %g", v[0]);
+    expect_failure("compare twice.exr still.exr", 1, "lights");
+    /* The move changes the image (the only light moved); the gain scales it (the only light). */
+    double moved = rel_l2_here("once.exr", "still.exr", "");
+    CHECK(moved > 0.01, "a light moved half a metre changes the image by %g", moved);
+    if (render("--spp 2 --seed 3 --light-gain 0,2 --out bright.exr")) return;
+    int w, h;
+    float *a = layer("bright.exr", "", &w, &h), *b = layer("still.exr", "", &w, &h);
+    double sa = 0.0, sb = 0.0;
+    for (size_t i = 0; a && b && i < 3 * (size_t)w * (size_t)h; i++) sa += a[i], sb += b[i];
+    CHECK_NEAR(sa / sb, 2.0, 1e-3, "the one light at twice its intensity doubles the image");
+    free(a);
+    free(b);
+    char desc[65536];
+    read_reference("bright.exr", desc, sizeof desc);
+    CHECK(strstr(desc, "\"lights\": \"0:0,0,0*2\""), "the gain recorded: %s", desc);
+    /* --camera-from: the camera of the file's description, whatever the file's size. */
+    if (render("--spp 1 --seed 4 --camera-from cam1.exr --move-light 0,0.5,0,0 --out from.exr")) return;
+    read_reference("from.exr", desc, sizeof desc);
+    CHECK(strstr(desc, "\"index\": 1,"), "camera 1's view is recorded as camera 1: %s", desc);
+    expect_failure("compare from.exr once.exr", 1, "seen from");
+    run("render builtin:atelier --size 32x18 --quiet --spp 1 --seed 5 --camera 1 --move-light 0,0.5,0,0 --out c1.exr");
+    compare("from.exr c1.exr", v);
+    CHECK(v[0] > 0.0 && isfinite(v[0]), "the same pose: compared (%g)", v[0]);
+    expect_failure("render builtin:atelier --size 32x18 --spp 1 --camera-from ramp.exr --out x.exr", 1,
+                   "no glint description");
+    expect_failure("render builtin:atelier --size 32x18 --spp 1 --camera-from doorway.exr --out x.exr", 1,
+                   "another scene");
+    expect_failure("render builtin:atelier --spp 1 --camera 1 --camera-from a.exr --out x.exr", 2, "exclude");
+    expect_failure("render builtin:atelier --spp 1 --camera-from nosuch.exr --out x.exr", 1, "nosuch.exr");
+    expect_failure("render builtin:atelier --spp 1 --move-light 0,1,2 --out x.exr", 2, "G,DX,DY,DZ");
+    expect_failure("render builtin:atelier --spp 1 --move-light 0,1,2,x --out x.exr", 2, "G,DX,DY,DZ");
+    expect_failure("render builtin:atelier --spp 1 --move-light 5,1,0,0 --out x.exr", 2, "no light 5");
+    expect_failure("render builtin:atelier --spp 1 --light-gain 0,2 --light-gain 0,3 --out x.exr", 2, "twice");
+    expect_failure("render builtin:atelier --spp 1 --light-gain 0,0 --out x.exr", 2, "1e-6 to 1e6");
+}
+
+int main(int argc, char **argv) {
+    int start = harness_start(argc, argv, "compare");
+    if (start != 0) return start;
+    test_numbers();
+    test_refusals();
+    test_render_poses();
+    return check_exit("test_compare");
+}
