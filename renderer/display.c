@@ -35,7 +35,10 @@ typedef struct {
  * this cosine and it lies within this many pixel footprints of the old point's plane. */
 #define REPROJECT_MIN_COS 0.9f
 #define REPROJECT_PLANE_PIXELS 2.0f
-#define DENOISE_LEVELS DENOISE_MAX_LEVELS
+/* The filter's passes: three reach 14 pixels, enough where most pixels have samples (more blur
+ * the image for no less noise); where many have none yet (a new view, the sparse updates while the
+ * camera moves) the passes reach as far as the holes are wide. */
+#define DENOISE_LEVELS 3
 
 /* A tile's evidence since the last light change: new samples' luminance (every component, divided
  * by the albedo) less the stale history's at the same pixels, its variance, the stale total. */
@@ -56,6 +59,8 @@ struct display {
     /* resolve's scratch: the filter's input per component (demodulated mean, samples, one sample's
      * luminance variance) and its output */
     float *light[COMP_COUNT], *count[COMP_COUNT], *variance[COMP_COUNT], *out[COMP_COUNT];
+    float *out_count[COMP_COUNT]; /* the samples behind the filter's value... */
+    float *take[COMP_COUNT];      /* ...and how much of it a pixel takes (weigh_row) */
     denoiser *dn;
     int active[COMP_COUNT]; /* a component had a sample other than zero since the last restart */
     /* after a light change: the history before it, and per tile what new samples say of it */
@@ -84,7 +89,10 @@ display *display_create(int width, int height, int threads, char *err, size_t er
         d->count[c] = malloc(sizeof(float) * n);
         d->variance[c] = malloc(sizeof(float) * n);
         d->out[c] = malloc(sizeof(float) * 3 * n);
-        ok = d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c];
+        d->out_count[c] = malloc(sizeof(float) * n);
+        d->take[c] = malloc(sizeof(float) * n);
+        ok = d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c] && d->out_count[c] &&
+             d->take[c];
     }
     if (ok) ok = (d->sink.stamp = calloc(n, sizeof(uint32_t))) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
@@ -116,6 +124,8 @@ void display_destroy(display *d) {
         free(d->count[c]);
         free(d->variance[c]);
         free(d->out[c]);
+        free(d->out_count[c]);
+        free(d->take[c]);
     }
     free(d->sink.stamp);
     free(d);
@@ -351,6 +361,8 @@ void display_change_view(display *d, const scene *s, const camera *cam, unsigned
     uint64_t t0 = clock_ns();
     int prev = d->cur, next = 1 - d->cur;
     gbuffer_trace(&d->g[next], s, cam, d->pool);
+    uint64_t t1 = clock_ns();
+    d->st.gbuffer_ms = 1e-6 * (double)(t1 - t0);
     if (!d->have_view) change |= DISPLAY_RESTART;
     if (d->judging && (change & DISPLAY_RESTART)) {
         memset(d->stale, 0, (size_t)d->width * (size_t)d->height * sizeof *d->stale);
@@ -420,6 +432,7 @@ typedef struct {
     int filtered;
     float *rgb;
     atomic_llong samples; /* the direct light's, over all pixels: how young the image is */
+    atomic_llong holes;   /* pixels with no sample of a component shown */
 } resolve_job;
 
 /* Component c of pixel i's history as shown: its own, or, while a light change is judged and the
@@ -445,9 +458,11 @@ static void split_row(void *ctx, int y, int worker) {
     resolve_job *j = ctx;
     display *d = j->d;
     double samples = 0.0;
+    long long holes = 0;
     for (int x = 0; x < d->width; x++) {
         size_t i = (size_t)y * (size_t)d->width + (size_t)x;
         samples += (double)d->h[d->cur][i].c[COMP_DIRECT].count;
+        int hole = 0;
         for (int c = 0; c < COMP_COUNT; c++) {
             if (!(j->mask >> c & 1u)) continue;
             float count = 0.0f, m2 = 0.0f;
@@ -457,11 +472,70 @@ static void split_row(void *ctx, int y, int worker) {
             float l = luminance3(v3(m[0], m[1], m[2]));
             for (int e = 0; e < 3; e++) d->light[c][3 * i + (size_t)e] = m[e];
             d->count[c][i] = count;
+            hole |= !(count > 0.0f);
             /* the moments give the population variance; the filter wants the unbiased one */
             d->variance[c][i] = count > 1.0f ? fmaxf(m2 - l * l, 0.0f) * count / (count - 1.0f) : 0.0f;
         }
+        holes += hole;
     }
     atomic_fetch_add(&j->samples, (long long)samples);
+    atomic_fetch_add(&j->holes, holes);
+}
+
+/* The filter's squared bias at pixel i, component c, as far as it shows against the pixel's own mean:
+ * E[(f - x)^2] = b^2 + var x - var f, the filter's value f taking the pixel's own x with weight about
+ * var f / var x. One sample of it; -1 where it cannot be had (no variance of its own yet). */
+static float bias_sample(const display *d, int c, size_t i) {
+    float n = d->count[c][i], s2 = d->variance[c][i];
+    if (!(n >= 2.0f)) return -1.0f;
+    const float *x = d->light[c] + 3 * i, *f = d->out[c] + 3 * i;
+    float diff = luminance3(v3(f[0] - x[0], f[1] - x[1], f[2] - x[2]));
+    float nf = fmaxf(d->out_count[c][i], n);
+    return diff * diff - s2 / n + s2 / nf;
+}
+
+/* How much of the filtered value each pixel takes: the mix of its own mean x (unbiased, variance
+ * v_x) and the filter's f (variance v_f, bias b) with the least expected squared error, v_x / (v_x +
+ * v_f + b^2), b^2 estimated from (f - x)^2 over the pixel's 3x3 neighbours on the same surface. A
+ * noisy pixel takes the filter; a converged one, or one where the filter blurs a feature its own
+ * samples resolve, keeps its own mean: the filter fades out as the image converges, pixel by pixel.
+ * A pixel without a variance of its own yet (fewer than two samples) takes the filter. */
+static void weigh_row(void *ctx, int y, int worker) {
+    (void)worker;
+    resolve_job *j = ctx;
+    display *d = j->d;
+    const gbuffer *g = &d->g[d->cur];
+    int w = d->width, h = d->height;
+    for (int x = 0; x < w; x++) {
+        size_t i = (size_t)y * (size_t)w + (size_t)x;
+        for (int c = 0; c < COMP_COUNT; c++) {
+            if (!(j->mask >> c & 1u)) continue;
+            float n = d->count[c][i], s2 = d->variance[c][i];
+            if (!(n >= 2.0f)) {
+                d->take[c][i] = 1.0f;
+                continue;
+            }
+            float b2 = 0.0f, s2_local = 0.0f;
+            int m = 0;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    int qx = x + dx, qy = y + dy;
+                    if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+                    size_t q = (size_t)qy * (size_t)w + (size_t)qx;
+                    if (g->material[q] != g->material[i]) continue;
+                    float e = bias_sample(d, c, q);
+                    if (e < -0.5f) continue;
+                    b2 += e, s2_local += d->variance[c][q], m++;
+                }
+            b2 = m ? fmaxf(b2 / (float)m, 0.0f) : 0.0f;
+            /* one pixel's variance from a few samples misses the rare bright ones: its surface's
+             * around it is steadier */
+            s2 = m ? fmaxf(s2, s2_local / (float)m) : s2;
+            float vx = s2 / n, vf = s2 / fmaxf(d->out_count[c][i], n);
+            float t = vx / (vx + vf + b2 + 1e-30f);
+            d->take[c][i] = isfinite(t) ? clampf(t, 0.0f, 1.0f) : 1.0f;
+        }
+    }
 }
 
 static void modulate_row(void *ctx, int y, int worker) {
@@ -476,9 +550,10 @@ static void modulate_row(void *ctx, int y, int worker) {
             if (!(j->mask >> c & 1u)) continue;
             float count, m2;
             const float *m;
-            if (j->filtered)
-                sum = add3(sum, get3(d->out[c], i));
-            else if ((m = shown_history(d, i, c, &count, &m2)))
+            if (j->filtered) {
+                vec3 own = get3(d->light[c], i), f = get3(d->out[c], i);
+                sum = add3(sum, madd3(own, sub3(f, own), d->take[c][i]));
+            } else if ((m = shown_history(d, i, c, &count, &m2)))
                 sum = add3(sum, v3(m[0], m[1], m[2]));
         }
         vec3 v = mul3(sum, get3(g->albedo, i));
@@ -508,10 +583,16 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
             in.count[k] = d->count[c];
             in.variance[k] = d->variance[c];
             out.light[k] = d->out[c];
+            out.count[k] = d->out_count[c];
         }
-        denoise_params p = {.levels = DENOISE_LEVELS};
+        /* a pass more for each halving of the pixels with samples, up to all five */
+        double covered = 1.0 - (double)atomic_load(&j.holes) / ((double)d->width * (double)d->height);
+        int levels = DENOISE_LEVELS;
+        for (double k = 0.5; covered < k && levels < DENOISE_MAX_LEVELS; k *= 0.5) levels++;
+        denoise_params p = {.levels = levels};
         if (in.components) denoise_run(d->dn, &in, &p, &out, d->pool);
-        d->st.levels = DENOISE_LEVELS;
+        threadpool_run(d->pool, weigh_row, &j, d->height);
+        d->st.levels = levels;
     }
     threadpool_run(d->pool, modulate_row, &j, d->height);
     d->st.resolve_ms = 1e-6 * (double)(clock_ns() - t0);

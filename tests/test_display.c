@@ -361,6 +361,63 @@ static void check_light_judgement(void) {
     scene_destroy(s);
 }
 
+/* The filter as shown: an image whose pixels have no noise (three samples each, all the same, a
+ * step of light across the plane) comes back as its own means, though the filter, seeing so few
+ * samples, takes the step for noise; a noisy flat one comes back nearer its truth than its own
+ * means are. */
+static void check_filter_fades(void) {
+    scene *s = plane_scene(0, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    const sample_sink *sk = display_sink(d);
+    const gbuffer *g = display_gbuffer(d);
+    for (int k = 0; k < 3; k++) {
+        for (int i = 0; i < W * H; i++) {
+            float v = g->pos[3 * i] > 0.0f ? 4.0f : 1.0f; /* a step at x = 0 */
+            for (int c = 0; c < COMP_COUNT; c++)
+                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = c == COMP_DIRECT ? v * g->albedo[3 * i + e] : 0.0f;
+            sk->stamp[i] = sk->serial;
+        }
+        display_take_samples(d);
+    }
+    float *raw = malloc(sizeof(float) * 3 * W * H), *shown = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, COMP_MASK_ALL, 0, raw);
+    display_resolve(d, COMP_MASK_ALL, 1, shown);
+    double worst = 0.0;
+    for (int i = 0; i < 3 * W * H; i++) worst = fmax(worst, fabs(shown[i] - raw[i]) / fmax(raw[i], 1e-6));
+    CHECK(worst < 1e-5, "a noiseless step comes back as it is (worst relative change %g)", worst);
+    /* noisy and flat: 3 samples of 1 +- 0.5 */
+    display_change_view(d, s, &a, DISPLAY_RESTART);
+    rng_state rng = rng_for(3, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        for (int i = 0; i < W * H; i++) {
+            float v = 0.5f + rng_float(&rng);
+            for (int c = 0; c < COMP_COUNT; c++)
+                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = c == COMP_DIRECT ? v * g->albedo[3 * i + e] : 0.0f;
+            sk->stamp[i] = sk->serial;
+        }
+        display_take_samples(d);
+    }
+    display_resolve(d, COMP_MASK_ALL, 0, raw);
+    display_resolve(d, COMP_MASK_ALL, 1, shown);
+    double e_raw = 0.0, e_shown = 0.0;
+    for (int i = 0; i < W * H; i++) {
+        double truth = g->albedo[3 * i];
+        e_raw += (raw[3 * i] - truth) * (raw[3 * i] - truth);
+        e_shown += (shown[3 * i] - truth) * (shown[3 * i] - truth);
+    }
+    CHECK(e_shown < 0.25 * e_raw, "the filter takes most of a flat image's noise: squared error %g of the raw %g",
+          e_shown, e_raw);
+    free(raw);
+    free(shown);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
 int main(void) {
     check_projection();
     check_static_mean();
@@ -369,5 +426,6 @@ int main(void) {
     check_glossy_history();
     check_changes();
     check_light_judgement();
+    check_filter_fades();
     return check_exit("test_display");
 }

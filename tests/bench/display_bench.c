@@ -1,0 +1,146 @@
+/* The display pipeline headless, as the viewer's render thread drives it: each update renders one
+ * part of a frame (session_render_part) into the display's sink, the display takes the samples and
+ * resolves the image shown; the camera may orbit a little before each update. Prints, per update,
+ * what it cost (part, view change, resolve) and, given a reference of the final pose, the error of
+ * the image shown and of the film. A measurement for tuning (use a release build with tests on),
+ * not a test; the viewer itself is measured by tests/bench/viewer_display.sh.
+ *
+ * usage: display_bench [--scene S] [--method M] [--size WxH] [--parts K] [--updates N]
+ *                      [--orbit DEG --orbit-updates M] [--denoise 0|1] [--reference REF.exr]
+ *                      [--threads T] [--seed S] [--save PREFIX]
+ * The orbit turns the camera by DEG about the vertical through a point 3 m in front of it before
+ * each of the first M updates; the reference is of the pose after them. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera.h"
+#include "clock.h"
+#include "display.h"
+#include "image_io.h"
+#include "metrics.h"
+#include "session.h"
+
+static camera orbit(camera c, float degrees, float dist) {
+    vec3 target = madd3(c.position, c.forward, dist);
+    float t = degrees * PI_F / 180.0f, cs = cosf(t), sn = sinf(t);
+    vec3 d = sub3(c.position, target);
+    vec3 r = v3(cs * d.x + sn * d.z, d.y, -sn * d.x + cs * d.z);
+    return camera_look_at(add3(target, r), target, v3(0, 1, 0), c.yfov);
+}
+
+int main(int argc, char **argv) {
+    const char *scene_path = "builtin:atelier", *method = "vsl", *ref_path = NULL, *save = NULL;
+    int w = 960, h = 540, parts = 64, updates = 30, orbit_updates = 0, denoise = 1, threads = 2;
+    float orbit_deg = 0.0f;
+    uint64_t seed = 1;
+    for (int i = 1; i + 1 < argc; i += 2) {
+        const char *a = argv[i], *v = argv[i + 1];
+        if (!strcmp(a, "--scene"))
+            scene_path = v;
+        else if (!strcmp(a, "--method"))
+            method = v;
+        else if (!strcmp(a, "--size"))
+            sscanf(v, "%dx%d", &w, &h);
+        else if (!strcmp(a, "--parts"))
+            parts = atoi(v);
+        else if (!strcmp(a, "--updates"))
+            updates = atoi(v);
+        else if (!strcmp(a, "--orbit"))
+            orbit_deg = (float)atof(v);
+        else if (!strcmp(a, "--orbit-updates"))
+            orbit_updates = atoi(v);
+        else if (!strcmp(a, "--denoise"))
+            denoise = atoi(v);
+        else if (!strcmp(a, "--reference"))
+            ref_path = v;
+        else if (!strcmp(a, "--threads"))
+            threads = atoi(v);
+        else if (!strcmp(a, "--seed"))
+            seed = strtoull(v, NULL, 10);
+        else if (!strcmp(a, "--save"))
+            save = v;
+        else
+            return fprintf(stderr, "display_bench: unknown option %s\n", a), 2;
+    }
+    char err[1200];
+    scene *s = scene_load(scene_path, NULL, NULL, err, sizeof err);
+    if (!s) return fprintf(stderr, "%s\n", err), 1;
+    image_rgb ref = {0};
+    if (ref_path && image_rgb_load(ref_path, &ref, err, sizeof err) != 0) return fprintf(stderr, "%s\n", err), 1;
+    render_params p = {.width = w, .height = h, .max_depth = DEFAULT_MAX_DEPTH, .seed = seed, .threads = threads};
+    int m = method_from_name(method);
+    if (m < 0) return fprintf(stderr, "unknown method %s\n", method), 2;
+    p.method = (render_method)m;
+    camera cam = scene_camera(s, 0, (float)w / (float)h);
+    render_session *rs = session_create(s, &cam, &p, err, sizeof err);
+    display *d = rs ? display_create(w, h, threads, err, sizeof err) : NULL;
+    if (!d) return fprintf(stderr, "%s\n", err), 1;
+    session_set_sink(rs, display_sink(d));
+    display_change_view(d, s, &cam, DISPLAY_RESTART);
+    size_t n = 3 * (size_t)w * (size_t)h;
+    float *shown = malloc(sizeof(float) * n), *raw = malloc(sizeof(float) * n);
+    printf("update,seconds,part_ms,view_ms,gbuffer_ms,resolve_ms,mean_count,frames,shown_error,film_error\n");
+    uint64_t t_start = clock_ns();
+    for (int u = 0; u < updates; u++) {
+        double view_ms = 0.0, gbuffer_ms = 0.0;
+        if (u < orbit_updates) {
+            cam = orbit(cam, orbit_deg, 3.0f);
+            p.seed = seed + (uint64_t)u + 1; /* each accumulation its own random numbers, as the viewer */
+            session_set_params(rs, &p);
+            session_set_camera(rs, &cam);
+            display_change_view(d, s, &cam, DISPLAY_CAMERA);
+            display_stats ds = display_get_stats(d);
+            view_ms = ds.view_ms;
+            gbuffer_ms = ds.gbuffer_ms;
+        }
+        uint64_t t0 = clock_ns();
+        int done = 0;
+        if (session_render_part(rs, parts, &done) != 0) return fprintf(stderr, "%s\n", session_error(rs)), 1;
+        double part_ms = 1e-6 * (double)(clock_ns() - t0);
+        display_take_samples(d);
+        display_resolve(d, COMP_MASK_ALL, denoise, shown);
+        display_stats ds = display_get_stats(d);
+        double e_shown = -1.0, e_film = -1.0;
+        int at_ref = ref.rgb && ref.width == w && ref.height == h && u >= orbit_updates;
+        if (at_ref) e_shown = metric_rel_l2(shown, ref.rgb, n);
+        if (at_ref && session_frames(rs) > 0 && session_frame_parts(rs) == 0) {
+            film_resolve(session_film(rs), COMP_MASK_ALL, raw);
+            e_film = metric_rel_l2(raw, ref.rgb, n);
+        }
+        printf("%d,%.3f,%.1f,%.1f,%.1f,%.1f,%.3f,%lld,%.4f,%.4f\n", u, 1e-9 * (double)(clock_ns() - t_start), part_ms,
+               view_ms, gbuffer_ms, ds.resolve_ms, ds.mean_count, session_frames(rs), e_shown, e_film);
+        fflush(stdout);
+    }
+    if (save) { /* the last image shown and the film, with their components: PREFIX-shown.exr, PREFIX-film.exr */
+        char path[1100];
+        float *layers[2][COMP_COUNT + 1];
+        for (int k = 0; k < 2; k++)
+            for (int c = 0; c <= COMP_COUNT; c++) {
+                unsigned mask = c == COMP_COUNT ? COMP_MASK_ALL : 1u << c;
+                layers[k][c] = malloc(sizeof(float) * n);
+                if (k == 0)
+                    display_resolve(d, mask, denoise, layers[k][c]);
+                else
+                    film_resolve(session_film(rs), mask, layers[k][c]);
+            }
+        const char *names[2] = {"shown", "film"};
+        for (int k = 0; k < 2; k++) {
+            snprintf(path, sizeof path, "%s-%s.exr", save, names[k]);
+            exr_layer l[COMP_COUNT + 1] = {{"", layers[k][COMP_COUNT]}};
+            for (int c = 0; c < COMP_COUNT; c++) l[c + 1] = (exr_layer){film_component_names[c], layers[k][c]};
+            if (exr_save_layers(path, w, h, l, COMP_COUNT + 1, WRITE_REPLACE, err, sizeof err) != 0)
+                fprintf(stderr, "%s\n", err);
+            for (int c = 0; c <= COMP_COUNT; c++) free(layers[k][c]);
+        }
+    }
+    free(shown);
+    free(raw);
+    image_rgb_free(&ref);
+    display_destroy(d);
+    session_destroy(rs);
+    scene_destroy(s);
+    return 0;
+}
