@@ -10,6 +10,7 @@
 #include "camera.h"
 #include "cli.h"
 #include "commands.h"
+#include "display.h"
 #include "film.h"
 #include "highlights.h"
 #include "image_io.h"
@@ -34,6 +35,7 @@ typedef struct {
     long long spp_total; /* a shard's: the whole render's --spp (spp is the shard's share) */
     double exposure;
     int quiet;
+    int denoise; /* --denoise: the display's filtered image as an extra layer */
 } render_options;
 
 #define DEFAULT_SPP 64
@@ -72,6 +74,8 @@ static void print_render_help(void) {
            "  --shard I/N          render shard I (from 0) of N: its share of the frames of the\n"
            "                       render --spp asks for, in a row, with the moments glint merge\n"
            "                       needs, to --out\n"
+           "  --denoise            also the image the viewer would show, filtered (denoise.h), as the\n"
+           "                       EXR's layer denoised.*: a view of the estimate, never in its place\n"
            "  --highlights-layer   camera-glossy-glossy-light paths (the highlight estimator's share)\n"
            "                       go to their own highlights.* layer, not indirect.*: pt, vsl+hl\n"
            "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
@@ -176,6 +180,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
     render_params *p = &o->params;
     const cli_opt opts[] = {
         {.name = "--quiet", .kind = CLI_FLAG, .out = &o->quiet},
+        {.name = "--denoise", .kind = CLI_FLAG, .out = &o->denoise},
         {.name = "--highlights-layer", .kind = CLI_FLAG, .out = &p->pt_highlights},
         {.name = "--method", .kind = CLI_METHOD, .out = &p->method},
         {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000, .given = &spp_given},
@@ -222,6 +227,9 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         return cli_error("%s: --out writes OpenEXR: name it .exr (--png writes a PNG)", o->out_exr), -1;
     if (o->out_png && !has_suffix(o->out_png, ".png"))
         return cli_error("%s: --png writes a PNG: name it .png (--out writes OpenEXR)", o->out_png), -1;
+    if (o->denoise && !o->out_exr) return cli_error("--denoise: the filtered image is a layer of --out FILE.exr"), -1;
+    if (o->denoise && o->shard)
+        return cli_error("--denoise: a shard is part of a render; filter the merged reference's render instead"), -1;
     if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
     if (o->shard) return parse_shard(o);
     return 0;
@@ -365,8 +373,9 @@ static char *describe_reference(const render_options *o, const render_session *r
     return json;
 }
 
+/* denoised: --denoise's image (NULL without), the layer denoised.* after the film's. */
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, const camera *cam,
-                         int cam_index, double seconds, reference_noise *rn, size_t clamped) {
+                         int cam_index, double seconds, reference_noise *rn, size_t clamped, const float *denoised) {
     const film *fm = session_film(rs);
     char err[1024];
     const unsigned layers = exr_layers(o);
@@ -374,7 +383,9 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
         char *json = describe_reference(o, rs, s, cam, cam_index, seconds, rn);
         if (!json) return -1;
         exr_text_attr attr = {REFERENCE_ATTR, json};
-        int st = film_save_exr_attrs(fm, layers, o->out_exr, &attr, 1, WRITE_REPLACE, err, sizeof err);
+        exr_layer extra = {"denoised", denoised};
+        int st = film_save_exr_extra(fm, layers, o->out_exr, &attr, 1, &extra, denoised ? 1 : 0, WRITE_REPLACE, err,
+                                     sizeof err);
         free(json);
         if (st != 0) {
             cli_error("%s", err);
@@ -502,6 +513,22 @@ int cmd_render(int argc, char **argv) {
         return EXIT_FAILURE_;
     }
 
+    /* --denoise: the display takes every frame's samples as the viewer's does, and filters at the end */
+    display *disp = NULL;
+    float *denoised = NULL;
+    if (o.denoise) {
+        disp = display_create(p.width, p.height, p.threads, err, sizeof err);
+        denoised = disp ? malloc(sizeof(float) * 3 * (size_t)p.width * (size_t)p.height) : NULL;
+        if (!denoised) {
+            cli_error("--denoise: %s", disp ? "out of memory" : err);
+            display_destroy(disp);
+            session_destroy(rs);
+            scene_destroy(s);
+            return EXIT_FAILURE_;
+        }
+        session_set_sink(rs, display_sink(disp));
+        display_change_view(disp, s, &cam, DISPLAY_RESTART);
+    }
     /* Only a reference (an EXR) pays for the noise estimate's snapshots. */
     reference_noise rn = {0};
     if (o.out_exr && reference_noise_init(&rn, p.width, p.height) != 0)
@@ -509,15 +536,14 @@ int cmd_render(int argc, char **argv) {
     progress pg = {!o.quiet, isatty(STDERR_FILENO), cli_now(), 0.0};
     pg.last = pg.start;
     double elapsed = 0.0;
+    int status = -1;
     for (long long frame = 0;; frame++) {
         if (o.spp > 0 ? frame >= o.spp : (frame > 0 && elapsed >= o.seconds)) break;
         if (session_render_frame(rs) != 0) {
             cli_error("%s: %s", s->path, session_error(rs));
-            reference_noise_deinit(&rn);
-            session_destroy(rs);
-            scene_destroy(s);
-            return EXIT_FAILURE_;
+            goto done;
         }
+        if (disp) display_take_samples(disp);
         double now = cli_now();
         elapsed = now - pg.start;
         reference_noise_frame(&rn, rs);
@@ -528,10 +554,14 @@ int cmd_render(int argc, char **argv) {
     if (st.rejected_samples) cli_warning("%llu NaN/Inf samples were rejected", (unsigned long long)st.rejected_samples);
     size_t clamped = film_count_clamped(session_film(rs), exr_layers(&o));
     if (clamped) cli_warning("%zu pixel values beyond float's range were written as the largest float", clamped);
+    if (disp) display_resolve(disp, COMP_MASK_ALL, 1, denoised);
 
-    int status = write_outputs(&o, rs, s, &cam, cam_index, elapsed, &rn, clamped);
+    status = write_outputs(&o, rs, s, &cam, cam_index, elapsed, &rn, clamped, denoised);
+done:
     reference_noise_deinit(&rn);
     session_destroy(rs);
+    display_destroy(disp);
+    free(denoised);
     scene_destroy(s);
     return status == 0 ? EXIT_OK : EXIT_FAILURE_;
 }

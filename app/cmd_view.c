@@ -22,6 +22,7 @@ typedef struct {
     const char *reference_path;
     long long spp;  /* refinement stops here; 0: never */
     double seconds; /* ...or after this long; 0: never */
+    int no_denoise; /* the image shown unfiltered */
 } view_options;
 
 static void print_view_help(void) {
@@ -41,6 +42,8 @@ static void print_view_help(void) {
            "  --seed S             random seed [0]\n"
            "  --exposure STOPS     display exposure [0]\n"
            "  --tonemap NAME       display tone mapper: reinhard, clamp, exponential [reinhard]\n"
+           "  --denoise on|off     filter the image shown while it is young (N toggles it; the\n"
+           "                       estimate, exports and the error are never filtered) [on]\n"
            "  --reference FILE.exr an image of the render's size: error view and plot\n"
            "  --spp N              stop refining at N samples per pixel (frames) [never]\n"
            "  --time SECONDS       stop refining after this long [never]\n"
@@ -84,6 +87,11 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0 ||
                    (r = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
             if (r < 0) return -1;
+        } else if (strcmp(a, "--denoise") == 0) {
+            if (!(v = cli_value(argc, argv, &i))) return -1;
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                return cli_error("--denoise: on or off, not '%s'", v), -1;
+            o->no_denoise = strcmp(v, "off") == 0;
         } else if (strcmp(a, "--tonemap") == 0) {
             if (!(v = cli_value(argc, argv, &i))) return -1;
             if ((o->tonemap = tonemap_from_name(v)) < 0)
@@ -179,6 +187,7 @@ int cmd_view(int argc, char **argv) {
                           .tonemap = o.tonemap,
                           .show = UI_SHOW_ALL,
                           .show_panel = 1,
+                          .denoise = !o.no_denoise,
                           .spp_limit = o.spp,
                           .time_limit = o.seconds,
                           .variant = u.info.variant};
@@ -198,6 +207,7 @@ int cmd_view(int argc, char **argv) {
     reset_view(&u);
     sh.cam = ctl_camera(&u.cam);
     sh.params = o.params;
+    sh.denoise = u.ctl.denoise;
     sh.render_w = fw > 0 ? fw : o.width;
     sh.render_h = fh > 0 ? fh : o.height;
     snprintf(sh.env_now, sizeof sh.env_now, "%s", o.env_path ? o.env_path : "");
@@ -245,6 +255,11 @@ int cmd_view(int argc, char **argv) {
     }
 
     render_thread_stop(rt);
+    if (o.script_path) { /* what the render thread did up to the end, for tests: counts, not times */
+        printf("exit frames_total=%llu late_parts=%llu\n", (unsigned long long)sh.stats.frames_total,
+               sh.stats.late_parts);
+        fflush(stdout);
+    }
     capture_finish(&u);
     if (u.texture) {
         GLuint t = u.texture;

@@ -1,17 +1,19 @@
 /* glint view: the interactive viewer's internals, shared by its files (not a public interface).
  *
- * Two threads, and a third for loading. The render thread (view_render.c) owns the scene and the
- * render sessions: it renders frame after frame, applies requested changes between frames, and
- * publishes each resolved image by swapping buffers under a lock held only for the swap. The
+ * Two threads, and a third for loading. The render thread (view_render.c) owns the scene, the
+ * render session and the display pipeline: it renders update after update (each a part of a
+ * frame), applies requested changes between updates, and publishes each image shown by swapping
+ * buffers under a lock held only for the swap. The
  * loader reads the scenes and maps asked for while frames go on; the render thread puts them in
  * place between frames. The UI thread owns the
  * window: it handles input (view_input.c, view_camera.c) and scripts (view_script_run.c),
  * tone-maps and draws the newest image with the panel (view_display.c), and never waits for a
  * frame. The two meet only in shared_state, under its lock.
  *
- * While the camera moves, frames come from a preview session at a fraction of the resolution
- * (coarser while its frames are slow) so the image follows the input; once things rest, the
- * full-resolution session accumulates.
+ * Every image is at the full resolution: an update renders part of the pixels (as few as keep it
+ * near a tenth of a second), and the display (renderer/display.h) carries what earlier updates and
+ * views left over camera and light changes and filters it. The film behind it, what exports and
+ * the error against a reference read, is the estimate glint render makes.
  *
  * Lights are edited the same way: the UI keeps the wanted offset and intensity of every light and
  * sends them with each change; the render thread applies the difference to the scene between
@@ -56,12 +58,13 @@ typedef struct {
 typedef struct {
     float *rgb;
     int width, height;
-    int preview;
-    int full_w, full_h;  /* the render size it belongs to (a preview's is larger than its own) */
+    int full_w, full_h;  /* the render size it belongs to */
     uint64_t generation; /* the request generation it shows */
     camera cam;
     light_edits lights;
-    long long frames;    /* full-resolution frames in it (0 for a preview) */
+    long long frames;    /* frames of the film behind it (the display adds what came before) */
+    uint64_t seed;       /* the film's random seed (each accumulation its own) */
+    int denoise;         /* resolved with the display's filter on */
     double published_at; /* cli_now() */
 } image_buf;
 
@@ -84,11 +87,21 @@ typedef struct {
  * copies them as a whole with each image it takes. */
 typedef struct {
     uint64_t frames_generation; /* the request generation those frames show */
-    long long frames;           /* full-resolution frames since the last reset */
-    uint64_t frames_total;      /* full-resolution frames ever */
+    long long frames;           /* whole frames since the last reset */
+    uint64_t frames_total;      /* whole frames ever */
     uint64_t resets;
     double reset_at, frame_ms, rays_per_second;
-    double full_frame_ms; /* the last full-resolution frame's time */
+    double full_frame_ms;       /* a whole frame's rendering time with these settings, from its parts */
+    uint64_t updates;           /* images published, ever */
+    int parts, parts_done;      /* the frame under way: its parts and those done (0: between frames) */
+    double part_ms;             /* the last update's part */
+    double view_ms, resolve_ms; /* the display's last view change (G-buffer, reprojection), resolve */
+    double mean_count;          /* samples behind the average pixel shown */
+    long long carried, lost;    /* pixels the last view change carried over, and lost */
+    int denoised;               /* the last image was filtered */
+    double shown_error;         /* the image shown against the reference (the whole image) */
+    double shown_error_at;      /* ... and its seconds since the reset */
+    uint64_t shown_error_serial, shown_error_resets;
     unsigned long long rejected;
     unsigned long long virtual_lights;
     char plan[1200]; /* the full-resolution session's effect plan, one pass a line */
@@ -98,9 +111,12 @@ typedef struct {
     double rel_error;                       /* the last full-resolution frame's against the reference */
     double rel_error_at;                    /* ... and its seconds since the reset */
     uint64_t rel_error_serial, rel_error_resets;
-    uint64_t preview_frames; /* reduced-resolution frames published, ever */
-    int error_paused;        /* the last full frame was not from the reference's camera: no error */
-    int standing;            /* refinement held and no frame in flight: the image stands still */
+    /* parts that ran to their end though a request (a change, a load, quit) came while they
+     * rendered: each request waits for at most the part in flight, and that only when the abort
+     * flag did not stop it (a count tests can trust, where a time would depend on the machine) */
+    unsigned long long late_parts;
+    int error_paused; /* the last update was not from the reference's camera (or lights): no error */
+    int standing;     /* refinement held: the image stands still */
 } view_stats;
 
 /* Everything the two threads hand each other; every field under lock except abort_frame. */
@@ -110,8 +126,11 @@ typedef struct {
     camera cam;
     render_params params;
     uint64_t generation; /* bumped by every change that resets the accumulation */
+    uint64_t requests;   /* bumped by every change, load read and quit: what the render thread owes */
     double changed_at;   /* when the last such change happened (cli_now) */
+    /* how the image is shown: never a reset */
     unsigned show_mask;
+    int denoise;            /* the display's filter (denoise.h) on */
     int render_w, render_h; /* requested full resolution */
     char export_path[1024];
     int export_pending;
@@ -124,11 +143,10 @@ typedef struct {
     light_edits lights;      /* wanted */
     image_rgb reference_new; /* a new reference for the error, handed over (the render thread frees it) */
     int reference_pending;
-    /* Set by the UI thread with every change that resets the accumulation, cleared by the render
-     * thread when it takes the change: a full-resolution frame in flight stops at its next tile,
-     * so a slow frame never holds up the first preview of a new view. */
+    /* Set when the viewer quits: the part in flight stops at its next chunk of pixels. A change
+     * does not stop it: a part is short, and its samples, of the view before, are the display's
+     * to carry over. */
     atomic_int abort_frame;
-    atomic_int abort_preview; /* set on quit alone: a preview frame in flight stops too */
     /* The reference's camera (when its description gives one): frames from elsewhere are not
      * measured against it, so the error plot pauses while the view is away. */
     int reference_cam_valid;
@@ -199,7 +217,9 @@ typedef struct {
 typedef struct {
     char label[96];
     int n;
-    float seconds[MAX_CURVE_POINTS], error[MAX_CURVE_POINTS];
+    float seconds[MAX_CURVE_POINTS], error[MAX_CURVE_POINTS]; /* the estimate's */
+    int shown_n;
+    float shown_seconds[MAX_CURVE_POINTS], shown_error[MAX_CURVE_POINTS]; /* the image shown's */
 } error_curve;
 
 typedef struct {
@@ -223,8 +243,7 @@ typedef struct {
      * unknown), and the generation of that change (full frames from it on measure the new ones). */
     double cost_before_ms;
     uint64_t cost_generation;
-    double step_ms;           /* from the last change sent to its first image taken here; < 0: none yet */
-    int preview_w, preview_h; /* the last preview frame's size */
+    double step_ms; /* from the last change sent to its first image taken here; < 0: none yet */
     double started_at;
     light_edits lights; /* the wanted offset and intensity of each, sent with every change */
     char light_labels[MAX_LIGHT_GROUPS][96];
@@ -239,7 +258,7 @@ typedef struct {
     /* the reference image and the error against it */
     image_rgb reference;
     char reference_path[1024];
-    double rel_error;
+    double rel_error, shown_error; /* the last measured, of the estimate and of the image shown */
     uint64_t curve_resets;
     error_curve curves[MAX_CURVES];
     int num_curves, current_curve;

@@ -54,7 +54,7 @@ int load_reference(ui_thread *u, const char *path) {
     reference_info info;
     char why[1200];
     u->reference_noise = reference_load(path, &info, why, sizeof why) == 0 && info.has_noise ? info.rel_l2_noise : -1.0;
-    u->rel_error = -1.0;
+    u->rel_error = u->shown_error = -1.0;
     u->num_curves = 0; /* errors against another image do not compare */
     u->current_curve = -1;
     u->need_tonemap = 1;
@@ -72,9 +72,10 @@ static void curve_label(const ui_thread *u, char *out, size_t n) {
         snprintf(out + len, n - (size_t)len, ", N %d, K %d", c->vl.secondary_rays, c->vl.clusters);
 }
 
-/* A new error measurement. A new accumulation starts its curve afresh, replacing an earlier one of
- * the same settings, so switching between methods leaves one curve for each side by side. */
-static void add_error_point(ui_thread *u, double seconds, double error, uint64_t resets) {
+/* A new error measurement, of the estimate or (shown) of the image shown. A new accumulation starts
+ * its curve afresh, replacing an earlier one of the same settings, so switching between methods
+ * leaves one curve for each side by side. */
+static void add_error_point(ui_thread *u, double seconds, double error, uint64_t resets, int shown) {
     if (u->current_curve < 0 || resets != u->curve_resets) {
         char label[96];
         curve_label(u, label, sizeof label);
@@ -88,22 +89,27 @@ static void add_error_point(ui_thread *u, double seconds, double error, uint64_t
             c = u->num_curves++;
         }
         snprintf(u->curves[c].label, sizeof u->curves[c].label, "%s", label);
-        u->curves[c].n = 0;
+        u->curves[c].n = u->curves[c].shown_n = 0;
         u->current_curve = c;
         u->curve_resets = resets;
     }
     error_curve *k = &u->curves[u->current_curve];
-    if (k->n == MAX_CURVE_POINTS) { /* keep the whole time span at half the density */
+    int *n = shown ? &k->shown_n : &k->n;
+    float *t = shown ? k->shown_seconds : k->seconds, *e = shown ? k->shown_error : k->error;
+    if (*n == MAX_CURVE_POINTS) { /* keep the whole time span at half the density */
         for (int i = 0; i < MAX_CURVE_POINTS / 2; i++) {
-            k->seconds[i] = k->seconds[2 * i + 1];
-            k->error[i] = k->error[2 * i + 1];
+            t[i] = t[2 * i + 1];
+            e[i] = e[2 * i + 1];
         }
-        k->n = MAX_CURVE_POINTS / 2;
+        *n = MAX_CURVE_POINTS / 2;
     }
-    k->seconds[k->n] = (float)seconds;
-    k->error[k->n] = (float)error;
-    k->n++;
-    u->rel_error = error;
+    t[*n] = (float)seconds;
+    e[*n] = (float)error;
+    (*n)++;
+    if (shown)
+        u->shown_error = error;
+    else
+        u->rel_error = error;
 }
 
 /* Per-pixel relative error |I - R| / (|R| + eps) as colours on a log scale: blue 1%, green 10%,
@@ -141,12 +147,12 @@ int fetch_published(ui_thread *u) {
         fresh = 1;
         if (u->step_ms < 0.0 && u->front.generation == u->sent_generation) /* the change's first image */
             u->step_ms = 1e3 * seconds_since(u->sent_at);
-        if (u->front.preview) u->preview_w = u->front.width, u->preview_h = u->front.height;
         u->images_shown++;
-        u->images_full += !u->front.preview;
+        u->images_full++; /* every image is at the render's full size */
         u->image_pixels += (unsigned long long)u->front.width * (unsigned long long)u->front.height;
     }
     int new_error = sh->stats.rel_error_serial != u->stats.rel_error_serial;
+    int new_shown = sh->stats.shown_error_serial != u->stats.shown_error_serial;
     u->stats = sh->stats;
     if (sh->message_serial != u->message_serial) {
         snprintf(u->message, sizeof u->message, "%s", sh->message);
@@ -159,7 +165,9 @@ int fetch_published(ui_thread *u) {
     }
     pthread_mutex_unlock(&sh->lock);
     if (new_error && u->reference.rgb)
-        add_error_point(u, u->stats.rel_error_at, u->stats.rel_error, u->stats.rel_error_resets);
+        add_error_point(u, u->stats.rel_error_at, u->stats.rel_error, u->stats.rel_error_resets, 0);
+    if (new_shown && u->reference.rgb)
+        add_error_point(u, u->stats.shown_error_at, u->stats.shown_error, u->stats.shown_error_resets, 1);
     if (new_info) { /* a new scene: its own view (not for another variant of it), lights and bookmarks */
         if (!u->info.kept_view) {
             u->ctl.camera = -1;
@@ -176,7 +184,7 @@ int fetch_published(ui_thread *u) {
 /* ---- the image and the panel ----------------------------------------------------------------- */
 
 /* The texture the image is drawn from; black until the first image (it has no storage yet).
- * Linear filtering: a preview is magnified smoothly, not in blocks. */
+ * Linear filtering: an image shown in a place of another size is scaled smoothly. */
 static void make_texture(ui_thread *u) {
     if (u->texture) return;
     GLuint t;
@@ -202,7 +210,7 @@ void tonemap_and_upload(ui_thread *u) {
     const image_rgb *ref = &u->reference;
     if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
         false_colour_error(u->front.rgb, ref->rgb, w * h, u->pixels);
-    } else { /* also the preview while moving in the error view: it has another size */
+    } else { /* also an image of another size than the reference's */
         tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f, (tonemap_op)u->ctl.tonemap};
         tonemap_apply(u->front.rgb, w * h, &tp, u->pixels);
     }
@@ -334,7 +342,7 @@ static char *describe_capture(ui_thread *u, const image_buf *im) {
     snprintf(info.method, sizeof info.method, "%s", method_name(p->method));
     reference_params_text(p, info.params, sizeof info.params);
     info.max_depth = p->max_depth > 0 ? p->max_depth : DEFAULT_MAX_DEPTH;
-    info.seed = p->seed;
+    info.seed = im->seed; /* the film's own: each accumulation draws its own random numbers */
     info.threads = p->threads;
     info.spp = im->frames;
     double now = cli_now();
@@ -343,7 +351,7 @@ static char *describe_capture(ui_thread *u, const image_buf *im) {
     info.seconds = info.since_change;
     info.since_start = now - u->started_at;
     info.image_age = now - im->published_at;
-    info.preview = im->preview;
+    info.preview = 0; /* every image is at the render's size */
     info.image_width = im->width;
     info.image_height = im->height;
     info.latest = im->generation == u->sent_generation;
@@ -428,7 +436,9 @@ void capture_window(ui_thread *u, int w, int h) {
  * controls; the panel edits u->ctl in place. */
 void draw_image_and_panel(ui_thread *u) {
     for (int c = 0; c < u->num_curves; c++)
-        u->ui_curves[c] = (ui_curve){u->curves[c].label, u->curves[c].seconds, u->curves[c].error, u->curves[c].n};
+        u->ui_curves[c] =
+            (ui_curve){u->curves[c].label,         u->curves[c].seconds,     u->curves[c].error,  u->curves[c].n,
+                       u->curves[c].shown_seconds, u->curves[c].shown_error, u->curves[c].shown_n};
     describe_bookmarks(u);
     ui_stats st = {.scene_name = u->info.name,
                    .frames = u->stats.frames,
@@ -448,7 +458,10 @@ void draw_image_and_panel(ui_thread *u) {
                    .plan = u->stats.plan,
                    .width = u->front.width,
                    .height = u->front.height,
-                   .previewing = u->front.preview,
+                   .parts = u->stats.parts,
+                   .parts_done = u->stats.parts_done,
+                   .denoised = u->stats.denoised,
+                   .mean_count = u->stats.mean_count,
                    .num_cameras = u->info.num_cameras,
                    .tonemap_names = tonemap_names,
                    .num_tonemaps = TONEMAP_COUNT,
@@ -457,6 +470,7 @@ void draw_image_and_panel(ui_thread *u) {
                    .light_movable = light_movable(u, u->ctl.light),
                    .reference = u->reference.rgb ? u->reference_path : NULL,
                    .rel_error = u->rel_error,
+                   .shown_error = u->shown_error,
                    .curves = u->ui_curves,
                    .num_curves = u->num_curves,
                    .bookmarks = u->bookmarks_text,

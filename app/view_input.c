@@ -33,9 +33,9 @@ void send_change(ui_thread *u) {
     sh->lights = u->lights;
     sh->lights_scene = u->info_serial;
     u->sent_generation = ++sh->generation;
+    sh->requests++;
     sh->changed_at = u->sent_at = cli_now();
     u->step_ms = -1.0;
-    if (!sh->export_pending) atomic_store(&sh->abort_frame, 1); /* an export takes the frame as asked */
     pthread_mutex_unlock(&sh->lock);
 }
 
@@ -65,9 +65,10 @@ void apply_controls(ui_thread *u, int camera_changed) {
     if (camera_changed) send_change(u);
     if (estimator_changed) u->cost_generation = u->sent_generation;
     if (u->ctl.exposure != u->applied_ctl.exposure || u->ctl.tonemap != u->applied_ctl.tonemap) u->need_tonemap = 1;
-    if (u->ctl.show != u->applied_ctl.show) {
+    if (u->ctl.show != u->applied_ctl.show || u->ctl.denoise != u->applied_ctl.denoise) {
         pthread_mutex_lock(&u->sh->lock);
         u->sh->show_mask = show_mask_of(u->ctl.show);
+        u->sh->denoise = u->ctl.denoise;
         pthread_mutex_unlock(&u->sh->lock);
         u->need_tonemap = 1;
     }

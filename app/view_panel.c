@@ -27,6 +27,7 @@ const view_shortcut view_shortcuts[] = {
     {"ctrl+click", "select the light nearest the cursor"},
     {"ctrl+drag", "move the selected light with the cursor"},
     {"Space", "pause or resume refinement"},
+    {"N", "denoise the image shown on or off (the estimate is never filtered)"},
     {"F1 or ?", "show or hide this list"},
     {"F12", "screenshot of the image (PNG)"},
     {"F11", "export the image and its layers (EXR)"},
@@ -215,12 +216,14 @@ double view_cost_ms(const ui_thread *u) {
 
 /* ---- the panel's keys and buttons ------------------------------------------------------------ */
 
-/* Before the panel is drawn: F1 or ? (shift+/) toggles the help, Space pausing; after it, the
+/* Before the panel is drawn: F1 or ? (shift+/) toggles the help, Space pausing, N the display's
+ * filter; after it, the
  * bookmark buttons. keys_pressed holds 1 + the modifiers of each key pressed this frame. */
 static void panel_keys(ui_thread *u) {
     int slash = u->keys_pressed[GLFW_KEY_SLASH];
     if (u->keys_pressed[GLFW_KEY_F1] || (slash && ((slash - 1) & GLFW_MOD_SHIFT))) u->ctl.show_help = !u->ctl.show_help;
     if (u->keys_pressed[GLFW_KEY_SPACE]) u->ctl.paused = !u->ctl.paused;
+    if (u->keys_pressed[GLFW_KEY_N]) u->ctl.denoise = !u->ctl.denoise;
 }
 
 void panel_frame(ui_thread *u, ui_stats *st) {

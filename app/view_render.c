@@ -1,6 +1,11 @@
-/* glint view: the render thread. It owns the scene and the render sessions; between frames it takes
- * the UI's requests from the shared state, and after each frame publishes the image and its
- * statistics there (see view.h). */
+/* glint view: the render thread. It owns the scene, the render session and the display pipeline;
+ * between updates it takes the UI's requests from the shared state, and after each update publishes
+ * the image shown and its statistics there (see view.h).
+ *
+ * An update renders one part of a frame (session_render_part), as many parts to a frame as keep an
+ * update near UPDATE_MS, and the display (display.h) takes that part's samples, carries history
+ * over camera and light changes, and filters: the window shows the full resolution at every
+ * update, moving or not, and the film behind it is the estimate glint render makes. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <pthread.h>
@@ -8,15 +13,23 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "display.h"
 #include "envmap.h"
 #include "lights.h"
 #include "metrics.h"
 #include "view.h"
 
-#define PREVIEW_DIVISOR 3      /* preview resolution = full / 3 on each axis, or coarser... */
-#define PREVIEW_TARGET_MS 70.0 /* ...so that a preview frame takes about this long... */
-#define PREVIEW_MAX_DIVISOR 12 /* ...down to 80x45 at 960x540: blurred, but 10 a second on a busy machine */
-#define PREVIEW_HOLD_SECONDS 0.3
+/* An update (a part and the display's work) takes about UPDATE_MS while things move and for
+ * YOUNG_SECONDS after a change, so the image follows motion about 10 times a second; later, at
+ * rest, REST_UPDATE_MS: larger parts, less of the display's fixed cost. A new estimator's first
+ * frame, its cost unknown, comes in FIRST_PARTS parts. */
+#define UPDATE_MS 100.0
+#define REST_UPDATE_MS 200.0
+#define YOUNG_SECONDS 3.0
+#define FIRST_PARTS 64
+/* Light edits are analysed (the plan made again) once they rest this long, not at every step of a
+ * drag. */
+#define SETTLE_SECONDS 0.3
 
 /* Loads go to a thread of their own, which reads files while frames go on: only a load that
  * succeeds stops the frame in flight, so a failed one leaves the accumulation as it was. One at a
@@ -39,19 +52,26 @@ struct render_thread {
     shared_state *sh;
     pthread_t thread;
     scene *scene;
-    render_session *full, *preview;
+    render_session *session;
+    display *disp;
     image_buf back;             /* the next image, swapped with the shared one when published */
     light_edits lights_applied; /* the edits the scene has */
     image_rgb reference;        /* for the error of each frame */
-    float *combined;            /* the whole image when another part is shown */
+    float *combined;            /* the film's whole image, or the display's, for the error */
     size_t combined_len;
-    int preview_divisor;
     int scene_edited; /* lights changed since the plan was made */
     pthread_t loader;
     int loader_running;
     load_job job;
-    int full_film_partial; /* a stopped frame left samples in the full film; cleared
-                                         * by the next full frame that completes */
+    int film_partial; /* a stopped part left samples in the film; cleared by the next frame that ends */
+    /* What an update costs with the current settings (0: not measured): a frame's rendering
+     * without its set-up, the set-up a frame begins with (the virtual lights), the display's work. */
+    double frame_ms, setup_ms, display_ms;
+    uint64_t accumulations; /* begun since the thread started: each its own random numbers */
+    render_params params_applied;
+    camera cam_applied;
+    unsigned shown_mask; /* what the last image published showed */
+    int shown_denoise;
 };
 
 void shared_state_init(shared_state *sh) {
@@ -109,80 +129,40 @@ static void set_message(render_thread *rt, const char *fmt, const char *a, const
     pthread_mutex_unlock(&sh->lock);
 }
 
-/* A preview session at the full session's size / divisor. NULL with err set on failure. */
-static render_session *create_preview(render_thread *rt, int divisor, const camera *cam, const render_params *params,
-                                      char *err, size_t errlen) {
-    const render_params *fp = session_params(rt->full);
-    render_params p = *params;
-    p.width = fp->width / divisor > 0 ? fp->width / divisor : 1;
-    p.height = fp->height / divisor > 0 ? fp->height / divisor : 1;
-    /* Only quitting stops a preview frame: while things move every one must finish, or none would
-     * be shown. */
-    render_session *rs = session_create(rt->scene, cam, &p, err, errlen);
-    if (rs) session_set_abort_flag(rs, &rt->sh->abort_preview);
-    return rs;
+/* Each accumulation its own random numbers: while the camera moves every update starts one, and
+ * with one seed each would draw the same virtual lights, whose blotches the display's history would
+ * then never average away. The first keeps the seed asked for: a view never left renders exactly as
+ * glint render --seed renders it. */
+static uint64_t accumulation_seed(uint64_t seed, uint64_t k) {
+    return k == 0 ? seed : seed ^ (k * 0x9e3779b97f4a7c15ull);
 }
 
-/* (Re)creates both sessions for the current scene at w x h. Returns 0 or -1 (message set). */
+/* (Re)creates the session and the display for the current scene at w x h. Returns 0 or -1
+ * (message set). */
 static int make_sessions(render_thread *rt, int w, int h, const camera *cam, const render_params *params) {
-    session_destroy(rt->full);
-    session_destroy(rt->preview);
-    rt->full = rt->preview = NULL;
+    session_destroy(rt->session);
+    display_destroy(rt->disp);
+    rt->session = NULL;
+    rt->disp = NULL;
     render_params p = *params;
     char err[512];
     p.width = w;
     p.height = h;
-    rt->full = session_create(rt->scene, cam, &p, err, sizeof err);
-    if (rt->full) session_set_abort_flag(rt->full, &rt->sh->abort_frame);
-    rt->full_film_partial = 0; /* a new film */
-    if (rt->preview_divisor < PREVIEW_DIVISOR) rt->preview_divisor = PREVIEW_DIVISOR;
-    if (rt->full) rt->preview = create_preview(rt, rt->preview_divisor, cam, params, err, sizeof err);
-    if (!rt->full || !rt->preview) {
+    p.seed = accumulation_seed(params->seed, rt->accumulations++);
+    rt->session = session_create(rt->scene, cam, &p, err, sizeof err);
+    if (rt->session) rt->disp = display_create(w, h, p.threads, err, sizeof err);
+    if (!rt->session || !rt->disp) {
         set_message(rt, "%s%s", err, "");
         return -1;
     }
+    session_set_abort_flag(rt->session, &rt->sh->abort_frame);
+    session_set_sink(rt->session, display_sink(rt->disp));
+    display_change_view(rt->disp, rt->scene, cam, DISPLAY_RESTART);
+    rt->film_partial = 0; /* a new film */
+    rt->frame_ms = rt->setup_ms = 0.0;
+    rt->params_applied = *params;
+    rt->cam_applied = *cam;
     return 0;
-}
-
-/* The preview session at full size / d, replacing the one there is (kept when that fails). */
-static void set_preview_divisor(render_thread *rt, int d, const camera *cam, const render_params *params) {
-    if (d == rt->preview_divisor) return;
-    char err[512];
-    render_session *p = create_preview(rt, d, cam, params, err, sizeof err);
-    if (!p) return;
-    session_destroy(rt->preview);
-    rt->preview = p;
-    rt->preview_divisor = d;
-}
-
-/* The divisor whose preview frames take about PREVIEW_TARGET_MS, from a frame of frame_ms at
- * divisor d (a frame's time goes about as its pixels, 1 / d^2), within the divisors' limits. */
-static int divisor_for(int d, double frame_ms) {
-    int fit = (int)ceil((double)d * sqrt(frame_ms / PREVIEW_TARGET_MS));
-    return fit < PREVIEW_DIVISOR ? PREVIEW_DIVISOR : fit > PREVIEW_MAX_DIVISOR ? PREVIEW_MAX_DIVISOR : fit;
-}
-
-/* Coarser previews when their frames are slow (a large window, a costly method, a busy
- * machine), at once to the size that should be quick enough; finer again, a step at a time,
- * when they are quick, so the image follows motion at about 10 frames a second or more. A step
- * finer makes a frame at most 1.78 times slower (from divisor 4 to 3): 0.45 of the target
- * becomes 0.8, still under the 1.3 that coarsens. */
-static void adapt_preview(render_thread *rt, double frame_ms, const camera *cam, const render_params *params) {
-    int d = rt->preview_divisor;
-    if (frame_ms > 1.3 * PREVIEW_TARGET_MS)
-        d = divisor_for(d, frame_ms);
-    else if (frame_ms < 0.45 * PREVIEW_TARGET_MS && d > PREVIEW_DIVISOR)
-        d--;
-    set_preview_divisor(rt, d, cam, params);
-}
-
-/* After the first full frame of a state: a preview size fitted to that frame's time, so that
- * the first preview after a change comes quickly instead of after adapt_preview's steps. Only
- * coarser: previews measured at the size there is know the costs a frame has whatever its size
- * (the virtual lights' pass) better than the full frame does. */
-static void fit_preview(render_thread *rt, double frame_ms, const camera *cam, const render_params *params) {
-    int d = divisor_for(1, frame_ms);
-    if (d > rt->preview_divisor) set_preview_divisor(rt, d, cam, params);
 }
 
 /* Gives s the environment named by source (a map's path, ENV_SKY, or "" for none). The scene
@@ -248,7 +228,7 @@ static void *loader_main(void *arg) {
         pthread_mutex_lock(&sh->lock);
         j->ok = ok;
         j->done = 1;
-        if (ok && !sh->export_pending) atomic_store(&sh->abort_frame, 1); /* a change: stop the frame */
+        sh->requests++;
     }
     pthread_mutex_unlock(&sh->lock);
     return NULL;
@@ -265,11 +245,12 @@ static void load_job_free(load_job *j) {
 static void replace_scene(render_thread *rt, scene *s, const char *env, const char *path, const render_params *params,
                           const camera *keep) {
     shared_state *sh = rt->sh;
-    /* The sessions read the old scene: replace them with it. */
-    int w = session_params(rt->full)->width, h = session_params(rt->full)->height;
-    session_destroy(rt->full);
-    session_destroy(rt->preview);
-    rt->full = rt->preview = NULL;
+    /* The session and the display read the old scene: replace them with it. */
+    int w = session_params(rt->session)->width, h = session_params(rt->session)->height;
+    session_destroy(rt->session);
+    display_destroy(rt->disp);
+    rt->session = NULL;
+    rt->disp = NULL;
     pthread_rwlock_wrlock(&sh->scene_lock);
     scene_destroy(rt->scene);
     rt->scene = s;
@@ -316,11 +297,11 @@ static int finish_load(render_thread *rt, load_job *j, const camera *cam, const 
     pthread_mutex_lock(&sh->lock);
     snprintf(sh->env_now, sizeof sh->env_now, "%s", source);
     pthread_mutex_unlock(&sh->lock);
-    /* The plan depends on the map (its prefiltering, its light) */
-    if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0)
-        load_failed(rt, session_error(rt->full));
-    session_set_camera(rt->full, cam);
-    session_set_camera(rt->preview, cam);
+    /* The plan depends on the map (its prefiltering, its light); the display keeps what the map
+     * did not change. */
+    if (session_scene_changed(rt->session) != 0) load_failed(rt, session_error(rt->session));
+    session_set_camera(rt->session, cam);
+    display_change_view(rt->disp, rt->scene, cam, DISPLAY_LIGHTS);
     set_message(rt,
                 kind == LOAD_SKY      ? "uniform sky%s%s"
                 : kind == LOAD_NO_ENV ? "no environment%s%s"
@@ -351,32 +332,44 @@ static void apply_light_edits(render_thread *rt, const light_edits *wanted) {
     pthread_rwlock_unlock(&rt->sh->scene_lock);
 }
 
-/* The relative L2 error of the whole image (every component, whatever is shown) against the
- * reference; -1 without a reference of this size. shown is the image resolved with mask. */
-static double frame_error(render_thread *rt, const film *f, unsigned mask, const float *shown) {
+/* The relative L2 error of img (w x h, every component) against the reference; -1 without a
+ * reference of this size. */
+static double image_error(const render_thread *rt, const float *img, int w, int h) {
     const image_rgb *ref = &rt->reference;
-    if (!ref->rgb || ref->width != f->width || ref->height != f->height) return -1.0;
-    size_t n = 3 * (size_t)f->width * (size_t)f->height;
-    const float *img = shown;
-    if (mask != COMP_MASK_ALL) {
-        if (rt->combined_len != n) {
-            free(rt->combined);
-            rt->combined = malloc(sizeof(float) * n);
-            rt->combined_len = rt->combined ? n : 0;
-            if (!rt->combined) return -1.0;
-        }
-        film_resolve(f, COMP_MASK_ALL, rt->combined);
-        img = rt->combined;
-    }
-    return metric_rel_l2(img, ref->rgb, n);
+    if (!ref->rgb || ref->width != w || ref->height != h) return -1.0;
+    return metric_rel_l2(img, ref->rgb, 3 * (size_t)w * (size_t)h);
 }
 
-/* before: the session's statistics before the frame, so the frame's own work is the difference.
- * The film is resolved with the components shown now, not when the frame started: a frame after a
- * display change shows that change. */
-static void publish(render_thread *rt, render_session *rs, int preview, int measure, double frame_ms,
-                    const render_stats *before, uint64_t resets_seen, uint64_t gen) {
+/* The film's whole image (the estimate, every component) into rt->combined; NULL out of memory. */
+static const float *estimate_image(render_thread *rt) {
+    const film *f = session_film(rt->session);
+    size_t n = 3 * (size_t)f->width * (size_t)f->height;
+    if (rt->combined_len != n) {
+        free(rt->combined);
+        rt->combined = malloc(sizeof(float) * n);
+        rt->combined_len = rt->combined ? n : 0;
+        if (!rt->combined) return NULL;
+    }
+    film_resolve(f, COMP_MASK_ALL, rt->combined);
+    return rt->combined;
+}
+
+/* What an update did, for publish. */
+typedef struct {
+    int measure;          /* the view is the reference's: errors count */
+    int frame_done;       /* the update ended a frame */
+    int rendered;         /* it rendered a part (not only a new look at the display) */
+    double part_ms;       /* its part's time */
+    render_stats before;  /* the session's statistics before it */
+    uint64_t resets_seen; /* the accumulation it belongs to */
+    uint64_t gen;
+} update_info;
+
+/* Resolves the display with the components shown and the filter as asked, and publishes it with
+ * the update's statistics; at the end of a frame also the estimate's error. */
+static void publish(render_thread *rt, const update_info *up) {
     shared_state *sh = rt->sh;
+    render_session *rs = rt->session;
     const film *f = session_film(rs);
     if (rt->back.width != f->width || rt->back.height != f->height) {
         free(rt->back.rgb);
@@ -387,57 +380,129 @@ static void publish(render_thread *rt, render_session *rs, int preview, int meas
     }
     pthread_mutex_lock(&sh->lock);
     unsigned mask = sh->show_mask;
+    int denoise = sh->denoise;
     pthread_mutex_unlock(&sh->lock);
-    film_resolve(f, mask, rt->back.rgb);
-    rt->back.preview = preview;
-    rt->back.full_w = session_film(rt->full)->width;
-    rt->back.full_h = session_film(rt->full)->height;
-    rt->back.generation = gen;
-    rt->back.cam = *session_camera(rs); /* what its frames were rendered from, whatever asked since */
+    display_resolve(rt->disp, mask, denoise, rt->back.rgb);
+    rt->shown_mask = mask;
+    rt->shown_denoise = denoise;
+    display_stats ds = display_get_stats(rt->disp);
+    rt->back.full_w = f->width;
+    rt->back.full_h = f->height;
+    rt->back.generation = up->gen;
+    rt->back.cam = *session_camera(rs); /* what its samples were rendered from, whatever asked since */
     rt->back.lights = rt->lights_applied;
-    rt->back.frames = preview ? 0 : session_frames(rs);
+    rt->back.frames = session_frames(rs);
+    rt->back.seed = session_params(rs)->seed;
+    rt->back.denoise = denoise;
     rt->back.published_at = cli_now();
-    double rel_error = preview || !measure ? -1.0 : frame_error(rt, f, mask, rt->back.rgb);
+    /* what is shown against the reference (the whole image only: another component has none) */
+    double shown_error =
+        up->measure && mask == COMP_MASK_ALL ? image_error(rt, rt->back.rgb, f->width, f->height) : -1.0;
+    /* the estimate's, at the end of each frame */
+    double rel_error = -1.0;
+    if (up->measure && up->frame_done && rt->reference.rgb) {
+        const float *est = estimate_image(rt);
+        if (est) rel_error = image_error(rt, est, f->width, f->height);
+    }
     render_stats st = session_stats(rs);
     uint64_t rays = 0;
     for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st.rays[k];
-    double thread_ns = 1e6 * frame_ms * (double)session_params(rs)->threads;
-    double merge_share = thread_ns > 0.0 ? (double)(st.hl_merge_ns - before->hl_merge_ns) / thread_ns : 0.0;
     pthread_mutex_lock(&sh->lock);
-    if (sh->stats.resets == resets_seen) { /* drop a frame of a state already replaced */
+    if (sh->stats.resets == up->resets_seen) { /* drop an update of a state already replaced */
         image_buf t = sh->image;
         sh->image = rt->back;
         rt->back = t;
         sh->image_serial++;
-        if (!preview) {
-            sh->stats.frames_generation = gen;
-            sh->stats.frames = session_frames(rs);
-            sh->stats.frames_total++;
-        }
-        sh->stats.frame_ms = frame_ms;
+        sh->stats.frames_generation = up->gen;
+        sh->stats.frames = session_frames(rs);
+        if (up->frame_done) sh->stats.frames_total++;
+        sh->stats.updates++;
+        sh->stats.parts = session_frame_parts(rs);
+        sh->stats.parts_done = session_frame_parts_done(rs);
+        if (up->rendered) sh->stats.part_ms = up->part_ms;
+        sh->stats.view_ms = ds.view_ms;
+        sh->stats.resolve_ms = ds.resolve_ms;
+        sh->stats.mean_count = ds.mean_count;
+        sh->stats.carried = ds.carried;
+        sh->stats.lost = ds.lost;
+        sh->stats.denoised = ds.levels > 0;
+        sh->stats.frame_ms = rt->frame_ms + rt->setup_ms;
         double secs = seconds_since(sh->stats.reset_at);
-        sh->stats.rays_per_second = secs > 0.0 && !preview ? (double)rays / secs : 0.0;
+        sh->stats.rays_per_second = secs > 0.0 ? (double)rays / secs : 0.0;
         sh->stats.rejected = st.rejected_samples;
-        if (preview) sh->stats.preview_frames++;
-        if (!preview && rel_error >= 0.0) {
+        if (rel_error >= 0.0) {
             sh->stats.rel_error = rel_error;
             sh->stats.rel_error_at = secs;
             sh->stats.rel_error_resets = sh->stats.resets;
             sh->stats.rel_error_serial++;
         }
-        if (!preview) {
-            sh->stats.full_frame_ms = frame_ms;
+        if (shown_error >= 0.0) {
+            sh->stats.shown_error = shown_error;
+            sh->stats.shown_error_at = secs;
+            sh->stats.shown_error_resets = sh->stats.resets;
+            sh->stats.shown_error_serial++;
+        }
+        sh->stats.error_paused = !up->measure;
+        if (up->frame_done) {
+            sh->stats.full_frame_ms = rt->frame_ms + rt->setup_ms;
             plan_summary(session_plan(rs), sh->stats.plan, sizeof sh->stats.plan);
             sh->stats.plan_highlights = session_plan(rs)->highlights;
             sh->stats.virtual_lights = st.virtual_lights;
-            sh->stats.hl_points = st.hl_points - before->hl_points;
-            sh->stats.hl_lobes = st.hl_lobes - before->hl_lobes;
-            sh->stats.hl_merge_share = merge_share;
-            sh->stats.error_paused = !measure;
+            sh->stats.hl_points = st.hl_points;
+            sh->stats.hl_lobes = st.hl_lobes;
+            double thread_ns = 1e6 * sh->stats.full_frame_ms * (double)session_params(rs)->threads *
+                               (double)(session_frames(rs) > 0 ? session_frames(rs) : 1);
+            sh->stats.hl_merge_share = thread_ns > 0.0 ? (double)st.hl_merge_ns / thread_ns : 0.0;
         }
     }
     pthread_mutex_unlock(&sh->lock);
     glfwPostEmptyEvent(); /* the UI thread, waiting for events, takes the image now */
+}
+
+/* How many parts the next frame takes: as few as keep an update (the frame's set-up, the part, the
+ * display) within the update time of the image's age; but a part never takes less than the display's
+ * own work, so that on a slow machine (or a sanitizer's build) rendering keeps at least half the time
+ * and frames still come. */
+static int parts_for(const render_thread *rt, double age) {
+    if (!(rt->frame_ms > 0.0)) return FIRST_PARTS;
+    double budget = (age < YOUNG_SECONDS ? UPDATE_MS : REST_UPDATE_MS) - rt->display_ms - rt->setup_ms;
+    budget = fmax(fmax(budget, 0.25 * UPDATE_MS), rt->display_ms);
+    int parts = 1;
+    while (parts < SESSION_MAX_PARTS && rt->frame_ms / parts > budget) parts *= 2;
+    return parts;
+}
+
+/* Learns an update's costs: ms for its part, which began a frame of `parts` parts when `began`
+ * (then setup_ms of it was the frame's set-up). Smoothed over updates. */
+static void learn_costs(render_thread *rt, double ms, int parts, int began, double setup_ms, double display_ms) {
+    const double a = 0.3;
+    double frame = fmax(ms - (began ? setup_ms : 0.0), 0.0) * parts;
+    rt->frame_ms = rt->frame_ms > 0.0 ? (1.0 - a) * rt->frame_ms + a * frame : frame;
+    if (began) rt->setup_ms = rt->setup_ms > 0.0 ? (1.0 - a) * rt->setup_ms + a * setup_ms : setup_ms;
+    rt->display_ms = rt->display_ms > 0.0 ? (1.0 - a) * rt->display_ms + a * display_ms : display_ms;
+}
+
+/* Whether two requests render the same estimate (the panel sends its parameters with their defaults
+ * resolved; the command line's may not be). */
+static int same_estimator(const render_params *a, const render_params *b) {
+    vl_params va = vl_params_resolve(&a->vl), vb = vl_params_resolve(&b->vl);
+    return a->method == b->method && a->max_depth == b->max_depth && memcmp(&va, &vb, sizeof va) == 0;
+}
+
+static void export_film(render_thread *rt, const char *path) {
+    char err[1200];
+    /* Highlights are a layer of their own when the film has them split off (as glint render). */
+    const render_params *fp = session_params(rt->session);
+    int split = fp->pt_highlights || fp->method == METHOD_VSL_HL;
+    const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (split ? 1u << COMP_HIGHLIGHTS : 0u);
+    if (film_save_exr(session_film(rt->session), layers, path, WRITE_NO_REPLACE, err, sizeof err) != 0) {
+        cli_error("%s", err);
+        set_message(rt, "%s%s", err, "");
+    } else {
+        printf("glint: wrote %s\n", path);
+        fflush(stdout);
+        set_message(rt, "wrote %s%s", path, "");
+    }
 }
 
 static void *render_main(void *arg) {
@@ -446,31 +511,29 @@ static void *render_main(void *arg) {
     uint64_t applied = 0;
     pthread_mutex_lock(&sh->lock);
     for (;;) {
-        /* Exports and loads first: a quit right after an export request still writes it. Not
-         * while a stopped frame's samples are in the film: after the next full frame. */
-        if (sh->export_pending && !rt->full_film_partial) {
-            char path[1024], err[1200];
-            snprintf(path, sizeof path, "%s", sh->export_path);
-            sh->export_pending = 0;
+        render_session *rs = rt->session;
+        /* Exports and loads first: a quit right after an export request still writes it. The film
+         * is a mean only between frames: an export waits for the frame under way to end. */
+        if (sh->export_pending && !rt->film_partial && session_frame_parts(rs) > 0) {
+            /* the frame under way first, before any change: the export is of the view it was asked in */
             pthread_mutex_unlock(&sh->lock);
-            /* Highlights are a layer of their own when the film has them split off (as glint render). */
-            const render_params *fp = session_params(rt->full);
-            int split = fp->pt_highlights || fp->method == METHOD_VSL_HL;
-            const unsigned layers = (1u << COMP_DIRECT) | (1u << COMP_INDIRECT) | (split ? 1u << COMP_HIGHLIGHTS : 0u);
-            if (film_save_exr(session_film(rt->full), layers, path, WRITE_NO_REPLACE, err, sizeof err) != 0) {
-                cli_error("%s", err);
-                set_message(rt, "%s%s", err, "");
-            } else {
-                printf("glint: wrote %s\n", path);
-                fflush(stdout);
-                set_message(rt, "wrote %s%s", path, "");
-            }
+            if (session_render_frame(rs) == 1) rt->film_partial = 1;
+            display_take_samples(rt->disp);
             pthread_mutex_lock(&sh->lock);
             continue;
         }
-        if (sh->quit && !(sh->export_pending && rt->full_film_partial)) break;
+        if (sh->export_pending && !rt->film_partial) {
+            char path[1024];
+            snprintf(path, sizeof path, "%s", sh->export_path);
+            sh->export_pending = 0;
+            pthread_mutex_unlock(&sh->lock);
+            export_film(rt, path);
+            pthread_mutex_lock(&sh->lock);
+            continue;
+        }
+        if (sh->quit && !(sh->export_pending && !rt->film_partial)) break;
         load_job *job = &rt->job;
-        if (job->active && job->done) { /* a load read (or failed): apply it between frames */
+        if (job->active && job->done) { /* a load read (or failed): apply it between updates */
             camera cam = sh->cam;
             render_params params = sh->params;
             pthread_mutex_unlock(&sh->lock);
@@ -482,13 +545,12 @@ static void *render_main(void *arg) {
             pthread_cond_signal(&sh->load_cond); /* the loader may take the next */
             continue;
         }
-        const film *ff = session_film(rt->full);
+        const film *ff = session_film(rs);
         int resize = ff->width != sh->render_w || ff->height != sh->render_h;
         uint64_t gen = sh->generation;
-        atomic_store(&sh->abort_frame, 0); /* this change is taken: frames of it run to the end */
         camera cam = sh->cam;
         render_params params = sh->params;
-        int preview = seconds_since(sh->changed_at) < PREVIEW_HOLD_SECONDS;
+        double age = seconds_since(sh->changed_at);
         /* Measured against the reference only from its camera (when its description names one). */
         int measure = !sh->reference_cam_valid || camera_same_view(&cam, &sh->reference_cam, rt->scene->diag);
         int lights_measured = sh->reference_cam_valid; /* a described reference: its lights too */
@@ -510,54 +572,88 @@ static void *render_main(void *arg) {
             sh->stats.reset_at = cli_now();
             sh->stats.frames = 0;
         }
-        uint64_t resets_seen = sh->stats.resets;
-        int held = !preview && gen == applied && !resize && refinement_held(sh, session_frames(rt->full));
+        uint64_t resets_seen = sh->stats.resets, requests_seen = sh->requests;
+        /* Held between frames: the frame under way when the pause came runs to its end (the film,
+         * its count and what the display shows then agree). */
+        int held = gen == applied && !resize && session_frame_parts(rs) == 0 && refinement_held(sh, session_frames(rs));
+        int look_changed = sh->show_mask != rt->shown_mask || sh->denoise != rt->shown_denoise;
         sh->stats.standing = held;
         pthread_mutex_unlock(&sh->lock);
-        if (held) { /* paused, or at the spp or time limit */
+        update_info up = {.measure = measure, .resets_seen = resets_seen, .gen = gen};
+        if (held) { /* paused, or at the spp or time limit; the display may still change its look */
+            if (look_changed) publish(rt, &up);
             refinement_hold(sh);
             continue;
         }
 
-        if (edit_lights) apply_light_edits(rt, &lights);
+        unsigned change = 0;
+        if (edit_lights) {
+            light_edits before = rt->lights_applied;
+            apply_light_edits(rt, &lights);
+            if (memcmp(&before, &rt->lights_applied, sizeof before) != 0) change |= DISPLAY_LIGHTS;
+        }
         /* ...and with the lights it was rendered with */
         if (measure && lights_measured) {
             char now[sizeof reference_lights];
             light_edits_text(&rt->lights_applied, now, sizeof now);
-            measure = reference_lights_same(now, reference_lights);
+            up.measure = reference_lights_same(now, reference_lights);
         }
-        /* The scene's analysis follows light edits once they settle, not at every step of a drag. */
-        if (rt->scene_edited && !preview) {
-            if (session_scene_changed(rt->full) != 0 || session_scene_changed(rt->preview) != 0)
-                set_message(rt, "%s%s", session_error(rt->full), "");
+        /* The scene's analysis follows light edits once they settle, not at every step of a drag;
+         * it restarts the film, but the light is what it was: the display keeps its history. */
+        int restart_film = gen != applied;
+        if (rt->scene_edited && age >= SETTLE_SECONDS) {
+            if (session_scene_changed(rs) != 0) set_message(rt, "%s%s", session_error(rs), "");
             rt->scene_edited = 0;
+            restart_film = 1;
         }
         if (resize) {
             if (make_sessions(rt, rw, rh, &cam, &params) != 0) break;
+            rs = rt->session;
             applied = gen;
-        } else if (gen != applied) {
-            session_set_params(rt->full, &params);
-            session_set_params(rt->preview, &params);
-            session_set_camera(rt->full, &cam);
-            session_set_camera(rt->preview, &cam);
+        } else if (restart_film) {
+            if (!same_estimator(&params, &rt->params_applied)) change |= DISPLAY_RESTART;
+            if (memcmp(&cam, &rt->cam_applied, sizeof cam) != 0) change |= DISPLAY_CAMERA;
+            /* every accumulation its own random numbers, or the display would take the same samples twice */
+            render_params p = params;
+            p.seed = accumulation_seed(params.seed, rt->accumulations++);
+            session_set_params(rs, &p);
+            session_set_camera(rs, &cam);
+            if (change) display_change_view(rt->disp, rt->scene, &cam, change);
+            rt->params_applied = params;
+            rt->cam_applied = cam;
+            rt->film_partial = 0;                                            /* a new film */
+            if (change & DISPLAY_RESTART) rt->frame_ms = rt->setup_ms = 0.0; /* another estimator's costs */
             applied = gen;
         }
-        render_session *rs = preview ? rt->preview : rt->full;
+        int began = session_frame_parts(rs) == 0;
+        int parts = began ? parts_for(rt, age) : session_frame_parts(rs);
         render_stats before = session_stats(rs);
+        up.before = before;
         double t0 = cli_now();
-        if (session_render_frame(rs) == 1) { /* stopped for a newer change: nothing to show */
-            if (rs == rt->full) rt->full_film_partial = 1;
-            pthread_mutex_lock(&sh->lock);
-            continue;
+        int r = session_render_part(rs, parts, &up.frame_done);
+        up.part_ms = 1e3 * seconds_since(t0);
+        up.rendered = r == 0;
+        if (r == 1) rt->film_partial = 1; /* stopped for a newer change: its samples still show */
+        if (r < 0) set_message(rt, "%s%s", session_error(rs), "");
+        if (up.frame_done) rt->film_partial = 0;
+        display_take_samples(rt->disp);
+        double t1 = cli_now();
+        publish(rt, &up);
+        if (r == 0) {
+            render_stats after = session_stats(rs);
+            /* a reset in between zeroes the statistics: then the set-up is not known from them */
+            double setup =
+                after.pass_ns[PASS_VIRTUAL_LIGHTS] >= before.pass_ns[PASS_VIRTUAL_LIGHTS]
+                    ? 1e-6 * (double)(after.pass_ns[PASS_VIRTUAL_LIGHTS] - before.pass_ns[PASS_VIRTUAL_LIGHTS])
+                    : 0.0;
+            display_stats ds = display_get_stats(rt->disp);
+            learn_costs(rt, up.part_ms, parts, began, setup, 1e3 * seconds_since(t1) + (change ? ds.view_ms : 0.0));
         }
-        if (rs == rt->full) rt->full_film_partial = 0;
-        double ms = 1e3 * seconds_since(t0);
-        publish(rt, rs, preview, measure, ms, &before, resets_seen, gen);
-        if (preview)
-            adapt_preview(rt, ms, &cam, &params);
-        else if (session_frames(rt->full) == 1)
-            fit_preview(rt, ms, &cam, &params);
-        pthread_mutex_lock(&sh->lock);
+        if (r < 0)
+            refinement_hold(sh);
+        else
+            pthread_mutex_lock(&sh->lock);
+        if (r == 0 && sh->requests != requests_seen) sh->stats.late_parts++;
     }
     pthread_mutex_unlock(&sh->lock);
     return NULL;
@@ -573,20 +669,18 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
     rt->scene = s;
     sh->scene_now = s;
     clear_light_edits(&rt->lights_applied);
-    sh->stats.reset_at = cli_now(); /* the first accumulation starts now, not at the clock's origin */
-    /* Previews first, as after a change: the window shows the scene at once (a full frame can take
-     * seconds), and their times size the previews before the first move. */
-    sh->changed_at = sh->stats.reset_at;
+    sh->stats.reset_at = cli_now();      /* the first accumulation starts now, not at the clock's origin */
+    sh->changed_at = sh->stats.reset_at; /* a young image: small parts first */
     if (make_sessions(rt, sh->render_w, sh->render_h, &sh->cam, &sh->params) != 0) {
-        session_destroy(rt->full); /* before the scene they read, which stays the caller's */
-        session_destroy(rt->preview);
+        session_destroy(rt->session); /* before the scene they read, which stays the caller's */
+        display_destroy(rt->disp);
         free(rt);
         return NULL;
     }
     if (pthread_create(&rt->loader, NULL, loader_main, rt) != 0) {
         snprintf(sh->message, sizeof sh->message, "cannot start the loading thread");
-        session_destroy(rt->full);
-        session_destroy(rt->preview);
+        session_destroy(rt->session);
+        display_destroy(rt->disp);
         free(rt);
         return NULL;
     }
@@ -598,16 +692,16 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
 void render_thread_stop(render_thread *rt) {
     pthread_mutex_lock(&rt->sh->lock);
     rt->sh->quit = 1;
+    rt->sh->requests++;
     pthread_cond_broadcast(&rt->sh->load_cond);
-    /* The frame in flight stops at its next tile (unless an export waits for it). */
+    /* The part in flight stops at its next chunk (unless an export waits for it). */
     if (!rt->sh->export_pending) atomic_store(&rt->sh->abort_frame, 1);
-    atomic_store(&rt->sh->abort_preview, 1);
     pthread_mutex_unlock(&rt->sh->lock);
     pthread_join(rt->thread, NULL);
     if (rt->loader_running) pthread_join(rt->loader, NULL); /* a load under way is waited for */
     load_job_free(&rt->job);
-    session_destroy(rt->full);
-    session_destroy(rt->preview);
+    session_destroy(rt->session);
+    display_destroy(rt->disp);
     scene_destroy(rt->scene);
     free(rt->back.rgb);
     free(rt->combined);

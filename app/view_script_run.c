@@ -31,17 +31,17 @@ static void print_stats(ui_thread *u) {
     flockfile(stdout);
     printf(
         "stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
-        "rel_error=%.6g preview_frames=%llu preview_size=%dx%d time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
+        "rel_error=%.6g displayed_error=%.6g time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
         u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z,
-        (double)lx, (double)ly, tonemap_names[u->ctl.tonemap], mean, u->rel_error,
-        (unsigned long long)u->stats.preview_frames, u->preview_w, u->preview_h, seconds_since(u->started_at),
-        (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z, nb ? marks : "-");
-    printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d preview=%d exposure=%g show=%d "
+        (double)lx, (double)ly, tonemap_names[u->ctl.tonemap], mean, u->rel_error, u->shown_error,
+        seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
+        nb ? marks : "-");
+    printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d exposure=%g show=%d "
            "max_depth=%d method=%s rejected=%llu virtual_lights=%llu hl_lobes=%llu plan_highlights=%d ",
            u->info.name, frames_of_current_state(u), (unsigned long long)u->stats.frames_total,
-           (unsigned long long)u->stats.resets, u->front.width, u->front.height, u->front.preview,
-           (double)u->ctl.exposure, u->ctl.show, u->ctl.params.max_depth, method_name(u->ctl.params.method),
-           u->stats.rejected, u->stats.virtual_lights, u->stats.hl_lobes, u->stats.plan_highlights);
+           (unsigned long long)u->stats.resets, u->front.width, u->front.height, (double)u->ctl.exposure, u->ctl.show,
+           u->ctl.params.max_depth, method_name(u->ctl.params.method), u->stats.rejected, u->stats.virtual_lights,
+           u->stats.hl_lobes, u->stats.plan_highlights);
     /* The environment, and the standing notes (the panel's status line) as flags. */
     char env[1024];
     pthread_mutex_lock(&u->sh->lock);
@@ -56,6 +56,13 @@ static void print_stats(ui_thread *u) {
      * pixels in all, and the size they render at: updates a second and their resolution. */
     printf(" images=%llu images_full=%llu image_pixels=%llu render_size=%dx%d", u->images_shown, u->images_full,
            u->image_pixels, u->front.full_w, u->front.full_h);
+    /* The display: updates published, the frame under way in parts, what an update cost, how much
+     * history the last view change carried, the samples behind a pixel shown, the filter. */
+    printf(" updates=%llu parts=%d parts_done=%d part_ms=%.1f view_ms=%.1f resolve_ms=%.1f carried=%lld lost=%lld "
+           "mean_count=%.2f denoise=%d denoised=%d late_parts=%llu",
+           (unsigned long long)u->stats.updates, u->stats.parts, u->stats.parts_done, u->stats.part_ms,
+           u->stats.view_ms, u->stats.resolve_ms, u->stats.carried, u->stats.lost, u->stats.mean_count, u->ctl.denoise,
+           u->stats.denoised, u->stats.late_parts);
     print_panel_stats(u);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
@@ -121,6 +128,10 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
         if (cli_parse_int(opt, value, -1, u->info.num_cameras - 1, &n) != 0)
             return snprintf(err, errlen, "no camera %s", value), -1;
         u->ctl.camera = (int)n;
+    } else if (strcmp(name, "denoise") == 0) {
+        if (strcmp(value, "on") != 0 && strcmp(value, "off") != 0)
+            return snprintf(err, errlen, "denoise: on or off"), -1;
+        u->ctl.denoise = strcmp(value, "on") == 0;
     } else if (strcmp(name, "panel") == 0) {
         if (cli_parse_int(opt, value, 0, 1, &n) != 0) return snprintf(err, errlen, "panel: 0 or 1"), -1;
         u->ctl.show_panel = (int)n;
@@ -145,6 +156,7 @@ static int key_from_name(const char *name, int *mods) {
     if (strcmp(name, "f") == 0) return GLFW_KEY_F;
     if (strcmp(name, "c") == 0) return GLFW_KEY_C;
     if (strcmp(name, "k") == 0) return GLFW_KEY_K;
+    if (strcmp(name, "n") == 0) return GLFW_KEY_N;
     if (strcmp(name, "f1") == 0) return GLFW_KEY_F1;
     if (strcmp(name, "space") == 0) return GLFW_KEY_SPACE;
     if (strcmp(name, "slash") == 0) return GLFW_KEY_SLASH;
@@ -177,6 +189,11 @@ void run_script(ui_thread *u) {
             u->script_waiting = 0;
             break;
         case ACT_SET:
+            if (u->script_waiting) { /* `set denoise`: until an image resolved so is shown */
+                if (u->front.denoise != u->ctl.denoise) return;
+                u->script_waiting = 0;
+                break;
+            }
             if (set_parameter(u, a->name, a->text, err, sizeof err) != 0) {
                 cli_error("%s:%d: %s", u->script_path_for_errors, a->line, err);
                 u->script_errors++;
@@ -186,6 +203,10 @@ void run_script(ui_thread *u) {
                 apply_controls(u, 1);
             } else {
                 apply_controls(u, 0);
+            }
+            if (strcmp(a->name, "denoise") == 0 && u->front.denoise != u->ctl.denoise) {
+                u->script_waiting = 1;
+                return;
             }
             break;
         case ACT_ORBIT:

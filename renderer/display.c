@@ -24,7 +24,7 @@ typedef struct {
 #define DISPLAY_MAX_CARRIED 64.0f
 /* A light change sets the history aside (stale) until new samples show, tile by tile, whether
  * the light there changed: a tile of TILE_PX x TILE_PX pixels is judged once it has
- * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "Light moves"). Until then
+ * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "The display while things move"). Until then
  * stale history counts as STALE_WEIGHT samples where a pixel has no new one: it fills holes, and
  * any new sample near it outweighs it. */
 #define TILE_PX 16
@@ -146,7 +146,8 @@ typedef struct {
     pixel_history *now;
     unsigned change;
     int same_camera;
-    float footprint; /* a pixel's width per unit distance in the new view */
+    float footprint;            /* a pixel's width per unit distance in the new view */
+    gbuffer_projector old_view; /* into the old image */
     atomic_llong carried, lost;
 } carry_job;
 
@@ -179,7 +180,7 @@ static int find_taps(const carry_job *j, int x, int y, size_t taps[4], float wei
     float ox, oy;
     if (j->same_camera) {
         taps[0] = i, weights[0] = 1.0f, n = 1;
-    } else if (gbuffer_project(j->from, get3(j->to->pos, i), &ox, &oy)) {
+    } else if (gbuffer_project_with(&j->old_view, get3(j->to->pos, i), &ox, &oy)) {
         float fx = ox - 0.5f, fy = oy - 0.5f;
         int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
         float ax = fx - (float)x0, ay = fy - (float)y0;
@@ -227,7 +228,7 @@ static void carry_row(void *ctx, int y, int worker) {
         /* What survives of each component: all of its diffuse share, of its glossy share what the
          * lobe and the view's turn there allow (the highlights are all glossy). */
         float glossy = 1.0f;
-        if (!j->same_camera && to->material[i] >= 0) {
+        if (!j->same_camera && to->material[i] >= 0 && to->gloss[i] > 0.0f) {
             vec3 p = get3(to->pos, i);
             vec3 a = normalize3(sub3(j->from->cam.position, p)), b = normalize3(sub3(to->cam.position, p));
             glossy = glossy_keep(dot3(a, b), to->alpha[i]);
@@ -377,7 +378,8 @@ void display_change_view(display *d, const scene *s, const camera *cam, unsigned
                    .now = d->h[next],
                    .change = change,
                    .same_camera = memcmp(&d->g[prev].cam, cam, sizeof *cam) == 0,
-                   .footprint = 2.0f * tanf(0.5f * cam->yfov) / (float)d->height};
+                   .footprint = 2.0f * tanf(0.5f * cam->yfov) / (float)d->height,
+                   .old_view = gbuffer_projector_of(&d->g[prev])};
     threadpool_run(d->pool, carry_row, &j, d->height);
     d->cur = next;
     d->have_view = 1;

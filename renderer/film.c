@@ -193,8 +193,16 @@ int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_m
 
 int film_save_exr_attrs(const film *f, unsigned layers_mask, const char *path, const exr_text_attr *attrs,
                         int num_attrs, write_mode mode, char *err, size_t errlen) {
+    return film_save_exr_extra(f, layers_mask, path, attrs, num_attrs, NULL, 0, mode, err, errlen);
+}
+
+#define FILM_MAX_EXTRA 4
+int film_save_exr_extra(const film *f, unsigned layers_mask, const char *path, const exr_text_attr *attrs,
+                        int num_attrs, const exr_layer *extra, int num_extra, write_mode mode, char *err,
+                        size_t errlen) {
     size_t n = 3 * (size_t)f->width * (size_t)f->height;
-    enum { MAX_LAYERS = 2 * (1 + COMP_COUNT) + 1 };
+    enum { MAX_LAYERS = 2 * (1 + COMP_COUNT) + 1 + FILM_MAX_EXTRA };
+    if (num_extra < 0 || num_extra > FILM_MAX_EXTRA) return snprintf(err, errlen, "%s: too many layers", path), -1;
     float *planes[MAX_LAYERS] = {0};
     exr_layer layers[MAX_LAYERS];
     char names[COMP_COUNT + 1][64];
@@ -229,7 +237,10 @@ int film_save_exr_attrs(const film *f, unsigned layers_mask, const char *path, c
         layers[nl] = (exr_layer){MOMENTS_REJECTED, planes[nl]};
         nl++;
     }
+    int own = nl;
+    for (int i = 0; i < num_extra; i++) layers[nl++] = extra[i];
     status = exr_save_layers_attrs(path, f->width, f->height, layers, nl, attrs, num_attrs, mode, err, errlen);
+    nl = own;
 done:
     for (int i = 0; i < nl; i++) free(planes[i]);
     return status;

@@ -119,6 +119,11 @@ float srgb_encode(float linear);
 int film_save_exr(const film *f, unsigned layers_mask, const char *path, write_mode mode, char *err, size_t errlen);
 int film_save_exr_attrs(const film *f, unsigned layers_mask, const char *path, const exr_text_attr *attrs,
                         int num_attrs, write_mode mode, char *err, size_t errlen);
+/* The same with more layers of the caller's after the film's (a view of it, such as the display's
+ * filtered image: never in place of the film's own). */
+int film_save_exr_extra(const film *f, unsigned layers_mask, const char *path, const exr_text_attr *attrs,
+                        int num_attrs, const exr_layer *extra, int num_extra, write_mode mode, char *err,
+                        size_t errlen);
 int film_save_png(const film *f, unsigned mask, const tonemap_params *tp, const char *path, write_mode mode, char *err,
                   size_t errlen);
 

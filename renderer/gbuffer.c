@@ -115,13 +115,20 @@ void gbuffer_trace(gbuffer *g, const scene *s, const camera *cam, threadpool *po
     }
 }
 
-int gbuffer_project(const gbuffer *g, vec3 p, float *x, float *y) {
+gbuffer_projector gbuffer_projector_of(const gbuffer *g) {
     const camera *c = &g->cam;
-    vec3 d = sub3(p, c->position);
-    float z = dot3(d, c->forward);
-    if (!(z > 0.0f)) return 0;
     float th = tanf(0.5f * c->yfov), aspect = (float)g->width / (float)g->height;
-    *x = (dot3(d, c->right) / z + th * aspect) * (float)g->width / (2.0f * th * aspect);
-    *y = (th - dot3(d, c->up) / z) * (float)g->height / (2.0f * th);
-    return isfinite(*x) && isfinite(*y);
+    return (gbuffer_projector){c->position,
+                               c->right,
+                               c->up,
+                               c->forward,
+                               (float)g->width / (2.0f * th * aspect),
+                               (float)g->height / (2.0f * th),
+                               0.5f * (float)g->width,
+                               0.5f * (float)g->height};
+}
+
+int gbuffer_project(const gbuffer *g, vec3 p, float *x, float *y) {
+    gbuffer_projector pr = gbuffer_projector_of(g);
+    return gbuffer_project_with(&pr, p, x, y);
 }

@@ -34,8 +34,23 @@ void gbuffer_deinit(gbuffer *g);
  * are) on pool's threads (NULL: the calling thread). */
 void gbuffer_trace(gbuffer *g, const scene *s, const camera *cam, threadpool *pool);
 
-/* Where world point p lands in g's camera: image coordinates (pixel (x, y) spans [x, x + 1)), or 0
- * when p is behind the camera. */
+/* Where world points land in g's camera, set up once (gbuffer_projector) so that each point is a few
+ * multiplies: image coordinates (pixel (x, y) spans [x, x + 1)); 0 when p is behind the camera. */
+typedef struct {
+    vec3 position, right, up, forward;
+    float sx, sy;         /* pixels per unit of tangent across and up */
+    float half_w, half_h; /* the image's centre */
+} gbuffer_projector;
+gbuffer_projector gbuffer_projector_of(const gbuffer *g);
+static inline int gbuffer_project_with(const gbuffer_projector *pr, vec3 p, float *x, float *y) {
+    vec3 d = sub3(p, pr->position);
+    float z = dot3(d, pr->forward);
+    if (!(z > 0.0f)) return 0;
+    float iz = 1.0f / z;
+    *x = pr->half_w + dot3(d, pr->right) * iz * pr->sx;
+    *y = pr->half_h - dot3(d, pr->up) * iz * pr->sy;
+    return isfinite(*x) && isfinite(*y);
+}
 int gbuffer_project(const gbuffer *g, vec3 p, float *x, float *y);
 
 #endif

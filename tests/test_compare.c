@@ -3,7 +3,9 @@
  * the reference's noise taken out in quadrature; the refusals (size, scene, camera, light edits;
  * glint bench's of a reference with a light moved);
  * glint render's --camera-from (the camera of another file's description, refused without one or
- * of another scene) and --move-light / --light-gain (the edits applied, recorded, compared).
+ * of another scene) and --move-light / --light-gain (the edits applied, recorded, compared);
+ * --denoise: the filtered image a layer of its own, the estimate's layers the same pixels as
+ * without it, and nearer a long render than the estimate it filters (a young vsl image).
  * Usage: test_compare PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -57,17 +59,23 @@ static float *layer(const char *name, const char *prefix, int *w, int *h) {
 }
 
 /* ||a - b|| / ||b|| summed here, in double. */
-static double rel_l2_here(const char *a, const char *b, const char *prefix) {
+/* ... of layer pa of a against layer pb of b. */
+static double rel_l2_here_layers(const char *a, const char *pa, const char *b, const char *pb) {
     int w, h, w2, h2;
-    float *x = layer(a, prefix, &w, &h), *y = layer(b, prefix, &w2, &h2);
+    float *x = layer(a, pa, &w, &h), *y = layer(b, pb, &w2, &h2);
+    int ok = x && y && w == w2 && h == h2;
     double d = 0.0, n = 0.0;
-    for (size_t i = 0; x && y && i < 3 * (size_t)w * (size_t)h; i++) {
+    for (size_t i = 0; ok && i < 3 * (size_t)w * (size_t)h; i++) {
         d += ((double)x[i] - y[i]) * ((double)x[i] - y[i]);
         n += (double)y[i] * y[i];
     }
     free(x);
     free(y);
-    return x && y ? sqrt(d / n) : NAN;
+    return ok ? sqrt(d / n) : NAN;
+}
+
+static double rel_l2_here(const char *a, const char *b, const char *prefix) {
+    return rel_l2_here_layers(a, prefix, b, prefix);
 }
 
 /* A w x h image of value v * (1 + pixel index / 100) in every channel, no description. */
@@ -199,11 +207,39 @@ static void test_render_poses(void) {
     expect_failure("render builtin:atelier --spp 1 --light-gain 0,0 --out x.exr", 2, "1e-6 to 1e6");
 }
 
+static void test_denoise_layer(void) {
+    /* the doorway at 96x54: 2 frames of vsl, and a 256-frame pt reference */
+    const char *scene = "render builtin:doorway --size 96x54 --quiet";
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "%s --method vsl --spp 2 --seed 3 --denoise --out dn.exr", scene);
+    CHECK(run(cmd) == 0, "'%s': %s", cmd, err_text);
+    snprintf(cmd, sizeof cmd, "%s --method vsl --spp 2 --seed 3 --out raw.exr", scene);
+    CHECK(run(cmd) == 0, "'%s': %s", cmd, err_text);
+    snprintf(cmd, sizeof cmd, "%s --method pt --spp 256 --seed 9 --out long.exr", scene);
+    CHECK(run(cmd) == 0, "'%s': %s", cmd, err_text);
+    const char *layers[] = {"", "direct", "indirect"};
+    for (int k = 0; k < 3; k++)
+        CHECK(rel_l2_here("dn.exr", "raw.exr", layers[k]) == 0.0, "--denoise changed the estimate's layer '%s'",
+              layers[k]);
+    /* the errors against the truth, the long render's own noise (its description's) taken out */
+    double v[3];
+    compare("raw.exr long.exr", v);
+    double noise2 = v[1] * v[1], filtered = rel_l2_here_layers("dn.exr", "denoised", "long.exr", "");
+    double raw = rel_l2_here("raw.exr", "long.exr", "");
+    filtered = sqrt(fmax(filtered * filtered - noise2, 0.0));
+    raw = sqrt(fmax(raw * raw - noise2, 0.0));
+    CHECK(filtered < 0.85 * raw, "the denoised layer is no nearer the truth: %g against the estimate's %g", filtered,
+          raw);
+    expect_failure("render builtin:atelier --spp 1 --denoise --png x.png", 2, "--out");
+    expect_failure("render builtin:atelier --spp 4 --shard 0/2 --denoise --out x.exr", 2, "shard");
+}
+
 int main(int argc, char **argv) {
     int start = harness_start(argc, argv, "compare");
     if (start != 0) return start;
     test_numbers();
     test_refusals();
     test_render_poses();
+    test_denoise_layer();
     return check_exit("test_compare");
 }

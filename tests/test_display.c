@@ -418,6 +418,50 @@ static void check_filter_fades(void) {
     scene_destroy(s);
 }
 
+/* The display is a view of the estimate, never the estimate: a session whose frames go in parts to
+ * a display that takes, carries and filters them (a camera move in between, as the viewer makes)
+ * keeps a film equal bit for bit to one rendered in whole frames with no display at all. */
+static void check_film_untouched(void) {
+    char err[1200];
+    scene *s = scene_load("builtin:doorway", NULL, NULL, err, sizeof err);
+    CHECK(s != NULL, "builtin:doorway: %s", err);
+    if (!s) return;
+    enum { FW = 70, FH = 42, FRAMES = 2 };
+    render_params p = {.width = FW, .height = FH, .method = METHOD_VSL_HL, .max_depth = 4, .seed = 11, .threads = 2};
+    camera cam = scene_camera(s, 0, (float)FW / (float)FH), moved = cam;
+    moved.position = add3(moved.position, v3(0.05f, 0.0f, 0.0f));
+    render_session *plain = session_create(s, &cam, &p, err, sizeof err);
+    render_session *shown = session_create(s, &moved, &p, err, sizeof err);
+    display *d = display_create(FW, FH, 2, err, sizeof err);
+    CHECK(plain && shown && d, "sessions, display: %s", err);
+    if (plain && shown && d) {
+        for (int f = 0; f < FRAMES; f++) session_render_frame(plain);
+        /* the viewer's way: a view, a part, the camera back, parts until the frames are done */
+        session_set_sink(shown, display_sink(d));
+        display_change_view(d, s, &moved, DISPLAY_RESTART);
+        int done = 0;
+        session_render_part(shown, 16, &done);
+        display_take_samples(d);
+        session_set_camera(shown, &cam);
+        display_change_view(d, s, &cam, DISPLAY_CAMERA);
+        float *img = malloc(sizeof(float) * 3 * FW * FH);
+        while (session_frames(shown) < FRAMES) {
+            session_render_part(shown, 16, &done);
+            display_take_samples(d);
+            display_resolve(d, COMP_MASK_ALL, 1, img);
+        }
+        free(img);
+        const film *a = session_film(plain), *b = session_film(shown);
+        int same = a->passes == b->passes && memcmp(a->rejected, b->rejected, sizeof(uint32_t) * FW * FH) == 0;
+        for (int c = 0; c < COMP_COUNT; c++) same &= memcmp(a->sum[c], b->sum[c], sizeof(double) * 3 * FW * FH) == 0;
+        CHECK(same, "the film with a display on it differs from the film without one");
+    }
+    display_destroy(d);
+    session_destroy(shown);
+    session_destroy(plain);
+    scene_destroy(s);
+}
+
 int main(void) {
     check_projection();
     check_static_mean();
@@ -427,5 +471,6 @@ int main(void) {
     check_changes();
     check_light_judgement();
     check_filter_fades();
+    check_film_untouched();
     return check_exit("test_display");
 }

@@ -146,19 +146,23 @@ static const ImU32 curve_colours[6] = {IM_COL32(255, 200, 60, 255),  IM_COL32(90
                                        IM_COL32(140, 255, 120, 255), IM_COL32(255, 110, 110, 255),
                                        IM_COL32(210, 140, 255, 255), IM_COL32(230, 230, 230, 255)};
 
-// Relative error against time since the reset, log scale, one polyline per method and setting.
+// Relative error against time since the reset, log scale, one polyline per method and setting
+// (the estimate's) with the image shown's as dots of the same colour.
 static void error_plot(const ui_stats *s) {
     float tmax = 0.0f, emin = INFINITY, emax = 0.0f;
     for (int c = 0; c < s->num_curves; c++)
-        for (int i = 0; i < s->curves[c].n; i++) {
-            float e = s->curves[c].error[i];
-            if (!(e > 0.0f) || !std::isfinite(e)) continue;
-            tmax = std::fmax(tmax, s->curves[c].seconds[i]);
-            emin = std::fmin(emin, e);
-            emax = std::fmax(emax, e);
+        for (int shown = 0; shown < 2; shown++) {
+            const ui_curve *k = &s->curves[c];
+            for (int i = 0; i < (shown ? k->shown_n : k->n); i++) {
+                float e = shown ? k->shown_error[i] : k->error[i];
+                if (!(e > 0.0f) || !std::isfinite(e)) continue;
+                tmax = std::fmax(tmax, shown ? k->shown_seconds[i] : k->seconds[i]);
+                emin = std::fmin(emin, e);
+                emax = std::fmax(emax, e);
+            }
         }
     if (!(emax > 0.0f)) {
-        ImGui::TextUnformatted("error plot: no full-resolution frame yet");
+        ImGui::TextUnformatted("error plot: nothing measured yet");
         return;
     }
     float noise = (float)s->reference_noise; // the floor no curve can go below on average
@@ -202,6 +206,14 @@ static void error_plot(const ui_stats *s) {
             dl->AddCircleFilled(pts[0], 2.0f, curve_colours[c % 6]);
         else if (pts.Size > 1)
             dl->AddPolyline(pts.Data, pts.Size, curve_colours[c % 6], 0, 1.5f);
+        const ui_curve *k = &s->curves[c];
+        for (int i = 0; i < k->shown_n; i++) {
+            float e = k->shown_error[i];
+            if (!(e > 0.0f) || !std::isfinite(e)) continue;
+            float x = p0.x + w * k->shown_seconds[i] / tmax;
+            float y = p0.y + h * (1.0f - (std::log10(e) - lo) / (hi - lo));
+            dl->AddCircleFilled(ImVec2(x, y), 1.5f * g_scale, curve_colours[c % 6]);
+        }
     }
     char label[32];
     std::snprintf(label, sizeof label, "%.2g", std::pow(10.0, (double)hi));
@@ -329,7 +341,7 @@ static void progress_section(ui_controls *c, const ui_stats *s) {
     if (why)
         ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", why);
     else
-        ImGui::TextUnformatted(s->previewing ? "moving: a reduced-resolution preview" : "refining");
+        ImGui::TextUnformatted(s->denoised ? "refining; the image shown is filtered (N)" : "refining");
     /* Standing notes: the error plot paused away from the reference's camera, no light. */
     if (s->status && s->status[0]) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", s->status);
     if (button(c->paused ? "resume (Space)" : "pause (Space)")) c->paused = !c->paused;
@@ -340,13 +352,18 @@ static void progress_section(ui_controls *c, const ui_stats *s) {
     float t = (float)c->time_limit;
     if (ImGui::InputFloat("stop at seconds", &t, 1.0f, 10.0f, "%.1f")) c->time_limit = t < 0.0f ? 0.0 : t;
     note("0: never stop");
-    ImGui::Text("%d x %d   last frame %.0f ms   %.2f M rays/s", s->width, s->height, s->frame_ms,
-                s->rays_per_second * 1e-6);
+    if (s->parts > 1)
+        ImGui::Text("%d x %d   frame %.0f ms in %d parts (%d done)   %.2f M rays/s", s->width, s->height, s->frame_ms,
+                    s->parts, s->parts_done, s->rays_per_second * 1e-6);
+    else
+        ImGui::Text("%d x %d   frame %.0f ms   %.2f M rays/s", s->width, s->height, s->frame_ms,
+                    s->rays_per_second * 1e-6);
     if (s->reference) {
         if (s->rel_error >= 0.0)
-            ImGui::Text("relative L2 error %.4f", s->rel_error);
+            ImGui::Text("relative L2 error %.4f (the estimate)", s->rel_error);
         else
             ImGui::TextUnformatted("relative L2 error -");
+        if (s->shown_error >= 0.0) ImGui::Text("%.4f of the image shown (dotted)", s->shown_error);
     }
 }
 
@@ -452,6 +469,11 @@ static void panel(ui_controls *c, const ui_stats *s) {
         if (s->num_tonemaps > 0) ImGui::Combo("tone mapper", &c->tonemap, s->tonemap_names, s->num_tonemaps);
         static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
         ImGui::Combo("show", &c->show, shows, s->reference ? UI_SHOW_COUNT : UI_SHOW_ERROR);
+        bool denoise = c->denoise != 0;
+        if (ImGui::Checkbox("denoise (N)", &denoise)) c->denoise = denoise;
+        help_tooltip("Filters the image shown while it is young (an edge-avoiding wavelet on the light over the "
+                     "albedo, as strong as the pixels' noise): a view of the estimate. The estimate itself (exports, "
+                     "the error against a reference, glint render) is never filtered.");
         if (c->show == UI_SHOW_ERROR)
             ImGui::TextUnformatted("per-pixel relative error:\nblue 1%, green 10%, red 100% and more");
     }
@@ -459,9 +481,10 @@ static void panel(ui_controls *c, const ui_stats *s) {
     if (s->reference && ImGui::CollapsingHeader("Reference", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::TextWrapped("%s", s->reference);
         if (s->rel_error >= 0.0)
-            ImGui::Text("relative L2 error %.4f", s->rel_error);
+            ImGui::Text("relative L2 error %.4f (the estimate)", s->rel_error);
         else
             ImGui::TextUnformatted("relative L2 error -");
+        if (s->shown_error >= 0.0) ImGui::Text("%.4f of the image shown (dotted)", s->shown_error);
         if (s->reference_noise >= 0.0)
             note("the reference's own noise: %.4f (the dashed line); below it, error is the reference's",
                  s->reference_noise);
@@ -506,7 +529,7 @@ static void panel(ui_controls *c, const ui_stats *s) {
     }
 
     if (ImGui::CollapsingHeader("Statistics")) {
-        ImGui::Text("%d x %d%s", s->width, s->height, s->previewing ? "  (preview while moving)" : "");
+        ImGui::Text("%d x %d, %.1f samples a pixel shown", s->width, s->height, s->mean_count);
         ImGui::Text("frames %lld   spp %.0f", s->frames, s->spp);
         ImGui::Text("time %.1f s   frame %.0f ms", s->seconds, s->frame_ms);
         ImGui::Text("%.2f M rays/s", s->rays_per_second * 1e-6);
@@ -535,16 +558,16 @@ static void overlay(const ui_controls *c, const ui_stats *s) {
                                    ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoNav |
                                    ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoSavedSettings;
     if (ImGui::Begin("##overlay", nullptr, flags)) {
-        char err[48] = "";
-        if (s->reference && s->rel_error >= 0.0) std::snprintf(err, sizeof err, "   error %.4f", s->rel_error);
+        char err[64] = "";
+        if (s->reference && s->rel_error >= 0.0 && s->shown_error >= 0.0)
+            std::snprintf(err, sizeof err, "   error %.4f (shown %.4f)", s->rel_error, s->shown_error);
+        else if (s->reference && s->rel_error >= 0.0)
+            std::snprintf(err, sizeof err, "   error %.4f", s->rel_error);
         double fps = s->frame_ms > 0.0 ? 1e3 / s->frame_ms : 0.0;
         ImGui::Text("%s   %.0f spp   %.1f s   %.1f fps%s", s->method ? s->method : "", s->spp, s->seconds, fps, err);
         char buf[160];
         const char *why = held_reason(c, s, buf, sizeof buf);
-        if (why)
-            ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", why);
-        else if (s->previewing)
-            ImGui::TextUnformatted("preview while moving");
+        if (why) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", why);
         ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
         ImGui::TextUnformatted(c->show_panel ? "F1 or ?: keys" : "F1 or ?: keys   Tab: panel");
         ImGui::PopStyleColor();

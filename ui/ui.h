@@ -31,6 +31,7 @@ typedef struct {
     int tonemap;    /* index into the tone mapper names given to ui_panel */
     int show;       /* UI_SHOW_* */
     int show_panel;
+    int denoise; /* the display's filter: on while the image is young, a view of the estimate only */
     /* one-shot actions, set by the panel, cleared by the viewer */
     int screenshot, export_exr, reset_view, load_scene, load_env, load_reference;
     char path[1024]; /* the panel's path field for loading */
@@ -46,11 +47,14 @@ typedef struct {
     int variant;                         /* the scene's material variant, -1 for the default materials */
 } ui_controls;
 
-/* One curve of the error plot: relative L2 error against seconds since a reset. */
+/* One curve of the error plot: relative L2 error against seconds since a reset, of the estimate
+ * (the film) and of the image shown (the display's view of it, filtered while young). */
 typedef struct {
     const char *label; /* the method and settings it was measured with */
     const float *seconds, *error;
     int n;
+    const float *shown_seconds, *shown_error;
+    int shown_n;
 } ui_curve;
 
 typedef struct {
@@ -64,8 +68,10 @@ typedef struct {
     double cost_ms, cost_before_ms;
     double rays_per_second;
     unsigned long long rejected_samples;
-    int width, height; /* of the image shown */
-    int previewing;    /* a reduced-resolution frame is shown while things move */
+    int width, height;     /* of the image shown */
+    int parts, parts_done; /* the frame under way: its parts and those done (0: between frames) */
+    int denoised;          /* the image shown is filtered */
+    double mean_count;     /* samples behind the average pixel shown (the display's history) */
     int num_cameras;
     const char *const *method_names;
     int num_methods;
@@ -82,7 +88,8 @@ typedef struct {
     int num_lights;
     int light_movable;      /* the selected light has a position */
     const char *reference;  /* the reference image's path, NULL without one */
-    double rel_error;       /* of the full-resolution image against it; < 0: none yet */
+    double rel_error;       /* of the estimate (the film) against it; < 0: none yet */
+    double shown_error;     /* of the image shown against it; < 0: none yet */
     const ui_curve *curves; /* the error plot, one curve per method and setting */
     int num_curves;
     const char *bookmarks;  /* which of bookmarks 1-9 are set, e.g. "1 3", and where they live */

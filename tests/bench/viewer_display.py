@@ -190,7 +190,7 @@ def orbit_rates(scenario_dir):
     px = int(b["image_pixels"]) - int(a["image_pixels"])
     w, h = (int(v) for v in b["render_size"].split("x"))
     return {"seconds": dt, "updates_per_s": n / dt, "full_per_s": full / dt,
-            "pixel_share": px / n / (w * h) if n else 0.0, "last_preview": b.get("preview_size", "-")}
+            "pixel_share": px / n / (w * h) if n else 0.0, "last_image": "%sx%s" % (b.get("width"), b.get("height"))}
 
 
 def cmd_table(root, refs, glint, out):
@@ -219,7 +219,7 @@ def cmd_table(root, refs, glint, out):
             if rates:
                 row.update({"updates_per_s": "%.2f" % rates["updates_per_s"], "full_per_s": "%.2f" % rates["full_per_s"],
                             "pixel_share": "%.3f" % rates["pixel_share"], "orbit_s": "%.2f" % rates["seconds"],
-                            "last_preview": rates["last_preview"]})
+                            "last_image": rates["last_image"]})
         rows.append(row)
     def when_key(w):  # at rest after opening, the orbit's steps, then seconds after the stop
         if w.startswith("opened-"):
@@ -229,7 +229,7 @@ def cmd_table(root, refs, glint, out):
     rows.sort(key=lambda r: (r["scene"], r["method"], r["scenario"], when_key(r["when"])))
     fields = ["scene", "method", "scenario", "when", "capture", "since_change", "preview", "image", "latest", "frames",
               "pose", "ref_spp", "rel_l2", "ref_noise", "net", "updates_per_s", "full_per_s", "pixel_share", "orbit_s",
-              "last_preview"]
+              "last_image"]
     with open(out + ".csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -251,7 +251,7 @@ def cmd_table(root, refs, glint, out):
                 "%.4f" % float(r["ref_noise"]) if r["ref_noise"] != "" else "-"))
         f.write("\nDuring the orbit (15 degrees at 15 degrees a second), from the stats lines before and after it:\n\n"
                 "| scene | method | updates/s | full-resolution updates/s | mean pixels an update (of full) | "
-                "orbit seconds | last preview |\n|---|---|---|---|---|---|---|\n")
+                "orbit seconds | last image |\n|---|---|---|---|---|---|---|\n")
         seen = set()
         for r in rows:
             key = (r["scene"], r["method"])
@@ -259,7 +259,7 @@ def cmd_table(root, refs, glint, out):
                 seen.add(key)
                 f.write("| %s | %s | %s | %s | %s | %s | %s |\n" % (
                     r["scene"], r["method"], r["updates_per_s"], r["full_per_s"], r["pixel_share"], r["orbit_s"],
-                    r["last_preview"]))
+                    r["last_image"]))
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@
 #   full-resolution frame is in flight, timed by the viewer from the step to the image it takes
 #   (the stats' step_ms);
 # - updates a second while orbiting continuously (a scripted drag, a little every drawn frame) for
-#   SECONDS: every image shown meanwhile is a reduced-resolution preview;
+#   SECONDS, and the size of the images shown meanwhile;
 # - quitting: from an Escape key press (xdotool) while a full-resolution frame is in flight to the
 #   process's exit, timed from outside.
 # A measurement, not a test: the issue's aims are 100 ms, 10 updates a second and 100 ms on 2 cores.
@@ -56,8 +56,8 @@ for method in $methods; do
     END {
       for (i = 1; i <= 5; i++) step[i] = f[i, "step_ms"]
       for (i = 1; i <= 5; i++) for (j = i + 1; j <= 5; j++) if (step[j] < step[i]) { t = step[i]; step[i] = step[j]; step[j] = t }
-      frames = f[7, "preview_frames"] - f[6, "preview_frames"]; dt = f[7, "time"] - f[6, "time"]
-      printf "  %-7s first image after a step: median %.0f ms, max %.0f ms (5 steps); orbiting: %.1f updates/s (%d previews in %.1f s, last %s); from Escape to the exit: %s\n",
-             m, step[3], step[5], frames / dt, frames, dt, f[7, "preview_size"], quit
+      frames = f[7, "images"] - f[6, "images"]; dt = f[7, "time"] - f[6, "time"]
+      printf "  %-7s first image after a step: median %.0f ms, max %.0f ms (5 steps); orbiting: %.1f updates/s (%d images in %.1f s, the last %sx%s); from Escape to the exit: %s\n",
+             m, step[3], step[5], frames / dt, frames, dt, f[7, "width"], f[7, "height"], quit
     }'
 done
