@@ -174,12 +174,8 @@ int cmd_view(int argc, char **argv) {
         return EXIT_FAILURE_;
     }
 
-    static shared_state sh; /* large (scene info, buffers): not on the stack */
-    shared_state_init(&sh);
-    u.sh = &sh;
     u.win = win;
     fill_scene_info(&u.info, s);
-    sh.info = u.info;
     /* The panel shows the values in use, so it edits the parameters with their defaults resolved. */
     u.ctl = (ui_controls){.params = o.params,
                           .camera = o.camera,
@@ -195,7 +191,7 @@ int cmd_view(int argc, char **argv) {
     u.applied_ctl = u.ctl;
     reset_lights(&u);
     bookmarks_load(&u);
-    u.rel_error = -1.0;
+    u.rel_error = u.shown_error = -1.0;
     u.step_ms = -1.0; /* the first image's time is measured from here */
     u.sent_at = cli_now();
     u.current_curve = -1;
@@ -203,25 +199,24 @@ int cmd_view(int argc, char **argv) {
     view_fit_window(&u, o.width, o.height); /* the image at --size beside the panel */
     int fw, fh;
     view_image_size(&u, &fw, &fh);
-    push_refinement(&u);
     reset_view(&u);
-    sh.cam = ctl_camera(&u.cam);
-    sh.params = o.params;
-    sh.denoise = u.ctl.denoise;
-    sh.render_w = fw > 0 ? fw : o.width;
-    sh.render_h = fh > 0 ? fh : o.height;
-    snprintf(sh.env_now, sizeof sh.env_now, "%s", o.env_path ? o.env_path : "");
-    render_thread *rt = render_thread_start(&sh, s);
-    if (!rt) {
-        cli_error("%s", sh.message);
+    view_start start = {.cam = ctl_camera(&u.cam),
+                        .params = o.params,
+                        .width = fw > 0 ? fw : o.width,
+                        .height = fh > 0 ? fh : o.height,
+                        .env = o.env_path,
+                        .denoise = u.ctl.denoise,
+                        .wake = glfwPostEmptyEvent}; /* the UI thread, waiting for events, takes the image */
+    if (!(u.vc = controller_start(s, &start, err, sizeof err))) {
+        cli_error("%s", err);
         ui_shutdown();
         glfwDestroyWindow(win);
         glfwTerminate();
         scene_destroy(s);
-        shared_state_deinit(&sh);
         view_script_free(&u.script);
         return EXIT_FAILURE_;
     }
+    push_refinement(&u);
     if (o.reference_path) open_reference(&u, o.reference_path); /* a bad one is shown; the viewer runs on */
 
     glfwGetCursorPos(win, &u.mouse_x, &u.mouse_y);
@@ -254,10 +249,11 @@ int cmd_view(int argc, char **argv) {
         glfwSwapBuffers(win);
     }
 
-    render_thread_stop(rt);
-    if (o.script_path) { /* what the render thread did up to the end, for tests: counts, not times */
-        printf("exit frames_total=%llu late_parts=%llu\n", (unsigned long long)sh.stats.frames_total,
-               sh.stats.late_parts);
+    view_stats last;
+    controller_stop(u.vc, &last);
+    if (o.script_path) { /* what the render side did up to the end, for tests: counts, not times */
+        printf("exit frames_total=%llu late_parts=%llu\n", (unsigned long long)last.frames_total,
+               (unsigned long long)last.late_parts);
         fflush(stdout);
     }
     capture_finish(&u);
@@ -268,7 +264,6 @@ int cmd_view(int argc, char **argv) {
     ui_shutdown();
     glfwDestroyWindow(win);
     glfwTerminate();
-    shared_state_deinit(&sh);
     image_rgb_free(&u.reference);
     free(u.front.rgb);
     free(u.pixels);

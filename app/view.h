@@ -1,28 +1,17 @@
-/* glint view: the interactive viewer's internals, shared by its files (not a public interface).
+/* glint view: the interactive viewer's UI side, shared by its files (not a public interface).
  *
- * Two threads, and a third for loading. The render thread (view_render.c) owns the scene, the
- * render session and the display pipeline: it renders update after update (each a part of a
- * frame), applies requested changes between updates, and publishes each image shown by swapping
- * buffers under a lock held only for the swap. The
- * loader reads the scenes and maps asked for while frames go on; the render thread puts them in
- * place between frames. The UI thread owns the
- * window: it handles input (view_input.c, view_camera.c) and scripts (view_script_run.c),
- * tone-maps and draws the newest image with the panel (view_display.c), and never waits for a
- * frame. The two meet only in shared_state, under its lock.
+ * The UI thread owns the window: it handles input (view_input.c, view_camera.c, view_nav.c) and
+ * scripts (view_script_run.c), tone-maps and draws the newest image with the panel
+ * (view_display.c, view_panel.c), and never waits for a frame. Everything it asks of the renderer,
+ * and everything it shows of it, goes through the narrow interface of view_controller.h; the one
+ * statistics record it shows and prints is ui/view_stats.h's.
  *
- * Every image is at the full resolution: an update renders part of the pixels (as few as keep it
- * near a tenth of a second), and the display (renderer/display.h) carries what earlier updates and
- * views left over camera and light changes and filters it. The film behind it, what exports and
- * the error against a reference read, is the estimate glint render makes.
- *
- * Lights are edited the same way: the UI keeps the wanted offset and intensity of every light and
- * sends them with each change; the render thread applies the difference to the scene between
- * frames, when nothing reads it. */
+ * Lights are edited as the UI keeps them: the wanted offset and intensity of every light, sent with
+ * each change; the render side applies the difference to the scene between updates. */
 #ifndef GLINT_VIEW_H
 #define GLINT_VIEW_H
 
 #include <pthread.h>
-#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -34,174 +23,14 @@
 #include "reference.h"
 #include "session.h"
 #include "ui.h"
+#include "view_controller.h"
 #include "view_script.h"
 
-#define MAX_VIEW_CAMERAS 32
-#define MAX_LIGHT_GROUPS 64  /* lights the viewer lists and edits; more are rendered, not listed */
 #define MAX_CURVES 6         /* error curves kept for comparison */
-#define MAX_VIEW_VARIANTS 64 /* material variants the panel lists */
 #define MAX_CURVE_POINTS 512 /* per curve; halved (every other point) when full */
 #define MAX_CAPTURES 8       /* captures written at once */
 
 static inline double seconds_since(double t) { return cli_now() - t; }
-
-/* ---- shared state (view_render.c) ------------------------------------------------------------ */
-
-/* Light edits: the offset and intensity multiplier of every light, against the scene as loaded. */
-typedef struct {
-    vec3 offset[MAX_LIGHT_GROUPS];
-    float gain[MAX_LIGHT_GROUPS];
-} light_edits;
-
-/* A published image and what it shows: the camera and lights it was rendered with travel with it,
- * as the UI's may have moved on since. */
-typedef struct {
-    float *rgb;
-    int width, height;
-    int full_w, full_h;  /* the render size it belongs to */
-    uint64_t generation; /* the request generation it shows */
-    camera cam;
-    light_edits lights;
-    long long frames;    /* frames of the film behind it (the display adds what came before) */
-    uint64_t seed;       /* the film's random seed (each accumulation its own) */
-    int denoise;         /* resolved with the display's filter on */
-    double published_at; /* cli_now() */
-} image_buf;
-
-typedef struct {
-    char name[1024];
-    int num_cameras;
-    camera cameras[MAX_VIEW_CAMERAS];
-    bounds3 bounds;
-    float diag;
-    int num_lights;
-    light_group lights[MAX_LIGHT_GROUPS]; /* as loaded */
-    int unlit;                            /* no light of its own (punctual or emissive): black without an environment */
-    /* material variants (KHR_materials_variants): names, the one shown (-1: the defaults) */
-    int num_variants, variant;
-    char variant_names[MAX_VIEW_VARIANTS][64];
-    int kept_view; /* it replaced the last scene to show another variant: the view stays */
-} scene_info;
-
-/* What the render thread reports about its frames. It writes them under the lock; the UI thread
- * copies them as a whole with each image it takes. */
-typedef struct {
-    uint64_t frames_generation; /* the request generation those frames show */
-    long long frames;           /* whole frames since the last reset */
-    uint64_t frames_total;      /* whole frames ever */
-    uint64_t resets;
-    double reset_at, frame_ms, rays_per_second;
-    double full_frame_ms;       /* a whole frame's rendering time with these settings, from its parts */
-    uint64_t updates;           /* images published, ever */
-    int parts, parts_done;      /* the frame under way: its parts and those done (0: between frames) */
-    double part_ms;             /* the last update's part */
-    double view_ms, resolve_ms; /* the display's last view change (G-buffer, reprojection), resolve */
-    double mean_count;          /* samples behind the average pixel shown */
-    long long carried, lost;    /* pixels the last view change carried over, and lost */
-    int denoised;               /* the last image was filtered */
-    double shown_error;         /* the image shown against the reference (the whole image) */
-    double shown_error_at;      /* ... and its seconds since the reset */
-    uint64_t shown_error_serial, shown_error_resets;
-    unsigned long long rejected;
-    unsigned long long virtual_lights;
-    char plan[1200]; /* the full-resolution session's effect plan, one pass a line */
-    int plan_highlights;
-    unsigned long long hl_points, hl_lobes; /* the last full-resolution frame's (vsl+hl) */
-    double hl_merge_share;                  /* its thread time spent merging, as a fraction */
-    double rel_error;                       /* the last full-resolution frame's against the reference */
-    double rel_error_at;                    /* ... and its seconds since the reset */
-    uint64_t rel_error_serial, rel_error_resets;
-    /* parts that ran to their end though a request (a change, a load, quit) came while they
-     * rendered: each request waits for at most the part in flight, and that only when the abort
-     * flag did not stop it (a count tests can trust, where a time would depend on the machine) */
-    unsigned long long late_parts;
-    int error_paused; /* the last update was not from the reference's camera (or lights): no error */
-    int standing;     /* refinement held: the image stands still */
-} view_stats;
-
-/* Everything the two threads hand each other; every field under lock except abort_frame. */
-typedef struct {
-    pthread_mutex_t lock;
-    /* requests: UI -> render thread */
-    camera cam;
-    render_params params;
-    uint64_t generation; /* bumped by every change that resets the accumulation */
-    uint64_t requests;   /* bumped by every change, load read and quit: what the render thread owes */
-    double changed_at;   /* when the last such change happened (cli_now) */
-    /* how the image is shown: never a reset */
-    unsigned show_mask;
-    int denoise;            /* the display's filter (denoise.h) on */
-    int render_w, render_h; /* requested full resolution */
-    char export_path[1024];
-    int export_pending;
-    char load_path[1024];
-    int load_kind;         /* 0 none, 1 scene, 2 environment map */
-    char load_variant[64]; /* a scene load: the material variant to show ("": the defaults)... */
-    int load_keep_view;    /* ...from where the view is (a variant switch) */
-    int quit;
-    uint64_t lights_scene;   /* the scene (info_serial) the light requests below refer to */
-    light_edits lights;      /* wanted */
-    image_rgb reference_new; /* a new reference for the error, handed over (the render thread frees it) */
-    int reference_pending;
-    /* Set when the viewer quits: the part in flight stops at its next chunk of pixels. A change
-     * does not stop it: a part is short, and its samples, of the view before, are the display's
-     * to carry over. */
-    atomic_int abort_frame;
-    /* The reference's camera (when its description gives one): frames from elsewhere are not
-     * measured against it, so the error plot pauses while the view is away. */
-    int reference_cam_valid;
-    camera reference_cam;
-    char reference_lights[4096]; /* its light edits (reference_lights_text), when it has a camera */
-    /* Loads (load_kind, load_path) are read by a thread of their own while frames go on and
-     * applied between frames; a failed one changes nothing. A script waits for loads_done. */
-    uint64_t load_requests, loads_done;
-    pthread_cond_t load_cond; /* signalled with each request, each result taken, and quit */
-    /* The scene the render thread has, for the UI's ray queries (zoom, fly): the UI reads it under
-     * scene_lock (never waiting: try-lock), which the render thread holds for writing whenever it
-     * changes or replaces the scene. */
-    pthread_rwlock_t scene_lock;
-    const scene *scene_now;
-    /* results: render thread -> UI */
-    image_buf image;
-    uint64_t image_serial;
-    view_stats stats;
-    char message[1200];
-    uint64_t message_serial;
-    scene_info info;
-    uint64_t info_serial;
-    /* The environment, kept across scene loads until cleared: a map's path, ENV_SKY or "". */
-    char env_now[1024];
-    /* refinement: full-resolution frames stop while paused or at a limit (view_panel.c) */
-    int paused;
-    long long spp_limit; /* 0: none */
-    double time_limit;   /* seconds since the reset; 0: none */
-} shared_state;
-
-#define ENV_SKY "sky" /* the uniform sky's name in env_now and in requests */
-/* load_kind values */
-enum { LOAD_NONE = 0, LOAD_SCENE, LOAD_ENV, LOAD_SKY, LOAD_NO_ENV };
-
-/* The render thread's own state, private to view_render.c. */
-typedef struct render_thread render_thread;
-
-/* The caller's memory: zeroed, the lock made, the scene as loaded (no light edits), everything
- * shown, no change yet. */
-void shared_state_init(shared_state *sh);
-/* Frees the buffers left in it (after the render thread stopped) and the lock. */
-void shared_state_deinit(shared_state *sh);
-/* What the UI thread knows of a scene: its name, cameras, bounds and lights as loaded. */
-void fill_scene_info(scene_info *info, const scene *s);
-/* The scene as loaded: no light edits. */
-void clear_light_edits(light_edits *e);
-/* The edits as a description gives them (reference_lights_text); "" when none. */
-void light_edits_text(const light_edits *e, char *out, size_t n);
-/* Creates the sessions for s at sh's requested size, camera and parameters and starts the thread,
- * which then owns s. Returns the thread (free with render_thread_stop), or NULL with the error in
- * sh->message; s is then still the caller's. */
-render_thread *render_thread_start(shared_state *sh, scene *s);
-/* Asks the thread to quit (a pending export is still written), waits for it and frees what it
- * owns, the scene included. */
-void render_thread_stop(render_thread *rt);
 
 /* ---- the UI thread --------------------------------------------------------------------------- */
 
@@ -223,7 +52,7 @@ typedef struct {
 } error_curve;
 
 typedef struct {
-    shared_state *sh;
+    view_controller *vc; /* the render side */
     GLFWwindow *win;
     ui_controls ctl, applied_ctl;
     cam_ctl cam;
@@ -366,7 +195,9 @@ void run_script(ui_thread *u);
 
 /* view_display.c: the image, its error against a reference, the panel */
 int fetch_published(ui_thread *u);
-int load_reference(ui_thread *u, const char *path);
+/* A reference image for the error view and plot, measured from cam with lights (its description's;
+ * NULL: from any view); 0, or -1 with the message shown. */
+int load_reference(ui_thread *u, const char *path, const camera *cam, const char *lights);
 void tonemap_and_upload(ui_thread *u);
 void take_screenshot(ui_thread *u, const char *name);
 /* Saves the image shown, linear and at the render's size (a preview magnified as the window
@@ -395,10 +226,6 @@ void view_fit_window(ui_thread *u, int image_w, int image_h);
 /* Takes a new size of the place beside the panel as the render size (a new accumulation) once the
  * window has stopped changing size and the panel's edge is no longer dragged. */
 void view_follow_size(ui_thread *u, double now);
-/* Render thread, under the lock: whether the full-resolution image of frames frames stops here. */
-int refinement_held(const shared_state *sh, long long frames);
-/* Render thread, without the lock: waits a little, and returns with the lock taken. */
-void refinement_hold(shared_state *sh);
 /* The pause and limits of the controls, to the render thread. */
 void push_refinement(ui_thread *u);
 /* A script's `variant NAME` (or `default`): the switch asked for; 0, or -1 with a message. */

@@ -14,9 +14,10 @@
 
 /* ---- the reference image and the error plot -------------------------------------------------- */
 
-/* Loads a reference for the error view and plot: it must match the render size. Returns 0, or -1
+/* Loads a reference for the error view and plot, measured from cam with lights when cam is not
+ * NULL (its description's), else from any view: it must match the render size. Returns 0, or -1
  * with the message shown (the previous reference stays). */
-int load_reference(ui_thread *u, const char *path) {
+int load_reference(ui_thread *u, const char *path, const camera *cam, const char *lights) {
     image_rgb img;
     char err[1200];
     if (image_rgb_load(path, &img, err, sizeof err) != 0) {
@@ -24,10 +25,8 @@ int load_reference(ui_thread *u, const char *path) {
         cli_error("%s", err);
         return -1;
     }
-    shared_state *sh = u->sh;
-    pthread_mutex_lock(&sh->lock);
-    int w = sh->render_w, h = sh->render_h;
-    pthread_mutex_unlock(&sh->lock);
+    int w, h;
+    controller_size(u->vc, &w, &h);
     image_rgb copy = {img.width, img.height, NULL};
     size_t bytes = sizeof(float) * 3 * (size_t)img.width * (size_t)img.height;
     if (img.width != w || img.height != h) {
@@ -42,11 +41,11 @@ int load_reference(ui_thread *u, const char *path) {
         return -1;
     }
     memcpy(copy.rgb, img.rgb, bytes);
-    pthread_mutex_lock(&sh->lock);
-    image_rgb_free(&sh->reference_new);
-    sh->reference_new = copy; /* the render thread's own copy, for the error of each frame */
-    sh->reference_pending = 1;
-    pthread_mutex_unlock(&sh->lock);
+    u->reference_cam_valid = cam != NULL;
+    if (cam) u->reference_cam = *cam;
+    snprintf(u->reference_lights, sizeof u->reference_lights, "%s", cam ? lights : "");
+    /* the render side's own copy, for the errors of its images */
+    controller_set_reference(u->vc, &copy, cam, u->reference_lights);
     image_rgb_free(&u->reference);
     u->reference = img;
     snprintf(u->reference_path, sizeof u->reference_path, "%s", path);
@@ -136,34 +135,20 @@ static void false_colour_error(const float *img, const float *ref, int num_pixel
 
 /* Takes the newest published image and statistics. Returns 1 when the image is new. */
 int fetch_published(ui_thread *u) {
-    shared_state *sh = u->sh;
-    int fresh = 0, new_info = 0;
-    pthread_mutex_lock(&sh->lock);
-    if (sh->image_serial != u->image_serial) {
-        image_buf t = u->front;
-        u->front = sh->image;
-        sh->image = t;
-        u->image_serial = sh->image_serial;
-        fresh = 1;
+    int fresh = controller_take_image(u->vc, &u->image_serial, &u->front);
+    if (fresh) {
         if (u->step_ms < 0.0 && u->front.generation == u->sent_generation) /* the change's first image */
             u->step_ms = 1e3 * seconds_since(u->sent_at);
         u->images_shown++;
         u->images_full++; /* every image is at the render's full size */
         u->image_pixels += (unsigned long long)u->front.width * (unsigned long long)u->front.height;
     }
-    int new_error = sh->stats.rel_error_serial != u->stats.rel_error_serial;
-    int new_shown = sh->stats.shown_error_serial != u->stats.shown_error_serial;
-    u->stats = sh->stats;
-    if (sh->message_serial != u->message_serial) {
-        snprintf(u->message, sizeof u->message, "%s", sh->message);
-        u->message_serial = sh->message_serial;
-    }
-    if (sh->info_serial != u->info_serial) {
-        u->info = sh->info;
-        u->info_serial = sh->info_serial;
-        new_info = 1;
-    }
-    pthread_mutex_unlock(&sh->lock);
+    view_stats was = u->stats;
+    controller_stats(u->vc, &u->stats);
+    int new_error = u->stats.rel_error_serial != was.rel_error_serial;
+    int new_shown = u->stats.shown_error_serial != was.shown_error_serial;
+    controller_take_message(u->vc, &u->message_serial, u->message, sizeof u->message);
+    int new_info = controller_take_info(u->vc, &u->info_serial, &u->info);
     if (new_error && u->reference.rgb)
         add_error_point(u, u->stats.rel_error_at, u->stats.rel_error, u->stats.rel_error_resets, 0);
     if (new_shown && u->reference.rgb)
@@ -440,29 +425,17 @@ void draw_image_and_panel(ui_thread *u) {
             (ui_curve){u->curves[c].label,         u->curves[c].seconds,     u->curves[c].error,  u->curves[c].n,
                        u->curves[c].shown_seconds, u->curves[c].shown_error, u->curves[c].shown_n};
     describe_bookmarks(u);
-    ui_stats st = {.scene_name = u->info.name,
-                   .frames = u->stats.frames,
-                   .spp = (double)u->stats.frames,
+    ui_stats st = {.render = u->stats,
+                   .scene_name = u->info.name,
+                   .spp = (double)frames_of_current_state(u),
                    .seconds = seconds_since(u->stats.reset_at),
-                   .frame_ms = u->stats.frame_ms,
                    .cost_ms = view_cost_ms(u),
                    .cost_before_ms = u->cost_before_ms,
-                   .rays_per_second = u->stats.rays_per_second,
-                   .rejected_samples = u->stats.rejected,
-                   .many_light = u->ctl.params.method != METHOD_PT,
-                   .virtual_lights = u->stats.virtual_lights,
-                   .highlights = u->ctl.params.method == METHOD_VSL_HL,
-                   .hl_points = u->stats.hl_points,
-                   .hl_lobes = u->stats.hl_lobes,
-                   .hl_merge_share = u->stats.hl_merge_share,
-                   .plan = u->stats.plan,
                    .width = u->front.width,
                    .height = u->front.height,
-                   .parts = u->stats.parts,
-                   .parts_done = u->stats.parts_done,
-                   .denoised = u->stats.denoised,
-                   .mean_count = u->stats.mean_count,
                    .num_cameras = u->info.num_cameras,
+                   .many_light = u->ctl.params.method != METHOD_PT,
+                   .highlights = u->ctl.params.method == METHOD_VSL_HL,
                    .tonemap_names = tonemap_names,
                    .num_tonemaps = TONEMAP_COUNT,
                    .light_names = u->light_label_ptrs,

@@ -21,22 +21,13 @@ static unsigned show_mask_of(int show) {
     }
 }
 
-/* Sends the camera and estimator settings to the render thread; each call is a change that
+/* Sends the camera, estimator settings and lights to the render side; each call is a change that
  * resets the accumulation. */
 void send_change(ui_thread *u) {
-    shared_state *sh = u->sh;
-    pthread_mutex_lock(&sh->lock);
-    sh->cam = ctl_camera(&u->cam);
-    sh->params.max_depth = u->ctl.params.max_depth;
-    sh->params.method = u->ctl.params.method;
-    sh->params.vl = u->ctl.params.vl;
-    sh->lights = u->lights;
-    sh->lights_scene = u->info_serial;
-    u->sent_generation = ++sh->generation;
-    sh->requests++;
-    sh->changed_at = u->sent_at = cli_now();
+    camera cam = ctl_camera(&u->cam);
+    u->sent_generation = controller_change(u->vc, &cam, &u->ctl.params, &u->lights, u->info_serial);
+    u->sent_at = cli_now();
     u->step_ms = -1.0;
-    pthread_mutex_unlock(&sh->lock);
 }
 
 /* Full-resolution frames rendered in the state the UI last asked for. */
@@ -66,10 +57,7 @@ void apply_controls(ui_thread *u, int camera_changed) {
     if (estimator_changed) u->cost_generation = u->sent_generation;
     if (u->ctl.exposure != u->applied_ctl.exposure || u->ctl.tonemap != u->applied_ctl.tonemap) u->need_tonemap = 1;
     if (u->ctl.show != u->applied_ctl.show || u->ctl.denoise != u->applied_ctl.denoise) {
-        pthread_mutex_lock(&u->sh->lock);
-        u->sh->show_mask = show_mask_of(u->ctl.show);
-        u->sh->denoise = u->ctl.denoise;
-        pthread_mutex_unlock(&u->sh->lock);
+        controller_set_look(u->vc, show_mask_of(u->ctl.show), u->ctl.denoise);
         u->need_tonemap = 1;
     }
     u->applied_ctl = u->ctl;
@@ -81,25 +69,11 @@ void request_export(ui_thread *u, const char *name) {
         snprintf(u->message, sizeof u->message, "%s: no free file name", name);
         return;
     }
-    shared_state *sh = u->sh;
-    pthread_mutex_lock(&sh->lock);
-    snprintf(sh->export_path, sizeof sh->export_path, "%s", path);
-    sh->export_pending = 1;
-    pthread_mutex_unlock(&sh->lock);
+    controller_export(u->vc, path);
 }
 
 static void request(ui_thread *u, int kind, const char *path, const char *variant, int keep_view) {
-    shared_state *sh = u->sh;
-    pthread_mutex_lock(&sh->lock);
-    snprintf(sh->load_path, sizeof sh->load_path, "%s", path);
-    snprintf(sh->load_variant, sizeof sh->load_variant, "%s", variant);
-    sh->load_keep_view = keep_view;
-    sh->load_kind = kind;
-    /* Not a change yet: the frame in flight goes on, and the accumulation too, unless the load
-     * succeeds (a new scene then arrives, and with it a new view). */
-    u->script_load_target = ++sh->load_requests;
-    pthread_cond_signal(&sh->load_cond);
-    pthread_mutex_unlock(&sh->lock);
+    u->script_load_target = controller_load(u->vc, kind, path, variant, keep_view);
 }
 
 void request_load(ui_thread *u, int kind, const char *path) { request(u, kind, path, "", 0); }
@@ -331,9 +305,9 @@ int handle_input(ui_thread *u, double dt) {
     }
     if (u->ctl.reference_view && reference_view(u) == 0) changed = 1;
     if (u->ctl.uniform_sky) { /* a toggle: the uniform sky on, or off again */
-        pthread_mutex_lock(&u->sh->lock);
-        int sky = strcmp(u->sh->env_now, ENV_SKY) == 0;
-        pthread_mutex_unlock(&u->sh->lock);
+        char env[1024];
+        controller_env(u->vc, env, sizeof env);
+        int sky = strcmp(env, ENV_SKY) == 0;
         request_load(u, sky ? LOAD_NO_ENV : LOAD_SKY, "");
     }
     u->ctl.frame_scene = u->ctl.reference_view = u->ctl.uniform_sky = 0;

@@ -12,16 +12,8 @@
 #include "reference.h"
 #include "view.h"
 
-float scene_distance(ui_thread *u, vec3 o, vec3 d) {
-    shared_state *sh = u->sh;
-    /* Never wait: while the render thread loads or edits the scene, navigate without it. */
-    if (pthread_rwlock_tryrdlock(&sh->scene_lock) != 0) return INFINITY;
-    float t = INFINITY;
-    surface_hit h;
-    if (sh->scene_now && scene_intersect(sh->scene_now, o, d, 1e30f, &h)) t = h.t;
-    pthread_rwlock_unlock(&sh->scene_lock);
-    return t;
-}
+/* Never waits: while the render side loads or edits the scene, navigation goes on without it. */
+float scene_distance(ui_thread *u, vec3 o, vec3 d) { return controller_scene_distance(u->vc, o, d); }
 
 void nav_zoom(ui_thread *u, float factor) {
     cam_ctl *c = &u->cam;
@@ -122,13 +114,10 @@ static int refuse(ui_thread *u, const char *why) {
 
 int describe_view(ui_thread *u, reference_info *out, int w, int h, const light_edits *lights, char *err,
                   size_t errlen) {
-    shared_state *sh = u->sh;
     char env[1024];
     memset(out, 0, sizeof *out);
     snprintf(out->model, sizeof out->model, "%s", BSDF_MODEL_STAMP);
-    pthread_mutex_lock(&sh->lock);
-    snprintf(env, sizeof env, "%s", sh->env_now);
-    pthread_mutex_unlock(&sh->lock);
+    controller_env(u->vc, env, sizeof env);
     out->width = w;
     out->height = h;
     snprintf(out->scene, sizeof out->scene, "%s", u->info.name);
@@ -152,24 +141,15 @@ int open_reference(ui_thread *u, const char *path) {
     int described = reference_load(path, &have, err, sizeof err);
     if (described < 0) return refuse(u, err);
     if (described == 0) { /* what this view renders, against what the reference was rendered from */
-        pthread_mutex_lock(&u->sh->lock);
-        int w = u->sh->render_w, h = u->sh->render_h;
-        pthread_mutex_unlock(&u->sh->lock);
+        int w, h;
+        controller_size(u->vc, &w, &h);
         if (describe_view(u, &want, w, h, &u->lights, err, sizeof err) != 0) return refuse(u, err);
         /* The view may be anywhere: the reference's camera is where the error is measured. */
         want.camera_index = have.camera_index;
         want.cam = have.cam;
         if (reference_check(path, &have, &want, err, sizeof err) != 0) return refuse(u, err);
     }
-    if (load_reference(u, path) != 0) return -1;
-    u->reference_cam_valid = described == 0;
-    if (described == 0) u->reference_cam = have.cam;
-    snprintf(u->reference_lights, sizeof u->reference_lights, "%s", described == 0 ? have.lights : "");
-    pthread_mutex_lock(&u->sh->lock);
-    u->sh->reference_cam_valid = u->reference_cam_valid;
-    u->sh->reference_cam = u->reference_cam;
-    snprintf(u->sh->reference_lights, sizeof u->sh->reference_lights, "%s", u->reference_lights);
-    pthread_mutex_unlock(&u->sh->lock);
+    if (load_reference(u, path, described == 0 ? &have.cam : NULL, have.lights) != 0) return -1;
     u->error_paused_shown = 0;
     if (described == 1) {
         snprintf(u->message, sizeof u->message, "reference %s: no description, its scene and camera unchecked", path);
@@ -193,9 +173,7 @@ int reference_view(ui_thread *u) {
 
 void update_status(ui_thread *u) {
     char env[1024];
-    pthread_mutex_lock(&u->sh->lock);
-    snprintf(env, sizeof env, "%s", u->sh->env_now);
-    pthread_mutex_unlock(&u->sh->lock);
+    controller_env(u->vc, env, sizeof env);
     int len = 0;
     u->status[0] = 0;
     if (u->info.unlit && !env[0]) {

@@ -97,10 +97,9 @@ void view_follow_size(ui_thread *u, double now) {
     int dropped = u->panel_dragging && !dragging;
     u->panel_dragging = dragging;
     view_image_size(u, &w, &h);
-    shared_state *sh = u->sh;
-    pthread_mutex_lock(&sh->lock);
-    int same = w == sh->render_w && h == sh->render_h;
-    pthread_mutex_unlock(&sh->lock);
+    int rw, rh;
+    controller_size(u->vc, &rw, &rh);
+    int same = w == rw && h == rh;
     if (w <= 0 || h <= 0 || same) { /* minimised, or rendered at that size already */
         u->pending_w = u->pending_h = 0;
         return;
@@ -111,28 +110,12 @@ void view_follow_size(ui_thread *u, double now) {
         u->pending_since = now;
     }
     if (dragging || (!dropped && now - u->pending_since < SIZE_SETTLE_SECONDS)) return;
-    pthread_mutex_lock(&sh->lock);
-    sh->render_w = w;
-    sh->render_h = h;
-    pthread_mutex_unlock(&sh->lock);
+    controller_set_size(u->vc, w, h);
     u->pending_w = u->pending_h = 0;
     send_change(u); /* a new aspect ratio: the camera too */
 }
 
 /* ---- pause and limits ------------------------------------------------------------------------ */
-
-int refinement_held(const shared_state *sh, long long frames) {
-    if (frames < 1) return 0; /* every new view gets one full frame */
-    return sh->paused || (sh->spp_limit > 0 && frames >= sh->spp_limit) ||
-           (sh->time_limit > 0.0 && seconds_since(sh->stats.reset_at) >= sh->time_limit);
-}
-
-void refinement_hold(shared_state *sh) {
-    double t0 = cli_now();
-    nanosleep(&(struct timespec){0, 10 * 1000 * 1000}, NULL);
-    pthread_mutex_lock(&sh->lock);
-    sh->stats.reset_at += cli_now() - t0; /* time held is not refinement time */
-}
 
 /* Held as asked, and the render thread stands: a frame already under way when the pause came
  * runs to its end (a stopped frame would leave part of its samples in the film). */
@@ -145,12 +128,7 @@ static int held(const ui_thread *u) {
 }
 
 void push_refinement(ui_thread *u) {
-    shared_state *sh = u->sh;
-    pthread_mutex_lock(&sh->lock);
-    sh->paused = u->ctl.paused;
-    sh->spp_limit = u->ctl.spp_limit;
-    sh->time_limit = u->ctl.time_limit;
-    pthread_mutex_unlock(&sh->lock);
+    controller_set_refinement(u->vc, u->ctl.paused, u->ctl.spp_limit, u->ctl.time_limit);
 }
 
 int panel_set(ui_thread *u, const char *name, const char *value, char *err, size_t errlen) {
@@ -253,12 +231,7 @@ void panel_frame(ui_thread *u, ui_stats *st) {
 /* ---- material variants ------------------------------------------------------------------------- */
 
 /* Whether the variant switch asked for has been tried and its outcome taken in. */
-static int variant_settled(ui_thread *u) {
-    pthread_mutex_lock(&u->sh->lock);
-    int done = u->sh->loads_done >= u->variant_target && u->sh->info_serial == u->info_serial;
-    pthread_mutex_unlock(&u->sh->lock);
-    return done;
-}
+static int variant_settled(ui_thread *u) { return controller_load_settled(u->vc, u->variant_target, u->info_serial); }
 
 /* The panel's choice against the scene shown: a switch reloads the scene with that variant (every
  * part of it follows the materials); one that failed puts the choice back. */

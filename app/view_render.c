@@ -1,6 +1,7 @@
 /* glint view: the render thread. It owns the scene, the render session and the display pipeline;
  * between updates it takes the UI's requests from the shared state, and after each update publishes
- * the image shown and its statistics there (see view.h).
+ * the image shown and its statistics there (view_render.h; the UI asks and takes through
+ * view_controller.h).
  *
  * An update renders one part of a frame (session_render_part), as many parts to a frame as keep an
  * update near UPDATE_MS, and the display (display.h) takes that part's samples, carries history
@@ -12,12 +13,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
+#include "camera.h"
+#include "cli.h"
 #include "display.h"
 #include "envmap.h"
 #include "lights.h"
 #include "metrics.h"
-#include "view.h"
+#include "reference.h"
+#include "view_render.h"
 
 /* An update (a part and the display's work) takes about UPDATE_MS while things move and for
  * YOUNG_SECONDS after a change, so the image follows motion about 10 times a second; later, at
@@ -74,59 +79,28 @@ struct render_thread {
     int shown_denoise;
 };
 
-void shared_state_init(shared_state *sh) {
-    memset(sh, 0, sizeof *sh);
-    pthread_mutex_init(&sh->lock, NULL);
-    pthread_rwlock_init(&sh->scene_lock, NULL);
-    pthread_cond_init(&sh->load_cond, NULL);
-    clear_light_edits(&sh->lights);
-    sh->show_mask = COMP_MASK_ALL;
-    sh->changed_at = -1e9;
-}
-
-void shared_state_deinit(shared_state *sh) {
-    image_rgb_free(&sh->reference_new);
-    free(sh->image.rgb);
-    pthread_rwlock_destroy(&sh->scene_lock);
-    pthread_cond_destroy(&sh->load_cond);
-    pthread_mutex_destroy(&sh->lock);
-}
-
-void fill_scene_info(scene_info *info, const scene *s) {
-    snprintf(info->name, sizeof info->name, "%s", s->path);
-    info->num_cameras = s->num_cameras < MAX_VIEW_CAMERAS ? s->num_cameras : MAX_VIEW_CAMERAS;
-    for (int i = 0; i < info->num_cameras; i++) info->cameras[i] = s->cameras[i];
-    info->bounds = s->bounds;
-    info->diag = s->diag;
-    int n = scene_light_groups(s, info->lights, MAX_LIGHT_GROUPS); /* -1 (out of memory): none listed */
-    info->num_lights = n < 0 ? 0 : n < MAX_LIGHT_GROUPS ? n : MAX_LIGHT_GROUPS;
-    info->unlit = s->num_lights - (s->env_light >= 0 ? 1 : 0) == 0;
-    info->num_variants = scene_num_variants(s) < MAX_VIEW_VARIANTS ? scene_num_variants(s) : MAX_VIEW_VARIANTS;
-    for (int i = 0; i < info->num_variants; i++)
-        snprintf(info->variant_names[i], sizeof info->variant_names[i], "%s", scene_variant_name(s, i));
-    info->variant = scene_variant(s) < info->num_variants ? scene_variant(s) : -1;
-    info->kept_view = 0;
-}
-
-void clear_light_edits(light_edits *e) {
-    for (int g = 0; g < MAX_LIGHT_GROUPS; g++) {
-        e->offset[g] = v3(0, 0, 0);
-        e->gain[g] = 1.0f;
-    }
-}
-
-void light_edits_text(const light_edits *e, char *out, size_t n) {
-    light_edit list[MAX_LIGHT_GROUPS];
-    for (int g = 0; g < MAX_LIGHT_GROUPS; g++) list[g] = (light_edit){g, e->offset[g], e->gain[g]};
-    if (reference_lights_text(list, MAX_LIGHT_GROUPS, out, n) != 0 && n) out[0] = 0; /* n too small: none said */
-}
-
 static void set_message(render_thread *rt, const char *fmt, const char *a, const char *b) {
     shared_state *sh = rt->sh;
     pthread_mutex_lock(&sh->lock);
     snprintf(sh->message, sizeof sh->message, fmt, a, b);
     sh->message_serial++;
     pthread_mutex_unlock(&sh->lock);
+}
+
+/* Under the lock: whether refinement of a view with `frames` whole frames stops here (paused, or at
+ * a limit). */
+static int refinement_held(const shared_state *sh, long long frames) {
+    if (frames < 1) return 0; /* every new view gets one whole frame */
+    return sh->paused || (sh->spp_limit > 0 && frames >= sh->spp_limit) ||
+           (sh->time_limit > 0.0 && cli_now() - sh->stats.reset_at >= sh->time_limit);
+}
+
+/* Without the lock: waits a little, and returns with the lock taken. */
+static void refinement_hold(shared_state *sh) {
+    double t0 = cli_now();
+    nanosleep(&(struct timespec){0, 10 * 1000 * 1000}, NULL);
+    pthread_mutex_lock(&sh->lock);
+    sh->stats.reset_at += cli_now() - t0; /* time held is not refinement time */
 }
 
 /* Each accumulation its own random numbers: while the camera moves every update starts one, and
@@ -427,7 +401,7 @@ static void publish(render_thread *rt, const update_info *up) {
         sh->stats.lost = ds.lost;
         sh->stats.denoised = ds.levels > 0;
         sh->stats.frame_ms = rt->frame_ms + rt->setup_ms;
-        double secs = seconds_since(sh->stats.reset_at);
+        double secs = cli_now() - sh->stats.reset_at;
         sh->stats.rays_per_second = secs > 0.0 ? (double)rays / secs : 0.0;
         sh->stats.rejected = st.rejected_samples;
         if (rel_error >= 0.0) {
@@ -456,7 +430,7 @@ static void publish(render_thread *rt, const update_info *up) {
         }
     }
     pthread_mutex_unlock(&sh->lock);
-    glfwPostEmptyEvent(); /* the UI thread, waiting for events, takes the image now */
+    if (sh->wake) sh->wake(); /* the UI thread, waiting for events, takes the image now */
 }
 
 /* How many parts the next frame takes: as few as keep an update (the frame's set-up, the part, the
@@ -550,7 +524,7 @@ static void *render_main(void *arg) {
         uint64_t gen = sh->generation;
         camera cam = sh->cam;
         render_params params = sh->params;
-        double age = seconds_since(sh->changed_at);
+        double age = cli_now() - sh->changed_at;
         /* Measured against the reference only from its camera (when its description names one). */
         int measure = !sh->reference_cam_valid || camera_same_view(&cam, &sh->reference_cam, rt->scene->diag);
         int lights_measured = sh->reference_cam_valid; /* a described reference: its lights too */
@@ -631,7 +605,7 @@ static void *render_main(void *arg) {
         up.before = before;
         double t0 = cli_now();
         int r = session_render_part(rs, parts, &up.frame_done);
-        up.part_ms = 1e3 * seconds_since(t0);
+        up.part_ms = 1e3 * (cli_now() - t0);
         up.rendered = r == 0;
         if (r == 1) rt->film_partial = 1; /* stopped for a newer change: its samples still show */
         if (r < 0) set_message(rt, "%s%s", session_error(rs), "");
@@ -647,7 +621,7 @@ static void *render_main(void *arg) {
                     ? 1e-6 * (double)(after.pass_ns[PASS_VIRTUAL_LIGHTS] - before.pass_ns[PASS_VIRTUAL_LIGHTS])
                     : 0.0;
             display_stats ds = display_get_stats(rt->disp);
-            learn_costs(rt, up.part_ms, parts, began, setup, 1e3 * seconds_since(t1) + (change ? ds.view_ms : 0.0));
+            learn_costs(rt, up.part_ms, parts, began, setup, 1e3 * (cli_now() - t1) + (change ? ds.view_ms : 0.0));
         }
         if (r < 0)
             refinement_hold(sh);

@@ -36,33 +36,21 @@ static void print_stats(ui_thread *u) {
         (double)lx, (double)ly, tonemap_names[u->ctl.tonemap], mean, u->rel_error, u->shown_error,
         seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
         nb ? marks : "-");
-    printf("scene=%s frames=%lld frames_total=%llu resets=%llu width=%d height=%d exposure=%g show=%d "
-           "max_depth=%d method=%s rejected=%llu virtual_lights=%llu hl_lobes=%llu plan_highlights=%d ",
-           u->info.name, frames_of_current_state(u), (unsigned long long)u->stats.frames_total,
-           (unsigned long long)u->stats.resets, u->front.width, u->front.height, (double)u->ctl.exposure, u->ctl.show,
-           u->ctl.params.max_depth, method_name(u->ctl.params.method), u->stats.rejected, u->stats.virtual_lights,
-           u->stats.hl_lobes, u->stats.plan_highlights);
+    printf("scene=%s frames=%lld width=%d height=%d exposure=%g show=%d max_depth=%d method=%s ", u->info.name,
+           frames_of_current_state(u), u->front.width, u->front.height, (double)u->ctl.exposure, u->ctl.show,
+           u->ctl.params.max_depth, method_name(u->ctl.params.method));
     /* The environment, and the standing notes (the panel's status line) as flags. */
     char env[1024];
-    pthread_mutex_lock(&u->sh->lock);
-    snprintf(env, sizeof env, "%s", u->sh->env_now[0] ? u->sh->env_now : "-");
-    pthread_mutex_unlock(&u->sh->lock);
-    printf("env=%s unlit_note=%d paused_note=%d error_paused=%d errors_measured=%llu step_ms=%.1f frame_ms=%.1f "
-           "cost_ms=%.1f cost_before_ms=%.1f",
-           env, strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->stats.error_paused,
-           (unsigned long long)u->stats.rel_error_serial, u->step_ms, u->stats.frame_ms, view_cost_ms(u),
-           u->cost_before_ms);
-    /* Images taken from the render thread (what the window showed), those at full resolution, their
+    controller_env(u->vc, env, sizeof env);
+    if (!env[0]) snprintf(env, sizeof env, "-");
+    printf("env=%s unlit_note=%d paused_note=%d step_ms=%.1f cost_ms=%.1f cost_before_ms=%.1f denoise=%d", env,
+           strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->step_ms, view_cost_ms(u),
+           u->cost_before_ms, u->ctl.denoise);
+    /* Images taken from the render side (what the window showed), those at full resolution, their
      * pixels in all, and the size they render at: updates a second and their resolution. */
     printf(" images=%llu images_full=%llu image_pixels=%llu render_size=%dx%d", u->images_shown, u->images_full,
            u->image_pixels, u->front.full_w, u->front.full_h);
-    /* The display: updates published, the frame under way in parts, what an update cost, how much
-     * history the last view change carried, the samples behind a pixel shown, the filter. */
-    printf(" updates=%llu parts=%d parts_done=%d part_ms=%.1f view_ms=%.1f resolve_ms=%.1f carried=%lld lost=%lld "
-           "mean_count=%.2f denoise=%d denoised=%d late_parts=%llu",
-           (unsigned long long)u->stats.updates, u->stats.parts, u->stats.parts_done, u->stats.part_ms,
-           u->stats.view_ms, u->stats.resolve_ms, u->stats.carried, u->stats.lost, u->stats.mean_count, u->ctl.denoise,
-           u->stats.denoised, u->stats.late_parts);
+    view_stats_print(&u->stats); /* the render side's record, as it names its fields */
     print_panel_stats(u);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
@@ -165,12 +153,7 @@ static int key_from_name(const char *name, int *mods) {
 }
 
 /* Whether the last load asked for has been tried and its outcome (a new scene) taken in. */
-static int load_settled(ui_thread *u) {
-    pthread_mutex_lock(&u->sh->lock);
-    int done = u->sh->loads_done >= u->script_load_target && u->sh->info_serial == u->info_serial;
-    pthread_mutex_unlock(&u->sh->lock);
-    return done;
-}
+static int load_settled(ui_thread *u) { return controller_load_settled(u->vc, u->script_load_target, u->info_serial); }
 
 /* Runs script actions until one has to wait. */
 void run_script(ui_thread *u) {

@@ -316,7 +316,7 @@ static void note(const char *fmt, ...) {
 static const char *held_reason(const ui_controls *c, const ui_stats *s, char *buf, size_t n) {
     if (!s->held) return nullptr;
     if (c->paused) return "paused (Space resumes)";
-    if (c->spp_limit > 0 && s->frames >= c->spp_limit)
+    if (c->spp_limit > 0 && s->render.frames >= c->spp_limit)
         std::snprintf(buf, n, "done: %lld spp limit reached", c->spp_limit);
     else
         std::snprintf(buf, n, "done: %.3g s limit reached", c->time_limit);
@@ -336,12 +336,12 @@ static void progress_section(ui_controls *c, const ui_stats *s) {
             std::snprintf(buf, sizeof buf, "%.1f / %.3g s", s->seconds, c->time_limit);
         ImGui::ProgressBar((float)std::fmin(fraction, 1.0), ImVec2(-FLT_MIN, 0), buf);
     }
-    ImGui::Text("%.0f spp (frames %lld) in %.1f s", s->spp, s->frames, s->seconds);
+    ImGui::Text("%.0f spp (frames %lld) in %.1f s", s->spp, s->render.frames, s->seconds);
     const char *why = held_reason(c, s, buf, sizeof buf);
     if (why)
         ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", why);
     else
-        ImGui::TextUnformatted(s->denoised ? "refining; the image shown is filtered (N)" : "refining");
+        ImGui::TextUnformatted(s->render.denoised ? "refining; the image shown is filtered (N)" : "refining");
     /* Standing notes: the error plot paused away from the reference's camera, no light. */
     if (s->status && s->status[0]) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", s->status);
     if (button(c->paused ? "resume (Space)" : "pause (Space)")) c->paused = !c->paused;
@@ -352,12 +352,12 @@ static void progress_section(ui_controls *c, const ui_stats *s) {
     float t = (float)c->time_limit;
     if (ImGui::InputFloat("stop at seconds", &t, 1.0f, 10.0f, "%.1f")) c->time_limit = t < 0.0f ? 0.0 : t;
     note("0: never stop");
-    if (s->parts > 1)
-        ImGui::Text("%d x %d   frame %.0f ms in %d parts (%d done)   %.2f M rays/s", s->width, s->height, s->frame_ms,
-                    s->parts, s->parts_done, s->rays_per_second * 1e-6);
+    if (s->render.parts > 1)
+        ImGui::Text("%d x %d   frame %.0f ms in %d parts (%d done)   %.2f M rays/s", s->width, s->height,
+                    s->render.frame_ms, s->render.parts, s->render.parts_done, s->render.rays_per_second * 1e-6);
     else
-        ImGui::Text("%d x %d   frame %.0f ms   %.2f M rays/s", s->width, s->height, s->frame_ms,
-                    s->rays_per_second * 1e-6);
+        ImGui::Text("%d x %d   frame %.0f ms   %.2f M rays/s", s->width, s->height, s->render.frame_ms,
+                    s->render.rays_per_second * 1e-6);
     if (s->reference) {
         if (s->rel_error >= 0.0)
             ImGui::Text("relative L2 error %.4f (the estimate)", s->rel_error);
@@ -442,9 +442,9 @@ static void panel(ui_controls *c, const ui_stats *s) {
                  s->cost_ms / s->cost_before_ms, s->cost_before_ms);
         else
             note("cost: %.0f ms a full frame", s->cost_ms);
-        if (s->plan && s->plan[0] &&
+        if (s->render.plan && s->render.plan[0] &&
             ImGui::TreeNodeEx("what runs, and why (effect plan)", ImGuiTreeNodeFlags_DefaultOpen)) {
-            note("%s", s->plan);
+            note("%s", s->render.plan);
             ImGui::TreePop();
         }
     }
@@ -529,16 +529,17 @@ static void panel(ui_controls *c, const ui_stats *s) {
     }
 
     if (ImGui::CollapsingHeader("Statistics")) {
-        ImGui::Text("%d x %d, %.1f samples a pixel shown", s->width, s->height, s->mean_count);
-        ImGui::Text("frames %lld   spp %.0f", s->frames, s->spp);
-        ImGui::Text("time %.1f s   frame %.0f ms", s->seconds, s->frame_ms);
-        ImGui::Text("%.2f M rays/s", s->rays_per_second * 1e-6);
-        if (s->rejected_samples) ImGui::Text("rejected samples %llu", s->rejected_samples);
-        if (s->many_light) ImGui::Text("virtual lights %llu", s->virtual_lights);
+        ImGui::Text("%d x %d, %.1f samples a pixel shown", s->width, s->height, s->render.mean_count);
+        ImGui::Text("frames %lld   spp %.0f", s->render.frames, s->spp);
+        ImGui::Text("time %.1f s   frame %.0f ms", s->seconds, s->render.frame_ms);
+        ImGui::Text("%.2f M rays/s", s->render.rays_per_second * 1e-6);
+        if (s->render.rejected) ImGui::Text("rejected samples %llu", (unsigned long long)s->render.rejected);
+        if (s->many_light) ImGui::Text("virtual lights %llu", (unsigned long long)s->render.virtual_lights);
         if (s->highlights) { /* always two lines, so the panel's height does not jump */
-            if (s->hl_points > 0) {
-                ImGui::Text("lobes lit %llu/frame (%.2f/hit)", s->hl_lobes, (double)s->hl_lobes / (double)s->hl_points);
-                ImGui::Text("merging %.1f%% of render time", 100.0 * s->hl_merge_share);
+            if (s->render.hl_points > 0 && s->render.frames > 0) {
+                ImGui::Text("lobes lit %.0f/frame (%.2f/hit)", (double)s->render.hl_lobes / (double)s->render.frames,
+                            (double)s->render.hl_lobes / (double)s->render.hl_points);
+                ImGui::Text("merging %.1f%% of render time", 100.0 * s->render.hl_merge_share);
             } else {
                 ImGui::TextUnformatted("lobes lit -");
                 ImGui::TextUnformatted("merging -");
@@ -563,7 +564,7 @@ static void overlay(const ui_controls *c, const ui_stats *s) {
             std::snprintf(err, sizeof err, "   error %.4f (shown %.4f)", s->rel_error, s->shown_error);
         else if (s->reference && s->rel_error >= 0.0)
             std::snprintf(err, sizeof err, "   error %.4f", s->rel_error);
-        double fps = s->frame_ms > 0.0 ? 1e3 / s->frame_ms : 0.0;
+        double fps = s->render.frame_ms > 0.0 ? 1e3 / s->render.frame_ms : 0.0;
         ImGui::Text("%s   %.0f spp   %.1f s   %.1f fps%s", s->method ? s->method : "", s->spp, s->seconds, fps, err);
         char buf[160];
         const char *why = held_reason(c, s, buf, sizeof buf);

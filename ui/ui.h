@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "params.h"
+#include "view_stats.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -58,30 +59,19 @@ typedef struct {
 } ui_curve;
 
 typedef struct {
+    view_stats render; /* the render side's record (view_stats.h), as it stands */
     const char *scene_name;
-    long long frames; /* at full resolution since the last reset */
-    double spp;
-    double seconds;  /* since the last reset */
-    double frame_ms; /* the last frame's render time */
-    /* a full-resolution frame's time with the current settings (0: none yet) and before the last
-     * change of estimator settings (0: unknown) */
+    double spp;     /* whole frames of the state shown */
+    double seconds; /* since the last reset (standing still while refinement is held) */
+    /* a whole frame's time with the current settings (0: none yet) and before the last change of
+     * estimator settings (0: unknown) */
     double cost_ms, cost_before_ms;
-    double rays_per_second;
-    unsigned long long rejected_samples;
-    int width, height;     /* of the image shown */
-    int parts, parts_done; /* the frame under way: its parts and those done (0: between frames) */
-    int denoised;          /* the image shown is filtered */
-    double mean_count;     /* samples behind the average pixel shown (the display's history) */
+    int width, height; /* of the image shown */
     int num_cameras;
     const char *const *method_names;
     int num_methods;
-    int many_light;                    /* the current method uses virtual lights: show their settings */
-    unsigned long long virtual_lights; /* deposited since the last reset */
-    int highlights;                    /* the current method is vsl+hl: show the highlight settings */
-    /* the last full-resolution frame's highlight work (vsl+hl) */
-    unsigned long long hl_points, hl_lobes; /* camera hits worked at, lobes lit */
-    double hl_merge_share;                  /* of the frame's thread time spent clustering and merging */
-    const char *plan;                       /* the effect plan, "pass: why" a line; empty before the first frame */
+    int many_light; /* the current method uses virtual lights: show their settings */
+    int highlights; /* the current method is vsl+hl: show the highlight settings */
     const char *const *tonemap_names;
     int num_tonemaps;
     const char *const *light_names; /* the scene's light groups, "name (type)" */
