@@ -570,6 +570,7 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
     for (int c = 0; c < COMP_COUNT; c++)
         if (mask >> c & 1u && d->active[c]) j.mask |= 1u << c;
     d->st.levels = 0;
+    d->st.filter_ms = 0.0;
     if (denoise) {
         threadpool_run(d->pool, split_row, &j, d->height);
         d->st.mean_count = (double)atomic_load(&j.samples) / ((double)d->width * (double)d->height);
@@ -590,7 +591,9 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
         int levels = DENOISE_LEVELS;
         for (double k = 0.5; covered < k && levels < DENOISE_MAX_LEVELS; k *= 0.5) levels++;
         denoise_params p = {.levels = levels};
+        uint64_t t1 = clock_ns();
         if (in.components) denoise_run(d->dn, &in, &p, &out, d->pool);
+        d->st.filter_ms = 1e-6 * (double)(clock_ns() - t1);
         threadpool_run(d->pool, weigh_row, &j, d->height);
         d->st.levels = levels;
     }

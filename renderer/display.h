@@ -31,7 +31,8 @@ typedef struct {
     int levels;        /* the filter's passes at the last resolve (0: not filtered) */
     double view_ms;    /* the last view change: G-buffer and reprojection... */
     double gbuffer_ms; /* ...of which the G-buffer */
-    double resolve_ms; /* the last resolve: filter and modulation */
+    double resolve_ms; /* the last resolve: filter and modulation... */
+    double filter_ms;  /* ...of which the filter (denoise_run) */
 } display_stats;
 
 typedef struct display display;

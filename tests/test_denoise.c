@@ -611,7 +611,7 @@ static int bench(int threads) {
                 float n = kind < 2 ? counts[kind] : (i % 4 == 0 && (i / (size_t)w) % 4 == 0 ? 1.0f : 0.0f);
                 set(&im, c, i, rng_float(&r), rng_float(&r), rng_float(&r), n, 0.1f);
             }
-        for (int levels = 4; levels <= 5; levels++) {
+        for (int levels = 3; levels <= 5; levels++) {
             denoise_params p = {.levels = levels};
             double best = 1e30, best_cpu = 1e30;
             for (int rep = 0; rep < 15; rep++) {
