@@ -310,7 +310,7 @@ static void level_row(void *ctx, int y, int worker) {
         for (int c = 0; c < j->comps; c++) {
             sums acc;
             float il[CHUNK];
-            luminance_stop(j, pl[c].n + p, pl[c].l + p, d->half[0][c].s2 + p, j->inv_sqrt_unit, il);
+            luminance_stop(j, pl[c].n + p, pl[c].l + p, d->half[1][c].s2 + p, j->inv_sqrt_unit, il);
             add_own(&acc, tap_at(&pl[c], p), B3[2] * B3[2], 1.0f);
             for (int k = 0; k < 12; k++)
                 add_pair_lum(&acc, pl[c].l + p, tap_at(&pl[c], p + off[k]), pl[c].l + p + off[k],
@@ -392,6 +392,7 @@ int denoise_run(denoiser *d, const denoise_input *in, const denoise_params *p, c
     j.kappa = pl.kappa_pool;
     j.inv_sqrt_unit = (float)(1.0 / sqrt(unit));
     run_rows(pool, denoise_pool_row, &j, d->half_height);
+    run_rows(pool, denoise_variance_row, &j, d->half_height);
     double coarse = unit * 16.0; /* see finish */
     for (int i = 0; i < pl.coarse; i++) {
         j.step = 1 << i;

@@ -130,8 +130,9 @@ struct denoiser {
     planes full[2][COMP_COUNT]; /* [x & 1] */
     geometry half_geo;          /* the geometry of one pixel of each block... */
     float *rx, *ry;             /* ...which (0 or 1 across, down) */
-    planes half[2][COMP_COUNT]; /* two buffers: a pass goes from one to the other; half[0]'s s2
-                                  * is the variance all passes go by (see pool_variance) */
+    planes half[2][COMP_COUNT]; /* two buffers: a pass goes from one to the other; half[0]'s s2 is
+                                  * the pooled variance (pool_variance), half[1]'s that steadied,
+                                  * which every later stop goes by (denoise_variance_row) */
 };
 
 static inline ptrdiff_t at(const denoiser *d, int y, int m) { return (ptrdiff_t)(y + MARGIN) * d->stride + MARGIN + m; }
@@ -279,8 +280,10 @@ static inline void finish(const sums *restrict a, float *restrict r, float *rest
     }
 }
 
-/* One row of a step (a task_fn): pooling the input into the half grid, and the output from both. */
+/* One row of a step (a task_fn): pooling the input into the half grid, its variance steadied, and
+ * the output from both. */
 void denoise_pool_row(void *ctx, int y, int worker);
+void denoise_variance_row(void *ctx, int y, int worker);
 void denoise_upsample_row(void *ctx, int y, int worker);
 
 #endif

@@ -233,6 +233,39 @@ void denoise_pool_row(void *ctx, int y, int worker) {
     }
 }
 
+/* Row y of the half grid's variance steadied: each pixel's pooled one (half[0]'s s2) averaged
+ * over its 3x3 with the weights (1, 2, 1) x (1, 2, 1) / 16, pixels without samples left out, into
+ * half[1]'s s2, which every later stop goes by. A footprint holds few samples while the image is
+ * young: one estimate low by chance would shut its pixels' stops, and their lone samples would
+ * show as specks (SVGF steadies its variance with the same 3x3). */
+static void add_variance(const float *restrict s2, const float *restrict n, float k, float *restrict sw,
+                         float *restrict sv) {
+    for (int i = 0; i < CHUNK; i++) {
+        float w = n[i] > 0.0f ? k : 0.0f;
+        sw[i] += w;
+        sv[i] += w * s2[i];
+    }
+}
+
+void denoise_variance_row(void *ctx, int y, int worker) {
+    (void)worker;
+    const job *j = ctx;
+    const denoiser *d = j->d;
+    for (int x0 = 0; x0 < d->half_width; x0 += CHUNK)
+        for (int c = 0; c < j->comps; c++) {
+            const planes *pl = &d->half[0][c];
+            ptrdiff_t p = at(d, y, x0);
+            float sw[CHUNK] = {0}, sv[CHUNK] = {0};
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    ptrdiff_t q = p + dy * d->stride + dx;
+                    add_variance(pl->s2 + q, pl->n + q, B1[dx + 2] * B1[dy + 2], sw, sv);
+                }
+            float *restrict out = d->half[1][c].s2 + p;
+            for (int i = 0; i < CHUNK; i++) out[i] = sv[i] / (sw[i] > 0.0f ? sw[i] : 1.0f);
+        }
+}
+
 /* The one-sample variance a full pixel's stops go by: the half grid's pooled one (see
  * pool_variance), of the four half pixels around it weighted as their light will be (bilinear and
  * geometry weights w), those with samples; its own where none is on its surface. */
@@ -324,6 +357,39 @@ static void write_out(const job *j, int c, int y, int m0, const float (*r)[CHUNK
     }
 }
 
+/* A pixel the steps above left a hole: a thin feature, or a block's minority side, with no sample
+ * of its surface in its 3x3 and none of the half pixels around it on its surface (the half grid
+ * shows another). It is filled as a pass would fill it, from the samples of its surface within
+ * FILL pixels (geometry weights and counts): rare, so one pixel at a time. The light and count
+ * (in out_unit) go to *r, *g, *b, *n; it stays a hole if there are none. */
+#define FILL 6
+
+static void fill_hole(const job *j, int c, int x, int y, float *r, float *g, float *b, float *n) {
+    const denoiser *d = j->d;
+    const geometry *gp = &d->full_geo[x & 1];
+    ptrdiff_t p = at(d, y, x >> 1);
+    float sa = 0.0f, sr = 0.0f, sg = 0.0f, sb = 0.0f, sq = 0.0f;
+    for (int dy = -FILL; dy <= FILL; dy++)
+        for (int dx = -FILL; dx <= FILL; dx++) {
+            int xx = x + dx, yy = y + dy;
+            if (xx < 0 || xx >= d->width || yy < 0 || yy >= d->height) continue;
+            const geometry *gq = &d->full_geo[xx & 1];
+            const planes *pq = &d->full[xx & 1][c];
+            ptrdiff_t q = at(d, yy, xx >> 1);
+            if (!(pq->n[q] > 0.0f)) continue;
+            float cs = gp->nx[p] * gq->nx[q] + gp->ny[p] * gq->ny[q] + gp->nz[p] * gq->nz[q];
+            float inv = depth_scale(gp->z[p], gp->gx[p], gp->gy[p], (float)dx, (float)dy, j->sigma_z);
+            float w = exp2_neg(normal_log2(cs, j->sigma_n) - fabsf(gp->z[p] - gq->z[q]) * inv), a = w * pq->n[q];
+            sa += a, sq += a * w;
+            sr += a * pq->r[q], sg += a * pq->g[q], sb += a * pq->b[q];
+        }
+    if (!(sa >= FLT_MIN)) return;
+    *r = clampf_to(sr / sa, FLT_MAX);
+    *g = clampf_to(sg / sa, FLT_MAX);
+    *b = clampf_to(sb / sa, FLT_MAX);
+    *n = sa * (sa / (sq > FLT_MIN ? sq : FLT_MIN)) / (COUNT_SCALE * j->out_unit); /* (sum a)^2 / sum b */
+}
+
 /* Row y of the output, from the full image's input and the half grid's result. First the full
  * resolution's own pass, 3x3 (B1): its value f and count n_f for each pixel. Then, as a pass whose
  * taps are the half grid's, f (weight UP_OWN n_f) and the four half pixels around it: bilinear
@@ -375,7 +441,7 @@ void denoise_upsample_row(void *ctx, int y, int worker) {
                 const float *ts2[4];
                 for (int k = 0; k < 4; k++) {
                     t[k] = tap_at(&co[c], qt[k]);
-                    ts2[k] = d->half[0][c].s2 + qt[k];
+                    ts2[k] = d->half[1][c].s2 + qt[k];
                 }
                 /* the variance the pixel's stops go by (one sample's): the half grid's */
                 float v[CHUNK], il[CHUNK];
@@ -398,6 +464,9 @@ void denoise_upsample_row(void *ctx, int y, int worker) {
                 add_pair(&acc, r, g, b, t[0], t[1], lnw[0], lnw[1], il);
                 add_pair(&acc, r, g, b, t[2], t[3], lnw[2], lnw[3], il);
                 finish(&acc, r, g, b, l, n, j->kappa / 5.0f);
+                for (int i = 0; i < CHUNK; i++)
+                    if (n[i] == 0.0f && 2 * (m0 + i) + ph < d->width)
+                        fill_hole(j, c, 2 * (m0 + i) + ph, y, r + i, g + i, b + i, n + i);
             }
         }
         for (int c = 0; c < j->comps; c++)
