@@ -239,10 +239,10 @@ static inline void add_own(sums *restrict a, tap t, float h, float u) {
  * (rp, gp, bp); il is log2 e over the luminance stop's scale. The stop compares colours by the
  * luminance's weights on each channel's absolute difference: |l_p - l_q| itself when the light
  * changes in brightness alone, but no longer blind to a change of colour at equal luminance
- * (docs/design.md). */
+ * (docs/design.md). best keeps the largest lnw of a tap with samples. */
 static inline void add_pair(sums *restrict s, const float *restrict rp, const float *restrict gp,
                             const float *restrict bp, tap ta, tap tb, const float *restrict lnw_a,
-                            const float *restrict lnw_b, const float *restrict il) {
+                            const float *restrict lnw_b, const float *restrict il, float *restrict best) {
     const float *restrict na = ta.n, *restrict nb = tb.n;
     const float *restrict ra = ta.r, *restrict rb = tb.r;
     const float *restrict ga = ta.g, *restrict gb = tb.g;
@@ -257,6 +257,9 @@ static inline void add_pair(sums *restrict s, const float *restrict rp, const fl
         s->g[i] += wa * ga[i] + wb * gb[i];
         s->b[i] += wa * ba[i] + wb * bb[i];
         s->bb[i] += wa * ea + wb * eb;
+        float la = na[i] > 0.0f ? lnw_a[i] : -FLT_MAX, lb = nb[i] > 0.0f ? lnw_b[i] : -FLT_MAX;
+        la = la > lb ? la : lb;
+        best[i] = la > best[i] ? la : best[i];
     }
 }
 

@@ -357,11 +357,13 @@ static void write_out(const job *j, int c, int y, int m0, const float (*r)[CHUNK
     }
 }
 
-/* A pixel the steps above left a hole: a thin feature, or a block's minority side, with no sample
- * of its surface in its 3x3 and none of the half pixels around it on its surface (the half grid
- * shows another). It is filled as a pass would fill it, from the samples of its surface within
- * FILL pixels (geometry weights and counts): rare, so one pixel at a time. The light and count
- * (in out_unit) go to *r, *g, *b, *n; it stays a hole if there are none. */
+/* A pixel whose surface none of the steps above found: a thin feature, or a block's minority
+ * side, with no sample of its surface in its 3x3 and none of the half pixels around it on its
+ * surface (the half grid shows another). Its light, if any, came at the weight of another surface
+ * (below 2^SURFACE_LOG2, kernel weights aside). It is filled as a pass would fill it, from the
+ * samples of its surface within FILL pixels (geometry weights and counts): rare, so one pixel at
+ * a time. The light and count (in out_unit) go to *r, *g, *b, *n when there are any. */
+#define SURFACE_LOG2 (-20.0f)
 #define FILL 6
 
 static void fill_hole(const job *j, int c, int x, int y, float *r, float *g, float *b, float *n) {
@@ -448,24 +450,26 @@ void denoise_upsample_row(void *ctx, int y, int worker) {
                 half_variance((const float(*)[CHUNK])ew, t, ts2, pl->s2 + p, v);
                 /* the 3x3 pass: f, n_f */
                 sums acc;
-                float l[CHUNK];
+                float l[CHUNK], best[CHUNK]; /* the best tap of its surface: its own sample's 2^0, or a tap's */
+                for (int i = 0; i < CHUNK; i++) best[i] = pl->n[p + i] > 0.0f ? 0.0f : -FLT_MAX;
                 lum_run(pl->r + p, pl->g + p, pl->b + p, l);
                 luminance_stop(j, pl->n + p, l, v, j->inv_sqrt_unit, il);
                 add_own(&acc, tap_at(pl, p), B1[2] * B1[2], 1.0f);
                 for (int k = 0; k < 4; k++)
                     add_pair(&acc, pl->r + p, pl->g + p, pl->b + p,
                              tap_at(&d->full[(ph + PAIRS3[k][0]) & 1][c], fpa[k]),
-                             tap_at(&d->full[(ph - PAIRS3[k][0]) & 1][c], fpb[k]), fw[k][0], fw[k][1], il);
+                             tap_at(&d->full[(ph - PAIRS3[k][0]) & 1][c], fpb[k]), fw[k][0], fw[k][1], il, best);
                 float *r = fr[c][ph], *g = fg[c][ph], *b = fb[c][ph], *n = fn[c][ph];
                 finish(&acc, r, g, b, l, n, j->kappa_fine / TAPS);
                 /* f and the half grid */
                 luminance_stop(j, n, l, v, j->fine_inv_sqrt_unit, il);
                 add_own(&acc, (tap){r, g, b, n}, UP_OWN, j->fine_to_coarse);
-                add_pair(&acc, r, g, b, t[0], t[1], lnw[0], lnw[1], il);
-                add_pair(&acc, r, g, b, t[2], t[3], lnw[2], lnw[3], il);
+                add_pair(&acc, r, g, b, t[0], t[1], lnw[0], lnw[1], il, best);
+                add_pair(&acc, r, g, b, t[2], t[3], lnw[2], lnw[3], il, best);
                 finish(&acc, r, g, b, l, n, j->kappa / 5.0f);
+                /* (the kernels' weights are 2^-4 at least) */
                 for (int i = 0; i < CHUNK; i++)
-                    if (n[i] == 0.0f && 2 * (m0 + i) + ph < d->width)
+                    if (best[i] < SURFACE_LOG2 - 4.0f && 2 * (m0 + i) + ph < d->width)
                         fill_hole(j, c, 2 * (m0 + i) + ph, y, r + i, g + i, b + i, n + i);
             }
         }
