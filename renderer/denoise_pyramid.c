@@ -3,6 +3,7 @@
  * resolution with the full image's own 3x3 pass. */
 #include "denoise_parts.h"
 
+/* The luminance of a run of light (the full image keeps none: only its stops' epsilon needs it). */
 static void lum_run(const float *restrict r, const float *restrict g, const float *restrict b, float *restrict l) {
     for (int i = 0; i < CHUNK; i++) l[i] = lum_of(r[i], g[i], b[i]);
 }

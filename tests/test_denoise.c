@@ -427,8 +427,8 @@ static void test_noise(void) {
     /* the real stops: no bias (the weights are symmetric in the noise), and the variance within a
      * factor 2 of the open filter's. A neighbour within the noise (a difference of N(0, 2 var))
      * keeps E[exp(-|d| / 4 sd)] = 0.77 of its weight, which raises sum w^2 / (sum w)^2 by 1.09 a
-     * pass, 1.5 over five; the weights' own randomness adds some. That holds only while the stop
-     * sees the noise's true size after each pass (kappa, docs/design.md): without, 8 times. */
+     * step; the weights' own randomness adds some. That holds only while the stop sees the noise's
+     * true size after each step (kappa, docs/design.md) and the variance estimate is right. */
     noise_runs(n, runs, 0.0f, sigma, &bias, &mse, &m);
     ratio = mse / (sigma * sigma);
     printf("noise, default stops: variance x %.4g (%.2f of the open filter's); bias %.2g sigma\n", ratio,
