@@ -1,147 +1,108 @@
-/* The display's à-trous filter (docs/design.md, "The display: denoising"). Images are held as
- * planes (structure of arrays) inside a MARGIN of empty pixels, so that no tap leaves its plane
- * and none needs a bounds test: a margin pixel has no sample and takes no weight. A row is cut
- * into runs of CHUNK pixels, and every inner loop goes over one run with its taps fixed (a tap and
- * its mirror together), so that the compiler vectorises it; the geometry's weights are computed
- * once per tap for all components. */
-#include "denoise.h"
-
-#include <float.h>
-#include <math.h>
-#include <stdint.h>
+/* The display's à-trous filter (docs/design.md, "The display: denoising"): the interface, the
+ * input into planes, the plan of the passes, and the half grid's passes; denoise_pyramid.c pools
+ * the input into the half grid and brings the result back up. */
 #include <stdlib.h>
-#include <string.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
-#define CHUNK 128
-#define MARGIN (2 << (DENOISE_MAX_LEVELS - 1)) /* the farthest tap of the last pass */
+#include "denoise_parts.h"
 
-/* Counts are held scaled so that no weight a = h w n is over 1/2 and no weighted sum of finite
- * values can overflow: n COUNT_SCALE <= 1/2, and after each pass the count is divided by 25, the
- * most it can grow by (Cauchy-Schwarz over 25 taps). COUNT_MAX (a trillion samples) caps it. */
-#define COUNT_MAX 0x1p40f
-#define COUNT_SCALE 0x1p-41f
-#define TAPS 25.0f
-/* Luminance only steers the weights: it is held within +-LUM_MAX, so its differences and squares
- * stay finite; so are variances and depths. */
-#define LUM_MAX 1e15f
-#define S2_MAX 1e30f
-#define DEPTH_MAX 1e18f
-/* The edge stops' epsilons, relative to the pixel's own depth or luminance, so the filter does not
- * depend on the scene's units: a few times float's own resolution of such a value, so that equal
- * values in all but rounding still meet, and no real step gets through. EPS_TINY keeps 0 / 0 out. */
-#define EPS_Z 1e-5f
-#define EPS_L 1e-6f
-#define EPS_TINY 1e-20f
-/* Weights are handled as their base-2 logarithms. One below 2^EXP2_FLOOR (2e-35) is taken as that:
- * it counts for nothing, and keeps the sums normal floats. */
-#define EXP2_FLOOR (-115.0f)
-#define LOG2E 1.44269504f
-/* An escaped ray's depth: no hit's depth is near it, so the depth stop keeps the two apart (and
- * escaped rays together, compared by direction through the stored normal). */
-#define DEPTH_SKY (-1e20f)
-/* Below this many samples the variance comes (in part) from the neighbours, as in SVGF. */
-#define YOUNG 4.0f
-
-static const float B3[5] = {1.0f / 16.0f, 1.0f / 4.0f, 3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f};
-static const float G3[3] = {0.25f, 0.5f, 0.25f}; /* the 3x3 Gaussian that steadies the variance */
-/* Half of the 5x5 and of the 7x7 taps (dx, dy) around the centre: each goes with its mirror. */
+/* Half of the 5x5 taps (dx, dy) around the centre: each goes with its mirror. */
 static const signed char PAIRS5[12][2] = {{1, 0}, {2, 0},  {-2, 1}, {-1, 1}, {0, 1}, {1, 1},
                                           {2, 1}, {-2, 2}, {-1, 2}, {0, 2},  {1, 2}, {2, 2}};
-static const signed char PAIRS7[24][2] = {{1, 0}, {2, 0},  {3, 0},  {-3, 1}, {-2, 1}, {-1, 1}, {0, 1}, {1, 1},
-                                          {2, 1}, {3, 1},  {-3, 2}, {-2, 2}, {-1, 2}, {0, 2},  {1, 2}, {2, 2},
-                                          {3, 2}, {-3, 3}, {-2, 3}, {-1, 3}, {0, 3},  {1, 3},  {2, 3}, {3, 3}};
 
-/* The inner loops hold no conversion between int and float and no nested ?: : either keeps gcc
- * from vectorising a loop. An integer k, |k| < 2^22, is the low bits of the float k + ROUNDER. */
-#define ROUNDER 0x1.8p23f
-#define ROUNDER_BITS 0x4b400000u
+/* ---- the plan: how much each step really lets the count grow ---------------------------------- */
 
-static inline uint32_t bits_of(float f) {
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
-static inline float float_of(uint32_t u) {
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-/* 2^x for x <= 0: 2^k from the exponent bits times 2^f, |f| <= 1/2, by a degree-3 fit exact at
- * f = 0 (so 2^0 is 1). Relative error under 1.0e-4 + 1e-7 |x| (the fit; the rounding of x): ample
- * for a weight. Below EXP2_FLOOR, and for NaN, it is 2^EXP2_FLOOR. */
-static inline float exp2_neg(float x) {
-    x = x > EXP2_FLOOR ? x : EXP2_FLOOR;
-    float kr = x + ROUNDER; /* x rounded to an integer k, held as k + ROUNDER */
-    float f = x - (kr - ROUNDER);
-    float p = 1.0f + f * (0.69328293f + f * (0.242210964f + f * 0.0550089153f));
-    return float_of(bits_of(p) + ((bits_of(kr) - ROUNDER_BITS) << 23));
-}
-
-/* log2 x for x in [1e-30, 1]: x = 2^e m with m in [2/3, 4/3), log2 m = r P(r) with r = m - 1 and
- * P a degree-5 fit of log2(1 + r) / r (relative error 7.2e-6): under 1e-6 on [0.9, 1], where it
- * matters (x^128 takes 128 times it). */
-static inline float log2_unit(float x) {
-    uint32_t e = (uint32_t)((int32_t)(bits_of(x) - 0x3f2aaaabu) >> 23); /* 0x3f2aaaab: 2/3 */
-    float r = float_of(bits_of(x) - (e << 23)) - 1.0f;
-    float p = 1.44270538f +
-              r * (-0.721376643f + r * (0.479251757f + r * (-0.358505738f + r * (0.326720598f + r * -0.279155602f))));
-    return (float_of(ROUNDER_BITS + e) - ROUNDER) + r * p;
-}
-
-static inline float clampf_to(float v, float lim) {
-    v = v < lim ? v : lim;
-    return v > -lim ? v : -lim;
-}
-static inline float lum_of(float r, float g, float b) {
-    return luminance3(v3(clampf_to(r, LUM_MAX), clampf_to(g, LUM_MAX), clampf_to(b, LUM_MAX)));
-}
-
-/* One component's image, a plane each. */
 typedef struct {
-    float *r, *g, *b; /* the light over the albedo */
-    float *l;         /* its luminance, within +-LUM_MAX */
-    float *s2;        /* the variance of one sample's luminance */
-    float *n;         /* samples behind the value, scaled (COUNT_SCALE, then 1/25 a pass); 0: a hole */
-} planes;
+    int coarse; /* passes on the half grid (holes 1, 2, ... of its pixels) */
+    float kappa_fine, kappa_pool, kappa_coarse[DENOISE_MAX_LEVELS], kappa_up;
+} plan;
 
-#define PLANES_EACH 6
-#define PLANES_GEOMETRY 6
+/* The open cascade's composite kernel in one dimension (it is separable), for the output pixel at
+ * KO, over the input's pixels. */
+enum { KLEN = 512, KO = KLEN / 2 };
 
-struct denoiser {
-    int width, height;
-    ptrdiff_t stride; /* floats a plane row: MARGIN, the width rounded up to CHUNK, MARGIN */
-    size_t plane_size;
-    float *mem;
-    float *z, *nx, *ny, *nz; /* depth (DEPTH_SKY: escaped), shading normal */
-    float *gx, *gy;          /* the depth's screen gradient, robust at edges */
-    planes buf[2][COMP_COUNT];
-    float kappa[DENOISE_MAX_LEVELS]; /* see level_row */
-};
+static double dot_k(const double *a, const double *b) {
+    double s = 0.0;
+    for (int u = 0; u < KLEN; u++) s += a[u] * b[u];
+    return s;
+}
 
-static ptrdiff_t at(const denoiser *d, int y, int x) { return (ptrdiff_t)(y + MARGIN) * d->stride + MARGIN + x; }
+/* out(u) = sum_t h_t k(u - t step): a pass with holes `step` input pixels apart. */
+static void conv_k(const double *k, double *out, int step, const float *h) {
+    memset(out, 0, sizeof(double) * KLEN);
+    for (int u = 0; u < KLEN; u++)
+        for (int t = 0; t < 5; t++) {
+            int v = u - (t - 2) * step;
+            if (v >= 0 && v < KLEN) out[u] += (double)h[t] * k[v];
+        }
+}
 
-/* kappa[i]: how much the open cascade's effective count 1 / sum K^2 really grows at pass i, over
- * the 1 / sum h^2 that the pass's weights would promise to independent taps. */
-static void cascade_kappa(float *kappa) {
-    enum { LEN = 4 * ((1 << DENOISE_MAX_LEVELS) - 1) + 1 };
-    double k[LEN] = {0}, next[LEN];
-    int r = 0; /* the composite kernel's radius so far */
-    k[LEN / 2] = 1.0;
-    double sum_h2 = 0.0, prev = 1.0;
-    for (int t = 0; t < 5; t++) sum_h2 += (double)B3[t] * (double)B3[t];
-    for (int i = 0; i < DENOISE_MAX_LEVELS; i++) {
-        memset(next, 0, sizeof next);
-        for (int x = LEN / 2 - r; x <= LEN / 2 + r; x++)
-            for (int t = 0; t < 5; t++) next[x + (t - 2) * (1 << i)] += k[x] * (double)B3[t];
-        memcpy(k, next, sizeof k);
-        r += 2 << i;
-        double s = 0.0;
-        for (int x = 0; x < LEN; x++) s += k[x] * k[x];
-        double count = 1.0 / (s * s); /* 2D: the kernel is separable */
-        kappa[i] = (float)(count / prev * sum_h2 * sum_h2);
-        prev = count;
+/* k shifted by d input pixels (the kernel of the pixel d to the right). */
+static void shift_k(const double *k, double *out, int d) {
+    memset(out, 0, sizeof(double) * KLEN);
+    for (int u = 0; u < KLEN; u++)
+        if (u - d >= 0 && u - d < KLEN) out[u] = k[u - d];
+}
+
+static double sum_sq_2d(const float *h, int taps) {
+    double s = 0.0;
+    for (int i = 0; i < taps; i++) s += (double)h[i] * (double)h[i];
+    return s * s;
+}
+
+/* kappa: how much the open cascade's effective count 1 / sum K^2 really grows at a step, over what
+ * the step's rule (sum a)^2 / sum (a^2 / n) promises independent taps (see level_row). Counts here
+ * are 2D, squares of the 1D ones; the input's pixels are independent, each of count 1. */
+static plan make_plan(int levels) {
+    plan p = {.coarse = levels - 1};
+    double k[KLEN] = {0}, t[KLEN], kf[KLEN], kc[KLEN], far[KLEN];
+    k[KO] = 1.0;
+    /* the full image's 3x3 pass */
+    conv_k(k, kf, 1, B1);
+    double nf = 1.0 / (dot_k(kf, kf) * dot_k(kf, kf));
+    p.kappa_fine = (float)(nf * sum_sq_2d(B1, 5));
+    /* the half grid's pixel 0: K4 x K4 on the 4x4 from full pixel -1 on, which is the 3x3 pass on
+     * full pixels 0 and 1, averaged */
+    shift_k(kf, t, 1);
+    for (int u = 0; u < KLEN; u++) kc[u] = 0.5 * (kf[u] + t[u]);
+    double nc = 1.0 / (dot_k(kc, kc) * dot_k(kc, kc));
+    p.kappa_pool = (float)(nc * sum_sq_2d(K4, 4));
+    for (int i = 0; i < p.coarse; i++) {
+        conv_k(kc, t, 2 << i, B3);
+        memcpy(kc, t, sizeof kc);
+        double n2 = 1.0 / (dot_k(kc, kc) * dot_k(kc, kc));
+        p.kappa_coarse[i] = (float)(n2 / nc * sum_sq_2d(B3, 5));
+        nc = n2;
     }
+    /* back up, for full pixel 0: the 3x3 pass's value (weight UP_OWN nf) and the half grid's pixels
+     * 0 (near, 3/4 a side) and -1 (far, 1/4), of kernels kf, kc and kc shifted: not separable, but
+     * its sum K^2 is a sum of products of separable terms' */
+    shift_k(kc, far, -2);
+    double ao = (double)UP_OWN * nf, bn = 0.75, bf = 0.25, total = ao + nc;
+    double cross = bn * dot_k(kf, kc) + bf * dot_k(kf, far), kk = dot_k(kf, kf);
+    double q = bn * bn * dot_k(kc, kc) + 2.0 * bn * bf * dot_k(kc, far) + bf * bf * dot_k(far, far);
+    double sum_k2 = (ao * ao * kk * kk + 2.0 * ao * nc * cross * cross + nc * nc * q * q) / (total * total);
+    double bil2 = (bn * bn + bf * bf) * (bn * bn + bf * bf);
+    double naive = total * total / ((double)UP_OWN * (double)UP_OWN * nf + nc * bil2);
+    p.kappa_up = (float)(1.0 / sum_k2 / naive);
+    return p;
+}
+
+/* ---- memory ---------------------------------------------------------------------------------- */
+
+static float *take_geometry(geometry *g, float *m, size_t size) {
+    float **each[PLANES_GEOMETRY] = {&g->z, &g->nx, &g->ny, &g->nz, &g->gx, &g->gy};
+    for (int i = 0; i < PLANES_GEOMETRY; i++, m += size) *each[i] = m;
+    return m;
+}
+
+/* with_l: the half grid's planes keep the luminance (the full image's is computed where needed) */
+static float *take_planes(planes *p, float *m, size_t size, int with_l) {
+    float **each[PLANES_EACH] = {&p->r, &p->g, &p->b, &p->s2, &p->n, &p->l};
+    for (int i = 0; i < PLANES_EACH - !with_l; i++, m += size) *each[i] = m;
+    return m;
 }
 
 denoiser *denoiser_create(int width, int height) {
@@ -150,25 +111,29 @@ denoiser *denoiser_create(int width, int height) {
     if (!d) return NULL;
     d->width = width;
     d->height = height;
-    d->stride = 2 * MARGIN + (width + CHUNK - 1) / CHUNK * CHUNK;
-    d->plane_size = (size_t)d->stride * (size_t)(height + 2 * MARGIN);
-    int count = PLANES_GEOMETRY + 2 * COMP_COUNT * PLANES_EACH;
+    d->half_width = (width + 1) / 2;
+    d->half_height = (height + 1) / 2;
+    d->stride = 2 * MARGIN + (d->half_width + CHUNK - 1) / CHUNK * CHUNK;
+    size_t full = (size_t)d->stride * (size_t)(height + 2 * MARGIN);
+    size_t half = (size_t)d->stride * (size_t)(d->half_height + 2 * MARGIN);
+    size_t n_full = 2 * (PLANES_GEOMETRY + COMP_COUNT * (PLANES_EACH - 1)); /* two parities, no l */
+    size_t n_half = PLANES_GEOMETRY + 2 + 2 * COMP_COUNT * PLANES_EACH;     /* rx, ry; two buffers */
     /* calloc: the margins stay 0, and a component never used is never touched (nor resident) */
-    d->mem = calloc((size_t)count * d->plane_size, sizeof(float));
+    d->mem = calloc(n_full * full + n_half * half, sizeof(float));
     if (!d->mem) {
         free(d);
         return NULL;
     }
     float *m = d->mem;
-    float **geometry[PLANES_GEOMETRY] = {&d->z, &d->nx, &d->ny, &d->nz, &d->gx, &d->gy};
-    for (int i = 0; i < PLANES_GEOMETRY; i++, m += d->plane_size) *geometry[i] = m;
+    for (int ph = 0; ph < 2; ph++) {
+        m = take_geometry(&d->full_geo[ph], m, full);
+        for (int c = 0; c < COMP_COUNT; c++) m = take_planes(&d->full[ph][c], m, full, 0);
+    }
+    m = take_geometry(&d->half_geo, m, half);
     for (int b = 0; b < 2; b++)
-        for (int c = 0; c < COMP_COUNT; c++) {
-            planes *p = &d->buf[b][c];
-            float **each[PLANES_EACH] = {&p->r, &p->g, &p->b, &p->l, &p->s2, &p->n};
-            for (int i = 0; i < PLANES_EACH; i++, m += d->plane_size) *each[i] = m;
-        }
-    cascade_kappa(d->kappa);
+        for (int c = 0; c < COMP_COUNT; c++) m = take_planes(&d->half[b][c], m, half, 1);
+    d->rx = m;
+    d->ry = m + half;
     return d;
 }
 
@@ -178,309 +143,182 @@ void denoiser_destroy(denoiser *d) {
     free(d);
 }
 
-typedef struct {
-    denoiser *d;
-    const denoise_input *in;
-    const denoise_output *out;
-    int comps;
-    float sigma_z, sigma_n, sigma_l;
-    /* the pass */
-    int step, src, last;
-    float kappa;
-    float inv_sqrt_unit; /* 1 / sqrt(the samples a scaled count of 1 stands for), before the pass */
-    float out_unit;      /* ... and after it */
-} job;
-
 static inline float sane_depth(float z) { return z > 0.0f ? (z < DEPTH_MAX ? z : DEPTH_MAX) : 0.0f; }
 static inline float sane_unit(float v) { return v > -1.0f ? (v < 1.0f ? v : 1.0f) : (v <= -1.0f ? -1.0f : 0.0f); }
 
 /* The depth's slope at z from its neighbours before (zm) and after (zp), 0 where absent or escaped:
  * the smaller one-sided difference, so a pixel at an edge takes its own surface's slope. */
-static float slope(float zm, float z, float zp) {
-    if (z == 0.0f) return 0.0f;
-    if (zm == 0.0f) return zp == 0.0f ? 0.0f : zp - z;
-    if (zp == 0.0f) return z - zm;
-    return fabsf(z - zm) < fabsf(zp - z) ? z - zm : zp - z;
+static inline float slope(float zm, float z, float zp) {
+    float dm = z - zm, dp = zp - z;
+    float s = fabsf(dm) < fabsf(dp) ? dm : dp;
+    float only_after = zp == 0.0f ? 0.0f : dp;
+    s = zp == 0.0f ? dm : s;
+    s = zm == 0.0f ? only_after : s;
+    return z == 0.0f ? 0.0f : s;
 }
 
-/* Row y of the input into the planes: geometry, and each component's light, luminance, variance and
- * scaled count; anything not finite is a hole (count 0). The run's tail past the image stays 0. */
+/* n items of k floats from src into a run, 0 past them (the run's tail past the image). */
+static void load_run(float *restrict dst, const float *restrict src, int n, int k) {
+    memcpy(dst, src, sizeof(float) * (size_t)(n * k));
+    memset(dst + n * k, 0, sizeof(float) * (size_t)((RUN - n) * k));
+}
+
+/* A run's pixels into the planes of their parity. */
+static void split_pairs(const float *restrict run, float *restrict even, float *restrict odd) {
+    for (int i = 0; i < CHUNK; i++) {
+        even[i] = run[2 * i];
+        odd[i] = run[2 * i + 1];
+    }
+}
+
+/* A run's geometry (into g: z, nx, ny, nz, gx, gy): zs its depths (0: none) with its left and right
+ * neighbours', za and zb those above and below, nrm its normals (3 floats each). */
+static void prep_geometry(const float *restrict zs, const float *restrict za, const float *restrict zb,
+                          const float *restrict nrm, float (*restrict g)[RUN]) {
+    for (int i = 0; i < RUN; i++) {
+        float zi = zs[i + 1];
+        g[0][i] = zi > 0.0f ? zi : DEPTH_SKY;
+        g[1][i] = sane_unit(nrm[3 * i]);
+        g[2][i] = sane_unit(nrm[3 * i + 1]);
+        g[3][i] = sane_unit(nrm[3 * i + 2]);
+        g[4][i] = slope(zs[i], zi, zs[i + 2]);
+        g[5][i] = slope(za[i], zi, zb[i]);
+    }
+}
+
+/* A run of one component's light (3 floats each), counts and variances into v: r, g, b, s2, n. */
+static void prep_light(const float *restrict rgb, const float *restrict count, const float *restrict var,
+                       float (*restrict v)[RUN]) {
+    for (int i = 0; i < RUN; i++) {
+        float vr = rgb[3 * i], vg = rgb[3 * i + 1], vb = rgb[3 * i + 2], k = count[i], s = var[i];
+        float finite = (vr - vr) + (vg - vg) + (vb - vb); /* x - x: 0 for a finite x, NaN otherwise */
+        float has = k > 0.0f && finite == 0.0f ? 1.0f : 0.0f;
+        vr = has > 0.0f ? vr : 0.0f;
+        vg = has > 0.0f ? vg : 0.0f;
+        vb = has > 0.0f ? vb : 0.0f;
+        k = k < COUNT_MAX ? k : COUNT_MAX;
+        s = s < S2_MAX ? s : S2_MAX;
+        v[0][i] = vr;
+        v[1][i] = vg;
+        v[2][i] = vb;
+        v[3][i] = has > 0.0f && s > 0.0f ? s : 0.0f;
+        v[4][i] = has > 0.0f ? k * COUNT_SCALE : 0.0f;
+    }
+}
+
+/* Row y of the input into the full image's planes: geometry, and each component's light, variance
+ * and scaled count; anything not finite is a hole (count 0). Pixels past the image are 0. A whole
+ * run is read where it lies, the image's last through a copy. */
 static void prep_row(void *ctx, int y, int worker) {
     (void)worker;
     const job *j = ctx;
     denoiser *d = j->d;
     const gbuffer *g = j->in->g;
     int w = d->width, h = d->height;
-    const float *depth = g->depth + (size_t)y * (size_t)w;
-    ptrdiff_t p0 = at(d, y, 0);
-    for (int x = 0; x < w; x++) {
-        size_t i = (size_t)y * (size_t)w + (size_t)x;
-        ptrdiff_t p = p0 + x;
-        float z = sane_depth(depth[x]);
-        d->z[p] = z > 0.0f ? z : DEPTH_SKY;
-        d->nx[p] = sane_unit(g->normal[3 * i]);
-        d->ny[p] = sane_unit(g->normal[3 * i + 1]);
-        d->nz[p] = sane_unit(g->normal[3 * i + 2]);
-        d->gx[p] = slope(x > 0 ? sane_depth(depth[x - 1]) : 0.0f, z, x + 1 < w ? sane_depth(depth[x + 1]) : 0.0f);
-        d->gy[p] = slope(y > 0 ? sane_depth(depth[x - w]) : 0.0f, z, y + 1 < h ? sane_depth(depth[x + w]) : 0.0f);
-    }
-    for (int c = 0; c < j->comps; c++) {
-        planes *pl = &d->buf[0][c];
-        const float *rgb_row = j->in->light[c] + 3 * (size_t)y * (size_t)w;
-        const float *count = j->in->count[c] + (size_t)y * (size_t)w;
-        const float *var = j->in->variance[c] ? j->in->variance[c] + (size_t)y * (size_t)w : NULL;
-        for (int x = 0; x < w; x++) {
-            ptrdiff_t p = p0 + x;
-            const float *rgb = rgb_row + 3 * x;
-            float n = count[x], v = var ? var[x] : 0.0f;
-            int ok = n > 0.0f && isfinite(rgb[0]) && isfinite(rgb[1]) && isfinite(rgb[2]);
-            pl->n[p] = ok ? (n < COUNT_MAX ? n : COUNT_MAX) * COUNT_SCALE : 0.0f;
-            pl->r[p] = ok ? rgb[0] : 0.0f;
-            pl->g[p] = ok ? rgb[1] : 0.0f;
-            pl->b[p] = ok ? rgb[2] : 0.0f;
-            pl->l[p] = lum_of(pl->r[p], pl->g[p], pl->b[p]);
-            pl->s2[p] = ok && v > 0.0f ? (v < S2_MAX ? v : S2_MAX) : 0.0f;
+    size_t row = (size_t)y * (size_t)w;
+    static const float none[3 * RUN];
+    for (int x0 = 0; x0 < w; x0 += RUN) {
+        int n = w - x0 < RUN ? w - x0 : RUN, whole = n == RUN;
+        ptrdiff_t p = at(d, y, x0 / 2);
+        size_t i0 = row + (size_t)x0;
+        /* depths (0: none) of the run and of its neighbours left, right, above and below */
+        float zs[RUN + 2], za[RUN], zb[RUN], nrm_run[3 * RUN];
+        load_run(zs + 1, g->depth + i0, n, 1);
+        zs[0] = x0 > 0 ? g->depth[i0 - 1] : 0.0f;
+        zs[n + 1] = x0 + n < w ? g->depth[i0 + (size_t)n] : 0.0f;
+        load_run(za, y > 0 ? g->depth + i0 - (size_t)w : none, y > 0 ? n : 0, 1);
+        load_run(zb, y + 1 < h ? g->depth + i0 + (size_t)w : none, y + 1 < h ? n : 0, 1);
+        for (int i = 0; i < RUN; i++) {
+            za[i] = sane_depth(za[i]);
+            zb[i] = sane_depth(zb[i]);
         }
-    }
-}
-
-/* The geometry weights h w_z w_n, as base-2 logarithms, of the taps at plane offsets +off and -off,
- * (dx, dy) and its mirror, for the run of pixels from p, into wa and wb; log2h is the kernel's
- * weight. The two taps share the depth gradient's step 1 / (sigma_z |grad z . (dx, dy)| + eps). */
-static void pair_geometry(const denoiser *d, const job *j, ptrdiff_t p, ptrdiff_t off, float dx, float dy, float log2h,
-                          float *restrict wa, float *restrict wb) {
-    const float *restrict z = d->z + p, *restrict za = d->z + p + off, *restrict zb = d->z + p - off;
-    const float *restrict nx = d->nx + p, *restrict ny = d->ny + p, *restrict nz = d->nz + p;
-    const float *restrict nxa = d->nx + p + off, *restrict nya = d->ny + p + off, *restrict nza = d->nz + p + off;
-    const float *restrict nxb = d->nx + p - off, *restrict nyb = d->ny + p - off, *restrict nzb = d->nz + p - off;
-    const float *restrict gx = d->gx + p, *restrict gy = d->gy + p;
-    float sz = j->sigma_z, sn = j->sigma_n;
-    for (int i = 0; i < CHUNK; i++) {
-        float zp = z[i];
-        float inv = LOG2E / (sz * fabsf(gx[i] * dx + gy[i] * dy) + EPS_Z * fabsf(zp) + EPS_TINY);
-        float ca = nx[i] * nxa[i] + ny[i] * nya[i] + nz[i] * nza[i];
-        float cb = nx[i] * nxb[i] + ny[i] * nyb[i] + nz[i] * nzb[i];
-        ca = ca < 1.0f ? ca : 1.0f;
-        ca = ca > 1e-30f ? ca : 1e-30f;
-        cb = cb < 1.0f ? cb : 1.0f;
-        cb = cb > 1e-30f ? cb : 1e-30f;
-        wa[i] = log2h + sn * log2_unit(ca) - fabsf(zp - za[i]) * inv;
-        wb[i] = log2h + sn * log2_unit(cb) - fabsf(zp - zb[i]) * inv;
-    }
-}
-
-/* SVGF's spatial variance where a pixel has fewer than YOUNG samples: the 7x7 neighbours on the
- * same surface (geometry weights w), each mean counted by its samples n, give
- *     s^2 = sum w n (l - lbar)^2 / D,   D = sum w - sum w^2 n / sum w n,
- * unbiased for equal means (D: its degrees of freedom). It is pooled with the given variance by
- * degrees of freedom, D against n - 1: a mean of one sample brings none of its own. Differences
- * are taken from the centre's luminance, so that the sums do not cancel. */
-typedef struct {
-    float w[CHUNK], wn[CHUNK], wnd[CHUNK], wnd2[CHUNK], w2n[CHUNK];
-} moments;
-
-static void add_moments(moments *restrict m, const planes *pl, ptrdiff_t p, ptrdiff_t off, const float *restrict w) {
-    const float *restrict l = pl->l + p, *restrict lq = pl->l + p + off, *restrict nq = pl->n + p + off;
-    for (int i = 0; i < CHUNK; i++) {
-        float wn = w[i] * nq[i], dl = lq[i] - l[i];
-        m->w[i] += nq[i] > 0.0f ? w[i] : 0.0f;
-        m->wn[i] += wn;
-        m->wnd[i] += wn * dl;
-        m->wnd2[i] += wn * dl * dl;
-        m->w2n[i] += w[i] * wn;
-    }
-}
-
-static void spatial_row(void *ctx, int y, int worker) {
-    (void)worker;
-    const job *j = ctx;
-    const denoiser *d = j->d;
-    const planes *pl = d->buf[0];
-    for (int x0 = 0; x0 < d->width; x0 += CHUNK) {
-        ptrdiff_t p = at(d, y, x0);
-        int young = 0;
+        for (int i = 0; i < RUN + 2; i++) zs[i] = sane_depth(zs[i]);
+        const float *nrm = g->normal + 3 * i0;
+        if (!whole) load_run(nrm_run, nrm, n, 3), nrm = nrm_run;
+        float v[PLANES_EACH][RUN];
+        prep_geometry(zs, za, zb, nrm, v);
+        for (int i = n; i < RUN; i++) v[0][i] = 0.0f; /* past the image: nothing */
+        const geometry *g0 = &d->full_geo[0], *g1 = &d->full_geo[1];
+        float *even[PLANES_GEOMETRY] = {g0->z, g0->nx, g0->ny, g0->nz, g0->gx, g0->gy};
+        float *odd[PLANES_GEOMETRY] = {g1->z, g1->nx, g1->ny, g1->nz, g1->gx, g1->gy};
+        for (int k = 0; k < PLANES_GEOMETRY; k++) split_pairs(v[k], even[k] + p, odd[k] + p);
         for (int c = 0; c < j->comps; c++) {
-            const float *restrict n = pl[c].n + p;
-            for (int i = 0; i < CHUNK; i++) young |= n[i] > 0.0f && n[i] < YOUNG * COUNT_SCALE;
-        }
-        if (!young) continue;
-        moments m[COMP_COUNT];
-        for (int c = 0; c < j->comps; c++) {
-            const float *restrict n = pl[c].n + p;
-            for (int i = 0; i < CHUNK; i++) {
-                m[c].w[i] = n[i] > 0.0f ? 1.0f : 0.0f;
-                m[c].wn[i] = m[c].w2n[i] = n[i];
-                m[c].wnd[i] = m[c].wnd2[i] = 0.0f;
+            float rgb_run[3 * RUN], count_run[RUN], var_run[RUN];
+            const float *rgb = j->in->light[c] + 3 * i0, *count = j->in->count[c] + i0;
+            const float *var = j->in->variance[c] ? j->in->variance[c] + i0 : none;
+            if (!whole || !j->in->variance[c]) {
+                load_run(rgb_run, rgb, n, 3);
+                load_run(count_run, count, n, 1);
+                load_run(var_run, var, j->in->variance[c] ? n : 0, 1);
+                rgb = rgb_run, count = count_run, var = var_run;
             }
-        }
-        for (int k = 0; k < 24; k++) {
-            ptrdiff_t off = (ptrdiff_t)PAIRS7[k][1] * d->stride + PAIRS7[k][0];
-            float lnw[2][CHUNK], w[CHUNK];
-            pair_geometry(d, j, p, off, (float)PAIRS7[k][0], (float)PAIRS7[k][1], 0.0f, lnw[0], lnw[1]);
-            for (int t = 0; t < 2; t++) {
-                for (int i = 0; i < CHUNK; i++) w[i] = exp2_neg(lnw[t][i]);
-                for (int c = 0; c < j->comps; c++) add_moments(&m[c], &pl[c], p, t == 0 ? off : -off, w);
-            }
-        }
-        for (int c = 0; c < j->comps; c++) {
-            for (int i = 0; i < CHUNK; i++) {
-                float n = pl[c].n[p + i];
-                if (!(n > 0.0f && n < YOUNG * COUNT_SCALE)) continue;
-                const moments *mc = &m[c];
-                double wn = (double)mc->wn[i], dof = (double)mc->w[i] - (double)mc->w2n[i] / wn;
-                double ss = (double)mc->wnd2[i] - (double)mc->wnd[i] * (double)mc->wnd[i] / wn;
-                double spatial = dof > 0.0 && ss > 0.0 ? ss / (dof * (double)COUNT_SCALE) : 0.0;
-                double own = (double)(n / COUNT_SCALE) - 1.0; /* the given variance's degrees of freedom */
-                if (own < 0.0) own = 0.0;
-                if (dof < 0.0) dof = 0.0;
-                if (dof + own > 0.0) {
-                    double v = (dof * spatial + own * (double)pl[c].s2[p + i]) / (dof + own);
-                    pl[c].s2[p + i] = v < (double)S2_MAX ? (float)v : S2_MAX;
-                }
-            }
+            prep_light(rgb, count, var, v);
+            const planes *e = &d->full[0][c], *o = &d->full[1][c];
+            float *pe[PLANES_EACH - 1] = {e->r, e->g, e->b, e->s2, e->n};
+            float *po[PLANES_EACH - 1] = {o->r, o->g, o->b, o->s2, o->n};
+            for (int k = 0; k < PLANES_EACH - 1; k++) split_pairs(v[k], pe[k] + p, po[k] + p);
         }
     }
 }
 
-/* log2 e / (sigma_l sqrt(var) + eps) for the run of pixels from p: var, the variance of the pixel's
- * current value, is the 3x3 Gaussian of its neighbours' one-sample variance (holes left out) over
- * its own count, so that a young neighbour's variance does not loosen a converged pixel's stop.
- * 0 at a hole: it has no luminance to compare, and is filled by geometry alone. */
-static void luminance_stop(const denoiser *d, const job *j, const planes *pl, ptrdiff_t p, float *restrict il) {
-    float gw[CHUNK] = {0}, gs[CHUNK] = {0};
-    for (int oy = -1; oy <= 1; oy++)
-        for (int ox = -1; ox <= 1; ox++) {
-            float k = G3[oy + 1] * G3[ox + 1];
-            const float *restrict nq = pl->n + p + oy * d->stride + ox;
-            const float *restrict s2 = pl->s2 + p + oy * d->stride + ox;
-            for (int i = 0; i < CHUNK; i++) {
-                float kk = nq[i] > 0.0f ? k : 0.0f;
-                gw[i] += kk;
-                gs[i] += kk * s2[i];
-            }
-        }
-    const float *restrict n = pl->n + p, *restrict l = pl->l + p;
-    float unit = j->inv_sqrt_unit, sigma = j->sigma_l;
+/* add_pair with SVGF's stop, on luminance alone (|l_p - l_q|, of the planes' l): what the half grid's
+ * passes use. A colour that changes at equal luminance blurs there, but the light at full
+ * resolution (the pooling, the 3x3 pass and the way back up) is compared channel by channel, so
+ * the half grid's light is taken only where it agrees in colour too (docs/design.md). */
+static void add_pair_lum(sums *restrict s, const float *restrict lp, tap ta, const float *restrict la, tap tb,
+                         const float *restrict lb, const float *restrict lnw_a, const float *restrict lnw_b,
+                         const float *restrict il) {
+    const float *restrict na = ta.n, *restrict nb = tb.n;
+    const float *restrict ra = ta.r, *restrict rb = tb.r;
+    const float *restrict ga = ta.g, *restrict gb = tb.g;
+    const float *restrict ba = ta.b, *restrict bb = tb.b;
     for (int i = 0; i < CHUNK; i++) {
-        int has = n[i] > 0.0f;
-        float v = gs[i] / (gw[i] > 0.0f ? gw[i] : 1.0f); /* gw > 0 wherever has */
-        float sd = sqrtf(v / (has ? n[i] : 1.0f)) * unit;
-        float inv = LOG2E / (sigma * sd + EPS_L * fabsf(l[i]) + EPS_TINY);
-        il[i] = has ? inv : 0.0f;
-    }
-}
-
-/* A pass's sums for one component over a run: a = h w n (weight by samples), b = a^2 / n (what the
- * mean's variance takes: SVGF's squared weights, over each tap's own count). */
-typedef struct {
-    float a[CHUNK], r[CHUNK], g[CHUNK], b[CHUNK], bb[CHUNK], bs[CHUNK];
-} sums;
-
-/* Adds the taps at +off and -off, whose h w_z w_n are 2^lnw_a, 2^lnw_b; il is log2 e over the
- * luminance stop's scale. The stop compares colours by the luminance's weights on each channel's
- * absolute difference: |l_p - l_q| itself when the light changes in brightness alone, but no
- * longer blind to a change of colour at equal luminance (docs/design.md). */
-static void add_pair(sums *restrict s, const planes *pl, ptrdiff_t p, ptrdiff_t off, const float *restrict lnw_a,
-                     const float *restrict lnw_b, const float *restrict il) {
-    const float *restrict rp = pl->r + p, *restrict gp = pl->g + p, *restrict bp = pl->b + p;
-    const float *restrict na = pl->n + p + off, *restrict nb = pl->n + p - off;
-    const float *restrict ra = pl->r + p + off, *restrict rb = pl->r + p - off;
-    const float *restrict ga = pl->g + p + off, *restrict gb = pl->g + p - off;
-    const float *restrict ba = pl->b + p + off, *restrict bb = pl->b + p - off;
-    const float *restrict sa = pl->s2 + p + off, *restrict sb = pl->s2 + p - off;
-    for (int i = 0; i < CHUNK; i++) {
-        float da = luminance3(v3(fabsf(rp[i] - ra[i]), fabsf(gp[i] - ga[i]), fabsf(bp[i] - ba[i])));
-        float db = luminance3(v3(fabsf(rp[i] - rb[i]), fabsf(gp[i] - gb[i]), fabsf(bp[i] - bb[i])));
+        float da = fabsf(lp[i] - la[i]), db = fabsf(lp[i] - lb[i]);
         float ea = exp2_neg(lnw_a[i] - da * il[i]), eb = exp2_neg(lnw_b[i] - db * il[i]);
-        float wa = ea * na[i], wb = eb * nb[i], qa = wa * ea, qb = wb * eb;
+        float wa = ea * na[i], wb = eb * nb[i];
         s->a[i] += wa + wb;
         s->r[i] += wa * ra[i] + wb * rb[i];
         s->g[i] += wa * ga[i] + wb * gb[i];
         s->b[i] += wa * ba[i] + wb * bb[i];
-        s->bb[i] += qa + qb;
-        s->bs[i] += qa * sa[i] + qb * sb[i];
+        s->bb[i] += wa * ea + wb * eb;
     }
 }
 
-/* The sums into the next planes: the weighted mean, the b-weighted mean of the one-sample variance,
- * and the effective count (sum a)^2 / sum b times kappa / TAPS (see level_row); a hole that stays
- * where no tap had a sample. */
-static void finish(const sums *restrict a, float *restrict r, float *restrict g, float *restrict b, float *restrict l,
-                   float *restrict n, float *restrict s2, float kappa) {
-    for (int i = 0; i < CHUNK; i++) {
-        float sa = a->a[i];
-        int has = sa >= FLT_MIN;
-        float inv = 1.0f / (has ? sa : 1.0f), bb = a->bb[i] > FLT_MIN ? a->bb[i] : FLT_MIN;
-        float vr = clampf_to(a->r[i] * inv, FLT_MAX), vg = clampf_to(a->g[i] * inv, FLT_MAX);
-        float vb = clampf_to(a->b[i] * inv, FLT_MAX);
-        float vn = kappa * sa * (sa / bb);
-        vn = vn < 0.5f ? vn : 0.5f;
-        r[i] = has ? vr : 0.0f;
-        g[i] = has ? vg : 0.0f;
-        b[i] = has ? vb : 0.0f;
-        l[i] = lum_of(r[i], g[i], b[i]);
-        n[i] = has ? vn : 0.0f;
-        s2[i] = has ? a->bs[i] / bb : 0.0f;
-    }
-}
-
-/* One à-trous pass over row y, from the src planes into the others (the last also into the output).
- * Each tap weighs h w_z w_n w_l n. The count after the pass is the effective count (sum a)^2 / sum b
- * times kappa: the sum alone would treat the taps as independent, but from pass 1 on they share
- * samples, and kappa is how much less the open cascade's count really grows. Without it the count
- * after 5 passes would be ~100 times too high, and the late passes' luminance stops that much too
- * tight (docs/design.md). */
+/* One à-trous pass over row y of the half grid, from the src planes into the others. Each tap
+ * weighs h w_z w_n w_l n. The count after the pass is the effective count (sum a)^2 / sum b times
+ * kappa: the sum alone would treat the taps as independent, but they share samples, and kappa is
+ * how much less the open cascade's count really grows. Without it the count after 5 passes would
+ * be ~100 times too high, and the late passes' luminance stops that much too tight
+ * (docs/design.md). */
 static void level_row(void *ctx, int y, int worker) {
     (void)worker;
     const job *j = ctx;
     const denoiser *d = j->d;
-    const planes *pl = d->buf[j->src], *to = d->buf[!j->src];
+    const planes *pl = d->half[j->src], *to = d->half[!j->src];
+    const geometry *g = &d->half_geo;
     const int s = j->step;
-    const float hc = B3[2] * B3[2];
-    for (int x0 = 0; x0 < d->width; x0 += CHUNK) {
-        ptrdiff_t p = at(d, y, x0);
-        float il[COMP_COUNT][CHUNK];
-        sums acc[COMP_COUNT];
-        for (int c = 0; c < j->comps; c++) {
-            luminance_stop(d, j, &pl[c], p, il[c]);
-            const float *restrict n = pl[c].n + p, *restrict r = pl[c].r + p, *restrict g = pl[c].g + p;
-            const float *restrict b = pl[c].b + p, *restrict s2 = pl[c].s2 + p;
-            sums *restrict a = &acc[c];
-            for (int i = 0; i < CHUNK; i++) {
-                float w = hc * n[i];
-                a->a[i] = w;
-                a->r[i] = w * r[i];
-                a->g[i] = w * g[i];
-                a->b[i] = w * b[i];
-                a->bb[i] = w * hc;
-                a->bs[i] = w * hc * s2[i];
-            }
-        }
+    for (int x0 = 0; x0 < d->half_width; x0 += CHUNK) {
+        ptrdiff_t p = at(d, y, x0), off[12];
+        float lnw[12][2][CHUNK];
         for (int k = 0; k < 12; k++) {
             int dx = PAIRS5[k][0] * s, dy = PAIRS5[k][1] * s;
-            ptrdiff_t off = (ptrdiff_t)dy * d->stride + dx;
-            float lnw[2][CHUNK], log2h = log2f(B3[PAIRS5[k][0] + 2] * B3[PAIRS5[k][1] + 2]);
-            pair_geometry(d, j, p, off, (float)dx, (float)dy, log2h, lnw[0], lnw[1]);
-            for (int c = 0; c < j->comps; c++) {
-                add_pair(&acc[c], &pl[c], p, off, lnw[0], lnw[1], il[c]);
-            }
+            off[k] = (ptrdiff_t)dy * d->stride + dx;
+            float log2h = log2f(B3[PAIRS5[k][0] + 2] * B3[PAIRS5[k][1] + 2]);
+            pair_geometry(j, g, p, g, p + off[k], g, p - off[k], (float)dx, (float)dy, log2h, lnw[k][0], lnw[k][1]);
         }
-        int tail = d->width - x0 < CHUNK ? d->width - x0 : CHUNK;
+        int tail = d->half_width - x0 < CHUNK ? d->half_width - x0 : CHUNK;
         for (int c = 0; c < j->comps; c++) {
+            sums acc;
+            float il[CHUNK];
+            luminance_stop(j, pl[c].n + p, pl[c].l + p, d->half[1][c].s2 + p, j->inv_sqrt_unit, il);
+            add_own(&acc, tap_at(&pl[c], p), B3[2] * B3[2], 1.0f);
+            for (int k = 0; k < 12; k++)
+                add_pair_lum(&acc, pl[c].l + p, tap_at(&pl[c], p + off[k]), pl[c].l + p + off[k],
+                             tap_at(&pl[c], p - off[k]), pl[c].l + p - off[k], lnw[k][0], lnw[k][1], il);
             const planes *dst = &to[c];
-            finish(&acc[c], dst->r + p, dst->g + p, dst->b + p, dst->l + p, dst->n + p, dst->s2 + p, j->kappa / TAPS);
+            finish(&acc, dst->r + p, dst->g + p, dst->b + p, dst->l + p, dst->n + p, j->kappa / TAPS);
             for (int i = tail; i < CHUNK; i++) /* the run's tail past the image: no sample */
-                to[c].r[p + i] = to[c].g[p + i] = to[c].b[p + i] = to[c].l[p + i] = to[c].n[p + i] = to[c].s2[p + i] =
-                    0.0f;
-            if (!j->last) continue;
-            size_t o = (size_t)y * (size_t)d->width + (size_t)x0;
-            float *out = j->out->light[c] + 3 * o, *count = j->out->count[c] ? j->out->count[c] + o : NULL;
-            for (int i = 0; i < tail; i++) {
-                out[3 * i] = to[c].r[p + i];
-                out[3 * i + 1] = to[c].g[p + i];
-                out[3 * i + 2] = to[c].b[p + i];
-                if (count) count[i] = clampf_to(to[c].n[p + i] * j->out_unit, FLT_MAX);
-            }
+                dst->r[p + i] = dst->g[p + i] = dst->b[p + i] = dst->l[p + i] = dst->n[p + i] = 0.0f;
         }
     }
 }
@@ -491,9 +329,9 @@ static void copy_row(void *ctx, int y, int worker) {
     const job *j = ctx;
     const denoiser *d = j->d;
     for (int c = 0; c < j->comps; c++) {
-        const planes *pl = &d->buf[0][c];
         for (int x = 0; x < d->width; x++) {
-            ptrdiff_t p = at(d, y, x);
+            const planes *pl = &d->full[x & 1][c];
+            ptrdiff_t p = at(d, y, x >> 1);
             size_t o = (size_t)y * (size_t)d->width + (size_t)x;
             float *out = j->out->light[c] + 3 * o;
             out[0] = pl->r[p];
@@ -504,11 +342,28 @@ static void copy_row(void *ctx, int y, int worker) {
     }
 }
 
-static void run_rows(threadpool *pool, task_fn fn, job *j) {
+/* While the filter's rows run, results too small for a normal float are flushed to zero and such
+ * inputs read as zero (x86's FTZ and DAZ, restored after each row: the pool's threads render too).
+ * A weight of 2^-115 times a small count is one: it counts for nothing, and handled as a denormal
+ * it costs a hundred times a normal float, which doubled the passes over a sparse image. */
+static void row_task(void *ctx, int y, int worker) {
+    job *j = ctx;
+#if defined(__SSE__)
+    unsigned csr = _mm_getcsr();
+    _mm_setcsr(csr | 0x8040u);
+    j->row(ctx, y, worker);
+    _mm_setcsr(csr);
+#else
+    j->row(ctx, y, worker);
+#endif
+}
+
+static void run_rows(threadpool *pool, task_fn fn, job *j, int rows) {
+    j->row = fn;
     if (pool) {
-        threadpool_run(pool, fn, j, j->d->height);
+        threadpool_run(pool, row_task, j, rows);
     } else {
-        for (int y = 0; y < j->d->height; y++) fn(j, y, 0);
+        for (int y = 0; y < rows; y++) row_task(j, y, 0);
     }
 }
 
@@ -527,22 +382,33 @@ int denoise_run(denoiser *d, const denoise_input *in, const denoise_params *p, c
     j.sigma_n = sigma_or(p->sigma_n, 128.0f);
     j.sigma_l = sigma_or(p->sigma_l, 4.0f);
     int levels = p->levels < 0 ? 0 : (p->levels > DENOISE_MAX_LEVELS ? DENOISE_MAX_LEVELS : p->levels);
-    run_rows(pool, prep_row, &j);
+    run_rows(pool, prep_row, &j, d->height);
     if (levels == 0) {
-        run_rows(pool, copy_row, &j);
+        run_rows(pool, copy_row, &j, d->height);
         return 0;
     }
-    run_rows(pool, spatial_row, &j);
+    plan pl = make_plan(levels);
     double unit = 1.0 / (double)COUNT_SCALE; /* samples a scaled count of 1 stands for */
-    for (int i = 0; i < levels; i++) {
+    j.kappa = pl.kappa_pool;
+    j.inv_sqrt_unit = (float)(1.0 / sqrt(unit));
+    run_rows(pool, denoise_pool_row, &j, d->half_height);
+    run_rows(pool, denoise_variance_row, &j, d->half_height);
+    double coarse = unit * 16.0; /* see finish */
+    for (int i = 0; i < pl.coarse; i++) {
         j.step = 1 << i;
         j.src = i & 1;
-        j.last = i == levels - 1;
-        j.kappa = d->kappa[i];
-        j.inv_sqrt_unit = (float)(1.0 / sqrt(unit));
-        unit *= (double)TAPS;
-        j.out_unit = (float)unit;
-        run_rows(pool, level_row, &j);
+        j.kappa = pl.kappa_coarse[i];
+        j.inv_sqrt_unit = (float)(1.0 / sqrt(coarse));
+        coarse *= (double)TAPS;
+        run_rows(pool, level_row, &j, d->half_height);
     }
+    j.coarse = pl.coarse & 1;
+    j.kappa_fine = pl.kappa_fine;
+    j.inv_sqrt_unit = (float)(1.0 / sqrt(unit));
+    j.fine_inv_sqrt_unit = (float)(1.0 / sqrt(unit * (double)TAPS));
+    j.fine_to_coarse = (float)(unit * (double)TAPS / coarse);
+    j.kappa = pl.kappa_up;
+    j.out_unit = (float)(coarse * 5.0);
+    run_rows(pool, denoise_upsample_row, &j, d->height);
     return 0;
 }

@@ -1,9 +1,10 @@
 /* glint — the display's spatial filter: an edge-avoiding à-trous wavelet (Dammertz et al. 2010)
- * with SVGF's variance-guided weights (Schied et al. 2017), on the CPU. It filters each film
- * component's light divided by the pixel's albedo (the caller multiplies back), guided by a
- * G-buffer; each sample counts by how many samples stand behind it, and holes (pixels with no
- * sample yet) are filled from their neighbours by geometry alone. Only the display reads the
- * result: the film is never filtered. docs/design.md, "The display: denoising". */
+ * with SVGF's variance-guided weights (Schied et al. 2017), on the CPU, its wide passes on a
+ * half-resolution grid (a pyramid). It filters each film component's light divided by the pixel's
+ * albedo (the caller multiplies back), guided by a G-buffer; each sample counts by how many
+ * samples stand behind it, and holes (pixels with no sample yet) are filled from their neighbours
+ * by geometry alone. Only the display reads the result: the film is never filtered.
+ * docs/design.md, "The display: denoising". */
 #ifndef GLINT_DENOISE_H
 #define GLINT_DENOISE_H
 
@@ -11,13 +12,15 @@
 #include "gbuffer.h"
 #include "threadpool.h"
 
-/* The farthest-reaching pass has holes 2^(DENOISE_MAX_LEVELS - 1): 5 passes reach 62 pixels. */
+/* The farthest-reaching pass has holes 2^(DENOISE_MAX_LEVELS - 1) pixels: five levels reach about 65. */
 #define DENOISE_MAX_LEVELS 5
 
 typedef struct {
     float sigma_z, sigma_n, sigma_l; /* the edge stops (depth, normal, luminance); 0: SVGF's 1, 128, 4 */
-    int levels;                      /* à-trous passes, holes 1, 2, 4, ...; 0: none (the output is the input,
-                                      * holes stay holes); at most DENOISE_MAX_LEVELS */
+    int levels;                      /* how far it reaches: the input pooled into the half grid, levels - 1
+                                      * passes there (holes 2, 4, 8, ... pixels), the way back up with the
+                                      * full image's 3x3 pass; 0: none (the output is the input, holes stay
+                                      * holes); at most DENOISE_MAX_LEVELS */
 } denoise_params;
 
 typedef struct {
@@ -42,9 +45,11 @@ typedef struct {
 
 typedef struct denoiser denoiser;
 
-/* Scratch for width x height images: 6 planes of geometry and 12 per component used, each of
- * (width rounded up to 128, + 64) x (height + 64) floats (79 MB for two components at 960x540).
- * NULL when out of memory or the size is not in 1..65536. */
+/* Scratch for width x height images: planes of (width / 2 rounded up to 128, + 32) floats a row,
+ * the full image's (height + 32 rows, 6 of geometry and 5 per component used, twice: a plane for
+ * each column parity) and the half grid's (height / 2 + 32 rows, 8 of geometry, 12 per component
+ * used): 61 MB for two components at 960x540. NULL when out of memory or the size is not in
+ * 1..65536. */
 denoiser *denoiser_create(int width, int height);
 void denoiser_destroy(denoiser *d); /* NULL is fine */
 

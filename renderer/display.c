@@ -35,9 +35,9 @@ typedef struct {
  * this cosine and it lies within this many pixel footprints of the old point's plane. */
 #define REPROJECT_MIN_COS 0.9f
 #define REPROJECT_PLANE_PIXELS 2.0f
-/* The filter's passes: three reach 14 pixels, enough where most pixels have samples (more blur
+/* The filter's levels: three reach about 15 pixels, enough where most pixels have samples (more blur
  * the image for no less noise); where many have none yet (a new view, the sparse updates while the
- * camera moves) the passes reach as far as the holes are wide. */
+ * camera moves) the levels reach as far as the holes are wide. */
 #define DENOISE_LEVELS 3
 
 /* A tile's evidence since the last light change: new samples' luminance (every component, divided
@@ -60,6 +60,7 @@ struct display {
      * luminance variance) and its output */
     float *light[COMP_COUNT], *count[COMP_COUNT], *variance[COMP_COUNT], *out[COMP_COUNT];
     float *out_count[COMP_COUNT]; /* the samples behind the filter's value... */
+    float *bias[COMP_COUNT];      /* ...a sample of its squared bias (bias_row)... */
     float *take[COMP_COUNT];      /* ...and how much of it a pixel takes (weigh_row) */
     denoiser *dn;
     int active[COMP_COUNT]; /* a component had a sample other than zero since the last restart */
@@ -90,9 +91,10 @@ display *display_create(int width, int height, int threads, char *err, size_t er
         d->variance[c] = malloc(sizeof(float) * n);
         d->out[c] = malloc(sizeof(float) * 3 * n);
         d->out_count[c] = malloc(sizeof(float) * n);
+        d->bias[c] = malloc(sizeof(float) * n);
         d->take[c] = malloc(sizeof(float) * n);
         ok = d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c] && d->out_count[c] &&
-             d->take[c];
+             d->bias[c] && d->take[c];
     }
     if (ok) ok = (d->sink.stamp = calloc(n, sizeof(uint32_t))) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
@@ -125,6 +127,7 @@ void display_destroy(display *d) {
         free(d->variance[c]);
         free(d->out[c]);
         free(d->out_count[c]);
+        free(d->bias[c]);
         free(d->take[c]);
     }
     free(d->sink.stamp);
@@ -496,6 +499,18 @@ static float bias_sample(const display *d, int c, size_t i) {
     return diff * diff - s2 / n + s2 / nf;
 }
 
+/* Each pixel's bias sample, once: weigh_row reads nine. */
+static void bias_row(void *ctx, int y, int worker) {
+    (void)worker;
+    resolve_job *j = ctx;
+    display *d = j->d;
+    size_t i0 = (size_t)y * (size_t)d->width;
+    for (int c = 0; c < COMP_COUNT; c++) {
+        if (!(j->mask >> c & 1u)) continue;
+        for (size_t i = i0; i < i0 + (size_t)d->width; i++) d->bias[c][i] = bias_sample(d, c, i);
+    }
+}
+
 /* How much of the filtered value each pixel takes: the mix of its own mean x (unbiased, variance
  * v_x) and the filter's f (variance v_f, bias b) with the least expected squared error, v_x / (v_x +
  * v_f + b^2), b^2 estimated from (f - x)^2 over the pixel's 3x3 neighbours on the same surface. A
@@ -525,7 +540,7 @@ static void weigh_row(void *ctx, int y, int worker) {
                     if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
                     size_t q = (size_t)qy * (size_t)w + (size_t)qx;
                     if (g->material[q] != g->material[i]) continue;
-                    float e = bias_sample(d, c, q);
+                    float e = d->bias[c][q];
                     if (e < -0.5f) continue;
                     b2 += e, s2_local += d->variance[c][q], m++;
                 }
@@ -572,6 +587,7 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
     for (int c = 0; c < COMP_COUNT; c++)
         if (mask >> c & 1u && d->active[c]) j.mask |= 1u << c;
     d->st.levels = 0;
+    d->st.filter_ms = 0.0;
     if (denoise) {
         threadpool_run(d->pool, split_row, &j, d->height);
         d->st.mean_count = (double)atomic_load(&j.samples) / ((double)d->width * (double)d->height);
@@ -587,12 +603,15 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
             out.light[k] = d->out[c];
             out.count[k] = d->out_count[c];
         }
-        /* a pass more for each halving of the pixels with samples, up to all five */
+        /* a level more for each halving of the pixels with samples, up to all five */
         double covered = 1.0 - (double)atomic_load(&j.holes) / ((double)d->width * (double)d->height);
         int levels = DENOISE_LEVELS;
         for (double k = 0.5; covered < k && levels < DENOISE_MAX_LEVELS; k *= 0.5) levels++;
         denoise_params p = {.levels = levels};
+        uint64_t t1 = clock_ns();
         if (in.components) denoise_run(d->dn, &in, &p, &out, d->pool);
+        d->st.filter_ms = 1e-6 * (double)(clock_ns() - t1);
+        threadpool_run(d->pool, bias_row, &j, d->height);
         threadpool_run(d->pool, weigh_row, &j, d->height);
         d->st.levels = levels;
     }

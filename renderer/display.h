@@ -28,10 +28,11 @@ typedef struct {
     long long carried; /* pixels whose history the last view change carried over... */
     long long lost;    /* ...and those it lost (disocclusions, another surface) */
     double mean_count; /* samples behind the average pixel's light at the last resolve */
-    int levels;        /* the filter's passes at the last resolve (0: not filtered) */
+    int levels;        /* the filter's levels at the last resolve (0: not filtered) */
     double view_ms;    /* the last view change: G-buffer and reprojection... */
     double gbuffer_ms; /* ...of which the G-buffer */
-    double resolve_ms; /* the last resolve: filter and modulation */
+    double resolve_ms; /* the last resolve: filter and modulation... */
+    double filter_ms;  /* ...of which the filter (denoise_run) */
 } display_stats;
 
 typedef struct display display;

@@ -1,8 +1,8 @@
 /* The display pipeline headless, as the viewer's render thread drives it: each update renders one
  * part of a frame (session_render_part) into the display's sink, the display takes the samples and
  * resolves the image shown; the camera may orbit a little before each update. Prints, per update,
- * what it cost (part, view change, resolve) and, given a reference of the final pose, the error of
- * the image shown and of the film. A measurement for tuning (use a release build with tests on),
+ * what it cost (part, view change, resolve: wall and CPU time, the filter's wall time and passes)
+ * and, given a reference of the final pose, the error of the image shown and of the film. A measurement for tuning (use a release build with tests on),
  * not a test; the viewer itself is measured by tests/bench/viewer_display.sh.
  *
  * usage: display_bench [--scene S] [--method M] [--size WxH] [--parts K] [--updates N]
@@ -22,6 +22,12 @@
 #include "image_io.h"
 #include "metrics.h"
 #include "session.h"
+
+static double cpu_ms(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
+}
 
 static camera orbit(camera c, float degrees, float dist) {
     vec3 target = madd3(c.position, c.forward, dist);
@@ -82,7 +88,8 @@ int main(int argc, char **argv) {
     display_change_view(d, s, &cam, DISPLAY_RESTART);
     size_t n = 3 * (size_t)w * (size_t)h;
     float *shown = malloc(sizeof(float) * n), *raw = malloc(sizeof(float) * n);
-    printf("update,seconds,part_ms,view_ms,gbuffer_ms,resolve_ms,mean_count,frames,shown_error,film_error\n");
+    printf("update,seconds,part_ms,view_ms,gbuffer_ms,resolve_ms,resolve_cpu_ms,filter_ms,levels,mean_count,frames,"
+           "shown_error,film_error\n");
     uint64_t t_start = clock_ns();
     for (int u = 0; u < updates; u++) {
         double view_ms = 0.0, gbuffer_ms = 0.0;
@@ -101,7 +108,9 @@ int main(int argc, char **argv) {
         if (session_render_part(rs, parts, &done) != 0) return fprintf(stderr, "%s\n", session_error(rs)), 1;
         double part_ms = 1e-6 * (double)(clock_ns() - t0);
         display_take_samples(d);
+        double cpu0 = cpu_ms();
         display_resolve(d, COMP_MASK_ALL, denoise, shown);
+        double resolve_cpu = cpu_ms() - cpu0;
         display_stats ds = display_get_stats(d);
         double e_shown = -1.0, e_film = -1.0;
         int at_ref = ref.rgb && ref.width == w && ref.height == h && u >= orbit_updates;
@@ -110,8 +119,9 @@ int main(int argc, char **argv) {
             film_resolve(session_film(rs), COMP_MASK_ALL, raw);
             e_film = metric_rel_l2(raw, ref.rgb, n);
         }
-        printf("%d,%.3f,%.1f,%.1f,%.1f,%.1f,%.3f,%lld,%.4f,%.4f\n", u, 1e-9 * (double)(clock_ns() - t_start), part_ms,
-               view_ms, gbuffer_ms, ds.resolve_ms, ds.mean_count, session_frames(rs), e_shown, e_film);
+        printf("%d,%.3f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%d,%.3f,%lld,%.4f,%.4f\n", u,
+               1e-9 * (double)(clock_ns() - t_start), part_ms, view_ms, gbuffer_ms, ds.resolve_ms, resolve_cpu,
+               ds.filter_ms, ds.levels, ds.mean_count, session_frames(rs), e_shown, e_film);
         fflush(stdout);
     }
     if (save) { /* the last image shown and the film, with their components: PREFIX-shown.exr, PREFIX-film.exr */
