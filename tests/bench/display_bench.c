@@ -8,8 +8,9 @@
  * usage: display_bench [--scene S] [--method M] [--size WxH] [--parts K] [--updates N]
  *                      [--orbit DEG --orbit-updates M] [--denoise 0|1] [--reference REF.exr]
  *                      [--threads T] [--seed S] [--save PREFIX]
- * The orbit turns the camera by DEG about the vertical through a point 3 m in front of it before
- * each of the first M updates; the reference is of the pose after them. */
+ * The orbit turns the camera by DEG about the vertical through the point in front of it as far as
+ * the scene's centre (as the viewer's orbit turns) before each of the first M updates; the
+ * reference is of the pose after them. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -94,7 +95,8 @@ int main(int argc, char **argv) {
     for (int u = 0; u < updates; u++) {
         double view_ms = 0.0, gbuffer_ms = 0.0;
         if (u < orbit_updates) {
-            cam = orbit(cam, orbit_deg, 3.0f);
+            cam = orbit(cam, orbit_deg,
+                        fmaxf(dot3(sub3(bounds_center(s->bounds), cam.position), cam.forward), 0.05f * s->diag));
             p.seed = seed + (uint64_t)u + 1; /* each accumulation its own random numbers, as the viewer */
             session_set_params(rs, &p);
             session_set_camera(rs, &cam);
