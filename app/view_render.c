@@ -333,8 +333,7 @@ typedef struct {
     int measure;          /* the view is the reference's: errors count */
     int frame_done;       /* the update ended a frame */
     int rendered;         /* it rendered a part (not only a new look at the display) */
-    double part_ms;       /* its part's time */
-    render_stats before;  /* the session's statistics before it */
+    double part_ms;       /* its last part's time */
     uint64_t resets_seen; /* the accumulation it belongs to */
     uint64_t gen;
 } update_info;
@@ -433,27 +432,38 @@ static void publish(render_thread *rt, const update_info *up) {
     if (sh->wake) sh->wake(); /* the UI thread, waiting for events, takes the image now */
 }
 
-/* How many parts the next frame takes: as few as keep an update (the frame's set-up, the part, the
- * display) within the update time of the image's age; but a part never takes less than the display's
- * own work, so that on a slow machine (or a sanitizer's build) rendering keeps at least half the time
- * and frames still come. */
-static int parts_for(const render_thread *rt, double age) {
+/* How long an update may render: what the update time of the image's age leaves beside the
+ * display's work. While the camera moves (and for a while after) the update rate comes first, and
+ * rendering gets what is left, a fifth at least; at rest rendering gets at least as long as the
+ * display, so that on a slow machine (or a sanitizer's build) frames still come. */
+static double render_budget(const render_thread *rt, double age) {
+    if (age < YOUNG_SECONDS) return fmax(UPDATE_MS - rt->display_ms, 0.2 * UPDATE_MS);
+    return fmax(REST_UPDATE_MS - rt->display_ms, rt->display_ms);
+}
+
+/* How many parts the next frame takes: as few as keep a part (and the frame's set-up) within what
+ * a young update may render; at rest an update renders as many of them as its budget holds. */
+static int parts_for(const render_thread *rt) {
     if (!(rt->frame_ms > 0.0)) return FIRST_PARTS;
-    double budget = (age < YOUNG_SECONDS ? UPDATE_MS : REST_UPDATE_MS) - rt->display_ms - rt->setup_ms;
-    budget = fmax(fmax(budget, 0.25 * UPDATE_MS), rt->display_ms);
+    double budget = fmax(UPDATE_MS - rt->display_ms - rt->setup_ms, 0.2 * UPDATE_MS);
     int parts = 1;
     while (parts < SESSION_MAX_PARTS && rt->frame_ms / parts > budget) parts *= 2;
     return parts;
 }
 
-/* Learns an update's costs: ms for its part, which began a frame of `parts` parts when `began`
- * (then setup_ms of it was the frame's set-up). Smoothed over updates. */
-static void learn_costs(render_thread *rt, double ms, int parts, int began, double setup_ms, double display_ms) {
+/* Learns a part's cost: ms for it, which began a frame of `parts` parts when `began` (then setup_ms
+ * of it was the frame's set-up). Smoothed over parts. */
+static void learn_costs(render_thread *rt, double ms, int parts, int began, double setup_ms) {
     const double a = 0.3;
     double frame = fmax(ms - (began ? setup_ms : 0.0), 0.0) * parts;
     rt->frame_ms = rt->frame_ms > 0.0 ? (1.0 - a) * rt->frame_ms + a * frame : frame;
     if (began) rt->setup_ms = rt->setup_ms > 0.0 ? (1.0 - a) * rt->setup_ms + a * setup_ms : setup_ms;
-    rt->display_ms = rt->display_ms > 0.0 ? (1.0 - a) * rt->display_ms + a * display_ms : display_ms;
+}
+
+/* ... and the display's, an update's. */
+static void learn_display(render_thread *rt, double ms) {
+    const double a = 0.3;
+    rt->display_ms = rt->display_ms > 0.0 ? (1.0 - a) * rt->display_ms + a * ms : ms;
 }
 
 /* Whether two requests render the same estimate (the panel sends its parameters with their defaults
@@ -599,30 +609,41 @@ static void *render_main(void *arg) {
             if (change & DISPLAY_RESTART) rt->frame_ms = rt->setup_ms = 0.0; /* another estimator's costs */
             applied = gen;
         }
-        int began = session_frame_parts(rs) == 0;
-        int parts = began ? parts_for(rt, age) : session_frame_parts(rs);
-        render_stats before = session_stats(rs);
-        up.before = before;
-        double t0 = cli_now();
-        int r = session_render_part(rs, parts, &up.frame_done);
-        up.part_ms = 1e3 * (cli_now() - t0);
-        up.rendered = r == 0;
-        if (r == 1) rt->film_partial = 1; /* stopped for a newer change: its samples still show */
-        if (r < 0) set_message(rt, "%s%s", session_error(rs), "");
-        if (up.frame_done) rt->film_partial = 0;
+        /* Parts until the update's budget is spent, a frame ends, or a request comes. */
+        double budget = render_budget(rt, age), spent = 0.0;
+        int r = 0;
+        for (;;) {
+            int began = session_frame_parts(rs) == 0;
+            int parts = began ? parts_for(rt) : session_frame_parts(rs);
+            render_stats before = session_stats(rs);
+            double t0 = cli_now();
+            r = session_render_part(rs, parts, &up.frame_done);
+            double ms = 1e3 * (cli_now() - t0);
+            spent += ms;
+            if (r == 1) rt->film_partial = 1; /* stopped by quitting */
+            if (r < 0) set_message(rt, "%s%s", session_error(rs), "");
+            if (r != 0) break;
+            up.rendered = 1;
+            up.part_ms = ms;
+            render_stats after = session_stats(rs);
+            /* a reset in between zeroes the statistics: then the set-up is not known from them */
+            double setup = after.pass_ns[PASS_VIRTUAL_LIGHTS] >= before.pass_ns[PASS_VIRTUAL_LIGHTS]
+                               ? 1e-6 * (double)(after.pass_ns[PASS_VIRTUAL_LIGHTS] - before.pass_ns[PASS_VIRTUAL_LIGHTS])
+                               : 0.0;
+            learn_costs(rt, ms, parts, began, setup);
+            if (up.frame_done) {
+                rt->film_partial = 0;
+                break;
+            }
+            pthread_mutex_lock(&sh->lock);
+            int asked = sh->requests != requests_seen;
+            pthread_mutex_unlock(&sh->lock);
+            if (asked || spent + rt->frame_ms / session_frame_parts(rs) > budget) break;
+        }
         display_take_samples(rt->disp);
         double t1 = cli_now();
         publish(rt, &up);
-        if (r == 0) {
-            render_stats after = session_stats(rs);
-            /* a reset in between zeroes the statistics: then the set-up is not known from them */
-            double setup =
-                after.pass_ns[PASS_VIRTUAL_LIGHTS] >= before.pass_ns[PASS_VIRTUAL_LIGHTS]
-                    ? 1e-6 * (double)(after.pass_ns[PASS_VIRTUAL_LIGHTS] - before.pass_ns[PASS_VIRTUAL_LIGHTS])
-                    : 0.0;
-            display_stats ds = display_get_stats(rt->disp);
-            learn_costs(rt, up.part_ms, parts, began, setup, 1e3 * (cli_now() - t1) + (change ? ds.view_ms : 0.0));
-        }
+        learn_display(rt, 1e3 * (cli_now() - t1) + (change ? display_get_stats(rt->disp).view_ms : 0.0));
         if (r < 0)
             refinement_hold(sh);
         else

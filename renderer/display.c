@@ -61,7 +61,6 @@ struct display {
     float *light[COMP_COUNT], *count[COMP_COUNT], *variance[COMP_COUNT], *out[COMP_COUNT];
     float *out_count[COMP_COUNT]; /* the samples behind the filter's value... */
     float *bias[COMP_COUNT];      /* ...a sample of its squared bias (bias_row)... */
-    float *take[COMP_COUNT];      /* ...and how much of it a pixel takes (weigh_row) */
     denoiser *dn;
     int active[COMP_COUNT]; /* a component had a sample other than zero since the last restart */
     /* after a light change: the history before it, and per tile what new samples say of it */
@@ -92,9 +91,8 @@ display *display_create(int width, int height, int threads, char *err, size_t er
         d->out[c] = malloc(sizeof(float) * 3 * n);
         d->out_count[c] = malloc(sizeof(float) * n);
         d->bias[c] = malloc(sizeof(float) * n);
-        d->take[c] = malloc(sizeof(float) * n);
         ok = d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c] && d->out_count[c] &&
-             d->bias[c] && d->take[c];
+             d->bias[c];
     }
     if (ok) ok = (d->sink.stamp = calloc(n, sizeof(uint32_t))) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
@@ -128,7 +126,6 @@ void display_destroy(display *d) {
         free(d->out[c]);
         free(d->out_count[c]);
         free(d->bias[c]);
-        free(d->take[c]);
     }
     free(d->sink.stamp);
     free(d);
@@ -499,7 +496,7 @@ static float bias_sample(const display *d, int c, size_t i) {
     return diff * diff - s2 / n + s2 / nf;
 }
 
-/* Each pixel's bias sample, once: weigh_row reads nine. */
+/* Each pixel's bias sample, once: take_of reads nine. */
 static void bias_row(void *ctx, int y, int worker) {
     (void)worker;
     resolve_job *j = ctx;
@@ -511,48 +508,39 @@ static void bias_row(void *ctx, int y, int worker) {
     }
 }
 
-/* How much of the filtered value each pixel takes: the mix of its own mean x (unbiased, variance
- * v_x) and the filter's f (variance v_f, bias b) with the least expected squared error, v_x / (v_x +
- * v_f + b^2), b^2 estimated from (f - x)^2 over the pixel's 3x3 neighbours on the same surface. A
- * noisy pixel takes the filter; a converged one, or one where the filter blurs a feature its own
- * samples resolve, keeps its own mean: the filter fades out as the image converges, pixel by pixel.
- * A pixel without a variance of its own yet (fewer than two samples) takes the filter. */
-static void weigh_row(void *ctx, int y, int worker) {
-    (void)worker;
-    resolve_job *j = ctx;
-    display *d = j->d;
-    const gbuffer *g = &d->g[d->cur];
+/* How much of the filtered value pixel (x, y) takes of component c: the mix of its own mean x
+ * (unbiased, variance v_x) and the filter's f (variance v_f, bias b) with the least expected squared
+ * error, v_x / (v_x + v_f + b^2), b^2 estimated from (f - x)^2 over the pixel's 3x3 neighbours on
+ * the same surface. A noisy pixel takes the filter; a converged one, or one where the filter blurs
+ * a feature its own samples resolve, keeps its own mean: the filter fades out as the image
+ * converges, pixel by pixel. A pixel without a variance of its own yet (fewer than two samples)
+ * takes the filter. */
+static float take_of(const display *d, const int32_t *mats, int c, int x, int y) {
     int w = d->width, h = d->height;
-    for (int x = 0; x < w; x++) {
-        size_t i = (size_t)y * (size_t)w + (size_t)x;
-        for (int c = 0; c < COMP_COUNT; c++) {
-            if (!(j->mask >> c & 1u)) continue;
-            float n = d->count[c][i], s2 = d->variance[c][i];
-            if (!(n >= 2.0f)) {
-                d->take[c][i] = 1.0f;
-                continue;
-            }
-            float b2 = 0.0f, s2_local = 0.0f;
-            int m = 0;
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dx = -1; dx <= 1; dx++) {
-                    int qx = x + dx, qy = y + dy;
-                    if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-                    size_t q = (size_t)qy * (size_t)w + (size_t)qx;
-                    if (g->material[q] != g->material[i]) continue;
-                    float e = d->bias[c][q];
-                    if (e < -0.5f) continue;
-                    b2 += e, s2_local += d->variance[c][q], m++;
-                }
-            b2 = m ? fmaxf(b2 / (float)m, 0.0f) : 0.0f;
-            /* one pixel's variance from a few samples misses the rare bright ones: its surface's
-             * around it is steadier */
-            s2 = m ? fmaxf(s2, s2_local / (float)m) : s2;
-            float vx = s2 / n, vf = s2 / fmaxf(d->out_count[c][i], n);
-            float t = vx / (vx + vf + b2 + 1e-30f);
-            d->take[c][i] = isfinite(t) ? clampf(t, 0.0f, 1.0f) : 1.0f;
+    size_t i = (size_t)y * (size_t)w + (size_t)x;
+    float n = d->count[c][i];
+    if (!(n >= 2.0f)) return 1.0f;
+    int32_t me = mats[i];
+    int x0 = x > 0 ? x - 1 : x, x1 = x + 1 < w ? x + 1 : x, y0 = y > 0 ? y - 1 : y, y1 = y + 1 < h ? y + 1 : y;
+    float b2 = 0.0f, s2_local = 0.0f;
+    int m = 0;
+    for (int qy = y0; qy <= y1; qy++) {
+        size_t row = (size_t)qy * (size_t)w;
+        const int32_t *mr = mats + row;
+        const float *br = d->bias[c] + row, *vr = d->variance[c] + row;
+        for (int qx = x0; qx <= x1; qx++) {
+            if (mr[qx] != me || br[qx] < -0.5f) continue;
+            b2 += br[qx], s2_local += vr[qx], m++;
         }
     }
+    b2 = m ? fmaxf(b2 / (float)m, 0.0f) : 0.0f;
+    /* one pixel's variance from a few samples misses the rare bright ones: its surface's around it
+     * is steadier */
+    float s2 = d->variance[c][i];
+    s2 = m ? fmaxf(s2, s2_local / (float)m) : s2;
+    float vx = s2 / n, vf = s2 / fmaxf(d->out_count[c][i], n);
+    float t = vx / (vx + vf + b2 + 1e-30f);
+    return isfinite(t) ? clampf(t, 0.0f, 1.0f) : 1.0f;
 }
 
 static void modulate_row(void *ctx, int y, int worker) {
@@ -569,7 +557,7 @@ static void modulate_row(void *ctx, int y, int worker) {
             const float *m;
             if (j->filtered) {
                 vec3 own = get3(d->light[c], i), f = get3(d->out[c], i);
-                sum = add3(sum, madd3(own, sub3(f, own), d->take[c][i]));
+                sum = add3(sum, madd3(own, sub3(f, own), take_of(d, g->material, c, x, y)));
             } else if ((m = shown_history(d, i, c, &count, &m2)))
                 sum = add3(sum, v3(m[0], m[1], m[2]));
         }
@@ -612,7 +600,6 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
         if (in.components) denoise_run(d->dn, &in, &p, &out, d->pool);
         d->st.filter_ms = 1e-6 * (double)(clock_ns() - t1);
         threadpool_run(d->pool, bias_row, &j, d->height);
-        threadpool_run(d->pool, weigh_row, &j, d->height);
         d->st.levels = levels;
     }
     threadpool_run(d->pool, modulate_row, &j, d->height);
