@@ -627,9 +627,10 @@ static void *render_main(void *arg) {
             up.part_ms = ms;
             render_stats after = session_stats(rs);
             /* a reset in between zeroes the statistics: then the set-up is not known from them */
-            double setup = after.pass_ns[PASS_VIRTUAL_LIGHTS] >= before.pass_ns[PASS_VIRTUAL_LIGHTS]
-                               ? 1e-6 * (double)(after.pass_ns[PASS_VIRTUAL_LIGHTS] - before.pass_ns[PASS_VIRTUAL_LIGHTS])
-                               : 0.0;
+            double setup =
+                after.pass_ns[PASS_VIRTUAL_LIGHTS] >= before.pass_ns[PASS_VIRTUAL_LIGHTS]
+                    ? 1e-6 * (double)(after.pass_ns[PASS_VIRTUAL_LIGHTS] - before.pass_ns[PASS_VIRTUAL_LIGHTS])
+                    : 0.0;
             learn_costs(rt, ms, parts, began, setup);
             if (up.frame_done) {
                 rt->film_partial = 0;
