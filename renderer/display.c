@@ -539,6 +539,9 @@ static float take_of(const display *d, const int32_t *mats, int c, int x, int y)
     float s2 = d->variance[c][i];
     s2 = m ? fmaxf(s2, s2_local / (float)m) : s2;
     float vx = s2 / n, vf = s2 / fmaxf(d->out_count[c][i], n);
+    /* b^2 from a few samples is mostly their noise, and the pixels whose samples fell low keep them:
+     * the image looks peppered and no closer. The estimate is trusted from 4 samples, fully at 16. */
+    b2 *= clampf((n - 4.0f) / 12.0f, 0.0f, 1.0f);
     float t = vx / (vx + vf + b2 + 1e-30f);
     return isfinite(t) ? clampf(t, 0.0f, 1.0f) : 1.0f;
 }

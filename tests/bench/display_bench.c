@@ -9,8 +9,9 @@
  *                      [--orbit DEG --orbit-updates M] [--denoise 0|1] [--reference REF.exr]
  *                      [--threads T] [--seed S] [--save PREFIX]
  * The orbit turns the camera by DEG about the vertical through the point in front of it as far as
- * the scene's centre (as the viewer's orbit turns) before each of the first M updates; the
- * reference is of the pose after them. */
+ * the scene's centre (as the viewer's orbit turns) before each of the first M updates; it begins
+ * DEG x M short of the scene's first camera, so that it ends there and a reference of that camera
+ * (glint render) serves every orbit. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -30,8 +31,7 @@ static double cpu_ms(void) {
     return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
 }
 
-static camera orbit(camera c, float degrees, float dist) {
-    vec3 target = madd3(c.position, c.forward, dist);
+static camera orbit(camera c, float degrees, vec3 target) {
     float t = degrees * PI_F / 180.0f, cs = cosf(t), sn = sinf(t);
     vec3 d = sub3(c.position, target);
     vec3 r = v3(cs * d.x + sn * d.z, d.y, -sn * d.x + cs * d.z);
@@ -82,6 +82,9 @@ int main(int argc, char **argv) {
     if (m < 0) return fprintf(stderr, "unknown method %s\n", method), 2;
     p.method = (render_method)m;
     camera cam = scene_camera(s, 0, (float)w / (float)h);
+    vec3 pivot = madd3(cam.position, cam.forward,
+                       fmaxf(dot3(sub3(bounds_center(s->bounds), cam.position), cam.forward), 0.05f * s->diag));
+    cam = orbit(cam, -orbit_deg * (float)orbit_updates, pivot);
     render_session *rs = session_create(s, &cam, &p, err, sizeof err);
     display *d = rs ? display_create(w, h, threads, err, sizeof err) : NULL;
     if (!d) return fprintf(stderr, "%s\n", err), 1;
@@ -95,8 +98,7 @@ int main(int argc, char **argv) {
     for (int u = 0; u < updates; u++) {
         double view_ms = 0.0, gbuffer_ms = 0.0;
         if (u < orbit_updates) {
-            cam = orbit(cam, orbit_deg,
-                        fmaxf(dot3(sub3(bounds_center(s->bounds), cam.position), cam.forward), 0.05f * s->diag));
+            cam = orbit(cam, orbit_deg, pivot);
             p.seed = seed + (uint64_t)u + 1; /* each accumulation its own random numbers, as the viewer */
             session_set_params(rs, &p);
             session_set_camera(rs, &cam);
