@@ -11,13 +11,15 @@
 
 /* One pixel's history, per film component: the mean of its samples divided by the pixel's albedo,
  * how many samples it stands for (fractional once part of it was let go), and the mean of their
- * squared luminance (the spread the filter needs). One cache line: reprojection reads four. */
+ * squared luminance (the spread the filter needs); and how far the view has turned at the point
+ * since its samples were taken (radians, their mean). One cache line: reprojection reads four. */
 typedef struct {
     struct {
         float mean[3], count, m2;
     } c[COMP_COUNT];
-    float pad[16 - 5 * COMP_COUNT];
+    float turn;
 } pixel_history;
+_Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line");
 
 /* History a camera move carries over is capped at this many samples: each reprojection resamples
  * (blurs) it a little, and a cap lets new samples take over at a steady pace while moving. */
@@ -60,7 +62,7 @@ struct display {
      * luminance variance) and its output */
     float *light[COMP_COUNT], *count[COMP_COUNT], *variance[COMP_COUNT], *out[COMP_COUNT];
     float *out_count[COMP_COUNT]; /* the samples behind the filter's value... */
-    float *bias[COMP_COUNT];      /* ...a sample of its squared bias (bias_row)... */
+    float *gap[COMP_COUNT];       /* ...its squared gap to the pixel's own mean (gap_row)... */
     denoiser *dn;
     int active[COMP_COUNT]; /* a component had a sample other than zero since the last restart */
     /* after a light change: the history before it, and per tile what new samples say of it */
@@ -90,9 +92,9 @@ display *display_create(int width, int height, int threads, char *err, size_t er
         d->variance[c] = malloc(sizeof(float) * n);
         d->out[c] = malloc(sizeof(float) * 3 * n);
         d->out_count[c] = malloc(sizeof(float) * n);
-        d->bias[c] = malloc(sizeof(float) * n);
-        ok = d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c] && d->out_count[c] &&
-             d->bias[c];
+        d->gap[c] = malloc(sizeof(float) * n);
+        ok =
+            d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c] && d->out_count[c] && d->gap[c];
     }
     if (ok) ok = (d->sink.stamp = calloc(n, sizeof(uint32_t))) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
@@ -125,7 +127,7 @@ void display_destroy(display *d) {
         free(d->variance[c]);
         free(d->out[c]);
         free(d->out_count[c]);
-        free(d->bias[c]);
+        free(d->gap[c]);
     }
     free(d->sink.stamp);
     free(d);
@@ -151,13 +153,21 @@ typedef struct {
     atomic_llong carried, lost;
 } carry_job;
 
-/* How much of a glossy lobe's share of a point's history survives the view turning by an angle
- * whose cosine is cos_turn: the reflected lobe turns about twice as far as the view, and its
- * width is about its microfacet alpha, so history falls off as a Gaussian in the turn over the
- * lobe (turn^2 taken as 2 (1 - cos), within 3% up to 40 degrees, beyond which nothing is kept). */
-static float glossy_keep(float cos_turn, float alpha) {
-    float w = 2.0f * fmaxf(alpha, 1e-3f);
-    return expf(-2.0f * (1.0f - cos_turn) / (w * w));
+/* How much of a glossy lobe's light, gathered a turn t of the view ago, still holds: the reflected
+ * lobe turns about twice as far as the view, and its width is about its microfacet alpha, so the
+ * light falls off as exp(-(t / alpha)^2 / 2). A move from turn t0 to t1 keeps G(t1) / G(t0) of what
+ * is left: many small turns cost what one turn as large does. */
+static float glossy_keep(float t0, float t1, float alpha) {
+    float a = fmaxf(alpha, 1e-3f);
+    return expf(-0.5f * (t1 * t1 - t0 * t0) / (a * a));
+}
+
+/* The share of a point's light that its glossy lobe may bring, at worst: a lobe alpha wide peaks
+ * about 1/alpha^2 above a diffuse lobe of the same albedo, so where it reflects a light the
+ * highlight outshines the rest though its share g of the albedo is small (docs/design.md). */
+static float glossy_share(float g, float alpha) {
+    float peak = g / fmaxf(alpha * alpha, 1e-6f);
+    return peak > 0.0f ? peak / (peak + 1.0f - g) : 0.0f;
 }
 
 /* Whether old pixel q shows the surface point of new pixel i (positions, normals, materials). */
@@ -226,14 +236,22 @@ static void carry_row(void *ctx, int y, int worker) {
         }
         carried++;
         /* What survives of each component: all of its diffuse share, of its glossy share what the
-         * lobe and the view's turn there allow (the highlights are all glossy). */
-        float glossy = 1.0f;
-        if (!j->same_camera && to->material[i] >= 0 && to->gloss[i] > 0.0f) {
+         * lobe and the view's turn there since the samples were taken allow (the highlights are
+         * all glossy). */
+        float turn = 0.0f, step = 0.0f;
+        for (int k = 0; k < kept; k++) turn += weights[k] * j->old[taps[k]].turn;
+        if (!j->same_camera && to->material[i] >= 0) {
             vec3 p = get3(to->pos, i);
             vec3 a = normalize3(sub3(j->from->cam.position, p)), b = normalize3(sub3(to->cam.position, p));
-            glossy = glossy_keep(dot3(a, b), to->alpha[i]);
+            step = acosf(clampf(dot3(a, b), -1.0f, 1.0f));
         }
-        float diffuse = (1.0f - to->gloss[i]) + to->gloss[i] * glossy;
+        now->turn = turn + step;
+        float glossy = 1.0f, share = 0.0f;
+        if (step > 0.0f && to->gloss[i] > 0.0f) {
+            glossy = glossy_keep(turn, turn + step, to->alpha[i]);
+            share = glossy_share(to->gloss[i], to->alpha[i]);
+        }
+        float diffuse = (1.0f - share) + share * glossy;
         for (int c = 0; c < COMP_COUNT; c++) {
             if (!j->d->active[c]) continue;
             float count = 0.0f, m2 = 0.0f, m[3] = {0.0f, 0.0f, 0.0f};
@@ -259,6 +277,8 @@ static void carry_row(void *ctx, int y, int worker) {
 
 /* Adds b's samples to a's, per component, b's counted at most cap each. */
 static void history_merge(pixel_history *a, const pixel_history *b, float cap) {
+    float da = a->c[COMP_DIRECT].count, db = fminf(b->c[COMP_DIRECT].count, cap);
+    if (da + db > 0.0f) a->turn = (da * a->turn + db * b->turn) / (da + db);
     for (int c = 0; c < COMP_COUNT; c++) {
         float nb = fminf(b->c[c].count, cap), na = a->c[c].count, n = na + nb;
         if (!(nb > 0.0f)) continue;
@@ -406,6 +426,7 @@ long long display_take_samples(display *d) {
         vec3 a = get3(g->albedo, i), e[COMP_COUNT];
         for (int c = 0; c < COMP_COUNT; c++) e[c] = div3(get3(d->sink.rgb[c], i), a);
         if (d->judging) gather_evidence(d, i, e);
+        h[i].turn *= h[i].c[COMP_DIRECT].count / (h[i].c[COMP_DIRECT].count + 1.0f); /* a new sample: turn 0 */
         for (int c = 0; c < COMP_COUNT; c++) {
             d->active[c] |= !is_black3(e[c]);
             float l = luminance3(e[c]);
@@ -484,37 +505,38 @@ static void split_row(void *ctx, int y, int worker) {
     atomic_fetch_add(&j->holes, holes);
 }
 
-/* The filter's squared bias at pixel i, component c, as far as it shows against the pixel's own mean:
- * E[(f - x)^2] = b^2 + var x - var f, the filter's value f taking the pixel's own x with weight about
- * var f / var x. One sample of it; -1 where it cannot be had (no variance of its own yet). */
-static float bias_sample(const display *d, int c, size_t i) {
-    float n = d->count[c][i], s2 = d->variance[c][i];
-    if (!(n >= 2.0f)) return -1.0f;
+/* The filter's value against the pixel's own mean at pixel i, component c: (f - x)^2, whose
+ * expectation is b^2 + var x - var f (the filter's value f takes the pixel's own x with weight about
+ * var f / var x). -1 where the pixel has no variance of its own yet. */
+static float filter_gap(const display *d, int c, size_t i) {
+    if (!(d->count[c][i] >= 2.0f)) return -1.0f;
     const float *x = d->light[c] + 3 * i, *f = d->out[c] + 3 * i;
     float diff = luminance3(v3(f[0] - x[0], f[1] - x[1], f[2] - x[2]));
-    float nf = fmaxf(d->out_count[c][i], n);
-    return diff * diff - s2 / n + s2 / nf;
+    return diff * diff;
 }
 
-/* Each pixel's bias sample, once: take_of reads nine. */
-static void bias_row(void *ctx, int y, int worker) {
+/* Each pixel's gap, once: take_of reads nine. */
+static void gap_row(void *ctx, int y, int worker) {
     (void)worker;
     resolve_job *j = ctx;
     display *d = j->d;
     size_t i0 = (size_t)y * (size_t)d->width;
     for (int c = 0; c < COMP_COUNT; c++) {
         if (!(j->mask >> c & 1u)) continue;
-        for (size_t i = i0; i < i0 + (size_t)d->width; i++) d->bias[c][i] = bias_sample(d, c, i);
+        for (size_t i = i0; i < i0 + (size_t)d->width; i++) d->gap[c][i] = filter_gap(d, c, i);
     }
 }
 
 /* How much of the filtered value pixel (x, y) takes of component c: the mix of its own mean x
  * (unbiased, variance v_x) and the filter's f (variance v_f, bias b) with the least expected squared
- * error, v_x / (v_x + v_f + b^2), b^2 estimated from (f - x)^2 over the pixel's 3x3 neighbours on
- * the same surface. A noisy pixel takes the filter; a converged one, or one where the filter blurs
- * a feature its own samples resolve, keeps its own mean: the filter fades out as the image
- * converges, pixel by pixel. A pixel without a variance of its own yet (fewer than two samples)
- * takes the filter. */
+ * error, v_x / (v_x + v_f + b^2). A noisy pixel takes the filter; a converged one, or one where the
+ * filter blurs a feature its own samples resolve, keeps its own mean: the filter fades out as the
+ * image converges, pixel by pixel. A pixel without a variance of its own yet (fewer than two
+ * samples) takes the filter.
+ * b^2 comes from the gaps (f - x)^2 of the pixel's neighbours on the same surface, less what their
+ * noise puts in them, reckoned with the variance of the whole 3x3 neighbourhood: a pixel's own gap
+ * would make the pixels whose few samples fell far keep them (a peppered image), and one pixel's
+ * variance from a few samples misses the rare bright ones, which read as bias. */
 static float take_of(const display *d, const int32_t *mats, int c, int x, int y) {
     int w = d->width, h = d->height;
     size_t i = (size_t)y * (size_t)w + (size_t)x;
@@ -522,26 +544,21 @@ static float take_of(const display *d, const int32_t *mats, int c, int x, int y)
     if (!(n >= 2.0f)) return 1.0f;
     int32_t me = mats[i];
     int x0 = x > 0 ? x - 1 : x, x1 = x + 1 < w ? x + 1 : x, y0 = y > 0 ? y - 1 : y, y1 = y + 1 < h ? y + 1 : y;
-    float b2 = 0.0f, s2_local = 0.0f;
-    int m = 0;
+    float gap = 0.0f, s2 = 0.0f;
+    int m = 0, k = 0;
     for (int qy = y0; qy <= y1; qy++) {
         size_t row = (size_t)qy * (size_t)w;
         const int32_t *mr = mats + row;
-        const float *br = d->bias[c] + row, *vr = d->variance[c] + row;
+        const float *br = d->gap[c] + row, *vr = d->variance[c] + row;
         for (int qx = x0; qx <= x1; qx++) {
             if (mr[qx] != me || br[qx] < -0.5f) continue;
-            b2 += br[qx], s2_local += vr[qx], m++;
+            s2 += vr[qx], k++;
+            if (qx != x || qy != y) gap += br[qx], m++;
         }
     }
-    b2 = m ? fmaxf(b2 / (float)m, 0.0f) : 0.0f;
-    /* one pixel's variance from a few samples misses the rare bright ones: its surface's around it
-     * is steadier */
-    float s2 = d->variance[c][i];
-    s2 = m ? fmaxf(s2, s2_local / (float)m) : s2;
+    s2 = fmaxf(d->variance[c][i], s2 / (float)k); /* k >= 1: the pixel itself */
     float vx = s2 / n, vf = s2 / fmaxf(d->out_count[c][i], n);
-    /* b^2 from a few samples is mostly their noise, and the pixels whose samples fell low keep them:
-     * the image looks peppered and no closer. The estimate is trusted from 4 samples, fully at 16. */
-    b2 *= clampf((n - 4.0f) / 12.0f, 0.0f, 1.0f);
+    float b2 = m ? fmaxf(gap / (float)m - vx + vf, 0.0f) : 0.0f;
     float t = vx / (vx + vf + b2 + 1e-30f);
     return isfinite(t) ? clampf(t, 0.0f, 1.0f) : 1.0f;
 }
@@ -602,7 +619,7 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
         uint64_t t1 = clock_ns();
         if (in.components) denoise_run(d->dn, &in, &p, &out, d->pool);
         d->st.filter_ms = 1e-6 * (double)(clock_ns() - t1);
-        threadpool_run(d->pool, bias_row, &j, d->height);
+        threadpool_run(d->pool, gap_row, &j, d->height);
         d->st.levels = levels;
     }
     threadpool_run(d->pool, modulate_row, &j, d->height);

@@ -18,12 +18,12 @@
 #define W 64
 #define H 40
 
-/* A grey Lambert plane z = 0 (facing +z), and in front of it a small quad at z = 1 of another
- * material; or a glossy plane (Phong, exponent n) when n > 0. */
-static scene *plane_scene(int with_quad, float phong_n) {
+/* A grey Lambert plane z = 0 (facing +z) of albedo kd, and in front of it a small quad at z = 1 of
+ * another material; or a glossy plane (Phong, exponent n, glossy albedo ks) when n > 0. */
+static scene *plane_scene(int with_quad, float phong_n, float kd, float ks) {
     scene *s = ts_new("display");
-    int plane = phong_n > 0.0f ? ts_material(s, ts_phong(v3s(0.3f), v3s(0.3f), phong_n))
-                               : ts_lambert(s, v3s(0.5f), v3s(0.0f), 0);
+    int plane =
+        phong_n > 0.0f ? ts_material(s, ts_phong(v3s(kd), v3s(ks), phong_n)) : ts_lambert(s, v3s(kd), v3s(0.0f), 0);
     ts_quad(s, v3(-50, -50, 0), v3(50, -50, 0), v3(50, 50, 0), v3(-50, 50, 0), plane);
     if (with_quad) {
         int q = ts_lambert(s, v3(0.8f, 0.2f, 0.1f), v3s(0.0f), 0);
@@ -58,7 +58,7 @@ static void write_samples(display *d, float gain, int mat, float value) {
 }
 
 static void check_projection(void) {
-    scene *s = plane_scene(0, 0.0f);
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     gbuffer g;
     CHECK(gbuffer_init(&g, W, H) == 0, "gbuffer_init");
     camera cam = view_from(v3(0.4f, -0.3f, 5), v3(0.1f, 0.2f, 0));
@@ -81,7 +81,7 @@ static void check_projection(void) {
 
 /* Samples at one view: the history is their mean, as the film's is. */
 static void check_static_mean(void) {
-    scene *s = plane_scene(0, 0.0f);
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     char err[256];
     display *d = display_create(W, H, 2, err, sizeof err);
     CHECK(d != NULL, "display_create: %s", err);
@@ -126,7 +126,7 @@ static display *moved(const scene *s, camera a, camera b, int n, unsigned change
 /* The history that comes with a pixel: its mean light (component c) and count, read back through
  * a resolve without the filter (the mean times the albedo) and the stats. */
 static void check_reprojection(void) {
-    scene *s = plane_scene(0, 0.0f);
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
     camera b = view_from(v3(0.37f, 0.11f, 5), v3(0.37f, 0.11f, 0)); /* a slide of a fraction of pixels */
     display *d = moved(s, a, b, 3, DISPLAY_CAMERA, -1, 0.0f);
@@ -169,7 +169,7 @@ static void check_reprojection(void) {
 /* A quad in front of the plane, the camera slides: plane pixels that saw the quad before start
  * empty; no plane pixel takes the quad's light. */
 static void check_disocclusion(void) {
-    scene *s = plane_scene(1, 0.0f);
+    scene *s = plane_scene(1, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
     camera b = view_from(v3(0.8f, 0, 5), v3(0.8f, 0, 0));
     int quad_material = 1;
@@ -212,14 +212,20 @@ static void check_disocclusion(void) {
     scene_destroy(s);
 }
 
-/* The history's sample count after a turn of the view, read from the stats' mean count (every
- * pixel sees the plane): diffuse keeps all (up to the cap), glossy what its lobe allows. */
-static double count_after_orbit(float phong_n, float degrees, unsigned mask_component, int n) {
-    scene *s = plane_scene(0, phong_n);
-    float r = 5.0f, t = degrees * PI_F / 180.0f;
+/* The history's sample count after the view turns about the plane's centre by `degrees` in `steps`
+ * equal steps with no samples between, read from the stats' mean count (every pixel sees the plane):
+ * diffuse keeps all (up to the cap), glossy what its lobe allows. The plane is Lambert, or Phong
+ * (exponent n, diffuse kd and glossy ks grey). */
+static double count_after_orbit(float phong_n, float kd, float ks, float degrees, int steps, unsigned mask_component) {
+    scene *s = plane_scene(0, phong_n, kd, ks);
+    float r = 5.0f, n = 8;
     camera a = view_from(v3(0, 0, r), v3(0, 0, 0));
-    camera b = view_from(v3(r * sinf(t), 0, r * cosf(t)), v3(0, 0, 0));
-    display *d = moved(s, a, b, n, DISPLAY_CAMERA, -1, 0.0f);
+    display *d = moved(s, a, a, (int)n, DISPLAY_CAMERA, -1, 0.0f);
+    for (int k = 1; d && k <= steps; k++) {
+        float t = degrees * PI_F / 180.0f * (float)k / (float)steps;
+        camera b = view_from(v3(r * sinf(t), 0, r * cosf(t)), v3(0, 0, 0));
+        display_change_view(d, s, &b, DISPLAY_CAMERA);
+    }
     double sum = 0.0;
     int m = 0;
     if (d) {
@@ -245,21 +251,40 @@ static double count_after_orbit(float phong_n, float degrees, unsigned mask_comp
 }
 
 static void check_glossy_history(void) {
-    double diffuse = count_after_orbit(0.0f, 10.0f, 1u << COMP_DIRECT, 8);
+    const unsigned direct = 1u << COMP_DIRECT, highlights = 1u << COMP_HIGHLIGHTS;
+    double diffuse = count_after_orbit(0.0f, 0.5f, 0.0f, 10.0f, 1, direct);
     CHECK_NEAR(diffuse, 8.0, 0.01, "a diffuse plane keeps its whole history through a 10 degree orbit");
-    /* Phong 400: alpha = sqrt(2 / 402) = 0.0705; the view turns 10 degrees at the centre */
-    double glossy_direct = count_after_orbit(400.0f, 10.0f, 1u << COMP_DIRECT, 8);
-    double glossy_hl = count_after_orbit(400.0f, 10.0f, 1u << COMP_HIGHLIGHTS, 8);
-    double small_turn = count_after_orbit(400.0f, 0.5f, 1u << COMP_HIGHLIGHTS, 8);
-    CHECK(glossy_hl < 0.5 * 8.0, "a sharp lobe's highlights lose most of their history in 10 degrees: %g", glossy_hl);
-    CHECK(glossy_direct > glossy_hl + 0.5 && glossy_direct < 8.0 - 0.5,
-          "the direct light of a glossy plane keeps its diffuse share: %g (highlights %g)", glossy_direct, glossy_hl);
+    /* Phong 400: alpha = 1 / sqrt(801) = 0.035, the highlight moves twice the view's turn: a turn
+     * of 3 degrees keeps exp(-(0.052 / 0.035)^2 / 2) = 0.33 of the glossy history at the centre */
+    double sharp_hl = count_after_orbit(400.0f, 0.3f, 0.3f, 3.0f, 1, highlights);
+    CHECK(sharp_hl > 0.2 * 8.0 && sharp_hl < 0.45 * 8.0, "a sharp lobe's highlights keep a third in 3 degrees: %g",
+          sharp_hl);
+    double far_turn = count_after_orbit(400.0f, 0.3f, 0.3f, 10.0f, 1, highlights);
+    CHECK(far_turn < 0.05 * 8.0, "a sharp lobe's highlights keep nothing after 10 degrees: %g", far_turn);
+    double small_turn = count_after_orbit(400.0f, 0.3f, 0.3f, 0.5f, 1, highlights);
     CHECK(small_turn > 0.9 * 8.0, "half a degree leaves a sharp lobe's history nearly whole: %g", small_turn);
+    /* many small turns cost what one turn as large does */
+    double steps_hl = count_after_orbit(400.0f, 0.3f, 0.3f, 3.0f, 10, highlights);
+    CHECK(fabs(steps_hl - sharp_hl) < 0.1 * sharp_hl, "ten turns of 0.3 degrees leave what one of 3 does: %g, %g",
+          steps_hl, sharp_hl);
+    /* a sharp lobe's highlight of a light outshines the diffuse light though its albedo is half */
+    double sharp_direct = count_after_orbit(400.0f, 0.3f, 0.3f, 3.0f, 1, direct);
+    CHECK(sharp_direct < sharp_hl + 0.1, "a sharp glossy plane's direct light goes with its lobe: %g (highlights %g)",
+          sharp_direct, sharp_hl);
+    /* Phong 8 (alpha 0.24), glossy albedo 4% of the whole: its highlights outshine the diffuse light
+     * less, so the direct light keeps what the lobe's worst share (0.4) leaves; 30 degrees turn the
+     * lobe well past its width */
+    double rough_hl = count_after_orbit(8.0f, 0.5f, 0.02f, 30.0f, 1, highlights);
+    double rough_direct = count_after_orbit(8.0f, 0.5f, 0.02f, 30.0f, 1, direct);
+    CHECK(rough_hl < 0.25 * 8.0, "a rough lobe's highlights lose most of their history in 30 degrees: %g", rough_hl);
+    CHECK(rough_direct > rough_hl + 2.0 && rough_direct < 8.0 - 1.0,
+          "a rough, weakly glossy plane's direct light keeps its diffuse share: %g (highlights %g)", rough_direct,
+          rough_hl);
 }
 
 /* Light edits keep little, a restart nothing; samples stamped before a change are not taken. */
 static void check_changes(void) {
-    scene *s = plane_scene(0, 0.0f);
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
     char err[256];
     display *d = display_create(W, H, 1, err, sizeof err);
@@ -311,7 +336,7 @@ static void check_changes(void) {
  * left half, noisy samples about the same mean) it comes back in full; where the light tripled
  * (the right half) it goes; tiles without new samples show it meanwhile. */
 static void check_light_judgement(void) {
-    scene *s = plane_scene(0, 0.0f);
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
     char err[256];
     display *d = display_create(W, H, 2, err, sizeof err);
@@ -366,7 +391,7 @@ static void check_light_judgement(void) {
  * samples, takes the step for noise; a noisy flat one comes back nearer its truth than its own
  * means are. */
 static void check_filter_fades(void) {
-    scene *s = plane_scene(0, 0.0f);
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
     char err[256];
     display *d = display_create(W, H, 2, err, sizeof err);

@@ -6,12 +6,13 @@
  * not a test; the viewer itself is measured by tests/bench/viewer_display.sh.
  *
  * usage: display_bench [--scene S] [--method M] [--size WxH] [--parts K] [--updates N]
- *                      [--orbit DEG --orbit-updates M] [--denoise 0|1] [--reference REF.exr]
+ *                      [--rest R] [--orbit DEG --orbit-updates M] [--denoise 0|1] [--reference REF.exr]
  *                      [--threads T] [--seed S] [--save PREFIX]
  * The orbit turns the camera by DEG about the vertical through the point in front of it as far as
  * the scene's centre (as the viewer's orbit turns) before each of the first M updates; it begins
  * DEG x M short of the scene's first camera, so that it ends there and a reference of that camera
- * (glint render) serves every orbit. */
+ * (glint render) serves every orbit. With --rest R the orbit begins after R updates at rest (history
+ * to carry over); --orbit 15 --orbit-updates 1 is then a jump. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -40,7 +41,7 @@ static camera orbit(camera c, float degrees, vec3 target) {
 
 int main(int argc, char **argv) {
     const char *scene_path = "builtin:atelier", *method = "vsl", *ref_path = NULL, *save = NULL;
-    int w = 960, h = 540, parts = 64, updates = 30, orbit_updates = 0, denoise = 1, threads = 2;
+    int w = 960, h = 540, parts = 64, updates = 30, rest = 0, orbit_updates = 0, denoise = 1, threads = 2;
     float orbit_deg = 0.0f;
     uint64_t seed = 1;
     for (int i = 1; i + 1 < argc; i += 2) {
@@ -55,6 +56,8 @@ int main(int argc, char **argv) {
             parts = atoi(v);
         else if (!strcmp(a, "--updates"))
             updates = atoi(v);
+        else if (!strcmp(a, "--rest"))
+            rest = atoi(v);
         else if (!strcmp(a, "--orbit"))
             orbit_deg = (float)atof(v);
         else if (!strcmp(a, "--orbit-updates"))
@@ -97,7 +100,7 @@ int main(int argc, char **argv) {
     uint64_t t_start = clock_ns();
     for (int u = 0; u < updates; u++) {
         double view_ms = 0.0, gbuffer_ms = 0.0;
-        if (u < orbit_updates) {
+        if (u >= rest && u < rest + orbit_updates) {
             cam = orbit(cam, orbit_deg, pivot);
             p.seed = seed + (uint64_t)u + 1; /* each accumulation its own random numbers, as the viewer */
             session_set_params(rs, &p);
@@ -117,7 +120,7 @@ int main(int argc, char **argv) {
         double resolve_cpu = cpu_ms() - cpu0;
         display_stats ds = display_get_stats(d);
         double e_shown = -1.0, e_film = -1.0;
-        int at_ref = ref.rgb && ref.width == w && ref.height == h && u >= orbit_updates;
+        int at_ref = ref.rgb && ref.width == w && ref.height == h && u >= rest + orbit_updates;
         if (at_ref) e_shown = metric_rel_l2(shown, ref.rgb, n);
         if (at_ref && session_frames(rs) > 0 && session_frame_parts(rs) == 0) {
             film_resolve(session_film(rs), COMP_MASK_ALL, raw);
