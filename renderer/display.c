@@ -240,14 +240,14 @@ static void carry_row(void *ctx, int y, int worker) {
          * all glossy). */
         float turn = 0.0f, step = 0.0f;
         for (int k = 0; k < kept; k++) turn += weights[k] * j->old[taps[k]].turn;
-        if (!j->same_camera && to->material[i] >= 0) {
+        if (!j->same_camera && to->material[i] >= 0 && to->gloss[i] > 0.0f) {
             vec3 p = get3(to->pos, i);
             vec3 a = normalize3(sub3(j->from->cam.position, p)), b = normalize3(sub3(to->cam.position, p));
-            step = acosf(clampf(dot3(a, b), -1.0f, 1.0f));
+            step = length3(sub3(a, b)); /* the chord, 2 sin(turn / 2): within 2% of the turn to 40 degrees */
         }
         now->turn = turn + step;
         float glossy = 1.0f, share = 0.0f;
-        if (step > 0.0f && to->gloss[i] > 0.0f) {
+        if (step > 0.0f) {
             glossy = glossy_keep(turn, turn + step, to->alpha[i]);
             share = glossy_share(to->gloss[i], to->alpha[i]);
         }
