@@ -25,12 +25,13 @@
 #include "view_render.h"
 
 /* An update (a part and the display's work) takes about UPDATE_MS while things move and for
- * YOUNG_SECONDS after a change, so the image follows motion about 10 times a second; later, at
- * rest, REST_UPDATE_MS: larger parts, less of the display's fixed cost. A new estimator's first
- * frame, its cost unknown, comes in FIRST_PARTS parts. */
+ * YOUNG_SECONDS after a change, so the image follows motion about 10 times a second; once the
+ * steps of a drag have stopped coming, REST_UPDATE_MS: the display's fixed cost (about half of a
+ * young update's) paid half as often, so that more of the first seconds after a stop go to
+ * samples. A new estimator's first frame, its cost unknown, comes in FIRST_PARTS parts. */
 #define UPDATE_MS 100.0
 #define REST_UPDATE_MS 200.0
-#define YOUNG_SECONDS 3.0
+#define YOUNG_SECONDS 0.5
 #define FIRST_PARTS 64
 /* Light edits are analysed (the plan made again) once they rest this long, not at every step of a
  * drag. */
