@@ -618,6 +618,8 @@ static void *render_main(void *arg) {
             int parts = began ? parts_for(rt) : session_frame_parts(rs);
             render_stats before = session_stats(rs);
             double t0 = cli_now();
+            /* a frame begins with the pixels the display lacks most */
+            if (began) session_set_packet_need(rs, display_packet_need(rt->disp));
             r = session_render_part(rs, parts, &up.frame_done);
             double ms = 1e3 * (cli_now() - t0);
             spent += ms;

@@ -70,6 +70,7 @@ struct display {
     int judging;
     int tiles_x, tiles_y;
     light_tile *tiles;
+    uint8_t *need; /* per packet (display_packet_need) */
     display_stats st;
 };
 
@@ -97,6 +98,9 @@ display *display_create(int width, int height, int threads, char *err, size_t er
             d->sink.rgb[c] && d->light[c] && d->count[c] && d->variance[c] && d->out[c] && d->out_count[c] && d->gap[c];
     }
     if (ok) ok = (d->sink.stamp = calloc(n, sizeof(uint32_t))) != NULL;
+    size_t packets = (size_t)((width + SESSION_PACKET - 1) / SESSION_PACKET) *
+                     (size_t)((height + SESSION_PACKET - 1) / SESSION_PACKET);
+    if (ok) ok = (d->need = calloc(packets, 1)) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
     if (!ok) {
         display_destroy(d);
@@ -130,6 +134,7 @@ void display_destroy(display *d) {
         free(d->gap[c]);
     }
     free(d->sink.stamp);
+    free(d->need);
     free(d);
 }
 
@@ -447,6 +452,28 @@ long long display_take_samples(display *d) {
     if (taken) d->st.updates++;
     d->st.samples += (uint64_t)taken;
     return taken;
+}
+
+const uint8_t *display_packet_need(display *d) {
+    uint8_t *need = d->need;
+    const pixel_history *h = d->h[d->cur];
+    const gbuffer *g = &d->g[d->cur];
+    int px = (d->width + SESSION_PACKET - 1) / SESSION_PACKET, py = (d->height + SESSION_PACKET - 1) / SESSION_PACKET;
+    for (int j = 0; j < py; j++)
+        for (int i = 0; i < px; i++) {
+            float lack = 0.0f;
+            int m = 0;
+            for (int y = SESSION_PACKET * j; y < SESSION_PACKET * (j + 1) && y < d->height; y++)
+                for (int x = SESSION_PACKET * i; x < SESSION_PACKET * (i + 1) && x < d->width; x++) {
+                    size_t k = (size_t)y * (size_t)d->width + (size_t)x;
+                    if (g->material[k] < 0) continue;
+                    lack += 1.0f / (1.0f + h[k].c[COMP_DIRECT].count);
+                    m++;
+                }
+            float level = m ? lack / (float)m * (float)(SESSION_NEED_LEVELS - 1) + 0.5f : 0.0f;
+            need[(size_t)j * (size_t)px + (size_t)i] = (uint8_t)level;
+        }
+    return need;
 }
 
 typedef struct {

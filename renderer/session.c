@@ -16,8 +16,8 @@
 #include "threadpool.h"
 
 #define TILE 16
-#define PACKET_W 4 /* PACKET_W x PACKET_H = SCENE_PACKET, dividing TILE */
-#define PACKET_H 4
+#define PACKET_W SESSION_PACKET /* PACKET_W x PACKET_H = SCENE_PACKET, dividing TILE */
+#define PACKET_H SESSION_PACKET
 
 /* Per-worker counters, padded so threads never share a cache line. */
 typedef struct {
@@ -40,6 +40,7 @@ typedef struct {
 typedef struct {
     part_cell cell;
     int cols, packets, chunk;
+    const uint32_t *list; /* or, in a frame ordered by need, these packets (y * packets_x + x) */
 } part_job;
 #define PART_CHUNK 16          /* packets at most a task: the atomic counter is read once per chunk */
 #define PART_CHUNKS_A_THREAD 8 /* ... and at least this many chunks a thread where the part has them */
@@ -72,7 +73,10 @@ struct render_session {
     /* A frame in parts (session_render_part): its count (0: no frame under way), the parts done and
      * the rank of its first; the rank after the last part begun, which session_reset keeps. */
     int frame_parts, parts_done, first_part, next_part;
-    part_job part; /* the part being rendered */
+    part_job part;       /* the part being rendered */
+    const uint8_t *need; /* per packet, the caller's (session_set_packet_need); NULL: none */
+    uint32_t *order;     /* the frame's packets by need, when it is ordered (else NULL) */
+    size_t order_size;
     char error[256];
 };
 
@@ -136,6 +140,7 @@ void session_destroy(render_session *rs) {
     pixel_alloc_free(&rs->direct);
     free(rs->hl_state);
     free(rs->direct_taken);
+    free(rs->order);
     free(rs->hl_merge);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
@@ -516,7 +521,12 @@ static void render_chunk(void *ctx, int chunk, int worker) {
     uint64_t chunk_start = clock_ns();
     int end = (chunk + 1) * job->chunk < job->packets ? (chunk + 1) * job->chunk : job->packets;
     for (int k = chunk * job->chunk; k < end; k++) {
-        int i = job->cell.x + job->cell.a * (k % job->cols), j = job->cell.y + job->cell.b * (k / job->cols);
+        int i, j;
+        if (job->list) {
+            i = (int)(job->list[k] % (uint32_t)job->cols), j = (int)(job->list[k] / (uint32_t)job->cols);
+        } else {
+            i = job->cell.x + job->cell.a * (k % job->cols), j = job->cell.y + job->cell.b * (k / job->cols);
+        }
         render_packet(rs, st, &raster, frame, PACKET_W * i, PACKET_H * j);
     }
     if (p->method == METHOD_PT) st->pass_ns[PASS_PATHS] += clock_ns() - chunk_start;
@@ -615,13 +625,55 @@ part_cell session_part_cell(int parts, int rank) {
     return c;
 }
 
+/* The frame's packets the neediest first, a need's in the lattice's order from the frame's first
+ * part on (a counting sort on need and rank): 0, or -1 out of memory. */
+static int order_by_need(render_session *rs, int packets_x, int packets_y) {
+    int parts = rs->frame_parts;
+    size_t n = (size_t)packets_x * (size_t)packets_y, keys = (size_t)SESSION_NEED_LEVELS * (size_t)parts;
+    if (rs->order_size < n) {
+        uint32_t *o = realloc(rs->order, sizeof(uint32_t) * n);
+        if (!o) return -1;
+        rs->order = o, rs->order_size = n;
+    }
+    int rank_of[SESSION_MAX_PARTS];
+    part_cell lattice = session_part_cell(parts, 0);
+    for (int r = 0; r < parts; r++) {
+        part_cell c = session_part_cell(parts, r);
+        rank_of[c.y * lattice.a + c.x] = (r - rs->first_part + parts) % parts;
+    }
+    uint32_t *start = calloc(keys + 1, sizeof(uint32_t));
+    if (!start) return -1;
+#define NEED_KEY(i, j)                                                                                                 \
+    ((size_t)(SESSION_NEED_LEVELS - 1 - (rs->need[(size_t)(j) * (size_t)packets_x + (size_t)(i)] & 15u)) *             \
+         (size_t)parts +                                                                                               \
+     (size_t)rank_of[((j) % lattice.b) * lattice.a + (i) % lattice.a])
+    for (int j = 0; j < packets_y; j++)
+        for (int i = 0; i < packets_x; i++) start[NEED_KEY(i, j) + 1]++;
+    for (size_t k = 0; k < keys; k++) start[k + 1] += start[k];
+    for (int j = 0; j < packets_y; j++)
+        for (int i = 0; i < packets_x; i++)
+            rs->order[start[NEED_KEY(i, j)]++] = (uint32_t)j * (uint32_t)packets_x + (uint32_t)i;
+#undef NEED_KEY
+    free(start);
+    return 0;
+}
+
 int session_render_part(render_session *rs, int parts, int *frame_done) {
     if (frame_done) *frame_done = 0;
+    int packets_x = (rs->params.width + PACKET_W - 1) / PACKET_W;
+    int packets_y = (rs->params.height + PACKET_H - 1) / PACKET_H;
     if (!rs->frame_parts) {
         if (begin_frame(rs) != 0) return -1;
         rs->frame_parts = allowed_parts(parts);
         rs->parts_done = 0;
         rs->first_part = rs->next_part % rs->frame_parts;
+        rs->part.list = NULL;
+        if (rs->need && rs->frame_parts > 1 && order_by_need(rs, packets_x, packets_y) != 0) {
+            rs->frame_parts = 0;
+            snprintf(rs->error, sizeof rs->error, "out of memory for a frame's order");
+            return -1;
+        }
+        if (rs->need && rs->frame_parts > 1) rs->part.list = rs->order;
     }
     int rank = (rs->first_part + rs->parts_done) % rs->frame_parts;
     rs->next_part = rank + 1; /* begun, whatever comes of it: the rotation never depends on timing */
@@ -629,12 +681,18 @@ int session_render_part(render_session *rs, int parts, int *frame_done) {
         threadpool_run(rs->pool, render_tile, rs, rs->tiles_x * rs->tiles_y);
     } else {
         part_job *job = &rs->part;
-        int packets_x = (rs->params.width + PACKET_W - 1) / PACKET_W;
-        int packets_y = (rs->params.height + PACKET_H - 1) / PACKET_H;
-        job->cell = session_part_cell(rs->frame_parts, rank);
-        /* cell.x < a: 0 where the image is too small for the cell (an empty part) */
-        job->cols = (packets_x - job->cell.x + job->cell.a - 1) / job->cell.a;
-        job->packets = job->cols * ((packets_y - job->cell.y + job->cell.b - 1) / job->cell.b);
+        if (job->list) { /* part p: the p-th of frame_parts equal runs of the order */
+            size_t n = (size_t)packets_x * (size_t)packets_y, p = (size_t)rs->parts_done, k = (size_t)rs->frame_parts;
+            size_t b = n * p / k, e = n * (p + 1) / k;
+            job->list = rs->order + b;
+            job->cols = packets_x;
+            job->packets = (int)(e - b);
+        } else {
+            job->cell = session_part_cell(rs->frame_parts, rank);
+            /* cell.x < a: 0 where the image is too small for the cell (an empty part) */
+            job->cols = (packets_x - job->cell.x + job->cell.a - 1) / job->cell.a;
+            job->packets = job->cols * ((packets_y - job->cell.y + job->cell.b - 1) / job->cell.b);
+        }
         int chunks = PART_CHUNKS_A_THREAD * threadpool_size(rs->pool);
         job->chunk = (job->packets + chunks - 1) / chunks;
         job->chunk = job->chunk < 1 ? 1 : job->chunk > PART_CHUNK ? PART_CHUNK : job->chunk;
@@ -665,6 +723,8 @@ int session_frame_parts(const render_session *rs) { return rs->frame_parts; }
 int session_frame_parts_done(const render_session *rs) { return rs->frame_parts ? rs->parts_done : 0; }
 
 void session_set_sink(render_session *rs, const sample_sink *sink) { rs->sink = sink; }
+
+void session_set_packet_need(render_session *rs, const uint8_t *need) { rs->need = need; }
 
 void session_set_abort_flag(render_session *rs, const atomic_int *flag) { rs->abort_flag = flag; }
 

@@ -56,6 +56,15 @@ typedef struct {
     int x, y; /* the cell: packets (x + a i, y + b j) */
 } part_cell;
 part_cell session_part_cell(int parts, int rank);
+/* What each packet needs, 0 .. SESSION_NEED_LEVELS - 1 (packets_x x packets_y of them, row major,
+ * packets of SESSION_PACKET x SESSION_PACKET pixels; the caller's memory, read when a frame in
+ * parts begins; NULL: nothing). Such a frame renders its packets the neediest first, a need's
+ * packets in the lattice's order from the frame's first part on, in `parts` parts of equal size: a
+ * display that carried history over a move has the pixels it lacks rendered first. A frame is the
+ * same, bit for bit, in whatever order its packets came. */
+#define SESSION_PACKET 4
+#define SESSION_NEED_LEVELS 16
+void session_set_packet_need(render_session *rs, const uint8_t *need);
 
 /* Where every sample the film takes also goes (whole frames or parts), for a display that reads
  * each part's fresh samples: per film component the sample's 3 floats at the pixel (zeros included;

@@ -4,8 +4,9 @@
  * taps of a linear function are exact); what the move reveals starts empty and never takes another
  * surface's light; a glossy lobe's share keeps what its width and the view's turn leave, a diffuse
  * point all of it; a light change keeps little, a restart nothing; samples written for an old
- * view are not taken for a new one; the image shown is finite whatever the samples. The G-buffer's
- * projection is checked against its own centre rays. */
+ * view are not taken for a new one; the image shown is finite whatever the samples; each packet's
+ * need follows its pixels' samples. The G-buffer's projection is checked against its own centre
+ * rays. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -487,6 +488,45 @@ static void check_film_untouched(void) {
     scene_destroy(s);
 }
 
+/* What each packet needs (display_packet_need): everything before any sample; 1 / (1 + 3) of it
+ * (level 4 of 0..15) after three everywhere; after a slide of the view by a quarter of its width,
+ * the old packets still so, the new strip at the right everything. */
+static void check_packet_need(void) {
+    enum { PX = (W + SESSION_PACKET - 1) / SESSION_PACKET, PY = (H + SESSION_PACKET - 1) / SESSION_PACKET };
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    /* half the view's width at the plane: 5 tan(0.35) x 1.6 = 2.92; the slide is 0.26 of the width */
+    camera b = view_from(v3(1.5f, 0, 5), v3(1.5f, 0, 0));
+    display *d = moved(s, a, a, 0, DISPLAY_CAMERA, -1, 0.0f);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    int off = 0;
+    const uint8_t *need = display_packet_need(d);
+    for (int k = 0; k < PX * PY; k++) off += need[k] != SESSION_NEED_LEVELS - 1;
+    CHECK(off == 0, "before any sample every packet needs everything: %d do not", off);
+    for (int k = 0; k < 3; k++) {
+        write_samples(d, 1.0f, -1, 0.0f);
+        display_take_samples(d);
+    }
+    need = display_packet_need(d);
+    off = 0;
+    for (int k = 0; k < PX * PY; k++) off += need[k] != 4;
+    CHECK(off == 0, "after three samples every packet needs a quarter (level 4): %d do not", off);
+    display_change_view(d, s, &b, DISPLAY_CAMERA);
+    need = display_packet_need(d);
+    int old_off = 0, new_off = 0;
+    for (int j = 0; j < PY; j++)
+        for (int i = 0; i < PX; i++) {
+            int x0 = SESSION_PACKET * i, x1 = x0 + SESSION_PACKET;
+            if (x1 <= W * 7 / 10) old_off += need[j * PX + i] != 4;
+            if (x0 >= W * 8 / 10) new_off += need[j * PX + i] != SESSION_NEED_LEVELS - 1;
+        }
+    CHECK(old_off == 0 && new_off == 0, "after the slide: %d carried packets and %d new ones with another need",
+          old_off, new_off);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
 int main(void) {
     check_projection();
     check_static_mean();
@@ -497,5 +537,6 @@ int main(void) {
     check_light_judgement();
     check_filter_fades();
     check_film_untouched();
+    check_packet_need();
     return check_exit("test_display");
 }

@@ -8,7 +8,8 @@
  * pixels of its cell's packets, every pixel once a frame (those into the void too), the first
  * quarter and half of a frame's parts cover the image evenly, the statistics count each part, the
  * sink's samples summed are the film's sums and a dropped sample writes nothing. Resetting after every part still walks through
- * all the parts; counts out of range are clamped; a stopped part abandons its frame. */
+ * all the parts; a frame ordered by need renders the neediest packets first and is the same frame;
+ * counts out of range are clamped; a stopped part abandons its frame. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -343,6 +344,52 @@ static void check_rotation(const scene *s, const camera *cam) {
     store_free(&k);
 }
 
+/* A frame ordered by need (session_set_packet_need), in 8 parts with a sink whose serial is the
+ * part's: every pixel once; no packet of a later part needs more than any of an earlier one; the
+ * parts as large as an even split makes them; the film the whole frame's, bit for bit. */
+static void check_need_order(const scene *s, const camera *cam) {
+    enum { PX = (W + SESSION_PACKET - 1) / SESSION_PACKET, PY = (H + SESSION_PACKET - 1) / SESSION_PACKET };
+    render_params p = {.width = W, .height = H, .method = METHOD_PT, .max_depth = 2, .seed = 5, .threads = 2};
+    render_session *rs = new_session(s, cam, &p), *whole = new_session(s, cam, &p);
+    uint8_t need[PX * PY];
+    for (int k = 0; k < PX * PY; k++) need[k] = (uint8_t)((k * 7 + k / PX * 3) % SESSION_NEED_LEVELS);
+    need[5 * PX + 9] = SESSION_NEED_LEVELS - 1;
+    session_set_packet_need(rs, need);
+    sample_sink sink = {0};
+    sink_store k;
+    store_init(&k, &sink);
+    session_set_sink(rs, &sink);
+    int part_of[PX * PY], size[8] = {0}, done = 0;
+    for (int q = 0; q < PX * PY; q++) part_of[q] = -1;
+    for (int t = 0; t < 8; t++) {
+        sink.serial = (uint32_t)t;
+        CHECK(session_render_part(rs, 8, &done) == 0, "ordered part %d: %s", t, session_error(rs));
+        take_part(&k, (uint32_t)t);
+        for (int i = 0; i < PIXELS; i++) {
+            int q = (i / W / SESSION_PACKET) * PX + i % W / SESSION_PACKET;
+            if (k.stamp[i] != (uint32_t)t || part_of[q] == t) continue;
+            CHECK(part_of[q] < 0, "packet %d rendered in parts %d and %d", q, part_of[q], t);
+            part_of[q] = t, size[t]++;
+        }
+    }
+    int once = 0, later_needier = 0, sizes_off = 0;
+    for (int i = 0; i < PIXELS; i++) once += k.seen[i] == 1;
+    for (int a = 0; a < PX * PY; a++)
+        for (int b = 0; b < PX * PY; b++) later_needier += part_of[a] < part_of[b] && need[b] > need[a];
+    for (int t = 0; t < 8; t++) sizes_off += size[t] != PX * PY * (t + 1) / 8 - PX * PY * t / 8;
+    CHECK(done && once == PIXELS, "an ordered frame must render every pixel once: %d of %d (done %d)", once, PIXELS,
+          done);
+    CHECK(later_needier == 0 && part_of[5 * PX + 9] == 0,
+          "the neediest packets first: %d pairs out of order, the neediest in part %d", later_needier,
+          part_of[5 * PX + 9]);
+    CHECK(sizes_off == 0, "an ordered frame's parts must split it evenly: %d parts off", sizes_off);
+    CHECK(session_render_frame(whole) == 0 && same_film(rs, whole),
+          "a frame ordered by need must be the whole frame, bit for bit");
+    session_destroy(rs);
+    session_destroy(whole);
+    store_free(&k);
+}
+
 /* Counts out of range are clamped to the nearest allowed value below (1 at least); a part stopped
  * by the abort flag abandons its frame, and after a reset the session renders as a fresh one. */
 static void check_clamp_and_abort(const scene *s, const camera *cam) {
@@ -397,6 +444,7 @@ int main(void) {
     check_sink(s, &cam, METHOD_PT);
     check_sink(s, &cam, METHOD_VSL);
     check_rotation(s, &cam);
+    check_need_order(s, &cam);
     check_clamp_and_abort(s, &cam);
     scene_destroy(s);
     check_sink_rejects();

@@ -6,13 +6,15 @@
  * not a test; the viewer itself is measured by tests/bench/viewer_display.sh.
  *
  * usage: display_bench [--scene S] [--method M] [--size WxH] [--parts K] [--updates N]
- *                      [--rest R] [--orbit DEG --orbit-updates M] [--denoise 0|1] [--reference REF.exr]
+ *                      [--rest R] [--orbit DEG --orbit-updates M] [--denoise 0|1] [--by-need 0|1] [--reference REF.exr]
  *                      [--threads T] [--seed S] [--save PREFIX]
  * The orbit turns the camera by DEG about the vertical through the point in front of it as far as
  * the scene's centre (as the viewer's orbit turns) before each of the first M updates; it begins
  * DEG x M short of the scene's first camera, so that it ends there and a reference of that camera
  * (glint render) serves every orbit. With --rest R the orbit begins after R updates at rest (history
- * to carry over); --orbit 15 --orbit-updates 1 is then a jump. */
+ * to carry over); --orbit 12 --orbit-updates 1 is then a jump (on atelier beyond 14 degrees the
+ * first camera leaves the room). --by-need 0 renders frames in the lattice's order, not the
+ * display's need's (session_set_packet_need). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -41,7 +43,7 @@ static camera orbit(camera c, float degrees, vec3 target) {
 
 int main(int argc, char **argv) {
     const char *scene_path = "builtin:atelier", *method = "vsl", *ref_path = NULL, *save = NULL;
-    int w = 960, h = 540, parts = 64, updates = 30, rest = 0, orbit_updates = 0, denoise = 1, threads = 2;
+    int w = 960, h = 540, parts = 64, updates = 30, rest = 0, orbit_updates = 0, denoise = 1, threads = 2, by_need = 1;
     float orbit_deg = 0.0f;
     uint64_t seed = 1;
     for (int i = 1; i + 1 < argc; i += 2) {
@@ -62,6 +64,8 @@ int main(int argc, char **argv) {
             orbit_deg = (float)atof(v);
         else if (!strcmp(a, "--orbit-updates"))
             orbit_updates = atoi(v);
+        else if (!strcmp(a, "--by-need"))
+            by_need = atoi(v);
         else if (!strcmp(a, "--denoise"))
             denoise = atoi(v);
         else if (!strcmp(a, "--reference"))
@@ -110,6 +114,7 @@ int main(int argc, char **argv) {
             view_ms = ds.view_ms;
             gbuffer_ms = ds.gbuffer_ms;
         }
+        if (by_need && session_frame_parts(rs) == 0) session_set_packet_need(rs, display_packet_need(d));
         uint64_t t0 = clock_ns();
         int done = 0;
         if (session_render_part(rs, parts, &done) != 0) return fprintf(stderr, "%s\n", session_error(rs)), 1;
