@@ -635,25 +635,25 @@ static int order_by_need(render_session *rs, int packets_x, int packets_y) {
         if (!o) return -1;
         rs->order = o, rs->order_size = n;
     }
+    uint32_t *key = malloc(sizeof(uint32_t) * n), *start = calloc(keys + 1, sizeof(uint32_t));
+    if (!key || !start) return free(key), free(start), -1;
     int rank_of[SESSION_MAX_PARTS];
     part_cell lattice = session_part_cell(parts, 0);
     for (int r = 0; r < parts; r++) {
         part_cell c = session_part_cell(parts, r);
         rank_of[c.y * lattice.a + c.x] = (r - rs->first_part + parts) % parts;
     }
-    uint32_t *start = calloc(keys + 1, sizeof(uint32_t));
-    if (!start) return -1;
-#define NEED_KEY(i, j)                                                                                                 \
-    ((size_t)(SESSION_NEED_LEVELS - 1 - (rs->need[(size_t)(j) * (size_t)packets_x + (size_t)(i)] & 15u)) *             \
-         (size_t)parts +                                                                                               \
-     (size_t)rank_of[((j) % lattice.b) * lattice.a + (i) % lattice.a])
     for (int j = 0; j < packets_y; j++)
-        for (int i = 0; i < packets_x; i++) start[NEED_KEY(i, j) + 1]++;
+        for (int i = 0; i < packets_x; i++) {
+            size_t q = (size_t)j * (size_t)packets_x + (size_t)i;
+            int need = rs->need[q] < SESSION_NEED_LEVELS ? rs->need[q] : SESSION_NEED_LEVELS - 1;
+            key[q] = (uint32_t)((SESSION_NEED_LEVELS - 1 - need) * parts +
+                                rank_of[j % lattice.b * lattice.a + i % lattice.a]);
+            start[key[q] + 1]++;
+        }
     for (size_t k = 0; k < keys; k++) start[k + 1] += start[k];
-    for (int j = 0; j < packets_y; j++)
-        for (int i = 0; i < packets_x; i++)
-            rs->order[start[NEED_KEY(i, j)]++] = (uint32_t)j * (uint32_t)packets_x + (uint32_t)i;
-#undef NEED_KEY
+    for (size_t q = 0; q < n; q++) rs->order[start[key[q]]++] = (uint32_t)q;
+    free(key);
     free(start);
     return 0;
 }
