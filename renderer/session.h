@@ -31,7 +31,8 @@ int session_render_frame(render_session *rs);
 /* Renders the next part of the frame under way, beginning a frame (in `parts` parts) when none is:
  * the image's 4x4-pixel packets in `parts` interleaved parts, each call one part. Packet (i, j) lies
  * in cell (i mod a, j mod b) of a lattice of a x b = parts cells (session_part_cell), and part p of a
- * frame is the packets of the cell of rank p. A frame begins at the part after the last one begun
+ * frame is the packets of the cell of rank p (or, given what each packet needs, the p-th run of the
+ * packets by need: session_set_packet_need). A frame begins at the part after the last one begun
  * (in whatever frame, stopped or not, mod the new frame's count; session_reset does not forget it),
  * so a caller who resets before every call still renders a different part each time; it ends after
  * its last part: *frame_done is then 1 (0 otherwise; frame_done may be NULL). The film after a frame
