@@ -290,8 +290,8 @@ def render_pair(glint, scene, env, size, spp, out_dir, name, lambert):
 
 
 def scenes_dir():
-    d = os.environ.get("GLINT_SHARED_SCENES") or os.path.join(os.path.dirname(ROOT), "shared", "scenes")
-    return d if os.path.isdir(d) else "/work/shared/scenes"
+    """The shared scenes: GLINT_SHARED_SCENES (the test sets it), else ../shared/scenes beside the checkout."""
+    return os.environ.get("GLINT_SHARED_SCENES") or os.path.join(os.path.dirname(ROOT), "shared", "scenes")
 
 
 def options(args, defaults):
