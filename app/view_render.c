@@ -452,20 +452,21 @@ static int parts_for(const render_thread *rt) {
     return parts;
 }
 
+/* A cost learnt: the new measurement blended in (the first taken as it is). */
+static void smooth(double *cost, double ms) {
+    const double a = 0.3;
+    *cost = *cost > 0.0 ? (1.0 - a) * *cost + a * ms : ms;
+}
+
 /* Learns a part's cost: ms for it, which began a frame of `parts` parts when `began` (then setup_ms
  * of it was the frame's set-up). Smoothed over parts. */
 static void learn_costs(render_thread *rt, double ms, int parts, int began, double setup_ms) {
-    const double a = 0.3;
-    double frame = fmax(ms - (began ? setup_ms : 0.0), 0.0) * parts;
-    rt->frame_ms = rt->frame_ms > 0.0 ? (1.0 - a) * rt->frame_ms + a * frame : frame;
-    if (began) rt->setup_ms = rt->setup_ms > 0.0 ? (1.0 - a) * rt->setup_ms + a * setup_ms : setup_ms;
+    smooth(&rt->frame_ms, fmax(ms - (began ? setup_ms : 0.0), 0.0) * parts);
+    if (began) smooth(&rt->setup_ms, setup_ms);
 }
 
 /* ... and the display's, an update's. */
-static void learn_display(render_thread *rt, double ms) {
-    const double a = 0.3;
-    rt->display_ms = rt->display_ms > 0.0 ? (1.0 - a) * rt->display_ms + a * ms : ms;
-}
+static void learn_display(render_thread *rt, double ms) { smooth(&rt->display_ms, ms); }
 
 /* Whether two requests render the same estimate (the panel sends its parameters with their defaults
  * resolved; the command line's may not be). */
