@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "display.h"
 
+#include <float.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,7 +71,8 @@ struct display {
     int judging;
     int tiles_x, tiles_y;
     light_tile *tiles;
-    uint8_t *need; /* per packet (display_packet_need) */
+    uint8_t *need;    /* per packet (display_packet_need)... */
+    float *need_gain; /* ...and its scratch */
     display_stats st;
 };
 
@@ -101,6 +103,7 @@ display *display_create(int width, int height, int threads, char *err, size_t er
     size_t packets = (size_t)((width + SESSION_PACKET - 1) / SESSION_PACKET) *
                      (size_t)((height + SESSION_PACKET - 1) / SESSION_PACKET);
     if (ok) ok = (d->need = calloc(packets, 1)) != NULL;
+    if (ok) ok = (d->need_gain = calloc(packets, sizeof(float))) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
     if (!ok) {
         display_destroy(d);
@@ -135,6 +138,7 @@ void display_destroy(display *d) {
     }
     free(d->sink.stamp);
     free(d->need);
+    free(d->need_gain);
     free(d);
 }
 
@@ -454,26 +458,70 @@ long long display_take_samples(display *d) {
     return taken;
 }
 
+/* What one more sample would take off pixel k's squared error as shown: a mean of n samples of
+ * one-sample variance s2 errs by s2 / n, one more by s2 / (n + 1). Summed over the components with
+ * light, each's variance of its light times the albedo (what the image shows); -1 where a component
+ * has fewer than two samples (its spread unknown). */
+static float sample_gain(const display *d, const pixel_history *p, size_t k) {
+    float a = luminance3(get3(d->g[d->cur].albedo, k)), gain = 0.0f;
+    if (!(p->c[COMP_DIRECT].count >= 2.0f)) return -1.0f; /* every sample counts in every component */
+    for (int c = 0; c < COMP_COUNT; c++) {
+        if (!d->active[c]) continue;
+        float n = p->c[c].count;
+        if (!(n >= 2.0f)) return -1.0f;
+        float l = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2]));
+        float s2 = fmaxf(p->c[c].m2 - l * l, 0.0f) * n / (n - 1.0f) * a * a;
+        gain += s2 / (n * (n + 1.0f));
+    }
+    return isfinite(gain) ? gain : -1.0f;
+}
+
+/* A packet's need, in two bands. Where some pixel's spread is unknown (fewer than two samples of a
+ * component) the upper band, 8 to 15, by the lack of samples, 1 / (1 + n) on average; elsewhere the
+ * lower, 0 to 7, by what a sample of each pixel would take off the error shown, summed over the
+ * packet, in factors of two about the mean known packet's (level 4). The sky needs nothing. */
 const uint8_t *display_packet_need(display *d) {
-    uint8_t *need = d->need;
     const pixel_history *h = d->h[d->cur];
     const gbuffer *g = &d->g[d->cur];
     int px = (d->width + SESSION_PACKET - 1) / SESSION_PACKET, py = (d->height + SESSION_PACKET - 1) / SESSION_PACKET;
+    float *gain = d->need_gain; /* per packet: the gain summed, or -(the lack) where a spread is unknown */
+    double total = 0.0;
+    int known = 0;
     for (int j = 0; j < py; j++)
         for (int i = 0; i < px; i++) {
+            double sum = 0.0;
             float lack = 0.0f;
-            int m = 0;
+            int unknown = 0, m = 0;
             for (int y = SESSION_PACKET * j; y < SESSION_PACKET * (j + 1) && y < d->height; y++)
                 for (int x = SESSION_PACKET * i; x < SESSION_PACKET * (i + 1) && x < d->width; x++) {
                     size_t k = (size_t)y * (size_t)d->width + (size_t)x;
                     if (g->material[k] < 0) continue;
-                    lack += 1.0f / (1.0f + h[k].c[COMP_DIRECT].count);
                     m++;
+                    lack += 1.0f / (1.0f + h[k].c[COMP_DIRECT].count);
+                    float gk = sample_gain(d, &h[k], k);
+                    if (gk < 0.0f)
+                        unknown = 1;
+                    else
+                        sum += (double)gk;
                 }
-            float level = m ? lack / (float)m * (float)(SESSION_NEED_LEVELS - 1) + 0.5f : 0.0f;
-            need[(size_t)j * (size_t)px + (size_t)i] = (uint8_t)level;
+            size_t q = (size_t)j * (size_t)px + (size_t)i;
+            sum = sum < (double)FLT_MAX ? sum : (double)FLT_MAX;
+            gain[q] = !m ? 0.0f : unknown ? -lack / (float)m : (float)sum;
+            if (m && !unknown) total += sum, known++;
         }
-    return need;
+    double mean = known ? total / known : 0.0;
+    for (size_t q = 0; q < (size_t)px * (size_t)py; q++) {
+        float v = gain[q];
+        int level;
+        if (v < 0.0f) {
+            level = SESSION_NEED_LEVELS / 2 + (int)(-v * (float)(SESSION_NEED_LEVELS / 2 - 1) + 0.5f);
+        } else {
+            level = v > 0.0f && mean > 0.0 ? (int)floor(log2((double)v / mean)) + SESSION_NEED_LEVELS / 4 : 0;
+            level = level < 0 ? 0 : level > SESSION_NEED_LEVELS / 2 - 1 ? SESSION_NEED_LEVELS / 2 - 1 : level;
+        }
+        d->need[q] = (uint8_t)level;
+    }
+    return d->need;
 }
 
 typedef struct {

@@ -55,9 +55,12 @@ void display_change_view(display *d, const scene *s, const camera *cam, unsigned
  * for the next update. Returns how many it took. */
 long long display_take_samples(display *d);
 
-/* What each packet of pixels needs now (session_set_packet_need, before a frame begins): the lack
- * of samples in its pixels' history, 1 / (1 + samples) on average, in SESSION_NEED_LEVELS levels;
- * the sky needs nothing. One entry per packet, row major, the display's own until the next call. */
+/* What each packet of pixels needs now (session_set_packet_need, before a frame begins), in
+ * SESSION_NEED_LEVELS levels: packets with a pixel whose spread is still unknown (fewer than two
+ * samples) in the upper half, by the lack of samples in their history, 1 / (1 + samples) on
+ * average; the others in the lower half, by how much a sample of each of their pixels would take
+ * off the error shown, against the mean packet's. The sky needs nothing. One entry per packet, row
+ * major, the display's own until the next call. */
 const uint8_t *display_packet_need(display *d);
 
 /* The image shown, of the components in mask (bit c = film component c), into rgb (3 floats a

@@ -488,9 +488,21 @@ static void check_film_untouched(void) {
     scene_destroy(s);
 }
 
-/* What each packet needs (display_packet_need): everything before any sample; 1 / (1 + 3) of it
- * (level 4 of 0..15) after three everywhere; after a slide of the view by a quarter of its width,
- * the old packets still so, the new strip at the right everything. */
+/* What each packet needs (display_packet_need). Before any sample every packet needs the most
+ * (15); after one sample everywhere, the upper band by the lack, 8 + 7 / 2 rounded (12). After three
+ * samples whose light varies in the left half (gains 0.5, 1.5, 1) and not in the right, every left
+ * packet is in the lower band above every right one (nothing to gain: level 0), the brightest left
+ * ones above the mean packet (level 5 or more: the mean counts the right's zeros). After a slide of
+ * the view by a quarter of its width, the new strip at the right needs the most again, and the
+ * carried packets stay in the lower band. */
+static void scale_left(display *d, float gain) {
+    const sample_sink *sk = display_sink(d);
+    for (int i = 0; i < W * H; i++)
+        if (i % W < W / 2)
+            for (int c = 0; c < COMP_COUNT; c++)
+                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] *= gain;
+}
+
 static void check_packet_need(void) {
     enum { PX = (W + SESSION_PACKET - 1) / SESSION_PACKET, PY = (H + SESSION_PACKET - 1) / SESSION_PACKET };
     scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
@@ -504,21 +516,40 @@ static void check_packet_need(void) {
     const uint8_t *need = display_packet_need(d);
     for (int k = 0; k < PX * PY; k++) off += need[k] != SESSION_NEED_LEVELS - 1;
     CHECK(off == 0, "before any sample every packet needs everything: %d do not", off);
+    const float gains[3] = {0.5f, 1.5f, 1.0f};
     for (int k = 0; k < 3; k++) {
         write_samples(d, 1.0f, -1, 0.0f);
+        scale_left(d, gains[k]);
         display_take_samples(d);
+        if (k > 0) continue;
+        need = display_packet_need(d);
+        off = 0;
+        for (int q = 0; q < PX * PY; q++) off += need[q] != 12;
+        CHECK(off == 0, "after one sample every packet is in the upper band at 12: %d are not", off);
     }
     need = display_packet_need(d);
-    off = 0;
-    for (int k = 0; k < PX * PY; k++) off += need[k] != 4;
-    CHECK(off == 0, "after three samples every packet needs a quarter (level 4): %d do not", off);
+    int lowest_left = SESSION_NEED_LEVELS, highest_left = -1, highest_right = -1;
+    for (int j = 0; j < PY; j++)
+        for (int i = 0; i < PX; i++) {
+            int x0 = SESSION_PACKET * i, x1 = x0 + SESSION_PACKET, v = need[j * PX + i];
+            if (x1 <= W / 2) {
+                lowest_left = v < lowest_left ? v : lowest_left;
+                highest_left = v > highest_left ? v : highest_left;
+            } else if (x0 >= W / 2) {
+                highest_right = v > highest_right ? v : highest_right;
+            }
+        }
+    CHECK(highest_right == 0 && lowest_left > highest_right && highest_left >= 5 &&
+              highest_left < SESSION_NEED_LEVELS / 2,
+          "after three samples: the varying packets at levels %d to %d, the steady ones up to %d", lowest_left,
+          highest_left, highest_right);
     display_change_view(d, s, &b, DISPLAY_CAMERA);
     need = display_packet_need(d);
     int old_off = 0, new_off = 0;
     for (int j = 0; j < PY; j++)
         for (int i = 0; i < PX; i++) {
             int x0 = SESSION_PACKET * i, x1 = x0 + SESSION_PACKET;
-            if (x1 <= W * 7 / 10) old_off += need[j * PX + i] != 4;
+            if (x1 <= W * 7 / 10) old_off += need[j * PX + i] >= SESSION_NEED_LEVELS / 2;
             if (x0 >= W * 8 / 10) new_off += need[j * PX + i] != SESSION_NEED_LEVELS - 1;
         }
     CHECK(old_off == 0 && new_off == 0, "after the slide: %d carried packets and %d new ones with another need",
