@@ -35,8 +35,9 @@
 # Usage: tests/bench/viewer_display.sh [--phase P] [--scenes "atelier doorway"]
 #          [--methods "vsl vsl+hl"] [--out DIR] [--refs DIR] [--ref-spp-rest 2048]
 #          [--ref-spp-motion 256] [--ref-shards 8] [--glint build/app/glint]
-# (add pt to --methods as a comparison). A measurement, not a test: use a release build on an
-# otherwise idle machine; the issue's aims are in docs/benchmarks.md.
+# (add pt to --methods as a comparison; SCENARIOS="orbit light" in the environment runs only those
+# of orbit, jump and light). A measurement, not a test: use a release build on an otherwise idle
+# machine; the issue's aims are in docs/benchmarks.md.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 phase=all scenes="atelier doorway" methods="vsl vsl+hl" size=960x540
@@ -128,7 +129,7 @@ run_captures() {
   echo "captures: $size, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), into $out"
   for scene in $scenes; do
     for method in $methods; do
-      for scenario in orbit jump light; do
+      for scenario in ${SCENARIOS:-orbit jump light}; do
         dir=$out/$scene/$method/$scenario
         rm -rf "$dir"
         mkdir -p "$dir"
