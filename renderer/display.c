@@ -458,6 +458,12 @@ long long display_take_samples(display *d) {
     return taken;
 }
 
+/* One sample's variance from n samples' moments (their mean's luminance l, the mean of their squared
+ * luminance m2): the moments give the population's, n / (n - 1) of it is unbiased; 0 below two. */
+static float sample_variance(float m2, float l, float n) {
+    return n > 1.0f ? fmaxf(m2 - l * l, 0.0f) * n / (n - 1.0f) : 0.0f;
+}
+
 /* What one more sample would take off pixel k's squared error as shown: a mean of n samples of
  * one-sample variance s2 errs by s2 / n, one more by s2 / (n + 1). Summed over the components with
  * light, each's variance of its light times the albedo (what the image shows); -1 where a component
@@ -470,7 +476,7 @@ static float sample_gain(const display *d, const pixel_history *p, size_t k) {
         float n = p->c[c].count;
         if (!(n >= 2.0f)) return -1.0f;
         float l = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2]));
-        float s2 = fmaxf(p->c[c].m2 - l * l, 0.0f) * n / (n - 1.0f) * a * a;
+        float s2 = sample_variance(p->c[c].m2, l, n) * a * a;
         gain += s2 / (n * (n + 1.0f));
     }
     return isfinite(gain) ? gain : -1.0f;
@@ -571,8 +577,7 @@ static void split_row(void *ctx, int y, int worker) {
             for (int e = 0; e < 3; e++) d->light[c][3 * i + (size_t)e] = m[e];
             d->count[c][i] = count;
             hole |= !(count > 0.0f);
-            /* the moments give the population variance; the filter wants the unbiased one */
-            d->variance[c][i] = count > 1.0f ? fmaxf(m2 - l * l, 0.0f) * count / (count - 1.0f) : 0.0f;
+            d->variance[c][i] = sample_variance(m2, l, count); /* the filter wants the unbiased one */
         }
         holes += hole;
     }
