@@ -187,7 +187,7 @@ static void prep_geometry(const float *restrict zs, const float *restrict za, co
 }
 
 /* A run of one component's light (3 floats each), counts and variances into v: r, g, b, s2, n. */
-static void prep_light(const float *restrict rgb, const float *restrict count, const float *restrict var,
+static void prep_light(const float *restrict rgb, const float *restrict count, const float *restrict var, float cap,
                        float (*restrict v)[RUN]) {
     for (int i = 0; i < RUN; i++) {
         float vr = rgb[3 * i], vg = rgb[3 * i + 1], vb = rgb[3 * i + 2], k = count[i], s = var[i];
@@ -196,7 +196,7 @@ static void prep_light(const float *restrict rgb, const float *restrict count, c
         vr = has > 0.0f ? vr : 0.0f;
         vg = has > 0.0f ? vg : 0.0f;
         vb = has > 0.0f ? vb : 0.0f;
-        k = k < COUNT_MAX ? k : COUNT_MAX;
+        k = k < cap ? k : cap;
         s = s < S2_MAX ? s : S2_MAX;
         v[0][i] = vr;
         v[1][i] = vg;
@@ -252,7 +252,7 @@ static void prep_row(void *ctx, int y, int worker) {
                 load_run(var_run, var, j->in->variance[c] ? n : 0, 1);
                 rgb = rgb_run, count = count_run, var = var_run;
             }
-            prep_light(rgb, count, var, v);
+            prep_light(rgb, count, var, j->count_cap, v);
             const planes *e = &d->full[0][c], *o = &d->full[1][c];
             float *pe[PLANES_EACH - 1] = {e->r, e->g, e->b, e->s2, e->n};
             float *po[PLANES_EACH - 1] = {o->r, o->g, o->b, o->s2, o->n};
@@ -381,6 +381,8 @@ int denoise_run(denoiser *d, const denoise_input *in, const denoise_params *p, c
     j.sigma_z = sigma_or(p->sigma_z, 1.0f);
     j.sigma_n = sigma_or(p->sigma_n, 128.0f);
     j.sigma_l = sigma_or(p->sigma_l, 4.0f);
+    j.count_cap =
+        p->count_cap >= 1.0f && p->count_cap < COUNT_MAX ? p->count_cap : COUNT_MAX; /* below one sample: none */
     int levels = p->levels < 0 ? 0 : (p->levels > DENOISE_MAX_LEVELS ? DENOISE_MAX_LEVELS : p->levels);
     run_rows(pool, prep_row, &j, d->height);
     if (levels == 0) {

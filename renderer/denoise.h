@@ -21,6 +21,10 @@ typedef struct {
                                       * passes there (holes 2, 4, 8, ... pixels), the way back up with the
                                       * full image's 3x3 pass; 0: none (the output is the input, holes stay
                                       * holes); at most DENOISE_MAX_LEVELS */
+    float count_cap;                 /* a pixel counts as this many samples at most (below 1: no cap): where a
+                                      * few pixels have far more samples than their neighbours (the
+                                      * display's extra samples), their own value is sure, but no surer
+                                      * a guide to their neighbours' light than any pixel's */
 } denoise_params;
 
 typedef struct {

@@ -149,6 +149,7 @@ typedef struct {
     int comps;
     float sigma_z, sigma_n, sigma_l;
     float kappa;
+    float count_cap;     /* a pixel's count, at most: denoise_params' */
     float inv_sqrt_unit; /* 1 / sqrt(the samples a scaled count of 1 stands for), before the step */
     int step, src;       /* a pass on the half grid: holes, buffer */
     /* back up: the half grid's result (buffer coarse), the full image's 3x3 pass */

@@ -1,80 +1,11 @@
 #define _POSIX_C_SOURCE 200809L
-#include "display.h"
-
 #include <float.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "clock.h"
-#include "denoise.h"
-#include "threadpool.h"
-
-/* One pixel's history, per film component: the mean of its samples divided by the pixel's albedo,
- * how many samples it stands for (fractional once part of it was let go), and the mean of their
- * squared luminance (the spread the filter needs); and how far the view has turned at the point
- * since its samples were taken (radians, their mean). One cache line: reprojection reads four. */
-typedef struct {
-    struct {
-        float mean[3], count, m2;
-    } c[COMP_COUNT];
-    float turn;
-} pixel_history;
-_Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line");
-
-/* History a camera move carries over is capped at this many samples: each reprojection resamples
- * (blurs) it a little, and a cap lets new samples take over at a steady pace while moving. */
-#define DISPLAY_MAX_CARRIED 64.0f
-/* A light change sets the history aside (stale) until new samples show, tile by tile, whether
- * the light there changed: a tile of TILE_PX x TILE_PX pixels is judged once it has
- * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "The display while things move"). Until then
- * stale history counts as STALE_WEIGHT samples where a pixel has no new one: it fills holes, and
- * any new sample near it outweighs it. */
-#define TILE_PX 16
-#define JUDGE_MIN_SAMPLES 16
-#define JUDGE_MAX_SAMPLES 64
-#define STALE_WEIGHT 0.25f
-/* Reprojection's tests: a surface point's old pixel is the same point if its normal is within
- * this cosine and it lies within this many pixel footprints of the old point's plane. */
-#define REPROJECT_MIN_COS 0.9f
-#define REPROJECT_PLANE_PIXELS 2.0f
-/* The filter's levels: three reach about 15 pixels, enough where most pixels have samples (more blur
- * the image for no less noise); where many have none yet (a new view, the sparse updates while the
- * camera moves) the levels reach as far as the holes are wide. */
-#define DENOISE_LEVELS 3
-
-/* A tile's evidence since the last light change: new samples' luminance (every component, divided
- * by the albedo) less the stale history's at the same pixels, its variance, the stale total. */
-enum { TILE_UNKNOWN = 0, TILE_SAME, TILE_CHANGED };
-typedef struct {
-    double diff, var, base;
-    int n, state;
-} light_tile;
-
-struct display {
-    int width, height;
-    threadpool *pool;
-    gbuffer g[2];        /* g[cur] the view shown, the other the one before */
-    pixel_history *h[2]; /* h[cur] the view shown, the other the one before */
-    int cur;
-    int have_view;
-    sample_sink sink;
-    /* resolve's scratch: the filter's input per component (demodulated mean, samples, one sample's
-     * luminance variance) and its output */
-    float *light[COMP_COUNT], *count[COMP_COUNT], *variance[COMP_COUNT], *out[COMP_COUNT];
-    float *out_count[COMP_COUNT]; /* the samples behind the filter's value... */
-    float *gap[COMP_COUNT];       /* ...its squared gap to the pixel's own mean (gap_row)... */
-    denoiser *dn;
-    int active[COMP_COUNT]; /* a component had a sample other than zero since the last restart */
-    /* after a light change: the history before it, and per tile what new samples say of it */
-    pixel_history *stale;
-    int judging;
-    int tiles_x, tiles_y;
-    light_tile *tiles;
-    uint8_t *need;    /* per packet (display_packet_need)... */
-    float *need_gain; /* ...and its scratch */
-    display_stats st;
-};
+#include "display_parts.h"
 
 display *display_create(int width, int height, int threads, char *err, size_t errlen) {
     display *d = calloc(1, sizeof *d);
@@ -104,6 +35,8 @@ display *display_create(int width, int height, int threads, char *err, size_t er
                      (size_t)((height + SESSION_PACKET - 1) / SESSION_PACKET);
     if (ok) ok = (d->need = calloc(packets, 1)) != NULL;
     if (ok) ok = (d->need_gain = calloc(packets, sizeof(float))) != NULL;
+    if (ok) ok = (d->spread = malloc(sizeof(float) * n)) != NULL;
+    if (ok) ok = (d->extra_pixels = malloc(sizeof(int) * n)) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
     if (!ok) {
         display_destroy(d);
@@ -113,6 +46,10 @@ display *display_create(int width, int height, int threads, char *err, size_t er
     if (!(d->pool = threadpool_create(threads))) {
         display_destroy(d);
         return snprintf(err, errlen, "cannot start the display's threads"), NULL;
+    }
+    if (!(d->extra_hist = malloc(sizeof(extra_histogram) * (size_t)threadpool_size(d->pool)))) {
+        display_destroy(d);
+        return snprintf(err, errlen, "out of memory for a %dx%d display", width, height), NULL;
     }
     return d;
 }
@@ -139,14 +76,15 @@ void display_destroy(display *d) {
     free(d->sink.stamp);
     free(d->need);
     free(d->need_gain);
+    free(d->spread);
+    free(d->extra_pixels);
+    free(d->extra_hist);
     free(d);
 }
 
 const sample_sink *display_sink(const display *d) { return &d->sink; }
 display_stats display_get_stats(const display *d) { return d->st; }
 const gbuffer *display_gbuffer(const display *d) { return &d->g[d->cur]; }
-
-static vec3 get3(const float *a, size_t i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
 
 /* ---- carrying history over a change of view ------------------------------------------------ */
 
@@ -177,6 +115,16 @@ static float glossy_keep(float t0, float t1, float alpha) {
 static float glossy_share(float g, float alpha) {
     float peak = g / fmaxf(alpha * alpha, 1e-6f);
     return peak > 0.0f ? peak / (peak + 1.0f - g) : 0.0f;
+}
+
+/* The most samples history may count as where a share `held` of its light still holds since its
+ * samples were taken, per unit of one sample's relative variance (s / L)^2: what no longer holds is
+ * a bias of about (1 - held) of the light L, which the mean of n samples of spread s matches in its
+ * noise at n = (s / L)^2 / (1 - held)^2. Many samples (the display's extra ones) of a highlight that
+ * has since moved would otherwise outweigh the new ones for seconds. */
+static float keep_cap(float held) {
+    float lost = 1.0f - held;
+    return lost > 1e-3f ? 1.0f / (lost * lost) : INFINITY;
 }
 
 /* Whether old pixel q shows the surface point of new pixel i (positions, normals, materials). */
@@ -255,12 +203,14 @@ static void carry_row(void *ctx, int y, int worker) {
             step = length3(sub3(a, b)); /* the chord, 2 sin(turn / 2): within 2% of the turn to 40 degrees */
         }
         now->turn = turn + step;
-        float glossy = 1.0f, share = 0.0f;
+        float glossy = 1.0f, share = 0.0f, held = 1.0f; /* held: of the samples' light when taken */
         if (step > 0.0f) {
             glossy = glossy_keep(turn, turn + step, to->alpha[i]);
             share = glossy_share(to->gloss[i], to->alpha[i]);
+            held = glossy_keep(0.0f, turn + step, to->alpha[i]);
         }
         float diffuse = (1.0f - share) + share * glossy;
+        float cap_glossy = fminf(cap, keep_cap(held)), cap_all = fminf(cap, keep_cap((1.0f - share) + share * held));
         for (int c = 0; c < COMP_COUNT; c++) {
             if (!j->d->active[c]) continue;
             float count = 0.0f, m2 = 0.0f, m[3] = {0.0f, 0.0f, 0.0f};
@@ -271,7 +221,11 @@ static void carry_row(void *ctx, int y, int worker) {
                 m2 += wk * o->c[c].m2;
                 for (int e = 0; e < 3; e++) m[e] += wk * o->c[c].mean[e];
             }
-            count = fminf(count * (c == COMP_HIGHLIGHTS ? glossy : diffuse), cap);
+            /* the cap per unit of one sample's relative variance (keep_cap), one sample at least */
+            float l = luminance3(v3(m[0], m[1], m[2])), rel = sample_variance(m2, l, count) / (l * l);
+            float at_most = c == COMP_HIGHLIGHTS ? cap_glossy : cap_all;
+            if (at_most < cap && isfinite(rel)) at_most = fmaxf(rel * at_most, 1.0f);
+            count = fminf(count * (c == COMP_HIGHLIGHTS ? glossy : diffuse), at_most);
             if (!(count > 0.0f)) continue;
             now->c[c].count = count;
             now->c[c].m2 = m2;
@@ -297,13 +251,24 @@ static void history_merge(pixel_history *a, const pixel_history *b, float cap) {
     }
 }
 
-static int tile_of(const display *d, size_t i) {
-    int x = (int)(i % (size_t)d->width), y = (int)(i / (size_t)d->width);
-    return (y / TILE_PX) * d->tiles_x + x / TILE_PX;
+static float total_luminance(const pixel_history *p, float *variance);
+
+/* Whether a pixel's new samples (h) disagree with its stale history (s) of many samples beyond
+ * their noise (a new sample as spread as the stale ones, at least; the components' variances
+ * summed COMP_COUNT times, as they may go together): a speck the light lit before (its reflection
+ * in a mirror, with the many extra samples such a pixel takes) has moved, though its tile as a
+ * whole has not changed. */
+#define STALE_MANY 8.0f
+static int pixel_changed(const pixel_history *h, const pixel_history *s) {
+    float n = h->c[COMP_DIRECT].count, m = s->c[COMP_DIRECT].count, vh, vs;
+    if (!(n >= 1.0f) || !(m >= STALE_MANY)) return 0;
+    float lh = total_luminance(h, &vh), ls = total_luminance(s, &vs), diff = fabsf(lh - ls);
+    float noise = sqrtf((float)COMP_COUNT * (vs / m + fmaxf(vh, vs) / n));
+    return diff > 3.0f * noise && diff > 0.1f * fmaxf(lh, ls);
 }
 
 /* A tile's verdict: where the light did not change its stale history comes back (counted in full),
- * where it did the stale history goes. */
+ * but for pixels whose new samples contradict it; where it did the stale history goes. */
 static void settle_tile(display *d, int t, int state) {
     d->tiles[t].state = state;
     int x0 = (t % d->tiles_x) * TILE_PX, y0 = (t / d->tiles_x) * TILE_PX;
@@ -311,7 +276,7 @@ static void settle_tile(display *d, int t, int state) {
     for (int y = y0; y < y0 + TILE_PX && y < d->height; y++)
         for (int x = x0; x < x0 + TILE_PX && x < d->width; x++) {
             size_t i = (size_t)y * (size_t)d->width + (size_t)x;
-            if (state == TILE_SAME) history_merge(&h[i], &d->stale[i], INFINITY);
+            if (state == TILE_SAME && !pixel_changed(&h[i], &d->stale[i])) history_merge(&h[i], &d->stale[i], INFINITY);
             memset(&d->stale[i], 0, sizeof d->stale[i]);
         }
 }
@@ -458,12 +423,6 @@ long long display_take_samples(display *d) {
     return taken;
 }
 
-/* One sample's variance from n samples' moments (their mean's luminance l, the mean of their squared
- * luminance m2): the moments give the population's, n / (n - 1) of it is unbiased; 0 below two. */
-static float sample_variance(float m2, float l, float n) {
-    return n > 1.0f ? fmaxf(m2 - l * l, 0.0f) * n / (n - 1.0f) : 0.0f;
-}
-
 /* What one more sample would take off pixel k's squared error as shown: a mean of n samples of
  * one-sample variance s2 errs by s2 / n, one more by s2 / (n + 1). Summed over the components with
  * light, each's variance of its light times the albedo (what the image shows); -1 where a component
@@ -473,10 +432,8 @@ static float sample_gain(const display *d, const pixel_history *p, size_t k) {
     if (!(p->c[COMP_DIRECT].count >= 2.0f)) return -1.0f; /* every sample counts in every component */
     for (int c = 0; c < COMP_COUNT; c++) {
         if (!d->active[c]) continue;
-        float n = p->c[c].count;
-        if (!(n >= 2.0f)) return -1.0f;
-        float l = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2]));
-        float s2 = sample_variance(p->c[c].m2, l, n) * a * a;
+        float n = p->c[c].count, s2 = shown_spread(p, c, a);
+        if (s2 < 0.0f) return -1.0f;
         gain += s2 / (n * (n + 1.0f));
     }
     return isfinite(gain) ? gain : -1.0f;
@@ -669,6 +626,9 @@ static void modulate_row(void *ctx, int y, int worker) {
     }
 }
 
+/* The filter's count cap (denoise_params): a few times the average pixel's samples. */
+static float count_cap_of(double mean) { return fmaxf(COUNT_CAP_MIN, COUNT_CAP_MEAN * (float)mean); }
+
 void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
     uint64_t t0 = clock_ns();
     resolve_job j = {.d = d, .filtered = denoise, .rgb = rgb};
@@ -695,7 +655,7 @@ void display_resolve(display *d, unsigned mask, int denoise, float *rgb) {
         double covered = 1.0 - (double)atomic_load(&j.holes) / ((double)d->width * (double)d->height);
         int levels = DENOISE_LEVELS;
         for (double k = 0.5; covered < k && levels < DENOISE_MAX_LEVELS; k *= 0.5) levels++;
-        denoise_params p = {.levels = levels};
+        denoise_params p = {.levels = levels, .count_cap = count_cap_of(d->st.mean_count)};
         uint64_t t1 = clock_ns();
         if (in.components) denoise_run(d->dn, &in, &p, &out, d->pool);
         d->st.filter_ms = 1e-6 * (double)(clock_ns() - t1);

@@ -33,6 +33,7 @@ typedef struct {
     double gbuffer_ms; /* ...of which the G-buffer */
     double resolve_ms; /* the last resolve: filter and modulation... */
     double filter_ms;  /* ...of which the filter (denoise_run) */
+    uint64_t extra;    /* extra samples taken (display_take_extra) */
 } display_stats;
 
 typedef struct display display;
@@ -62,6 +63,18 @@ long long display_take_samples(display *d);
  * off the error shown, against the mean packet's. The sky needs nothing. One entry per packet, row
  * major, the display's own until the next call. */
 const uint8_t *display_packet_need(display *d);
+
+/* Extra samples for the display alone (session_render_extra), where they take most off the error
+ * shown: a pixel of one-sample spread s (its variance's square root, times its albedo) with n
+ * samples errs by s^2 / n, and the least sum of that over the image for `budget` samples more has
+ * each pixel's n + k in proportion to its s (k >= 0; docs/design.md, "Extra samples"). Pixels
+ * whose spread is unknown (fewer than two samples) take none: the film's next frame is theirs.
+ * Writes at most max requests (pixel, samples, luminance weights) and returns how many. The plan
+ * reads the samples so far, so the display's mean is no longer unbiased where it takes them: a
+ * view, like the filter. */
+int display_plan_extra(display *d, int budget, extra_request *req, int max);
+/* Blends the requests' samples (session_render_extra's) into the history. */
+void display_take_extra(display *d, const extra_request *req, int n);
 
 /* The image shown, of the components in mask (bit c = film component c), into rgb (3 floats a
  * pixel, width x height): the history times the albedo, filtered when denoise is set (its

@@ -77,6 +77,9 @@ struct render_session {
     const uint8_t *need; /* per packet, the caller's (session_set_packet_need); NULL: none */
     uint32_t *order;     /* the frame's packets by need, when it is ordered (else NULL) */
     size_t order_size;
+    int frame_begun;      /* a frame began since the last reset: its estimators serve extra samples */
+    uint64_t extra_calls; /* session_render_extra's calls: each its own random numbers */
+    extra_request *extra; /* the call's requests */
     char error[256];
 };
 
@@ -215,6 +218,12 @@ static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, u
     return (qmc_run){(uint32_t)taken, sx, rng_next_u32(&start)};
 }
 
+/* A display-only sample's run (session_render_extra): scrambled afresh from its own stream. */
+static qmc_run fresh_run(rng_state *rng) {
+    uint32_t sx = rng_next_u32(rng);
+    return (qmc_run){0, sx, rng_next_u32(rng)};
+}
+
 /* The direct light at a pixel, the mean of `samples` estimates. The first is at the frame's own
  * camera hit (first; NULL: none), the others each at a camera hit of its own, at the next points of
  * the pixel's run of them (its count of them kept in direct_taken: a run's points taken in a row
@@ -228,7 +237,7 @@ static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_rast
                          const surface_hit *first, int samples, pixel_record *rec, rng_state *rng) {
     const scene *s = rs->scene;
     qmc_run run = pixel_run(rs, pixel, RUN_DIRECT_POINTS, rs->direct_taken[pixel], 1);
-    rs->direct_taken[pixel] += (uint32_t)(samples - 1);
+    if (samples > 1) rs->direct_taken[pixel] += (uint32_t)(samples - 1); /* one: nothing written (extra samples) */
     float u_select = rng_float(rng);
     vec3 sum = v3(0, 0, 0);
     for (int k = 0; k < samples; k++) {
@@ -277,7 +286,7 @@ static int dim_judged(const render_session *rs) {
  * take its image, not the sample's spread, so the merge's expectation does not depend on how many
  * rays it merged (docs/design.md, "Where the samples go"). */
 static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                             const surface_hit *first, rng_state *rng) {
+                             const surface_hit *first, rng_state *rng, int extra) {
     rng_state hl_rng = rng_fork(rng, 0x686967686c69ULL);
     hl_setup setup = rs->hl;
     if (dim_judged(rs)) { /* the pixel was kept: its highlights are bright */
@@ -285,7 +294,7 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
         setup.secondary_rays = n < HL_MAX_SECONDARY_RAYS ? n : HL_MAX_SECONDARY_RAYS;
         setup.clusters = 2 * setup.clusters < HL_MAX_CLUSTERS ? 2 * setup.clusters : HL_MAX_CLUSTERS;
     }
-    int spread = rs->adapt && rs->hl_state[pixel] == HL_PIXEL_SHARP;
+    int spread = rs->adapt && !extra && rs->hl_state[pixel] == HL_PIXEL_SHARP;
     int points = 1;
     if (spread) {
         int n = setup.secondary_rays * HL_SHARP_RAY_FACTOR;
@@ -298,17 +307,21 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     /* --merge auto: a pixel judged to take the trace does; the others record the trace beside */
     hl_merge_record *rec = rs->adapt && setup.choose ? &rs->hl_merge[pixel] : NULL;
     if (rec && rec->traced) setup.mode = HL_TRACED, rec = NULL;
+    if (extra) rec = NULL;
     int sharp = 0;
     /* Each point its own run (its rays' directions over frames); spread points get fresh ones. */
     qmc_run runs[HL_PIXEL_POINTS];
     for (int j = 0; j < points; j++) {
-        runs[j] = pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
-                            next_frame_index(rs) * (uint64_t)hl_rays_of_point(setup.secondary_rays, points, j), 0);
+        runs[j] =
+            extra ? fresh_run(&hl_rng)
+                  : pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
+                              next_frame_index(rs) * (uint64_t)hl_rays_of_point(setup.secondary_rays, points, j), 0);
     }
     vec3 traced;
     vec3 L = hl_estimate(&setup, rs->scene, xs, points, runs, &hl_rng, st, &sharp, rec ? &traced : NULL);
     if (rec && is_finite3(L) && is_finite3(traced)) hl_merge_record_add(rec, avg3(L), avg3(traced));
-    if (sharp) rs->hl_state[pixel] = HL_PIXEL_SHARP; /* read from the next frame on: one sample a pixel a frame */
+    if (sharp && !extra)
+        rs->hl_state[pixel] = HL_PIXEL_SHARP; /* read from the next frame on: one sample a pixel a frame */
     return L;
 }
 
@@ -319,56 +332,67 @@ static void sink_put(const sample_sink *k, int pixel, const float sample[COMP_CO
 }
 
 /* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL; its
- * highlights, when its block shared them, in shared_hl. */
-static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                          const surface_hit *first, rng_state *rng, const vec3 *shared_hl) {
+ * highlights, when its block shared them, in shared_hl; into L. A display's extra sample (extra)
+ * reads the pixel's records but writes none, takes its one direct sample at its own camera hit and
+ * draws its runs afresh from rng. */
+static void estimate_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                            const surface_hit *first, rng_state *rng, const vec3 *shared_hl, int extra,
+                            vec3 L[COMP_COUNT]) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
     /* render_tile probed the pixel's highlight state */
-    int spread = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_SHARP;
+    int spread = rs->adapt && !extra && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_SHARP;
     int dim = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_DIM;
-    int direct_samples = p->method == METHOD_PT ? 1 : rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES;
-    /* into the void (and its other points too): every component is zero, nothing to add */
+    int direct_samples = p->method == METHOD_PT || extra ? 1
+                         : rs->adapt                     ? rs->direct.samples[pixel]
+                                                         : MANYLIGHT_DIRECT_SAMPLES;
+    for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
+    /* into the void (and its other points too): every component is zero */
     if (!first && !s->env && !spread && direct_samples == 1) {
         st->rays[RAY_CAMERA]++;
-        static const float zero[COMP_COUNT][3];
-        if (rs->sink) sink_put(rs->sink, pixel, zero); /* a sample all the same */
         return;
     }
-    vec3 L[COMP_COUNT];
     int depth = rs->plan.max_depth;
     if (p->method == METHOD_PT) {
         pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, first,
-                    pixel_run(rs, pixel, RUN_PATH, next_frame_index(rs), 0), rng, L, st->rays);
-    } else {
-        /* Many lights: the shared direct estimator, then the virtual lights at the hit and the
-         * highlights, each pass timed. */
-        for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
-        uint64_t t0 = clock_ns();
-        if (!p->only || p->only & (1u << COMP_DIRECT))
-            L[COMP_DIRECT] = pixel_direct(rs, st, raster, pixel, d, first, direct_samples,
-                                          rs->adapt ? &rs->direct.rec[pixel] : NULL, rng);
-        else
-            st->rays[RAY_CAMERA]++;
-        uint64_t t1 = clock_ns();
-        st->pass_ns[PASS_DIRECT] += t1 - t0;
-        if (first && depth > 1 && rs->plan.virtual_lights) {
-            shading_point sp = shading_point_at(s, first, d);
-            int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
-            /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
-            uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : next_frame_index(rs) * (uint64_t)split;
-            L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, dim ? &L[COMP_HIGHLIGHTS] : NULL, depth, split,
-                                                  pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
-                                                  rs->adapt ? &rs->glossy.rec[pixel] : NULL, rng, st);
-            uint64_t t2 = clock_ns();
-            st->pass_ns[PASS_GATHER] += t2 - t1;
-            t1 = t2;
-        }
-        if (depth > 1 && rs->plan.highlights && !dim) {
-            L[COMP_HIGHLIGHTS] = shared_hl ? *shared_hl : pixel_highlights(rs, st, raster, pixel, d, first, rng);
-            st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
-        }
+                    extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, next_frame_index(rs), 0), rng, L, st->rays);
+        return;
     }
+    /* Many lights: the shared direct estimator, then the virtual lights at the hit and the
+     * highlights, each pass timed. */
+    int record = rs->adapt && !extra;
+    uint64_t t0 = clock_ns();
+    if (!p->only || p->only & (1u << COMP_DIRECT))
+        L[COMP_DIRECT] =
+            pixel_direct(rs, st, raster, pixel, d, first, direct_samples, record ? &rs->direct.rec[pixel] : NULL, rng);
+    else
+        st->rays[RAY_CAMERA]++;
+    uint64_t t1 = clock_ns();
+    st->pass_ns[PASS_DIRECT] += t1 - t0;
+    if (first && depth > 1 && rs->plan.virtual_lights) {
+        shading_point sp = shading_point_at(s, first, d);
+        int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
+        /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
+        uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : next_frame_index(rs) * (uint64_t)split;
+        L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, dim ? &L[COMP_HIGHLIGHTS] : NULL, depth, split,
+                                              extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
+                                              record ? &rs->glossy.rec[pixel] : NULL, rng, st);
+        uint64_t t2 = clock_ns();
+        st->pass_ns[PASS_GATHER] += t2 - t1;
+        t1 = t2;
+    }
+    if (depth > 1 && rs->plan.highlights && !dim) {
+        L[COMP_HIGHLIGHTS] = shared_hl ? *shared_hl : pixel_highlights(rs, st, raster, pixel, d, first, rng, extra);
+        st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
+    }
+}
+
+/* The film's sample of a pixel (as estimate_sample), added, or dropped and counted when it is not
+ * finite (a NaN or Inf never reaches the film); and to the sink. */
+static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                          const surface_hit *first, rng_state *rng, const vec3 *shared_hl) {
+    vec3 L[COMP_COUNT];
+    estimate_sample(rs, st, raster, pixel, d, first, rng, shared_hl, 0, L);
     float sample[COMP_COUNT][3];
     int finite = 1;
     for (int c = 0; c < COMP_COUNT; c++) {
@@ -377,7 +401,6 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
         sample[c][1] = L[c].y;
         sample[c][2] = L[c].z;
     }
-    /* A NaN or Inf never reaches the film: the sample is dropped and counted. */
     if (finite) {
         film_add(&rs->film, pixel, (const float(*)[3])sample);
         if (rs->sink) sink_put(rs->sink, pixel, (const float(*)[3])sample);
@@ -664,6 +687,7 @@ int session_render_part(render_session *rs, int parts, int *frame_done) {
     int packets_y = (rs->params.height + PACKET_H - 1) / PACKET_H;
     if (!rs->frame_parts) {
         if (begin_frame(rs) != 0) return -1;
+        rs->frame_begun = 1;
         rs->frame_parts = allowed_parts(parts);
         rs->parts_done = 0;
         rs->first_part = rs->next_part % rs->frame_parts;
@@ -719,6 +743,54 @@ int session_render_frame(render_session *rs) {
     return status;
 }
 
+/* One request of session_render_extra: its samples from a stream of their own (the call's, the
+ * request's), at R2 positions over the pixel from a random start. */
+static void render_extra(void *ctx, int task, int worker) {
+    render_session *rs = ctx;
+    extra_request *q = &rs->extra[task];
+    memset(q->sum, 0, sizeof q->sum);
+    memset(q->sumsq, 0, sizeof q->sumsq);
+    q->taken = 0;
+    const render_params *p = &rs->params;
+    if (q->pixel < 0 || q->pixel >= p->width * p->height) return;
+    if (rs->abort_flag && atomic_load_explicit(rs->abort_flag, memory_order_relaxed)) return;
+    render_stats *st = &rs->workers[worker].st;
+    camera_raster raster = camera_raster_make(&rs->cam, p->width, p->height);
+    rng_state rng = rng_for((uint64_t)task, (1ull << 62) | rs->extra_calls, p->seed); /* no frame's stream */
+    vec2 shift = rng_vec2(&rng);
+    int x = q->pixel % p->width, y = q->pixel / p->width;
+    for (int k = 0; k < q->samples; k++) {
+        vec2 u = sample_r2(k, shift);
+        vec3 d = camera_raster_dir(&raster, (float)x + u.x, (float)y + u.y), L[COMP_COUNT];
+        surface_hit hit;
+        const surface_hit *first = scene_intersect(rs->scene, rs->cam.position, d, INFINITY, &hit) ? &hit : NULL;
+        estimate_sample(rs, st, &raster, q->pixel, d, first, &rng, NULL, 1, L);
+        int finite = 1;
+        for (int c = 0; c < COMP_COUNT; c++) finite &= is_finite3(L[c]);
+        if (!finite) {
+            st->rejected_samples++;
+            continue;
+        }
+        for (int c = 0; c < COMP_COUNT; c++) {
+            float l = q->weight[0] * L[c].x + q->weight[1] * L[c].y + q->weight[2] * L[c].z;
+            q->sum[c][0] += L[c].x, q->sum[c][1] += L[c].y, q->sum[c][2] += L[c].z;
+            q->sumsq[c] += l * l;
+        }
+        q->taken++;
+    }
+}
+
+int session_render_extra(render_session *rs, extra_request *req, int n) {
+    for (int i = 0; i < n; i++) req[i].taken = 0;
+    if (!rs->frame_begun || (rs->abort_flag && atomic_load(rs->abort_flag))) return 1;
+    rs->extra = req;
+    threadpool_run(rs->pool, render_extra, rs, n);
+    rs->extra = NULL;
+    rs->extra_calls++;
+    gather_stats(rs);
+    return 0;
+}
+
 int session_frame_parts(const render_session *rs) { return rs->frame_parts; }
 int session_frame_parts_done(const render_session *rs) { return rs->frame_parts ? rs->parts_done : 0; }
 
@@ -740,6 +812,7 @@ void session_reset(render_session *rs) {
         memset(rs->hl_merge, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->hl_merge);
     rs->frames = 0;
     rs->frame_parts = 0; /* a frame under way is abandoned; next_part stays, so the next part differs */
+    rs->frame_begun = 0;
     memset(&rs->totals, 0, sizeof rs->totals); /* statistics describe the running mean */
 }
 

@@ -81,6 +81,22 @@ typedef struct {
 /* NULL: none (the default). */
 void session_set_sink(render_session *rs, const sample_sink *sink);
 
+/* Samples for a display only (display.h): for each request, `samples` more samples of its pixel,
+ * each through a camera ray of its own (their positions spread evenly over the pixel), with the
+ * estimators of the frame under way or the last one, summed per film component, and each sample's
+ * luminance (weight . rgb, by the caller's weights) squared and summed. The film, the per-pixel
+ * records the frames keep and every later frame are untouched: a render with extra samples between
+ * its parts has the same film, bit for bit, as one without. Returns 0, or 1 (nothing rendered) when
+ * no frame has begun since the last reset or the abort flag is set. */
+typedef struct {
+    int pixel, samples;       /* asked */
+    float weight[3];          /* a sample's luminance, as the caller reckons it */
+    float sum[COMP_COUNT][3]; /* written: the finite samples' sum, per film component... */
+    float sumsq[COMP_COUNT];  /* ...their luminances squared, summed... */
+    int taken;                /* ...and how many (a sample not finite is dropped) */
+} extra_request;
+int session_render_extra(render_session *rs, extra_request *req, int n);
+
 /* A flag the session polls before each tile (in a part, each chunk of its packets): while it is
  * non-zero, frames stop early (above). For interactive use, where the change that sets it resets
  * the accumulation anyway. NULL: none. */

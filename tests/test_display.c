@@ -214,14 +214,28 @@ static void check_disocclusion(void) {
 }
 
 /* The history's sample count after the view turns about the plane's centre by `degrees` in `steps`
- * equal steps with no samples between, read from the stats' mean count (every pixel sees the plane):
- * diffuse keeps all (up to the cap), glossy what its lobe allows. The plane is Lambert, or Phong
- * (exponent n, diffuse kd and glossy ks grey). */
+ * equal steps with no samples between (every pixel sees the plane): diffuse keeps all (up to the
+ * cap), glossy what its lobe allows. The plane is Lambert, or Phong (exponent n, diffuse kd and
+ * glossy ks grey). Its 8 samples are 0 and twice the light in turn: as spread as they are bright,
+ * as a Monte Carlo estimate's are (a history of exact samples may keep no more than one where
+ * any of its light has moved on). */
+static display *spread_history(const scene *s, camera a, int n) {
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    if (!d) return NULL;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    for (int k = 0; k < n; k++) {
+        write_samples(d, k % 2 ? 2.0f : 0.0f, -1, 0.0f);
+        display_take_samples(d);
+    }
+    return d;
+}
+
 static double count_after_orbit(float phong_n, float kd, float ks, float degrees, int steps, unsigned mask_component) {
     scene *s = plane_scene(0, phong_n, kd, ks);
     float r = 5.0f, n = 8;
     camera a = view_from(v3(0, 0, r), v3(0, 0, 0));
-    display *d = moved(s, a, a, (int)n, DISPLAY_CAMERA, -1, 0.0f);
+    display *d = spread_history(s, a, (int)n);
     for (int k = 1; d && k <= steps; k++) {
         float t = degrees * PI_F / 180.0f * (float)k / (float)steps;
         camera b = view_from(v3(r * sinf(t), 0, r * cosf(t)), v3(0, 0, 0));

@@ -9,7 +9,9 @@
  * quarter and half of a frame's parts cover the image evenly, the statistics count each part, the
  * sink's samples summed are the film's sums and a dropped sample writes nothing. Resetting after every part still walks through
  * all the parts; a frame ordered by need renders the neediest packets first and is the same frame;
- * counts out of range are clamped; a stopped part abandons its frame. */
+ * counts out of range are clamped; a stopped part abandons its frame. Extra samples for a display
+ * (session_render_extra) between a frame's parts leave its film as it is without them, bit for
+ * bit, whatever records --adapt keeps. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -71,7 +73,8 @@ static int same_counts(const render_session *a, const render_session *b) {
 static void check_same_frames(const scene *s, const camera *cam, const render_params *p, const char *name) {
     static const int counts[4] = {4, 16, 256, 1};
     render_session *a = new_session(s, cam, p), *b = new_session(s, cam, p), *c = new_session(s, cam, p),
-                   *d = new_session(s, cam, p);
+                   *d = new_session(s, cam, p), *e = new_session(s, cam, p);
+    static extra_request extra[PIXELS / 3];
     for (int k = 0; k < 3; k++) CHECK(session_render_part(c, 8, NULL) == 0, "%s: a part of 8", name);
     session_reset(c);
     CHECK(session_frame_parts(c) == 0 && session_frames(c) == 0, "%s: a reset must abandon the frame", name);
@@ -83,6 +86,14 @@ static void check_same_frames(const scene *s, const camera *cam, const render_pa
         CHECK(session_frame_parts(d) == 16 && session_render_frame(d) == 0 && session_frame_parts(d) == 0 &&
                   session_frames(d) == f + 1,
               "%s: session_render_frame must finish frame %d begun in parts (%lld frames)", name, f, session_frames(d));
+        for (int k = 0, done = 0; !done; k++) { /* a frame in 4 parts, extra samples of every third pixel between */
+            CHECK(session_render_part(e, 4, &done) == 0, "%s: a part of 4", name);
+            for (int i = 0; i < PIXELS / 3; i++)
+                extra[i] = (extra_request){.pixel = 3 * i + k % 3, .samples = 1 + i % 3, .weight = {1, 1, 1}};
+            CHECK(session_render_extra(e, extra, PIXELS / 3) == 0 && extra[1].taken == 2,
+                  "%s: extra samples between parts", name);
+        }
+        CHECK(same_film(a, e), "%s: frame %d with extra samples between its parts: the film differs", name, f);
         CHECK(same_film(a, b), "%s: frame %d in %d parts: the film differs from whole frames'", name, f, counts[f]);
         CHECK(same_film(a, c), "%s: frame %d in %d parts from a rotation of 3: the film differs", name, f, counts[f]);
         CHECK(same_film(a, d), "%s: frame %d finished by session_render_frame: the film differs", name, f);
@@ -99,6 +110,7 @@ static void check_same_frames(const scene *s, const camera *cam, const render_pa
     session_destroy(b);
     session_destroy(c);
     session_destroy(d);
+    session_destroy(e);
 }
 
 /* The order against brute force over every lattice: a permutation of the cells, of the lattice's

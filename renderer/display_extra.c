@@ -1,0 +1,204 @@
+/* The display's own samples, where the image shown errs most (display_plan_extra,
+ * display_take_extra; docs/design.md, "Extra samples where the image errs most"). */
+#include <math.h>
+#include <string.h>
+
+#include "display_parts.h"
+
+/* A ratio's bin: a float's exponent and its mantissa's top three bits. */
+#define EXTRA_FIRST ((127 + EXTRA_LOW) * 8) /* the first bin's bits >> 20 */
+/* Samples a request at most: a pixel's many go as several requests, shared out over the threads. */
+#define EXTRA_CHUNK 16
+/* A hole's samples as the plan reckons them: its first sample is worth two of a pixel with one. */
+#define HOLE_COUNT 0.5f
+
+static int extra_bin(float ratio) {
+    uint32_t u;
+    memcpy(&u, &ratio, sizeof u); /* ratio > 0 */
+    int b = (int)(u >> 20) - EXTRA_FIRST;
+    return b < 0 ? 0 : b >= EXTRA_BINS ? EXTRA_BINS - 1 : b;
+}
+
+/* The least ratio of bin b. */
+static double extra_edge(int b) {
+    uint32_t u = (uint32_t)(b + EXTRA_FIRST) << 20;
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return (double)f;
+}
+
+static float plan_count(const pixel_history *p) {
+    float n = p->c[COMP_DIRECT].count;
+    return n >= 1.0f ? n : HOLE_COUNT;
+}
+
+/* Pixel i's one-sample spread as shown: the square root of its components' variances summed,
+ * times its albedo's luminance; from a single sample, that sample's own value (a Monte Carlo
+ * sample is typically as spread as it is bright). 0 where it has no sample. */
+static float pixel_spread(const display *d, size_t i) {
+    const pixel_history *p = &d->h[d->cur][i];
+    float a = luminance3(get3(d->g[d->cur].albedo, i)), s2 = 0.0f;
+    if (!(p->c[COMP_DIRECT].count >= 1.0f)) return 0.0f;
+    for (int c = 0; c < COMP_COUNT; c++) {
+        if (!d->active[c]) continue;
+        float v = shown_spread(p, c, a);
+        if (v < 0.0f) {
+            float l = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2])) * a;
+            v = l * l;
+        }
+        s2 += v;
+    }
+    float s = sqrtf(s2);
+    return isfinite(s) ? s : 0.0f;
+}
+
+/* Every pixel's spread into d->spread (0: none to plan for), a row a task; their sum and count per
+ * worker. */
+static void spread_row(void *ctx, int y, int worker) {
+    display *d = ctx;
+    const gbuffer *g = &d->g[d->cur];
+    extra_histogram *k = &d->extra_hist[worker];
+    for (size_t i = (size_t)y * (size_t)d->width; i < (size_t)(y + 1) * (size_t)d->width; i++) {
+        /* while a light change is judged, a tile not yet judged has its history set aside: none */
+        int unjudged = d->judging && d->tiles[tile_of(d, i)].state == TILE_UNKNOWN;
+        d->spread[i] = g->material[i] < 0 || unjudged ? 0.0f : pixel_spread(d, i);
+        if (d->spread[i] > 0.0f) k->spread_sum += (double)d->spread[i], k->spread_n++;
+    }
+}
+
+/* A hole (no sample yet, not the sky) takes the largest spread of its neighbours': the filter fills
+ * it from them, so it is as hard as the hardest of them (a hole beside a bright speck in a mirror
+ * is filled with the speck); one among holes only, the average pixel's (d->spread_mean): nothing
+ * is known of it, and its first sample says where the rest should go (a chrome sphere after a
+ * jump, all holes, whose streak waited for the film). Then each pixel's ratio into its worker's
+ * histogram. */
+
+static void hole_row(void *ctx, int y, int worker) {
+    display *d = ctx;
+    const pixel_history *h = d->h[d->cur];
+    const gbuffer *g = &d->g[d->cur];
+    int w = d->width, ht = d->height;
+    for (int x = 0; x < w; x++) {
+        size_t i = (size_t)y * (size_t)w + (size_t)x;
+        int unjudged = d->judging && d->tiles[tile_of(d, i)].state == TILE_UNKNOWN;
+        if (g->material[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= 1.0f) && !unjudged) {
+            float most = 0.0f;
+            for (int qy = y - 1; qy <= y + 1; qy++)
+                for (int qx = x - 1; qx <= x + 1; qx++) {
+                    if (qx < 0 || qy < 0 || qx >= w || qy >= ht) continue;
+                    size_t q = (size_t)qy * (size_t)w + (size_t)qx;
+                    if (h[q].c[COMP_DIRECT].count >= 1.0f) most = fmaxf(most, d->spread[q]); /* not a hole's */
+                }
+            d->spread[i] = most > 0.0f ? most : d->spread_mean;
+        }
+        if (!(d->spread[i] > 0.0f)) continue;
+        extra_histogram *k = &d->extra_hist[worker];
+        float n = plan_count(&h[i]);
+        int b = extra_bin(d->spread[i] / n);
+        k->count[b]++, k->s[b] += (double)d->spread[i], k->n[b] += (double)n;
+    }
+}
+
+/* The samples pixel i wants at multiplier mu: as many more as bring its count to s mu. */
+static double extra_wanted(const display *d, size_t i, double mu) {
+    double k = (double)d->spread[i] * mu - (double)plan_count(&d->h[d->cur][i]);
+    return k > 0.0 ? k : 0.0;
+}
+
+/* What the m pixels want at multiplier mu, in all. */
+static double extra_total(const display *d, const int *pixels, int m, double mu) {
+    double want = 0.0;
+    for (int k = 0; k < m; k++) want += extra_wanted(d, (size_t)pixels[k], mu);
+    return want;
+}
+
+int display_plan_extra(display *d, int budget, extra_request *req, int max) {
+    if (budget <= 0 || max <= 0) return 0;
+    const pixel_history *h = d->h[d->cur];
+    const gbuffer *g = &d->g[d->cur];
+    size_t np = (size_t)d->width * (size_t)d->height;
+    int workers = threadpool_size(d->pool);
+    for (int k = 0; k < workers; k++) d->extra_hist[k].spread_sum = 0.0, d->extra_hist[k].spread_n = 0;
+    threadpool_run(d->pool, spread_row, d, d->height);
+    double spread_sum = 0.0;
+    long long spread_n = 0;
+    for (int k = 0; k < workers; k++) {
+        spread_sum += d->extra_hist[k].spread_sum, spread_n += d->extra_hist[k].spread_n;
+        memset(d->extra_hist[k].count, 0, sizeof d->extra_hist[k].count);
+        memset(d->extra_hist[k].s, 0, sizeof d->extra_hist[k].s);
+        memset(d->extra_hist[k].n, 0, sizeof d->extra_hist[k].n);
+    }
+    d->spread_mean = spread_n ? (float)(spread_sum / (double)spread_n) : 0.0f;
+    threadpool_run(d->pool, hole_row, d, d->height);
+    for (int k = 1; k < workers; k++)
+        for (int b = 0; b < EXTRA_BINS; b++) {
+            d->extra_hist[0].count[b] += d->extra_hist[k].count[b];
+            d->extra_hist[0].s[b] += d->extra_hist[k].s[b];
+            d->extra_hist[0].n[b] += d->extra_hist[k].n[b];
+        }
+    const int *count = d->extra_hist[0].count;
+    const double *sum_s = d->extra_hist[0].s, *sum_n = d->extra_hist[0].n;
+    /* the lowest bin whose edge, as 1 / mu, has the pixels above it want the budget, or as low as
+     * leaves at most max of them */
+    int b = EXTRA_BINS - 1, m = 0;
+    double s_above = 0.0, n_above = 0.0;
+    for (; b > 0; b--) {
+        if (m + count[b] > max) {
+            b++;
+            break;
+        }
+        m += count[b], s_above += sum_s[b], n_above += sum_n[b];
+        double mu = 1.0 / extra_edge(b - 1); /* where the next bin's pixels begin to want samples */
+        if (s_above * mu - n_above >= (double)budget) break;
+    }
+    /* those pixels, in raster order, and mu where they want the budget: hi doubled until they do,
+     * then halved to it */
+    m = 0;
+    int *cand = d->extra_pixels;
+    for (size_t i = 0; i < np && m < max; i++)
+        if (d->spread[i] > 0.0f && extra_bin(d->spread[i] / plan_count(&h[i])) >= b) cand[m++] = (int)i;
+    double lo = 0.0, hi = 2.0 / extra_edge(b);
+    for (int it = 0; it < 64 && extra_total(d, cand, m, hi) < (double)budget; it++) lo = hi, hi *= 2.0;
+    for (int it = 0; it < 40; it++) {
+        double mu = 0.5 * (lo + hi);
+        *(extra_total(d, cand, m, mu) > (double)budget ? &hi : &lo) = mu;
+    }
+    static const float W[3] = {0.2126f, 0.7152f, 0.0722f}; /* luminance3's */
+    int out = 0;
+    for (int k = 0; k < m && out < max; k++) {
+        size_t i = (size_t)cand[k];
+        double want = extra_wanted(d, i, lo) + 0.5;
+        long long left = want < (double)budget ? (long long)want : budget;
+        for (; left > 0 && out < max; left -= EXTRA_CHUNK) {
+            extra_request *q = &req[out++];
+            q->pixel = (int)i;
+            q->samples = left < EXTRA_CHUNK ? (int)left : EXTRA_CHUNK;
+            for (int e = 0; e < 3; e++) q->weight[e] = W[e] / g->albedo[3 * i + (size_t)e];
+        }
+    }
+    return out;
+}
+
+void display_take_extra(display *d, const extra_request *req, int n) {
+    const gbuffer *g = &d->g[d->cur];
+    pixel_history *h = d->h[d->cur];
+    size_t np = (size_t)d->width * (size_t)d->height;
+    for (int r = 0; r < n; r++) {
+        const extra_request *q = &req[r];
+        if (q->taken <= 0 || q->pixel < 0 || (size_t)q->pixel >= np) continue;
+        size_t i = (size_t)q->pixel;
+        float k = (float)q->taken, old = h[i].c[COMP_DIRECT].count;
+        h[i].turn *= old / (old + k); /* new samples: turn 0 */
+        for (int c = 0; c < COMP_COUNT; c++) {
+            vec3 e = div3(scale3(v3(q->sum[c][0], q->sum[c][1], q->sum[c][2]), 1.0f / k), get3(g->albedo, i));
+            d->active[c] |= !is_black3(e);
+            float t = h[i].c[c].count + k, f = k / t, *m = h[i].c[c].mean;
+            m[0] += (e.x - m[0]) * f;
+            m[1] += (e.y - m[1]) * f;
+            m[2] += (e.z - m[2]) * f;
+            h[i].c[c].m2 += (q->sumsq[c] / k - h[i].c[c].m2) * f;
+            h[i].c[c].count = t;
+        }
+        d->st.extra += (uint64_t)q->taken;
+    }
+}

@@ -1,0 +1,119 @@
+/* glint — the display's parts (docs/design.md, "The display while things move"): what display.c
+ * (history, reprojection, light changes, the image shown) and display_extra.c (the display's own
+ * samples) share. display.h is the interface; nothing else includes this. */
+#ifndef GLINT_DISPLAY_PARTS_H
+#define GLINT_DISPLAY_PARTS_H
+
+#include "denoise.h"
+#include "display.h"
+#include "threadpool.h"
+
+/* One pixel's history, per film component: the mean of its samples divided by the pixel's albedo,
+ * how many samples it stands for (fractional once part of it was let go), and the mean of their
+ * squared luminance (the spread the filter needs); and how far the view has turned at the point
+ * since its samples were taken (radians, their mean). One cache line: reprojection reads four. */
+typedef struct {
+    struct {
+        float mean[3], count, m2;
+    } c[COMP_COUNT];
+    float turn;
+} pixel_history;
+_Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line");
+
+/* History a camera move carries over is capped at this many samples: each reprojection resamples
+ * (blurs) it a little, and a cap lets new samples take over at a steady pace while moving. */
+#define DISPLAY_MAX_CARRIED 64.0f
+/* A light change sets the history aside (stale) until new samples show, tile by tile, whether
+ * the light there changed: a tile of TILE_PX x TILE_PX pixels is judged once it has
+ * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "The display while things move"). Until then
+ * stale history counts as STALE_WEIGHT samples where a pixel has no new one: it fills holes, and
+ * any new sample near it outweighs it. */
+#define TILE_PX 16
+#define JUDGE_MIN_SAMPLES 16
+#define JUDGE_MAX_SAMPLES 64
+#define STALE_WEIGHT 0.25f
+/* Reprojection's tests: a surface point's old pixel is the same point if its normal is within
+ * this cosine and it lies within this many pixel footprints of the old point's plane. */
+#define REPROJECT_MIN_COS 0.9f
+#define REPROJECT_PLANE_PIXELS 2.0f
+/* The filter's levels: three reach about 15 pixels, enough where most pixels have samples (more blur
+ * the image for no less noise); where many have none yet (a new view, the sparse updates while the
+ * camera moves) the levels reach as far as the holes are wide. */
+#define DENOISE_LEVELS 3
+/* display_plan_extra's histogram of the pixels' s / n (the spread of one sample over the samples)
+ * over EXTRA_BINS bins, eight an octave from 2^EXTRA_LOW, per thread. */
+#define EXTRA_BINS 1024
+#define EXTRA_LOW (-64)
+typedef struct extra_histogram {
+    int count[EXTRA_BINS];
+    double s[EXTRA_BINS], n[EXTRA_BINS];
+    double spread_sum; /* ...and the pixels' spreads summed, and counted */
+    long long spread_n;
+} extra_histogram;
+/* The filter counts no pixel as more than COUNT_CAP_MEAN times the average pixel's samples, nor
+ * fewer than COUNT_CAP_MIN: a pixel that took many extra samples (display_plan_extra) is sure of
+ * its own light, not of its neighbours'. */
+#define COUNT_CAP_MEAN 4.0f
+#define COUNT_CAP_MIN 4.0f
+
+/* A tile's evidence since the last light change: new samples' luminance (every component, divided
+ * by the albedo) less the stale history's at the same pixels, its variance, the stale total. */
+enum { TILE_UNKNOWN = 0, TILE_SAME, TILE_CHANGED };
+typedef struct {
+    double diff, var, base;
+    int n, state;
+} light_tile;
+
+struct display {
+    int width, height;
+    threadpool *pool;
+    gbuffer g[2];        /* g[cur] the view shown, the other the one before */
+    pixel_history *h[2]; /* h[cur] the view shown, the other the one before */
+    int cur;
+    int have_view;
+    sample_sink sink;
+    /* resolve's scratch: the filter's input per component (demodulated mean, samples, one sample's
+     * luminance variance) and its output */
+    float *light[COMP_COUNT], *count[COMP_COUNT], *variance[COMP_COUNT], *out[COMP_COUNT];
+    float *out_count[COMP_COUNT]; /* the samples behind the filter's value... */
+    float *gap[COMP_COUNT];       /* ...its squared gap to the pixel's own mean (gap_row)... */
+    denoiser *dn;
+    int active[COMP_COUNT]; /* a component had a sample other than zero since the last restart */
+    /* after a light change: the history before it, and per tile what new samples say of it */
+    pixel_history *stale;
+    int judging;
+    int tiles_x, tiles_y;
+    light_tile *tiles;
+    uint8_t *need;               /* per packet (display_packet_need)... */
+    float *need_gain;            /* ...and its scratch */
+    float *spread;               /* per pixel, display_plan_extra's scratch... */
+    int *extra_pixels;           /* ...the pixels it plans for... */
+    extra_histogram *extra_hist; /* ...a histogram per thread... */
+    float spread_mean;           /* ...and the average pixel's spread */
+    display_stats st;
+};
+
+/* The light-change tile of pixel i. */
+static inline int tile_of(const display *d, size_t i) {
+    int x = (int)(i % (size_t)d->width), y = (int)(i / (size_t)d->width);
+    return (y / TILE_PX) * d->tiles_x + x / TILE_PX;
+}
+
+static inline vec3 get3(const float *a, size_t i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
+
+/* One sample's variance from n samples' moments (their mean's luminance l, the mean of their squared
+ * luminance m2): the moments give the population's, n / (n - 1) of it is unbiased; 0 below two. */
+static inline float sample_variance(float m2, float l, float n) {
+    return n > 1.0f ? fmaxf(m2 - l * l, 0.0f) * n / (n - 1.0f) : 0.0f;
+}
+
+/* Component c's one-sample variance in history p as shown, times a^2 (a the albedo's luminance);
+ * -1 where it has fewer than two samples (its spread unknown). */
+static inline float shown_spread(const pixel_history *p, int c, float a) {
+    float n = p->c[c].count;
+    if (!(n >= 2.0f)) return -1.0f;
+    float l = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2]));
+    return sample_variance(p->c[c].m2, l, n) * a * a;
+}
+
+#endif
