@@ -27,7 +27,7 @@ const view_shortcut view_shortcuts[] = {
     {"ctrl+click", "select the light nearest the cursor"},
     {"ctrl+drag", "move the selected light with the cursor"},
     {"Space", "pause or resume refinement"},
-    {"N", "denoise the image shown on or off (the estimate is never filtered)"},
+    {"N", "the display's filter and its own samples on or off (the estimate is never filtered)"},
     {"F1 or ?", "show or hide this list"},
     {"F12", "screenshot of the image (PNG)"},
     {"F11", "export the image and its layers (EXR)"},

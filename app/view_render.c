@@ -33,6 +33,12 @@
 #define REST_UPDATE_MS 200.0
 #define YOUNG_SECONDS 0.5
 #define FIRST_PARTS 64
+/* Of what an update may render, this share goes to the display's own samples (display_plan_extra):
+ * where the image shown errs most, a bright speck in a curved mirror, the film's one sample a
+ * frame is far too few, and a few hundred there take more off the error than a part's thousands
+ * spread evenly (docs/benchmarks.md). At most EXTRA_REQUESTS pixels an update. */
+#define EXTRA_SHARE 0.2
+#define EXTRA_REQUESTS 4096
 /* Light edits are analysed (the plan made again) once they rest this long, not at every step of a
  * drag. */
 #define SETTLE_SECONDS 0.3
@@ -73,6 +79,8 @@ struct render_thread {
     /* What an update costs with the current settings (0: not measured): a frame's rendering
      * without its set-up, the set-up a frame begins with (the virtual lights), the display's work. */
     double frame_ms, setup_ms, display_ms;
+    double extra_ms;        /* an extra sample's (display_plan_extra), 0: not measured */
+    extra_request *extra;   /* EXTRA_REQUESTS of them */
     uint64_t accumulations; /* begun since the thread started: each its own random numbers */
     render_params params_applied;
     camera cam_applied;
@@ -397,6 +405,7 @@ static void publish(render_thread *rt, const update_info *up) {
         sh->stats.view_ms = ds.view_ms;
         sh->stats.resolve_ms = ds.resolve_ms;
         sh->stats.mean_count = ds.mean_count;
+        sh->stats.extra_samples = ds.extra;
         sh->stats.carried = ds.carried;
         sh->stats.lost = ds.lost;
         sh->stats.denoised = ds.levels > 0;
@@ -467,6 +476,25 @@ static void learn_costs(render_thread *rt, double ms, int parts, int began, doub
 
 /* ... and the display's, an update's. */
 static void learn_display(render_thread *rt, double ms) { smooth(&rt->display_ms, ms); }
+
+/* The display's own samples for about ms (display_plan_extra), at what one cost so far (at first,
+ * a film's pixel's). The plan's own time (a few ms at 960x540) is not counted against them: counted,
+ * it left the young image of the first half second after a stop almost none (atelier's orbit, 1 s
+ * after the stop: 0.28 and 0.29 in two runs, against 0.12 and 0.15). */
+static void add_extra_samples(render_thread *rt, double ms) {
+    const render_params *p = session_params(rt->session);
+    double each = rt->extra_ms > 0.0 ? rt->extra_ms : rt->frame_ms / ((double)p->width * (double)p->height);
+    if (!rt->extra || !(each > 0.0) || !(ms > 0.0)) return;
+    double want = ms / each;
+    int n = display_plan_extra(rt->disp, want < 1e6 ? (int)want : 1000000, rt->extra, EXTRA_REQUESTS);
+    if (n <= 0) return;
+    double t0 = cli_now();
+    if (session_render_extra(rt->session, rt->extra, n) != 0) return;
+    long long taken = 0;
+    for (int k = 0; k < n; k++) taken += rt->extra[k].samples;
+    display_take_extra(rt->disp, rt->extra, n);
+    if (taken > 0) smooth(&rt->extra_ms, 1e3 * (cli_now() - t0) / (double)taken);
+}
 
 /* Whether two requests render the same estimate (the panel sends its parameters with their defaults
  * resolved; the command line's may not be). */
@@ -563,6 +591,7 @@ static void *render_main(void *arg) {
          * its count and what the display shows then agree). */
         int held = gen == applied && !resize && session_frame_parts(rs) == 0 && refinement_held(sh, session_frames(rs));
         int look_changed = sh->show_mask != rt->shown_mask || sh->denoise != rt->shown_denoise;
+        int own_samples = sh->denoise; /* the display's own samples go with its filter */
         sh->stats.standing = held;
         pthread_mutex_unlock(&sh->lock);
         update_info up = {.measure = measure, .resets_seen = resets_seen, .gen = gen};
@@ -613,6 +642,7 @@ static void *render_main(void *arg) {
         }
         /* Parts until the update's budget is spent, a frame ends, or a request comes. */
         double budget = render_budget(rt, age), spent = 0.0;
+        double film_budget = own_samples ? (1.0 - EXTRA_SHARE) * budget : budget;
         int r = 0;
         for (;;) {
             int began = session_frame_parts(rs) == 0;
@@ -643,9 +673,10 @@ static void *render_main(void *arg) {
             pthread_mutex_lock(&sh->lock);
             int asked = sh->requests != requests_seen;
             pthread_mutex_unlock(&sh->lock);
-            if (asked || spent + rt->frame_ms / session_frame_parts(rs) > budget) break;
+            if (asked || spent + rt->frame_ms / session_frame_parts(rs) > film_budget) break;
         }
         display_take_samples(rt->disp);
+        if (r == 0 && up.rendered && own_samples) add_extra_samples(rt, EXTRA_SHARE * budget);
         double t1 = cli_now();
         publish(rt, &up);
         learn_display(rt, 1e3 * (cli_now() - t1) + (change ? display_get_stats(rt->disp).view_ms : 0.0));
@@ -667,6 +698,7 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
     }
     rt->sh = sh;
     rt->scene = s;
+    rt->extra = calloc(EXTRA_REQUESTS, sizeof *rt->extra); /* none: no extra samples */
     sh->scene_now = s;
     clear_light_edits(&rt->lights_applied);
     sh->stats.reset_at = cli_now();      /* the first accumulation starts now, not at the clock's origin */
@@ -674,6 +706,7 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
     if (make_sessions(rt, sh->render_w, sh->render_h, &sh->cam, &sh->params) != 0) {
         session_destroy(rt->session); /* before the scene they read, which stays the caller's */
         display_destroy(rt->disp);
+        free(rt->extra);
         free(rt);
         return NULL;
     }
@@ -681,6 +714,7 @@ render_thread *render_thread_start(shared_state *sh, scene *s) {
         snprintf(sh->message, sizeof sh->message, "cannot start the loading thread");
         session_destroy(rt->session);
         display_destroy(rt->disp);
+        free(rt->extra);
         free(rt);
         return NULL;
     }
@@ -706,5 +740,6 @@ void render_thread_stop(render_thread *rt) {
     free(rt->back.rgb);
     free(rt->combined);
     image_rgb_free(&rt->reference);
+    free(rt->extra);
     free(rt);
 }

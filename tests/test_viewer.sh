@@ -275,9 +275,9 @@ grep -q 'highlights.exr: the reference is 48x27 but the render is 96x54' err.txt
 
 # A bad script line is reported with its line number, before any window opens.
 # ---- captures: the image shown, linear, at the render's size, with its own camera -----------
-# At rest and paused, with the display's filter off, a capture is the film's image (the display's
-# history holds the same samples, in float); with it on it is not, and the export (the estimate)
-# is the same pixels either way. An orbit and a capture in one UI frame: the image shown is still
+# At rest and paused, with the display's filter off from the start (and with it the display's own
+# samples), a capture is the film's image (the display's history holds the same samples, in
+# float); with it on it is not, and the export (the estimate) is the same pixels either way. An orbit and a capture in one UI frame: the image shown is still
 # the one before the orbit, and the capture says so (its camera, not the new one; not the latest).
 # Soon after, the new view's first images: at the render's full size, as every image is. The stats
 # count the images the window took.
@@ -307,7 +307,7 @@ stats
 quit
 EOF
 rm -f still*.exr moved*.exr soon*.exr
-view --size 160x90 --script capture.txt
+view --size 160x90 --denoise off --script capture.txt
 rc=$?
 [ $rc -eq 0 ] || fail "capture script exited $rc: $(cat err.txt)"
 grep '^stats ' out.txt >stats.txt

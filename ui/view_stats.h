@@ -24,6 +24,7 @@
     X(DBL, view_ms, "view_ms", "the display's last view change: G-buffer and reprojection")                            \
     X(DBL, resolve_ms, "resolve_ms", "the display's last resolve: the filter and the mix")                             \
     X(DBL, mean_count, "mean_count", "samples behind the average pixel shown")                                         \
+    X(U64, extra_samples, "extra_samples", "the display's own samples, where the image shown erred most")              \
     X(I64, carried, "carried", "pixels the last view change carried over...")                                          \
     X(I64, lost, "lost", "... and those it lost")                                                                      \
     X(INT, denoised, "denoised", "the last image was filtered")                                                        \
