@@ -142,7 +142,7 @@ static int make_sessions(render_thread *rt, int w, int h, const camera *cam, con
     session_set_sink(rt->session, display_sink(rt->disp));
     display_change_view(rt->disp, rt->scene, cam, DISPLAY_RESTART);
     rt->film_partial = 0; /* a new film */
-    rt->frame_ms = rt->setup_ms = 0.0;
+    rt->frame_ms = rt->setup_ms = rt->extra_ms = 0.0;
     rt->params_applied = *params;
     rt->cam_applied = *cam;
     return 0;
@@ -636,8 +636,9 @@ static void *render_main(void *arg) {
             if (change) display_change_view(rt->disp, rt->scene, &cam, change);
             rt->params_applied = params;
             rt->cam_applied = cam;
-            rt->film_partial = 0;                                            /* a new film */
-            if (change & DISPLAY_RESTART) rt->frame_ms = rt->setup_ms = 0.0; /* another estimator's costs */
+            rt->film_partial = 0; /* a new film */
+            if (change & DISPLAY_RESTART)
+                rt->frame_ms = rt->setup_ms = rt->extra_ms = 0.0; /* another estimator's costs */
             applied = gen;
         }
         /* Parts until the update's budget is spent, a frame ends, or a request comes. */
