@@ -222,9 +222,11 @@ static void carry_row(void *ctx, int y, int worker) {
                 for (int e = 0; e < 3; e++) m[e] += wk * o->c[c].mean[e];
             }
             /* the cap per unit of one sample's relative variance (keep_cap), one sample at least */
-            float l = luminance3(v3(m[0], m[1], m[2])), rel = sample_variance(m2, l, count) / (l * l);
             float at_most = c == COMP_HIGHLIGHTS ? cap_glossy : cap_all;
-            if (at_most < cap && isfinite(rel)) at_most = fmaxf(rel * at_most, 1.0f);
+            if (at_most < cap) {
+                float l = luminance3(v3(m[0], m[1], m[2])), rel = sample_variance(m2, l, count) / (l * l);
+                if (isfinite(rel)) at_most = fmaxf(rel * at_most, 1.0f);
+            }
             count = fminf(count * (c == COMP_HIGHLIGHTS ? glossy : diffuse), at_most);
             if (!(count > 0.0f)) continue;
             now->c[c].count = count;
@@ -400,17 +402,9 @@ long long display_take_samples(display *d) {
         vec3 a = get3(g->albedo, i), e[COMP_COUNT];
         for (int c = 0; c < COMP_COUNT; c++) e[c] = div3(get3(d->sink.rgb[c], i), a);
         if (d->judging) gather_evidence(d, i, e);
-        h[i].turn *= h[i].c[COMP_DIRECT].count / (h[i].c[COMP_DIRECT].count + 1.0f); /* a new sample: turn 0 */
-        for (int c = 0; c < COMP_COUNT; c++) {
-            d->active[c] |= !is_black3(e[c]);
-            float l = luminance3(e[c]);
-            float k = h[i].c[c].count + 1.0f, *m = h[i].c[c].mean;
-            m[0] += (e[c].x - m[0]) / k;
-            m[1] += (e[c].y - m[1]) / k;
-            m[2] += (e[c].z - m[2]) / k;
-            h[i].c[c].m2 += (l * l - h[i].c[c].m2) / k;
-            h[i].c[c].count = k;
-        }
+        float q[COMP_COUNT];
+        for (int c = 0; c < COMP_COUNT; c++) q[c] = luminance3(e[c]) * luminance3(e[c]);
+        history_add(d, &h[i], e, q, 1.0f);
     }
     if (d->judging) judge_tiles(d);
     d->sink.serial++;

@@ -67,9 +67,10 @@ const uint8_t *display_packet_need(display *d);
 /* Extra samples for the display alone (session_render_extra), where they take most off the error
  * shown: a pixel of one-sample spread s (its variance's square root, times its albedo) with n
  * samples errs by s^2 / n, and the least sum of that over the image for `budget` samples more has
- * each pixel's n + k in proportion to its s (k >= 0; docs/design.md, "Extra samples"). Pixels
- * whose spread is unknown (fewer than two samples) take none: the film's next frame is theirs.
- * Writes at most max requests (pixel, samples, luminance weights) and returns how many. The plan
+ * each pixel's n + k in proportion to its s (k >= 0; docs/design.md, "Extra samples where the
+ * image errs most"). A single sample's s is its own value; a hole (no sample yet) counts as half a
+ * sample, its s its hardest neighbour's, or among holes only the average pixel's; the sky and, after
+ * a light change, tiles not yet judged take none. Writes at most max requests (pixel, samples, luminance weights) and returns how many. The plan
  * reads the samples so far, so the display's mean is no longer unbiased where it takes them: a
  * view, like the filter. */
 int display_plan_extra(display *d, int budget, extra_request *req, int max);

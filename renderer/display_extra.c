@@ -187,18 +187,13 @@ void display_take_extra(display *d, const extra_request *req, int n) {
         const extra_request *q = &req[r];
         if (q->taken <= 0 || q->pixel < 0 || (size_t)q->pixel >= np) continue;
         size_t i = (size_t)q->pixel;
-        float k = (float)q->taken, old = h[i].c[COMP_DIRECT].count;
-        h[i].turn *= old / (old + k); /* new samples: turn 0 */
+        float k = (float)q->taken, mean_sq[COMP_COUNT];
+        vec3 e[COMP_COUNT];
         for (int c = 0; c < COMP_COUNT; c++) {
-            vec3 e = div3(scale3(v3(q->sum[c][0], q->sum[c][1], q->sum[c][2]), 1.0f / k), get3(g->albedo, i));
-            d->active[c] |= !is_black3(e);
-            float t = h[i].c[c].count + k, f = k / t, *m = h[i].c[c].mean;
-            m[0] += (e.x - m[0]) * f;
-            m[1] += (e.y - m[1]) * f;
-            m[2] += (e.z - m[2]) * f;
-            h[i].c[c].m2 += (q->sumsq[c] / k - h[i].c[c].m2) * f;
-            h[i].c[c].count = t;
+            e[c] = div3(scale3(v3(q->sum[c][0], q->sum[c][1], q->sum[c][2]), 1.0f / k), get3(g->albedo, i));
+            mean_sq[c] = q->sumsq[c] / k;
         }
+        history_add(d, &h[i], e, mean_sq, k);
         d->st.extra += (uint64_t)q->taken;
     }
 }

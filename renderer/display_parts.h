@@ -101,6 +101,23 @@ static inline int tile_of(const display *d, size_t i) {
 
 static inline vec3 get3(const float *a, size_t i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
 
+/* k samples more into history p, each component's their mean e[c] (over the albedo) and the mean
+ * of their squared luminance q[c] (the film's samples one at a time, the display's own in
+ * batches): a running mean, and the view's turn since they were taken 0. */
+static inline void history_add(display *d, pixel_history *p, const vec3 *e, const float *q, float k) {
+    float old = p->c[COMP_DIRECT].count;
+    p->turn *= old / (old + k);
+    for (int c = 0; c < COMP_COUNT; c++) {
+        d->active[c] |= !is_black3(e[c]);
+        float t = p->c[c].count + k, *m = p->c[c].mean;
+        m[0] += (e[c].x - m[0]) * k / t;
+        m[1] += (e[c].y - m[1]) * k / t;
+        m[2] += (e[c].z - m[2]) * k / t;
+        p->c[c].m2 += (q[c] - p->c[c].m2) * k / t;
+        p->c[c].count = t;
+    }
+}
+
 /* One sample's variance from n samples' moments (their mean's luminance l, the mean of their squared
  * luminance m2): the moments give the population's, n / (n - 1) of it is unbiased; 0 below two. */
 static inline float sample_variance(float m2, float l, float n) {
