@@ -105,6 +105,12 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     return 0;
 }
 
+/* A frame is drawn when something changed, for this long after any input (Dear ImGui settles its
+ * widgets' states over a few frames), and at least this often (what changes unannounced). llvmpipe
+ * draws on the CPU the renderer needs: 60 frames a second cost it a tenth of two cores. */
+#define REDRAW_AFTER_INPUT 0.25
+#define IDLE_REDRAW_SECONDS 0.5
+
 static void on_glfw_error(int code, const char *description) {
     (void)code;
     cli_warning("window system: %s", description);
@@ -166,6 +172,7 @@ int cmd_view(int argc, char **argv) {
     glfwSetKeyCallback(win, on_key);
     glfwSetScrollCallback(win, on_scroll);
     glfwSetDropCallback(win, on_drop);
+    note_input_callbacks(win);
     if (ui_init(win) != 0) {
         cli_error("cannot initialise the panel");
         glfwDestroyWindow(win);
@@ -226,16 +233,22 @@ int cmd_view(int argc, char **argv) {
         glfwWaitEventsTimeout(1.0 / 60.0);
         double now = cli_now(), dt = now - u.last_time;
         u.last_time = now;
-        if (fetch_published(&u)) u.need_tonemap = 1;
+        int news = fetch_published(&u);
+        if (news & VIEW_NEW_IMAGE) u.need_tonemap = 1;
+        int script_was = u.script_pos, shot_asked = u.window_shot[0] != 0;
         run_script(&u);
         update_status(&u);
+        if (u.input_events != u.drawn_events) u.redraw_until = now + REDRAW_AFTER_INPUT;
+        int settle = u.settle, acted = u.script_pos != script_was || u.window_shot[0] || now < u.redraw_until;
+        int draw = news || u.need_tonemap || acted || settle || now - u.drawn_at >= IDLE_REDRAW_SECONDS;
 
-        ui_begin_frame();
-        draw_image_and_panel(&u);
-
+        if (draw) {
+            ui_begin_frame();
+            draw_image_and_panel(&u);
+        }
         apply_controls(&u, handle_input(&u, dt));
-
         view_follow_size(&u, now);
+        if (!draw) continue;
 
         glfwGetFramebufferSize(win, &fw, &fh);
         if (u.need_tonemap) {
@@ -246,8 +259,13 @@ int cmd_view(int argc, char **argv) {
         glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         ui_end_frame();
-        if (u.window_shot[0]) capture_window(&u, fw, fh);
+        if (shot_asked && settle) capture_window(&u, fw, fh); /* asked before the frame that settled */
         glfwSwapBuffers(win);
+        u.drawn_events = u.input_events;
+        u.drawn_at = now;
+        /* Dear ImGui sizes a window to what it held the frame before: a frame more after any
+         * change but a new image's (whose overlay line keeps its size). */
+        u.settle = !settle && (acted || news != VIEW_NEW_IMAGE);
     }
 
     view_stats last;

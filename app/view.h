@@ -112,6 +112,12 @@ typedef struct {
     double scroll;
     int keys_pressed[GLFW_KEY_LAST + 1];
     double last_time;
+    /* Drawing: llvmpipe draws the window on the CPU the renderer needs, so a frame is drawn only
+     * when something changed (an image, input, the script) and otherwise twice a second. */
+    unsigned long long input_events; /* GLFW input callbacks so far */
+    unsigned long long drawn_events; /* ...as of the last frame drawn */
+    double drawn_at, redraw_until;   /* the last frame drawn; frames drawn until then after input */
+    int settle;                      /* the next frame is drawn: the last one changed the panel */
     /* script */
     view_script script;
     const char *script_path_for_errors;
@@ -164,6 +170,7 @@ void press_key(ui_thread *u, int key, int mods);
 void on_key(GLFWwindow *win, int key, int scancode, int action, int mods);
 void on_scroll(GLFWwindow *win, double dx, double dy);
 void on_drop(GLFWwindow *win, int count, const char **paths);
+void note_input_callbacks(GLFWwindow *win);
 int handle_input(ui_thread *u, double dt);
 
 /* view_nav.c: navigation that cannot get lost, the reference's description and camera, status */
@@ -194,6 +201,9 @@ void update_status(ui_thread *u);
 void run_script(ui_thread *u);
 
 /* view_display.c: the image, its error against a reference, the panel */
+/* Takes what the render thread published: VIEW_NEW_IMAGE if an image, VIEW_NEW_NEWS if an error
+ * measured, a message or a scene's description (0: nothing new to draw). */
+enum { VIEW_NEW_IMAGE = 1, VIEW_NEW_NEWS = 2 };
 int fetch_published(ui_thread *u);
 /* A reference image for the error view and plot, measured from cam with lights (its description's;
  * NULL: from any view); 0, or -1 with the message shown. */

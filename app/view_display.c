@@ -147,6 +147,7 @@ int fetch_published(ui_thread *u) {
     controller_stats(u->vc, &u->stats);
     int new_error = u->stats.rel_error_serial != was.rel_error_serial;
     int new_shown = u->stats.shown_error_serial != was.shown_error_serial;
+    uint64_t message_was = u->message_serial;
     controller_take_message(u->vc, &u->message_serial, u->message, sizeof u->message);
     int new_info = controller_take_info(u->vc, &u->info_serial, &u->info);
     if (new_error && u->reference.rgb)
@@ -163,7 +164,8 @@ int fetch_published(ui_thread *u) {
         reset_lights(u);
         bookmarks_load(u);
     }
-    return fresh;
+    int news = new_error || new_shown || new_info || u->message_serial != message_was;
+    return (fresh ? VIEW_NEW_IMAGE : 0) | (news ? VIEW_NEW_NEWS : 0);
 }
 
 /* ---- the image and the panel ----------------------------------------------------------------- */

@@ -167,12 +167,14 @@ void press_key(ui_thread *u, int key, int mods) {
 void on_key(GLFWwindow *win, int key, int scancode, int action, int mods) {
     (void)scancode;
     ui_thread *u = glfwGetWindowUserPointer(win);
+    u->input_events++;
     if (action == GLFW_PRESS && !ui_wants_keyboard()) press_key(u, key, mods);
 }
 
 void on_scroll(GLFWwindow *win, double dx, double dy) {
     (void)dx;
     ui_thread *u = glfwGetWindowUserPointer(win);
+    u->input_events++;
     /* Over the image only: the panel's hover state is the last frame's, and a cursor that has
      * just moved onto the panel would zoom instead of scrolling it. */
     double x, y;
@@ -185,11 +187,35 @@ void on_scroll(GLFWwindow *win, double dx, double dy) {
 
 void on_drop(GLFWwindow *win, int count, const char **paths) {
     ui_thread *u = glfwGetWindowUserPointer(win);
+    u->input_events++;
     if (count < 1) return;
     /* An image is an environment map; anything else is taken for a scene. */
     const char *dot = strrchr(paths[0], '.');
     int env = dot && (strcmp(dot, ".exr") == 0 || strcmp(dot, ".hdr") == 0);
     request_load(u, env ? LOAD_ENV : LOAD_SCENE, paths[0]);
+}
+
+/* The other input, counted only: a frame is drawn after any (the panel's widgets answer it). */
+static void note_input(GLFWwindow *win) { ((ui_thread *)glfwGetWindowUserPointer(win))->input_events++; }
+static void on_cursor(GLFWwindow *win, double x, double y) { (void)x, (void)y, note_input(win); }
+static void on_button(GLFWwindow *win, int button, int action, int mods) {
+    (void)button, (void)action, (void)mods, note_input(win);
+}
+static void on_char(GLFWwindow *win, unsigned c) { (void)c, note_input(win); }
+static void on_enter(GLFWwindow *win, int entered) { (void)entered, note_input(win); }
+static void on_focus(GLFWwindow *win, int focused) { (void)focused, note_input(win); }
+static void on_size(GLFWwindow *win, int w, int h) { (void)w, (void)h, note_input(win); }
+static void on_refresh(GLFWwindow *win) { note_input(win); }
+
+/* Installed before Dear ImGui's backend, which chains to them. */
+void note_input_callbacks(GLFWwindow *win) {
+    glfwSetCursorPosCallback(win, on_cursor);
+    glfwSetMouseButtonCallback(win, on_button);
+    glfwSetCharCallback(win, on_char);
+    glfwSetCursorEnterCallback(win, on_enter);
+    glfwSetWindowFocusCallback(win, on_focus);
+    glfwSetFramebufferSizeCallback(win, on_size);
+    glfwSetWindowRefreshCallback(win, on_refresh);
 }
 
 /* Keys, mouse and the panel's actions. Returns 1 when the camera changed. */

@@ -157,6 +157,7 @@ static int load_settled(ui_thread *u) { return controller_load_settled(u->vc, u-
 
 /* Runs script actions until one has to wait. */
 void run_script(ui_thread *u) {
+    if (u->window_shot[0]) return; /* later actions wait for the capture (a frame or two on) */
     while (u->script_pos < u->script.count && !u->quit) {
         const script_action *a = &u->script.actions[u->script_pos];
         char err[1200];
@@ -283,7 +284,7 @@ void run_script(ui_thread *u) {
             if (!load_settled(u)) return;
             u->script_waiting = 0;
             break;
-        case ACT_WINDOW_SHOT: /* taken after this frame's draw: later actions wait for it */
+        case ACT_WINDOW_SHOT: /* taken once the panel settled: later actions wait for it */
             snprintf(u->window_shot, sizeof u->window_shot, "%s", a->text);
             u->script_pos++;
             return;
