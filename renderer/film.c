@@ -2,6 +2,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -131,9 +132,70 @@ float srgb_encode(float x) {
     return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
 }
 
+/* srgb8_encode's tables: where each byte value begins (the least x that rounds to it), and per
+ * bucket of x's float bits, 2^SRGB8_BITS to an octave from 2^SRGB8_LOW_OCTAVE to 1, the byte
+ * at the bucket's start. Below the buckets the byte is 0 or 1 (the linear segment, 3295 x). The
+ * curve's slope keeps each bucket within one step of bytes. */
+#define SRGB8_BITS 7 /* of the mantissa: 128 buckets an octave */
+#define SRGB8_LOW_OCTAVE (-13)
+#define SRGB8_BUCKETS (-SRGB8_LOW_OCTAVE << SRGB8_BITS)
+static float srgb8_start[257];
+static uint8_t srgb8_bucket[SRGB8_BUCKETS];
+static pthread_once_t srgb8_once = PTHREAD_ONCE_INIT;
+
+static uint8_t srgb8_exact(float x) { return (uint8_t)(srgb_encode(x) * 255.0f + 0.5f); }
+
+static uint32_t float_bits(float x) {
+    uint32_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+static float bits_float(uint32_t b) {
+    float x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+static void srgb8_tables(void) {
+    srgb8_start[0] = -INFINITY;
+    srgb8_start[256] = INFINITY;
+    for (int k = 1; k < 256; k++) { /* bisection over the bits of x in [0, 1]: rounding is monotone */
+        uint32_t lo = 0, hi = float_bits(1.0f);
+        while (lo < hi) {
+            uint32_t mid = lo + (hi - lo) / 2;
+            if (srgb8_exact(bits_float(mid)) >= k)
+                hi = mid;
+            else
+                lo = mid + 1;
+        }
+        srgb8_start[k] = bits_float(lo);
+    }
+    uint32_t first = float_bits(ldexpf(1.0f, SRGB8_LOW_OCTAVE));
+    for (int i = 0; i < SRGB8_BUCKETS; i++)
+        srgb8_bucket[i] = srgb8_exact(bits_float(first + ((uint32_t)i << (23 - SRGB8_BITS))));
+}
+
+/* (uint8_t)(srgb_encode(x) * 255 + 0.5), without its powf: the display tone-maps every pixel of
+ * every image shown. */
+static inline uint8_t srgb8_encode(float x) {
+    if (!(x > 0.0f)) return 0;
+    if (x >= 1.0f) return 255;
+    uint32_t b = float_bits(x), first = float_bits(ldexpf(1.0f, SRGB8_LOW_OCTAVE));
+    if (b < first) return x >= srgb8_start[1] ? 1 : 0;
+    int k = srgb8_bucket[(b - first) >> (23 - SRGB8_BITS)];
+    return (uint8_t)(x >= srgb8_start[k + 1] ? k + 1 : k);
+}
+
+uint8_t srgb8_of(float x) {
+    pthread_once(&srgb8_once, srgb8_tables);
+    return srgb8_encode(x);
+}
+
 static float lum(const float *c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
 void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *out) {
+    pthread_once(&srgb8_once, srgb8_tables);
     /* Log-average luminance (Reinhard's eq. 1), delta guarding log(0). */
     double log_sum = 0.0;
     int counted = 0;
@@ -153,10 +215,7 @@ void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p,
         float ls = l * scale;
         float ld = ls * (1.0f + ls * inv_white2) / (1.0f + ls);
         float k = l > 0.0f && isfinite(l) ? ld / l : 0.0f;
-        for (int j = 0; j < 3; j++) {
-            float v = srgb_encode(c[j] * k);
-            out[3 * (size_t)i + (size_t)j] = (uint8_t)(v * 255.0f + 0.5f);
-        }
+        for (int j = 0; j < 3; j++) out[3 * (size_t)i + (size_t)j] = srgb8_encode(c[j] * k);
     }
 }
 
@@ -174,12 +233,12 @@ static void tonemap_curve(const float *rgb, int num_pixels, float exposure, int 
     for (size_t i = 0; i < 3 * (size_t)num_pixels; i++) {
         float x = rgb[i] * scale;
         if (!isfinite(x)) x = 0.0f;
-        float v = srgb_encode(exponential ? 1.0f - expf(-x) : x);
-        out[i] = (uint8_t)(v * 255.0f + 0.5f);
+        out[i] = srgb8_encode(exponential ? 1.0f - expf(-x) : x);
     }
 }
 
 void tonemap_apply(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *out) {
+    pthread_once(&srgb8_once, srgb8_tables);
     switch (p->op) {
     case TONEMAP_CLAMP: tonemap_curve(rgb, num_pixels, p->exposure, 0, out); break;
     case TONEMAP_EXPONENTIAL: tonemap_curve(rgb, num_pixels, p->exposure, 1, out); break;

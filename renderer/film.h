@@ -110,6 +110,8 @@ void tonemap_apply(const float *rgb, int num_pixels, const tonemap_params *p, ui
  * luminance, keep chromaticity; then the sRGB transfer function to 8 bits. */
 void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p, uint8_t *srgb8);
 float srgb_encode(float linear);
+/* The byte of srgb_encode(linear): (uint8_t)(srgb_encode(linear) * 255 + 0.5), from tables. */
+uint8_t srgb8_of(float linear);
 
 /* Exports (atomic; see image_io.h for write_mode). The EXR holds R,G,B (the sum of the
  * components) plus one layer per component in layers_mask ("direct.R", ...), the moments of

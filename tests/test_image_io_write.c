@@ -1,9 +1,10 @@
 /* The writing side of image I/O: the atomic writer's guarantees (no replace, no partial file, no
  * temporary left behind, only regular files replaced, links written through, the umask honoured), errors that name the
- * path, free names for exports, string attributes in EXR headers as written and read back, and
- * PNGs as stb_image decodes them. */
+ * path, free names for exports, string attributes in EXR headers as written and read back,
+ * PNGs as stb_image decodes them, and the sRGB bytes they and the viewer's display hold. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,6 +14,7 @@
 #include <stb/stb_image.h>
 
 #include "check.h"
+#include "film.h"
 #include "image_io.h"
 #include "scratch.h"
 
@@ -294,8 +296,56 @@ static void test_png(void) {
     CHECK(stray_temp_files(scratch_dir) == 0, "temporary files left behind");
 }
 
+/* ---- sRGB bytes ------------------------------------------------------------------------------ */
+
+static float float_of(uint32_t b) {
+    float x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* The tables' byte is the formula's, (uint8_t)(srgb_encode(x) * 255 + 0.5): at every third float
+ * of (0, 1) from 2^-16 on, at every float within 64 of each byte's first, and at the edges; and the
+ * formula is the standard's (IEC 61966-2-1) at values worked by hand. */
+static void test_srgb_bytes(void) {
+    long long wrong = 0;
+    uint32_t lo, hi;
+    float a = ldexpf(1.0f, -16), one = 1.0f;
+    memcpy(&lo, &a, sizeof lo);
+    memcpy(&hi, &one, sizeof hi);
+    for (uint32_t b = lo; b < hi; b += 3) {
+        float x = float_of(b);
+        if (srgb8_of(x) != (uint8_t)(srgb_encode(x) * 255.0f + 0.5f) && wrong++ < 5)
+            fprintf(stderr, "  x = %.9g: %d, the formula %d\n", (double)x, srgb8_of(x),
+                    (uint8_t)(srgb_encode(x) * 255.0f + 0.5f));
+    }
+    for (int k = 1; k < 256; k++) { /* where byte k begins, found here by bisection on the formula */
+        uint32_t l = 0, h = hi;
+        while (l < h) {
+            uint32_t m = l + (h - l) / 2;
+            if ((uint8_t)(srgb_encode(float_of(m)) * 255.0f + 0.5f) >= k)
+                h = m;
+            else
+                l = m + 1;
+        }
+        for (uint32_t b = l >= 64 ? l - 64 : 0; b <= l + 64 && b < hi; b++)
+            if (srgb8_of(float_of(b)) != (uint8_t)(srgb_encode(float_of(b)) * 255.0f + 0.5f)) wrong++;
+    }
+    CHECK(wrong == 0, "%lld floats whose byte is not the formula's", wrong);
+    const float edge[] = {0.0f, -0.0f, -1.0f, NAN, -INFINITY, 1e-45f, 1.0f, 1.5f, INFINITY};
+    const int edge_byte[] = {0, 0, 0, 0, 0, 0, 255, 255, 255};
+    for (int i = 0; i < 9; i++)
+        CHECK(srgb8_of(edge[i]) == edge_byte[i], "x = %g: %d, expected %d", (double)edge[i], srgb8_of(edge[i]),
+              edge_byte[i]);
+    /* 0.5 -> 1.055 * 0.5^(1/2.4) - 0.055 = 0.73536 -> 187.5 (188); 0.18 -> 0.46135 -> 117.6 (118);
+     * 0.002 -> 12.92 * 0.002 = 0.02584 -> 6.59 (7) */
+    CHECK(srgb8_of(0.5f) == 188 && srgb8_of(0.18f) == 118 && srgb8_of(0.002f) == 7,
+          "sRGB of 0.5, 0.18, 0.002: %d %d %d", srgb8_of(0.5f), srgb8_of(0.18f), srgb8_of(0.002f));
+}
+
 int main(void) {
     if (scratch_open("test_image_io_write") != 0) return 1;
+    test_srgb_bytes();
     test_write_modes();
     test_unique_path();
     test_exr_attributes();
