@@ -93,7 +93,7 @@ static plan make_plan(int levels) {
 /* ---- memory ---------------------------------------------------------------------------------- */
 
 static float *take_geometry(geometry *g, float *m, size_t size) {
-    float **each[PLANES_GEOMETRY] = {&g->z, &g->nx, &g->ny, &g->nz, &g->gx, &g->gy};
+    float **each[PLANES_GEOMETRY] = {&g->z, &g->nx, &g->ny, &g->nz, &g->gx, &g->gy, &g->sn};
     for (int i = 0; i < PLANES_GEOMETRY; i++, m += size) *each[i] = m;
     return m;
 }
@@ -171,10 +171,12 @@ static void split_pairs(const float *restrict run, float *restrict even, float *
     }
 }
 
-/* A run's geometry (into g: z, nx, ny, nz, gx, gy): zs its depths (0: none) with its left and right
- * neighbours', za and zb those above and below, nrm its normals (3 floats each). */
+/* A run's geometry (into g: z, nx, ny, nz, gx, gy, sn): zs its depths (0: none) with its left and
+ * right neighbours', za and zb those above and below, nrm its normals (3 floats each), gloss and
+ * alpha its glossy lobes (normal_stop with sigma_n). */
 static void prep_geometry(const float *restrict zs, const float *restrict za, const float *restrict zb,
-                          const float *restrict nrm, float (*restrict g)[RUN]) {
+                          const float *restrict nrm, const float *restrict gloss, const float *restrict alpha,
+                          float sigma_n, float (*restrict g)[RUN]) {
     for (int i = 0; i < RUN; i++) {
         float zi = zs[i + 1];
         g[0][i] = zi > 0.0f ? zi : DEPTH_SKY;
@@ -183,6 +185,7 @@ static void prep_geometry(const float *restrict zs, const float *restrict za, co
         g[3][i] = sane_unit(nrm[3 * i + 2]);
         g[4][i] = slope(zs[i], zi, zs[i + 2]);
         g[5][i] = slope(za[i], zi, zb[i]);
+        g[6][i] = normal_stop(sigma_n, gloss[i], alpha[i]);
     }
 }
 
@@ -233,14 +236,19 @@ static void prep_row(void *ctx, int y, int worker) {
             zb[i] = sane_depth(zb[i]);
         }
         for (int i = 0; i < RUN + 2; i++) zs[i] = sane_depth(zs[i]);
-        const float *nrm = g->normal + 3 * i0;
-        if (!whole) load_run(nrm_run, nrm, n, 3), nrm = nrm_run;
-        float v[PLANES_EACH][RUN];
-        prep_geometry(zs, za, zb, nrm, v);
+        const float *nrm = g->normal + 3 * i0, *gloss = g->gloss + i0, *alpha = g->alpha + i0;
+        float gloss_run[RUN], alpha_run[RUN];
+        if (!whole) {
+            load_run(nrm_run, nrm, n, 3), nrm = nrm_run;
+            load_run(gloss_run, gloss, n, 1), gloss = gloss_run;
+            load_run(alpha_run, alpha, n, 1), alpha = alpha_run;
+        }
+        float v[PLANES_GEOMETRY][RUN];
+        prep_geometry(zs, za, zb, nrm, gloss, alpha, j->sigma_n, v);
         for (int i = n; i < RUN; i++) v[0][i] = 0.0f; /* past the image: nothing */
         const geometry *g0 = &d->full_geo[0], *g1 = &d->full_geo[1];
-        float *even[PLANES_GEOMETRY] = {g0->z, g0->nx, g0->ny, g0->nz, g0->gx, g0->gy};
-        float *odd[PLANES_GEOMETRY] = {g1->z, g1->nx, g1->ny, g1->nz, g1->gx, g1->gy};
+        float *even[PLANES_GEOMETRY] = {g0->z, g0->nx, g0->ny, g0->nz, g0->gx, g0->gy, g0->sn};
+        float *odd[PLANES_GEOMETRY] = {g1->z, g1->nx, g1->ny, g1->nz, g1->gx, g1->gy, g1->sn};
         for (int k = 0; k < PLANES_GEOMETRY; k++) split_pairs(v[k], even[k] + p, odd[k] + p);
         for (int c = 0; c < j->comps; c++) {
             float rgb_run[3 * RUN], count_run[RUN], var_run[RUN];

@@ -3,7 +3,9 @@
  * half-resolution grid (a pyramid). It filters each film component's light divided by the pixel's
  * albedo (the caller multiplies back), guided by a G-buffer; each sample counts by how many
  * samples stand behind it, and holes (pixels with no sample yet) are filled from their neighbours
- * by geometry alone. Only the display reads the result: the film is never filtered.
+ * by geometry alone. A pixel whose glossy lobe is sharp tells normals apart as sharply as the lobe
+ * does (a light's speck in a curved mirror stays a speck). Only the display reads the result: the
+ * film is never filtered.
  * docs/design.md, "The display: denoising". */
 #ifndef GLINT_DENOISE_H
 #define GLINT_DENOISE_H
@@ -50,9 +52,9 @@ typedef struct {
 typedef struct denoiser denoiser;
 
 /* Scratch for width x height images: planes of (width / 2 rounded up to 128, + 32) floats a row,
- * the full image's (height + 32 rows, 6 of geometry and 5 per component used, twice: a plane for
- * each column parity) and the half grid's (height / 2 + 32 rows, 8 of geometry, 12 per component
- * used): 61 MB for two components at 960x540. NULL when out of memory or the size is not in
+ * the full image's (height + 32 rows, 7 of geometry and 5 per component used, twice: a plane for
+ * each column parity) and the half grid's (height / 2 + 32 rows, 9 of geometry, 12 per component
+ * used): 64 MB for two components at 960x540. NULL when out of memory or the size is not in
  * 1..65536. */
 denoiser *denoiser_create(int width, int height);
 void denoiser_destroy(denoiser *d); /* NULL is fine */

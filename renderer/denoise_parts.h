@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "denoise.h"
+#include "gbuffer.h"
 
 #define CHUNK 128
 #define MARGIN (2 << (DENOISE_MAX_LEVELS - 2)) /* the farthest tap of the half grid's last pass */
@@ -113,10 +114,12 @@ typedef struct {
 typedef struct {
     float *z, *nx, *ny, *nz; /* depth (DEPTH_SKY: escaped), shading normal */
     float *gx, *gy;          /* the depth's slope per pixel of its grid, robust at edges */
+    float *sn;               /* the normal stop's exponent seen from this pixel, less sigma_n
+                              * (normal_stop): 0 in the margins, as where no lobe is sharp */
 } geometry;
 
 #define PLANES_EACH 6
-#define PLANES_GEOMETRY 6
+#define PLANES_GEOMETRY 7
 
 /* Two grids share one shape of plane, MARGIN, half the image's width rounded up to CHUNK, MARGIN
  * floats a row: the half grid (2x2 blocks pooled, where the passes run) and the full image, whose
@@ -159,6 +162,18 @@ typedef struct {
     float out_unit;       /* the samples an output count of 1 stands for */
 } job;
 
+/* The normal stop's exponent seen from a pixel whose glossy lobe (gloss, alpha) may bring a share s
+ * of its light (gbuffer_glossy_share), less sigma_n: SVGF's sigma_n, or, for a lobe so sharp that
+ * it is more, s / alpha^2. A turn of the normal by t turns the reflected lobe by 2 t, and the light it gathers
+ * changes over a turn of about alpha: cos(t)^(s / alpha^2) ~ exp(-s t^2 / (2 alpha^2)), so a
+ * mirror's pixels take nothing from neighbours that reflect something else (a light's speck in a
+ * curved mirror stays a speck), while a flat or rough surface is filtered as before. */
+static inline float normal_stop(float sigma_n, float gloss, float alpha) {
+    float a = alpha > 1e-3f ? alpha : 1e-3f;
+    float sharp = gbuffer_glossy_share(gloss, alpha) / (a * a);
+    return sharp > sigma_n ? sharp - sigma_n : 0.0f;
+}
+
 /* sigma_n log2 of a normals' cosine, kept within [1e-30, 1] */
 static inline float normal_log2(float cosine, float sigma_n) {
     cosine = cosine < 1.0f ? cosine : 1.0f;
@@ -182,15 +197,15 @@ static inline void pair_geometry(const job *j, const geometry *c, ptrdiff_t p, c
     const float *restrict nx = c->nx + p, *restrict ny = c->ny + p, *restrict nz = c->nz + p;
     const float *restrict nxa = ga->nx + pa, *restrict nya = ga->ny + pa, *restrict nza = ga->nz + pa;
     const float *restrict nxb = gb->nx + pb, *restrict nyb = gb->ny + pb, *restrict nzb = gb->nz + pb;
-    const float *restrict gx = c->gx + p, *restrict gy = c->gy + p;
-    float sz = j->sigma_z, sn = j->sigma_n;
+    const float *restrict gx = c->gx + p, *restrict gy = c->gy + p, *restrict sn = c->sn + p;
+    float sz = j->sigma_z, sn0 = j->sigma_n;
     for (int i = 0; i < CHUNK; i++) {
         float zp = z[i];
         float inv = depth_scale(zp, gx[i], gy[i], dx, dy, sz);
         float ca = nx[i] * nxa[i] + ny[i] * nya[i] + nz[i] * nza[i];
         float cb = nx[i] * nxb[i] + ny[i] * nyb[i] + nz[i] * nzb[i];
-        wa[i] = log2h + normal_log2(ca, sn) - fabsf(zp - za[i]) * inv;
-        wb[i] = log2h + normal_log2(cb, sn) - fabsf(zp - zb[i]) * inv;
+        wa[i] = log2h + normal_log2(ca, sn0 + sn[i]) - fabsf(zp - za[i]) * inv;
+        wb[i] = log2h + normal_log2(cb, sn0 + sn[i]) - fabsf(zp - zb[i]) * inv;
     }
 }
 

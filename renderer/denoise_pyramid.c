@@ -33,16 +33,17 @@ static void tap_weight(const job *j, const geometry *gc, ptrdiff_t pc, const geo
     const float *restrict z = gc->z + pc, *restrict nx = gc->nx + pc, *restrict ny = gc->ny + pc;
     const float *restrict nz = gc->nz + pc, *restrict gx = gc->gx + pc, *restrict gy = gc->gy + pc;
     const float *restrict zq = gt->z + pt, *restrict xq = gt->nx + pt, *restrict yq = gt->ny + pt;
-    const float *restrict wq = gt->nz + pt;
-    float sz = j->sigma_z, sn = j->sigma_n;
+    const float *restrict wq = gt->nz + pt, *restrict sn = gc->sn + pc;
+    float sz = j->sigma_z, sn0 = j->sigma_n;
     for (int i = 0; i < CHUNK; i++) {
         float cs = nx[i] * xq[i] + ny[i] * yq[i] + nz[i] * wq[i];
-        w[i] = exp2_neg(normal_log2(cs, sn) - fabsf(z[i] - zq[i]) * depth_scale(z[i], gx[i], gy[i], dx, dy, sz));
+        w[i] =
+            exp2_neg(normal_log2(cs, sn0 + sn[i]) - fabsf(z[i] - zq[i]) * depth_scale(z[i], gx[i], gy[i], dx, dy, sz));
     }
 }
 
 /* The pixel a run of half pixels takes its geometry from (rx, ry: its place in the block). */
-enum { CZ, CNX, CNY, CNZ, CGX, CGY, CRX, CRY, CHOSEN };
+enum { CZ, CNX, CNY, CNZ, CGX, CGY, CSN, CRX, CRY, CHOSEN };
 typedef struct {
     float v[CHOSEN][CHUNK];
 } chosen;
@@ -54,12 +55,12 @@ static void footprint_weight(const job *j, const chosen *rep, const geometry *g,
     const float *restrict zq = g->z + q, *restrict xq = g->nx + q, *restrict yq = g->ny + q, *restrict wq = g->nz + q;
     const float *restrict z = rep->v[CZ], *restrict nx = rep->v[CNX], *restrict ny = rep->v[CNY];
     const float *restrict nz = rep->v[CNZ], *restrict gx = rep->v[CGX], *restrict gy = rep->v[CGY];
-    const float *restrict rx = rep->v[CRX], *restrict ry = rep->v[CRY];
-    float sz = j->sigma_z, sn = j->sigma_n, lk = log2f(k), cx = (float)(c - 1), cy = (float)(r - 1);
+    const float *restrict rx = rep->v[CRX], *restrict ry = rep->v[CRY], *restrict sn = rep->v[CSN];
+    float sz = j->sigma_z, sn0 = j->sigma_n, lk = log2f(k), cx = (float)(c - 1), cy = (float)(r - 1);
     for (int i = 0; i < CHUNK; i++) {
         float cs = nx[i] * xq[i] + ny[i] * yq[i] + nz[i] * wq[i];
         float inv = depth_scale(z[i], gx[i], gy[i], cx - rx[i], cy - ry[i], sz);
-        w[i] = exp2_neg(lk + normal_log2(cs, sn) - fabsf(z[i] - zq[i]) * inv);
+        w[i] = exp2_neg(lk + normal_log2(cs, sn0 + sn[i]) - fabsf(z[i] - zq[i]) * inv);
     }
 }
 
@@ -160,11 +161,11 @@ void denoise_pool_row(void *ctx, int y, int worker) {
             pick[i] = score[3][i] > best ? 3.0f : k;
         }
         chosen rep;
-        for (int k = 0; k < 6; k++) {
+        for (int k = 0; k < PLANES_GEOMETRY; k++) {
             const float *v[4];
             for (int a = 0; a < 4; a++) {
                 const geometry *g = ga[a];
-                const float *each[6] = {g->z, g->nx, g->ny, g->nz, g->gx, g->gy};
+                const float *each[PLANES_GEOMETRY] = {g->z, g->nx, g->ny, g->nz, g->gx, g->gy, g->sn};
                 v[a] = each[k] + pa[a];
             }
             pick_of(v[0], v[1], v[2], v[3], pick, 1.0f, rep.v[k]);
@@ -175,8 +176,8 @@ void denoise_pool_row(void *ctx, int y, int worker) {
         }
         int tail = d->half_width - x0 < CHUNK ? d->half_width - x0 : CHUNK;
         const geometry *hg = &d->half_geo;
-        float *dst_geo[CHOSEN] = {hg->z + q,  hg->nx + q, hg->ny + q, hg->nz + q,
-                                  hg->gx + q, hg->gy + q, d->rx + q,  d->ry + q};
+        float *dst_geo[CHOSEN] = {hg->z + q,  hg->nx + q, hg->ny + q, hg->nz + q, hg->gx + q,
+                                  hg->gy + q, hg->sn + q, d->rx + q,  d->ry + q};
         for (int k = 0; k < CHOSEN; k++) {
             float scale = k == CGX || k == CGY ? 2.0f : 1.0f; /* the slope per half pixel */
             for (int i = 0; i < tail; i++) dst_geo[k][i] = scale * rep.v[k][i];
@@ -300,12 +301,12 @@ static void half_geometry(const job *j, const geometry *c, ptrdiff_t p, const ge
     const float *restrict z = c->z + p, *restrict nx = c->nx + p, *restrict ny = c->ny + p;
     const float *restrict nz = c->nz + p, *restrict gx = c->gx + p, *restrict gy = c->gy + p;
     const float *restrict qz = h->z + q, *restrict qx = h->nx + q, *restrict qy = h->ny + q;
-    const float *restrict qnz = h->nz + q, *restrict dx = rx + q, *restrict dy = ry + q;
-    float sz = j->sigma_z, sn = j->sigma_n;
+    const float *restrict qnz = h->nz + q, *restrict dx = rx + q, *restrict dy = ry + q, *restrict sn = c->sn + p;
+    float sz = j->sigma_z, sn0 = j->sigma_n;
     for (int i = 0; i < CHUNK; i++) {
         float inv = depth_scale(z[i], gx[i], gy[i], dx[i] + ox, dy[i] + oy, sz);
         float cs = nx[i] * qx[i] + ny[i] * qy[i] + nz[i] * qnz[i];
-        w[i] = log2h + normal_log2(cs, sn) - fabsf(z[i] - qz[i]) * inv;
+        w[i] = log2h + normal_log2(cs, sn0 + sn[i]) - fabsf(z[i] - qz[i]) * inv;
     }
 }
 

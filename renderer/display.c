@@ -109,14 +109,6 @@ static float glossy_keep(float t0, float t1, float alpha) {
     return expf(-0.5f * (t1 * t1 - t0 * t0) / (a * a));
 }
 
-/* The share of a point's light that its glossy lobe may bring, at worst: a lobe alpha wide peaks
- * about 1/alpha^2 above a diffuse lobe of the same albedo, so where it reflects a light the
- * highlight outshines the rest though its share g of the albedo is small (docs/design.md). */
-static float glossy_share(float g, float alpha) {
-    float peak = g / fmaxf(alpha * alpha, 1e-6f);
-    return peak > 0.0f ? peak / (peak + 1.0f - g) : 0.0f;
-}
-
 /* The most samples history may count as where a share `held` of its light still holds since its
  * samples were taken, per unit of one sample's relative variance (s / L)^2: what no longer holds is
  * a bias of about (1 - held) of the light L, which the mean of n samples of spread s matches in its
@@ -206,7 +198,7 @@ static void carry_row(void *ctx, int y, int worker) {
         float glossy = 1.0f, share = 0.0f, held = 1.0f; /* held: of the samples' light when taken */
         if (step > 0.0f) {
             glossy = glossy_keep(turn, turn + step, to->alpha[i]);
-            share = glossy_share(to->gloss[i], to->alpha[i]);
+            share = gbuffer_glossy_share(to->gloss[i], to->alpha[i]);
             held = glossy_keep(0.0f, turn + step, to->alpha[i]);
         }
         float diffuse = (1.0f - share) + share * glossy;

@@ -4,6 +4,7 @@
 #ifndef GLINT_GBUFFER_H
 #define GLINT_GBUFFER_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "scene.h"
@@ -23,6 +24,16 @@ typedef struct {
     float *alpha;      /* the glossy lobe's width (microfacet alpha); 1 without a glossy lobe */
     int32_t *material; /* the material's index; -1 where the ray escapes */
 } gbuffer;
+
+/* The share of a point's light that its glossy lobe (albedo share gloss, width alpha) may bring, at
+ * worst: a lobe alpha wide peaks about 1 / alpha^2 above a diffuse lobe of the same albedo, so where
+ * it reflects a light the highlight outshines the rest though its share of the albedo is small
+ * (docs/design.md). What the display's history keeps of a turned view, and how sharply its filter
+ * tells normals apart, go by it. */
+static inline float gbuffer_glossy_share(float gloss, float alpha) {
+    float peak = gloss / fmaxf(alpha * alpha, 1e-6f);
+    return peak > 0.0f ? peak / (peak + 1.0f - gloss) : 0.0f;
+}
 
 /* Below this albedo a channel is not divided any further: a black surface keeps its light. */
 #define GBUFFER_MIN_ALBEDO 0.02f

@@ -804,9 +804,58 @@ static void test_count_cap(void) {
           hole[1]);
 }
 
+/* A sharp lobe's normal stop: a curved mirror (normals of a sphere 20 pixels in radius, GGX alpha
+ * 0.02), young and noisy everywhere (one sample a pixel, a wide spread, so the luminance stop is
+ * open), with a light's speck at its centre. The speck's neighbours reflect something else: they
+ * take a fraction of what they take on a rough surface of the same shape, and the speck keeps more
+ * of its own light. A flat mirror (one normal) is filtered as a rough surface is: the stop goes by
+ * how far the reflected lobe turns, not by the material. */
+static void speck_filtered(float gloss, float alpha, int curved, double *beside, double *own) {
+    enum { W = 33 };
+    img im;
+    img_make(&im, W, W, 1);
+    for (int y = 0; y < W; y++)
+        for (int x = 0; x < W; x++) {
+            size_t i = (size_t)y * W + (size_t)x;
+            float dx = curved ? (float)(x - W / 2) / 20.0f : 0.0f, dy = curved ? (float)(y - W / 2) / 20.0f : 0.0f;
+            set_normal(&im, i, dx, dy, sqrtf(1.0f - dx * dx - dy * dy));
+            im.g.gloss[i] = gloss;
+            im.g.alpha[i] = alpha;
+            set(&im, 0, i, 1.0f, 1.0f, 1.0f, 1.0f, 1e4f);
+        }
+    size_t c = (size_t)(W / 2) * W + W / 2;
+    set(&im, 0, c, 100.0f, 100.0f, 100.0f, 1.0f, 1e4f);
+    CHECK(run(&im, 3, 0.0f) == 0, "speck run failed");
+    *beside = 0.0;
+    for (int k = 0; k < 4; k++) { /* the four pixels two away */
+        int x = W / 2 + (k == 0 ? 2 : k == 1 ? -2 : 0), y = W / 2 + (k == 2 ? 2 : k == 3 ? -2 : 0);
+        *beside += 0.25 * (lum(im.out[0] + 3 * ((size_t)y * W + (size_t)x)) - 1.0);
+    }
+    *own = lum(im.out[0] + 3 * c);
+    img_free(&im);
+}
+
+static void test_sharp_lobe(void) {
+    double rough_beside, rough_own, mirror_beside, mirror_own, flat_beside, flat_own, rflat_beside, rflat_own;
+    speck_filtered(0.0f, 1.0f, 1, &rough_beside, &rough_own);
+    speck_filtered(1.0f, 0.02f, 1, &mirror_beside, &mirror_own);
+    speck_filtered(1.0f, 0.02f, 0, &flat_beside, &flat_own);
+    speck_filtered(0.0f, 1.0f, 0, &rflat_beside, &rflat_own);
+    printf("sharp lobe: beside the speck +%.2f rough, +%.2f curved mirror; the speck %.1f, %.1f; flat %.2f, %.2f\n",
+           rough_beside, mirror_beside, rough_own, mirror_own, rflat_beside, flat_beside);
+    CHECK(rough_beside > 0.3, "a rough surface's noisy speck should spread (+%.2f beside it): the measure sees it",
+          rough_beside);
+    CHECK(mirror_beside < 0.2 * rough_beside, "a curved mirror's pixels beside the speck take +%.2f (rough: +%.2f)",
+          mirror_beside, rough_beside);
+    CHECK(mirror_own > 1.5 * rough_own, "the mirror's speck keeps %.1f (rough: %.1f)", mirror_own, rough_own);
+    CHECK(fabs(flat_beside - rflat_beside) <= 1e-6 * rflat_beside && fabs(flat_own - rflat_own) <= 1e-6 * rflat_own,
+          "a flat mirror is filtered as a flat rough surface: beside %.4f vs %.4f", flat_beside, rflat_beside);
+}
+
 int main(int argc, char **argv) {
     if (argc > 1 && strcmp(argv[1], "--bench") == 0) return bench(argc > 2 ? atoi(argv[2]) : 2);
     test_count_cap();
+    test_sharp_lobe();
     test_identity();
     test_brute();
     test_holes();
