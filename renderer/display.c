@@ -36,6 +36,7 @@ display *display_create(int width, int height, int threads, char *err, size_t er
     if (ok) ok = (d->need = calloc(packets, 1)) != NULL;
     if (ok) ok = (d->need_gain = calloc(packets, sizeof(float))) != NULL;
     if (ok) ok = (d->spread = malloc(sizeof(float) * n)) != NULL;
+    if (ok) ok = (d->spread_own = malloc(sizeof(float) * n)) != NULL;
     if (ok) ok = (d->extra_pixels = malloc(sizeof(int) * n)) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
     if (!ok) {
@@ -77,6 +78,7 @@ void display_destroy(display *d) {
     free(d->need);
     free(d->need_gain);
     free(d->spread);
+    free(d->spread_own);
     free(d->extra_pixels);
     free(d->extra_hist);
     free(d);

@@ -11,6 +11,10 @@
 #define EXTRA_CHUNK 16
 /* A hole's samples as the plan reckons them: its first sample is worth two of a pixel with one. */
 #define HOLE_COUNT 0.5f
+/* Below this many samples a pixel's own spread may miss what its few samples did not hit (a speck
+ * in a mirror that one neighbour's sample found): it takes its neighbours' on the same surface,
+ * their mean where that is more. */
+#define SPREAD_YOUNG 4.0f
 
 static int extra_bin(float ratio) {
     uint32_t u;
@@ -52,8 +56,8 @@ static float pixel_spread(const display *d, size_t i) {
     return isfinite(s) ? s : 0.0f;
 }
 
-/* Every pixel's spread into d->spread (0: none to plan for), a row a task; their sum and count per
- * worker. */
+/* Every pixel's own spread into d->spread_own (0: none to plan for), a row a task; their sum and
+ * count per worker. */
 static void spread_row(void *ctx, int y, int worker) {
     display *d = ctx;
     const gbuffer *g = &d->g[d->cur];
@@ -61,17 +65,21 @@ static void spread_row(void *ctx, int y, int worker) {
     for (size_t i = (size_t)y * (size_t)d->width; i < (size_t)(y + 1) * (size_t)d->width; i++) {
         /* while a light change is judged, a tile not yet judged has its history set aside: none */
         int unjudged = d->judging && d->tiles[tile_of(d, i)].state == TILE_UNKNOWN;
-        d->spread[i] = g->material[i] < 0 || unjudged ? 0.0f : pixel_spread(d, i);
-        if (d->spread[i] > 0.0f) k->spread_sum += (double)d->spread[i], k->spread_n++;
+        d->spread_own[i] = g->material[i] < 0 || unjudged ? 0.0f : pixel_spread(d, i);
+        if (d->spread_own[i] > 0.0f) k->spread_sum += (double)d->spread_own[i], k->spread_n++;
     }
 }
 
-/* A hole (no sample yet, not the sky) takes the largest spread of its neighbours': the filter fills
- * it from them, so it is as hard as the hardest of them (a hole beside a bright speck in a mirror
- * is filled with the speck); one among holes only, the average pixel's (d->spread_mean): nothing
- * is known of it, and its first sample says where the rest should go (a chrome sphere after a
- * jump, all holes, whose streak waited for the film). Then each pixel's ratio into its worker's
- * histogram. */
+/* The spread the plan goes by, into d->spread. A hole (no sample yet, not the sky) takes the largest
+ * of its neighbours' own: the filter fills it from them, so it is as hard as the hardest of them (a
+ * hole beside a bright speck in a mirror is filled with the speck); one among holes only, the
+ * average pixel's (d->spread_mean): nothing is known of it, and its first sample says where the
+ * rest should go (a chrome sphere after a jump, all holes, whose streak waited for the film). A
+ * young pixel (under SPREAD_YOUNG samples) takes the mean of its own and its neighbours' on the
+ * same surface where that is more than its own: a speck's neighbours, whose few samples missed
+ * it, may be as hard as it is (the mean, not the largest: in a young image every pixel has some
+ * bright neighbour, and the largest spreads the budget over all of them). Then each pixel's ratio
+ * into its worker's histogram. */
 
 static void hole_row(void *ctx, int y, int worker) {
     display *d = ctx;
@@ -81,21 +89,26 @@ static void hole_row(void *ctx, int y, int worker) {
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * (size_t)w + (size_t)x;
         int unjudged = d->judging && d->tiles[tile_of(d, i)].state == TILE_UNKNOWN;
-        if (g->material[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= 1.0f) && !unjudged) {
-            float most = 0.0f;
+        float n = h[i].c[COMP_DIRECT].count;
+        d->spread[i] = d->spread_own[i];
+        if (g->material[i] >= 0 && !(n >= SPREAD_YOUNG) && !unjudged) {
+            int hole = !(n >= 1.0f), m = 0;
+            float most = 0.0f, sum = 0.0f;
             for (int qy = y - 1; qy <= y + 1; qy++)
                 for (int qx = x - 1; qx <= x + 1; qx++) {
                     if (qx < 0 || qy < 0 || qx >= w || qy >= ht) continue;
                     size_t q = (size_t)qy * (size_t)w + (size_t)qx;
-                    if (h[q].c[COMP_DIRECT].count >= 1.0f) most = fmaxf(most, d->spread[q]); /* not a hole's */
+                    if (h[q].c[COMP_DIRECT].count >= 1.0f && (hole || g->material[q] == g->material[i]))
+                        most = fmaxf(most, d->spread_own[q]), sum += d->spread_own[q], m++; /* not a hole's */
                 }
-            d->spread[i] = most > 0.0f ? most : d->spread_mean;
+            if (!hole) most = fmaxf(d->spread_own[i], sum / (float)m); /* m >= 1: the pixel itself */
+            d->spread[i] = most > 0.0f || !hole ? most : d->spread_mean;
         }
         if (!(d->spread[i] > 0.0f)) continue;
         extra_histogram *k = &d->extra_hist[worker];
-        float n = plan_count(&h[i]);
-        int b = extra_bin(d->spread[i] / n);
-        k->count[b]++, k->s[b] += (double)d->spread[i], k->n[b] += (double)n;
+        float pn = plan_count(&h[i]);
+        int b = extra_bin(d->spread[i] / pn);
+        k->count[b]++, k->s[b] += (double)d->spread[i], k->n[b] += (double)pn;
     }
 }
 

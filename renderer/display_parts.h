@@ -86,7 +86,7 @@ struct display {
     light_tile *tiles;
     uint8_t *need;               /* per packet (display_packet_need)... */
     float *need_gain;            /* ...and its scratch */
-    float *spread;               /* per pixel, display_plan_extra's scratch... */
+    float *spread, *spread_own;  /* per pixel, display_plan_extra's scratch... */
     int *extra_pixels;           /* ...the pixels it plans for... */
     extra_histogram *extra_hist; /* ...a histogram per thread... */
     float spread_mean;           /* ...and the average pixel's spread */

@@ -4,7 +4,8 @@
  * test can fail), for pt and vsl. There are none before a frame has begun, after a reset or while
  * the abort flag is set. The plan gives samples where one takes most off the error shown: to the
  * pixel whose samples spread, none to those whose samples agree, some to a hole beside the spread
- * one, within the budget. Taken, a request's samples are blended into the history as their sums say.
+ * one, within the budget; in a young image also to the spread pixel's neighbours, whose few samples
+ * may have missed what its found. Taken, a request's samples are blended into the history as their sums say.
  * (That they never touch the film is test_parts'.) */
 #include <math.h>
 #include <stdlib.h>
@@ -171,9 +172,47 @@ static void check_plan(void) {
     scene_destroy(s);
 }
 
+/* A young image (two samples a pixel): one pixel's samples spread (a speck one of them found), its
+ * neighbours' agree. The neighbours on its surface may have missed the speck: the plan gives them
+ * samples too, and none to the pixels beyond (with four samples each, check_plan, they get none). */
+static void check_young(void) {
+    scene *s = ts_new("extra young");
+    int m = ts_lambert(s, v3s(0.5f), v3s(0.0f), 0);
+    ts_quad(s, v3(-50, -50, 0), v3(50, -50, 0), v3(50, 50, 0), v3(-50, 50, 0), m);
+    ts_point_light(s, v3(0, 0, 10));
+    ts_finalize(s);
+    camera cam = camera_look_at(v3(0, 0, 5), v3(0, 0, 0), v3(0, 1, 0), 0.7f);
+    char err[256];
+    display *d = display_create(PW, PH, 2, err, sizeof err);
+    CHECK(d != NULL, "display: %s", err);
+    if (!d) return;
+    display_change_view(d, s, &cam, DISPLAY_RESTART);
+    const int speck = 10 * PW + 10, beside = 11 * PW + 11, beyond = 10 * PW + 13;
+    static float value[PW * PH];
+    static unsigned char skip[PW * PH];
+    for (int k = 0; k < 2; k++) {
+        for (int i = 0; i < PW * PH; i++) value[i] = 1.0f;
+        value[speck] = k ? 40.0f : 0.0f;
+        write(d, value, skip);
+    }
+    static extra_request req[PW * PH];
+    int n = display_plan_extra(d, 200, req, PW * PH);
+    int at[3] = {0, 0, 0};
+    for (int r = 0; r < n; r++) {
+        int i = req[r].pixel, dx = i % PW - speck % PW, dy = i / PW - speck / PW;
+        at[i == speck ? 0 : i == beside ? 1 : 2] += req[r].samples;
+        CHECK(abs(dx) <= 1 && abs(dy) <= 1, "samples at (%d, %d) from the speck: only it and its neighbours", dx, dy);
+        CHECK(i != beyond, "samples two pixels from the speck");
+    }
+    CHECK(at[0] > 0 && at[1] > 0, "samples at the speck (%d) and at its young neighbour (%d)", at[0], at[1]);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
 int main(void) {
     check_refusals();
     check_plan();
+    check_young();
     check_unbiased();
     return check_exit("test_extra");
 }
