@@ -202,7 +202,7 @@ void tonemap_reinhard(const float *rgb, int num_pixels, const tonemap_params *p,
     for (int i = 0; i < num_pixels; i++) {
         float l = lum(rgb + 3 * (size_t)i);
         if (!isfinite(l)) continue;
-        log_sum += log(1e-4 + (double)fmaxf(l, 0.0f));
+        log_sum += (double)logf(1e-4f + fmaxf(l, 0.0f));
         counted++;
     }
     double avg = counted ? exp(log_sum / counted) : 1.0;
