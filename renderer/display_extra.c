@@ -38,11 +38,11 @@ static float plan_count(const pixel_history *p) {
 
 /* Pixel i's one-sample spread as shown: the square root of its components' variances summed,
  * times its albedo's luminance; from a single sample, that sample's own value (a Monte Carlo
- * sample is typically as spread as it is bright). 0 where it has no sample. */
+ * sample is typically as spread as it is bright). -1 where it has no sample (a hole). */
 static float pixel_spread(const display *d, size_t i) {
     const pixel_history *p = &d->h[d->cur][i];
     float a = luminance3(get3(d->g[d->cur].albedo, i)), s2 = 0.0f;
-    if (!(p->c[COMP_DIRECT].count >= 1.0f)) return 0.0f;
+    if (!(p->c[COMP_DIRECT].count >= 1.0f)) return -1.0f;
     for (int c = 0; c < COMP_COUNT; c++) {
         if (!d->active[c]) continue;
         float v = shown_spread(p, c, a);
@@ -56,8 +56,8 @@ static float pixel_spread(const display *d, size_t i) {
     return isfinite(s) ? s : 0.0f;
 }
 
-/* Every pixel's own spread into d->spread_own (0: none to plan for), a row a task; their sum and
- * count per worker. */
+/* Every pixel's own spread into d->spread_own (0: none to plan for, -1: a hole to plan for), a row
+ * a task; their sum and count per worker. */
 static void spread_row(void *ctx, int y, int worker) {
     display *d = ctx;
     const gbuffer *g = &d->g[d->cur];
@@ -84,31 +84,34 @@ static void spread_row(void *ctx, int y, int worker) {
 static void hole_row(void *ctx, int y, int worker) {
     display *d = ctx;
     const pixel_history *h = d->h[d->cur];
-    const gbuffer *g = &d->g[d->cur];
-    int w = d->width, ht = d->height;
+    const int32_t *mat = d->g[d->cur].material;
+    const float *own = d->spread_own;
+    int w = d->width, y0 = y > 0 ? y - 1 : y, y1 = y + 1 < d->height ? y + 1 : y;
+    extra_histogram *k = &d->extra_hist[worker];
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * (size_t)w + (size_t)x;
-        int unjudged = d->judging && d->tiles[tile_of(d, i)].state == TILE_UNKNOWN;
-        float n = h[i].c[COMP_DIRECT].count;
-        d->spread[i] = d->spread_own[i];
-        if (g->material[i] >= 0 && !(n >= SPREAD_YOUNG) && !unjudged) {
-            int hole = !(n >= 1.0f), m = 0;
+        int hole = own[i] < 0.0f, young = !hole && mat[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= SPREAD_YOUNG);
+        if (young && d->judging) young = d->tiles[tile_of(d, i)].state != TILE_UNKNOWN;
+        float s = hole ? 0.0f : own[i];
+        if (hole || young) {
+            int x0 = x > 0 ? x - 1 : x, x1 = x + 1 < w ? x + 1 : x, m = 0;
             float most = 0.0f, sum = 0.0f;
-            for (int qy = y - 1; qy <= y + 1; qy++)
-                for (int qx = x - 1; qx <= x + 1; qx++) {
-                    if (qx < 0 || qy < 0 || qx >= w || qy >= ht) continue;
+            for (int qy = y0; qy <= y1; qy++)
+                for (int qx = x0; qx <= x1; qx++) {
                     size_t q = (size_t)qy * (size_t)w + (size_t)qx;
-                    if (h[q].c[COMP_DIRECT].count >= 1.0f && (hole || g->material[q] == g->material[i]))
-                        most = fmaxf(most, d->spread_own[q]), sum += d->spread_own[q], m++; /* not a hole's */
+                    if (own[q] >= 0.0f && (hole || mat[q] == mat[i])) /* not a hole's */
+                        most = fmaxf(most, own[q]), sum += own[q], m++;
                 }
-            if (!hole) most = fmaxf(d->spread_own[i], sum / (float)m); /* m >= 1: the pixel itself */
-            d->spread[i] = most > 0.0f || !hole ? most : d->spread_mean;
+            if (hole)
+                s = most > 0.0f ? most : d->spread_mean;
+            else
+                s = fmaxf(s, sum / (float)m); /* m >= 1: the pixel itself */
         }
-        if (!(d->spread[i] > 0.0f)) continue;
-        extra_histogram *k = &d->extra_hist[worker];
+        d->spread[i] = s;
+        if (!(s > 0.0f)) continue;
         float pn = plan_count(&h[i]);
-        int b = extra_bin(d->spread[i] / pn);
-        k->count[b]++, k->s[b] += (double)d->spread[i], k->n[b] += (double)pn;
+        int b = extra_bin(s / pn);
+        k->count[b]++, k->s[b] += (double)s, k->n[b] += (double)pn;
     }
 }
 
