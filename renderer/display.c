@@ -263,16 +263,25 @@ static int pixel_changed(const pixel_history *h, const pixel_history *s) {
     return diff > 3.0f * noise && diff > 0.1f * fmaxf(lh, ls);
 }
 
-/* A tile's verdict: where the light did not change its stale history comes back (counted in full),
- * but for pixels whose new samples contradict it; where it did the stale history goes. */
+/* A tile's verdict: where the light did not change its stale history comes back, but for pixels
+ * whose new samples contradict it; where it did the stale history goes. A pixel with samples of its
+ * own that agree takes it back in full; one without takes it back as one sample (the tile's verdict
+ * is its sampled pixels', and a speck the light lit may have moved where none was sampled), and not
+ * at all where its light is mostly its glossy lobe's, which moves with the light. */
 static void settle_tile(display *d, int t, int state) {
     d->tiles[t].state = state;
     int x0 = (t % d->tiles_x) * TILE_PX, y0 = (t / d->tiles_x) * TILE_PX;
     pixel_history *h = d->h[d->cur];
+    const gbuffer *g = &d->g[d->cur];
     for (int y = y0; y < y0 + TILE_PX && y < d->height; y++)
         for (int x = x0; x < x0 + TILE_PX && x < d->width; x++) {
             size_t i = (size_t)y * (size_t)d->width + (size_t)x;
-            if (state == TILE_SAME && !pixel_changed(&h[i], &d->stale[i])) history_merge(&h[i], &d->stale[i], INFINITY);
+            if (state == TILE_SAME && !pixel_changed(&h[i], &d->stale[i])) {
+                if (h[i].c[COMP_DIRECT].count >= 1.0f)
+                    history_merge(&h[i], &d->stale[i], INFINITY);
+                else if (!(gbuffer_glossy_share(g->gloss[i], g->alpha[i]) > STALE_GLOSSY))
+                    history_merge(&h[i], &d->stale[i], 1.0f);
+            }
             memset(&d->stale[i], 0, sizeof d->stale[i]);
         }
 }
@@ -486,10 +495,14 @@ typedef struct {
 
 /* Component c of pixel i's history as shown: its own, or, while a light change is judged and the
  * pixel has none of its own since, the stale history's counted as STALE_WEIGHT samples (where its
- * tile was not judged changed). NULL when there is nothing. */
+ * tile was not judged changed, and its light is not mostly its glossy lobe's: a light's reflection
+ * moves with the light, and where it was stays bright until the tile is judged). NULL when there is
+ * nothing. */
 static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2) {
     const pixel_history *p = &d->h[d->cur][i];
-    if (!(p->c[c].count > 0.0f) && d->judging && d->stale[i].c[c].count > 0.0f) {
+    const gbuffer *g = &d->g[d->cur];
+    if (!(p->c[c].count > 0.0f) && d->judging && d->stale[i].c[c].count > 0.0f &&
+        !(gbuffer_glossy_share(g->gloss[i], g->alpha[i]) > STALE_GLOSSY)) {
         p = &d->stale[i];
         *count = fminf(p->c[c].count, STALE_WEIGHT);
     } else if (p->c[c].count > 0.0f) {

@@ -32,6 +32,9 @@ _Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line
 #define JUDGE_MIN_SAMPLES 16
 #define JUDGE_MAX_SAMPLES 64
 #define STALE_WEIGHT 0.25f
+/* ...but not where a pixel's light is mostly its glossy lobe's (gbuffer_glossy_share above this):
+ * a light's reflection moves with the light. */
+#define STALE_GLOSSY 0.5f
 /* Reprojection's tests: a surface point's old pixel is the same point if its normal is within
  * this cosine and it lies within this many pixel footprints of the old point's plane. */
 #define REPROJECT_MIN_COS 0.9f

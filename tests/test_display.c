@@ -3,7 +3,8 @@
  * history to where the point lands (a light linear in position comes back exactly, since bilinear
  * taps of a linear function are exact); what the move reveals starts empty and never takes another
  * surface's light; a glossy lobe's share keeps what its width and the view's turn leave, a diffuse
- * point all of it; a light change keeps little, a restart nothing; samples written for an old
+ * point all of it; a light change keeps little (a sharp glossy surface, whose highlights move with
+ * the light, nothing unconfirmed), a restart nothing; samples written for an old
  * view are not taken for a new one; the image shown is finite whatever the samples; each packet's
  * need follows its pixels' samples. The G-buffer's projection is checked against its own centre
  * rays. */
@@ -349,9 +350,10 @@ static void check_changes(void) {
 
 /* A light change, judged tile by tile from new samples: where they agree with the history (the
  * left half, noisy samples about the same mean) it comes back in full; where the light tripled
- * (the right half) it goes; tiles without new samples show it meanwhile. */
-static void check_light_judgement(void) {
-    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
+ * (the right half) it goes; tiles without new samples show it meanwhile, but on a sharp glossy
+ * plane (phong_n > 0), whose light is mostly its lobe's and moves with the light, they do not. */
+static void check_light_judgement(float phong_n) {
+    scene *s = phong_n > 0.0f ? plane_scene(0, phong_n, 0.3f, 0.3f) : plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
     char err[256];
     display *d = display_create(W, H, 2, err, sizeof err);
@@ -395,7 +397,11 @@ static void check_light_judgement(void) {
     CHECK(fabs(left - 1.0) < 0.05 && sqrt(left2 / nl) < 0.15, "unchanged light keeps its history: mean %g, RMS %g",
           left, sqrt(left2 / nl));
     CHECK(fabs(right - 3.0) < 0.15, "changed light shows the new samples alone: mean %g", right);
-    CHECK(fabs(unjudged - 1.0) < 0.05, "tiles without new samples show the old light meanwhile: %g", unjudged);
+    if (phong_n > 0.0f)
+        CHECK(unjudged == 0.0, "a glossy plane's tiles without new samples show nothing of the old light: %g",
+              unjudged);
+    else
+        CHECK(fabs(unjudged - 1.0) < 0.05, "tiles without new samples show the old light meanwhile: %g", unjudged);
     free(img);
     display_destroy(d);
     scene_destroy(s);
@@ -579,7 +585,8 @@ int main(void) {
     check_disocclusion();
     check_glossy_history();
     check_changes();
-    check_light_judgement();
+    check_light_judgement(0.0f);
+    check_light_judgement(400.0f);
     check_filter_fades();
     check_film_untouched();
     check_packet_need();

@@ -7,14 +7,17 @@
  *
  * usage: display_bench [--scene S] [--method M] [--size WxH] [--parts K] [--updates N]
  *                      [--rest R] [--orbit DEG --orbit-updates M] [--denoise 0|1] [--by-need 0|1] [--reference REF.exr]
- *                      [--threads T] [--seed S] [--save PREFIX]
+ *                      [--threads T] [--seed S] [--save PREFIX] [--light DX,DY,DZ]
  * The orbit turns the camera by DEG about the vertical through the point in front of it as far as
  * the scene's centre (as the viewer's orbit turns) before each of the first M updates; it begins
  * DEG x M short of the scene's first camera, so that it ends there and a reference of that camera
  * (glint render) serves every orbit. With --rest R the orbit begins after R updates at rest (history
  * to carry over); --orbit 12 --orbit-updates 1 is then a jump (on atelier beyond 14 degrees the
  * first camera leaves the room). --by-need 0 renders frames in the lattice's order, not the
- * display's need's (session_set_packet_need). */
+ * display's need's (session_set_packet_need). --light drags the scene's light 0 by (DX, DY, DZ) in
+ * M equal steps (--orbit-updates M, the camera still) after the rest, as the viewer's light drag
+ * does, and makes the plan again after the last step (the viewer does 0.3 s later); the reference
+ * is then one rendered with the light moved (glint render --move-light). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -48,6 +51,7 @@ int main(int argc, char **argv) {
     int w = 960, h = 540, parts = 64, updates = 30, rest = 0, orbit_updates = 0, denoise = 1, threads = 2, by_need = 1;
     int extra = 0;
     float orbit_deg = 0.0f;
+    vec3 light_move = v3(0.0f, 0.0f, 0.0f);
     uint64_t seed = 1;
     for (int i = 1; i + 1 < argc; i += 2) {
         const char *a = argv[i], *v = argv[i + 1];
@@ -81,6 +85,8 @@ int main(int argc, char **argv) {
             seed = strtoull(v, NULL, 10);
         else if (!strcmp(a, "--save"))
             save = v;
+        else if (!strcmp(a, "--light"))
+            sscanf(v, "%f,%f,%f", &light_move.x, &light_move.y, &light_move.z);
         else
             return fprintf(stderr, "display_bench: unknown option %s\n", a), 2;
     }
@@ -96,7 +102,7 @@ int main(int argc, char **argv) {
     camera cam = scene_camera(s, 0, (float)w / (float)h);
     vec3 pivot = madd3(cam.position, cam.forward,
                        fmaxf(dot3(sub3(bounds_center(s->bounds), cam.position), cam.forward), 0.05f * s->diag));
-    cam = orbit(cam, -orbit_deg * (float)orbit_updates, pivot);
+    if (is_black3(light_move)) cam = orbit(cam, -orbit_deg * (float)orbit_updates, pivot);
     render_session *rs = session_create(s, &cam, &p, err, sizeof err);
     display *d = rs ? display_create(w, h, threads, err, sizeof err) : NULL;
     if (!d) return fprintf(stderr, "%s\n", err), 1;
@@ -109,12 +115,17 @@ int main(int argc, char **argv) {
     uint64_t t_start = clock_ns();
     for (int u = 0; u < updates; u++) {
         double view_ms = 0.0, gbuffer_ms = 0.0;
+        int dragging = !is_black3(light_move);
         if (u >= rest && u < rest + orbit_updates) {
-            cam = orbit(cam, orbit_deg, pivot);
+            if (dragging && scene_move_light(s, 0, scale3(light_move, 1.0f / (float)orbit_updates), err, sizeof err))
+                return fprintf(stderr, "%s\n", err), 1;
+            if (!dragging) cam = orbit(cam, orbit_deg, pivot);
             p.seed = seed + (uint64_t)u + 1; /* each accumulation its own random numbers, as the viewer */
             session_set_params(rs, &p);
             session_set_camera(rs, &cam);
-            display_change_view(d, s, &cam, DISPLAY_CAMERA);
+            if (dragging && u + 1 == rest + orbit_updates && session_scene_changed(rs) != 0)
+                return fprintf(stderr, "%s\n", session_error(rs)), 1;
+            display_change_view(d, s, &cam, dragging ? DISPLAY_LIGHTS : DISPLAY_CAMERA);
             display_stats ds = display_get_stats(d);
             view_ms = ds.view_ms;
             gbuffer_ms = ds.gbuffer_ms;
