@@ -81,6 +81,15 @@ static void spread_row(void *ctx, int y, int worker) {
  * bright neighbour, and the largest spreads the budget over all of them). Then each pixel's ratio
  * into its worker's histogram. */
 
+/* Whether pixel i's light is mostly its glossy lobe's and the view has turned at it since its
+ * samples were taken by more than the lobe is wide: what they say of its light is mostly stale (a
+ * light's speck in a mirror has moved), and the plan takes it as it takes a hole. */
+static int turned(const display *d, size_t i) {
+    const gbuffer *g = &d->g[d->cur];
+    float a = fmaxf(g->alpha[i], 1e-3f), t = d->h[d->cur][i].turn;
+    return t > a && gbuffer_glossy_share(g->gloss[i], g->alpha[i]) > STALE_GLOSSY;
+}
+
 static void hole_row(void *ctx, int y, int worker) {
     display *d = ctx;
     const pixel_history *h = d->h[d->cur];
@@ -90,9 +99,10 @@ static void hole_row(void *ctx, int y, int worker) {
     extra_histogram *k = &d->extra_hist[worker];
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * (size_t)w + (size_t)x;
-        int hole = own[i] < 0.0f, young = !hole && mat[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= SPREAD_YOUNG);
+        int hole = own[i] < 0.0f || turned(d, i),
+            young = !hole && mat[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= SPREAD_YOUNG);
         if (young && d->judging) young = d->tiles[tile_of(d, i)].state != TILE_UNKNOWN;
-        float s = hole ? 0.0f : own[i];
+        float s = own[i] > 0.0f ? own[i] : 0.0f;
         if (hole || young) {
             int x0 = x > 0 ? x - 1 : x, x1 = x + 1 < w ? x + 1 : x, m = 0;
             float most = 0.0f, sum = 0.0f;
@@ -103,7 +113,7 @@ static void hole_row(void *ctx, int y, int worker) {
                         most = fmaxf(most, own[q]), sum += own[q], m++;
                 }
             if (hole)
-                s = most > 0.0f ? most : d->spread_mean;
+                s = fmaxf(s, most > 0.0f ? most : d->spread_mean);
             else
                 s = fmaxf(s, sum / (float)m); /* m >= 1: the pixel itself */
         }
