@@ -77,7 +77,8 @@ struct render_thread {
     load_job job;
     int film_partial; /* a stopped part left samples in the film; cleared by the next frame that ends */
     /* What an update costs with the current settings (0: not measured): a frame's rendering
-     * without its set-up, the set-up a frame begins with (the virtual lights), the display's work. */
+     * without its set-up, the set-up a frame begins with (the virtual lights), the rest of an
+     * update (the display's work: the view's change, the extra samples' plan, the image shown). */
     double frame_ms, setup_ms, display_ms;
     double extra_ms;        /* an extra sample's (display_plan_extra), 0: not measured */
     extra_request *extra;   /* EXTRA_REQUESTS of them */
@@ -474,26 +475,30 @@ static void learn_costs(render_thread *rt, double ms, int parts, int began, doub
     if (began) smooth(&rt->setup_ms, setup_ms);
 }
 
-/* ... and the display's, an update's. */
-static void learn_display(render_thread *rt, double ms) { smooth(&rt->display_ms, ms); }
+/* ... and the rest of an update's: all of its time but what rendered (parts and extra samples), so
+ * that an update takes about what render_budget aims at, whatever the display's work includes. */
+static void learn_display(render_thread *rt, double ms) { smooth(&rt->display_ms, fmax(ms, 0.0)); }
 
 /* The display's own samples for about ms (display_plan_extra), at what one cost so far (at first,
- * a film's pixel's). The plan's own time (a few ms at 960x540) is not counted against them: counted,
- * it left the young image of the first half second after a stop almost none (atelier's orbit, 1 s
- * after the stop: 0.28 and 0.29 in two runs, against 0.12 and 0.15). */
-static void add_extra_samples(render_thread *rt, double ms) {
+ * a film's pixel's). Returns the time they took, without the plan's: the plan (a few ms at 960x540)
+ * is not counted against them, which left the young image of the first half second after a stop
+ * almost none (atelier's orbit, 1 s after the stop: 0.28 and 0.29 in two runs, against 0.12 and
+ * 0.15), but against the update's render budget, as the rest of the display's work is. */
+static double add_extra_samples(render_thread *rt, double ms) {
     const render_params *p = session_params(rt->session);
     double each = rt->extra_ms > 0.0 ? rt->extra_ms : rt->frame_ms / ((double)p->width * (double)p->height);
-    if (!rt->extra || !(each > 0.0) || !(ms > 0.0)) return;
+    if (!rt->extra || !(each > 0.0) || !(ms > 0.0)) return 0.0;
     double want = ms / each;
     int n = display_plan_extra(rt->disp, want < 1e6 ? (int)want : 1000000, rt->extra, EXTRA_REQUESTS);
-    if (n <= 0) return;
+    if (n <= 0) return 0.0;
     double t0 = cli_now();
-    if (session_render_extra(rt->session, rt->extra, n) != 0) return;
+    if (session_render_extra(rt->session, rt->extra, n) != 0) return 1e3 * (cli_now() - t0);
     long long taken = 0;
     for (int k = 0; k < n; k++) taken += rt->extra[k].samples;
     display_take_extra(rt->disp, rt->extra, n);
-    if (taken > 0) smooth(&rt->extra_ms, 1e3 * (cli_now() - t0) / (double)taken);
+    double took = 1e3 * (cli_now() - t0);
+    if (taken > 0) smooth(&rt->extra_ms, took / (double)taken);
+    return took;
 }
 
 /* Whether two requests render the same estimate (the panel sends its parameters with their defaults
@@ -595,6 +600,7 @@ static void *render_main(void *arg) {
         sh->stats.standing = held;
         pthread_mutex_unlock(&sh->lock);
         update_info up = {.measure = measure, .resets_seen = resets_seen, .gen = gen};
+        double began_at = cli_now();
         if (held) { /* paused, or at the spp or time limit; the display may still change its look */
             if (look_changed) publish(rt, &up);
             refinement_hold(sh);
@@ -677,10 +683,9 @@ static void *render_main(void *arg) {
             if (asked || spent + rt->frame_ms / session_frame_parts(rs) > film_budget) break;
         }
         display_take_samples(rt->disp);
-        if (r == 0 && up.rendered && own_samples) add_extra_samples(rt, EXTRA_SHARE * budget);
-        double t1 = cli_now();
+        if (r == 0 && up.rendered && own_samples) spent += add_extra_samples(rt, EXTRA_SHARE * budget);
         publish(rt, &up);
-        learn_display(rt, 1e3 * (cli_now() - t1) + (change ? display_get_stats(rt->disp).view_ms : 0.0));
+        learn_display(rt, 1e3 * (cli_now() - began_at) - spent);
         if (r < 0)
             refinement_hold(sh);
         else
