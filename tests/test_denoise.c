@@ -660,9 +660,11 @@ static void test_hostile(void) {
                 if (kind == 5) { /* every ray escaped */
                     im.g.depth[i] = 0.0f;
                     set_normal(&im, i, 0.0f, 0.0f, -1.0f);
-                } else if (kind >= 3) { /* hostile geometry */
+                } else if (kind >= 3) { /* hostile geometry, and lobes (the sharp lobe's normal stop) */
                     im.g.depth[i] = bad_values[rng_next_u32(&r) % (uint32_t)nb];
                     set_normal(&im, i, x, bad_values[rng_next_u32(&r) % (uint32_t)nb], 1.0f);
+                    im.g.gloss[i] = bad_values[rng_next_u32(&r) % (uint32_t)nb];
+                    im.g.alpha[i] = bad_values[rng_next_u32(&r) % (uint32_t)nb];
                 } else {
                     im.g.depth[i] = 10.0f;
                     set_normal(&im, i, 0.0f, 0.0f, 1.0f);
