@@ -263,6 +263,7 @@ int cmd_view(int argc, char **argv) {
         glfwSwapBuffers(win);
         u.drawn_events = u.input_events;
         u.drawn_at = now;
+        u.frames_drawn++;
         /* Dear ImGui sizes a window to what it held the frame before: a frame more after any
          * change but a new image's (whose overlay line keeps its size). */
         u.settle = !settle && (acted || news != VIEW_NEW_IMAGE);

@@ -118,6 +118,7 @@ typedef struct {
     unsigned long long drawn_events; /* ...as of the last frame drawn */
     double drawn_at, redraw_until;   /* the last frame drawn; frames drawn until then after input */
     int settle;                      /* the next frame is drawn: the last one changed the panel */
+    unsigned long long frames_drawn; /* for the stats line */
     /* script */
     view_script script;
     const char *script_path_for_errors;

@@ -50,7 +50,8 @@ static void print_stats(ui_thread *u) {
      * pixels in all, and the size they render at: updates a second and their resolution. */
     printf(" images=%llu images_full=%llu image_pixels=%llu render_size=%dx%d", u->images_shown, u->images_full,
            u->image_pixels, u->front.full_w, u->front.full_h);
-    view_stats_print(&u->stats); /* the render side's record, as it names its fields */
+    printf(" frames_drawn=%llu", u->frames_drawn); /* the window's: only when something changed */
+    view_stats_print(&u->stats);                   /* the render side's record, as it names its fields */
     print_panel_stats(u);
     /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;

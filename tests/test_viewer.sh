@@ -280,7 +280,7 @@ grep -q 'highlights.exr: the reference is 48x27 but the render is 96x54' err.txt
 # float); with it on it is not, and the export (the estimate) is the same pixels either way. An orbit and a capture in one UI frame: the image shown is still
 # the one before the orbit, and the capture says so (its camera, not the new one; not the latest).
 # Soon after, the new view's first images: at the render's full size, as every image is. The stats
-# count the images the window took.
+# count the images the window took, and the frames it drew.
 cat >capture.txt <<'EOF'
 wait 1
 pause
@@ -303,6 +303,8 @@ wait 1
 pause
 wait-held
 capture moved-rest.exr
+stats
+sleep 2
 stats
 quit
 EOF
@@ -338,6 +340,11 @@ i1=$(field 1 images) i4=$(field 4 images) f4=$(field 4 images_full)
 [ "${i1:-0}" -ge 1 ] && [ "${i4:-0}" -gt "$i1" ] || fail "images counted $i1 then $i4"
 [ "${f4:-0}" = "$i4" ] || fail "full-resolution images $f4 of $i4: every image is at full resolution"
 [ "$(field 1 render_size)" = 160x90 ] || fail "render_size $(field 1 render_size)"
+# Paused, nothing changes: the window is drawn twice a second (and once more as the panel settles),
+# not at 60 frames a second (the renderer's cores draw it). An upper bound: a slow machine draws less.
+d4=$(field 4 frames_drawn) d5=$(field 5 frames_drawn)
+[ -n "$d4" ] && [ -n "$d5" ] && [ $((d5 - d4)) -ge 1 ] && [ $((d5 - d4)) -le 16 ] ||
+  fail "frames drawn in 2 s at rest: ${d4:-?} -> ${d5:-?} (want 1 to 16)"
 
 # A reference rendered with a light moved is not of the scene as loaded: refused with the reason.
 "$glint" render --size 64x36 --spp 1 --quiet --move-light 0,0.5,0,0 --out ref-moved.exr ||
