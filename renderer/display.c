@@ -279,7 +279,7 @@ static void settle_tile(display *d, int t, int state) {
             if (state == TILE_SAME && !pixel_changed(&h[i], &d->stale[i])) {
                 if (h[i].c[COMP_DIRECT].count >= 1.0f)
                     history_merge(&h[i], &d->stale[i], INFINITY);
-                else if (!(gbuffer_glossy_share(g->gloss[i], g->alpha[i]) > STALE_GLOSSY))
+                else if (!mostly_glossy(g, i))
                     history_merge(&h[i], &d->stale[i], 1.0f);
             }
             memset(&d->stale[i], 0, sizeof d->stale[i]);
@@ -501,8 +501,7 @@ typedef struct {
 static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2) {
     const pixel_history *p = &d->h[d->cur][i];
     const gbuffer *g = &d->g[d->cur];
-    if (!(p->c[c].count > 0.0f) && d->judging && d->stale[i].c[c].count > 0.0f &&
-        !(gbuffer_glossy_share(g->gloss[i], g->alpha[i]) > STALE_GLOSSY)) {
+    if (!(p->c[c].count > 0.0f) && d->judging && d->stale[i].c[c].count > 0.0f && !mostly_glossy(g, i)) {
         p = &d->stale[i];
         *count = fminf(p->c[c].count, STALE_WEIGHT);
     } else if (p->c[c].count > 0.0f) {

@@ -87,7 +87,7 @@ static void spread_row(void *ctx, int y, int worker) {
 static int turned(const display *d, size_t i) {
     const gbuffer *g = &d->g[d->cur];
     float a = fmaxf(g->alpha[i], 1e-3f), t = d->h[d->cur][i].turn;
-    return t > a && gbuffer_glossy_share(g->gloss[i], g->alpha[i]) > STALE_GLOSSY;
+    return t > a && mostly_glossy(g, i);
 }
 
 static void hole_row(void *ctx, int y, int worker) {

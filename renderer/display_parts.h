@@ -32,8 +32,8 @@ _Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line
 #define JUDGE_MIN_SAMPLES 16
 #define JUDGE_MAX_SAMPLES 64
 #define STALE_WEIGHT 0.25f
-/* ...but not where a pixel's light is mostly its glossy lobe's (gbuffer_glossy_share above this):
- * a light's reflection moves with the light. */
+/* ...but not where a pixel's light is mostly its glossy lobe's (mostly_glossy): a light's
+ * reflection moves with the light. */
 #define STALE_GLOSSY 0.5f
 /* Reprojection's tests: a surface point's old pixel is the same point if its normal is within
  * this cosine and it lies within this many pixel footprints of the old point's plane. */
@@ -100,6 +100,12 @@ struct display {
 static inline int tile_of(const display *d, size_t i) {
     int x = (int)(i % (size_t)d->width), y = (int)(i / (size_t)d->width);
     return (y / TILE_PX) * d->tiles_x + x / TILE_PX;
+}
+
+/* Whether pixel i's light is mostly its glossy lobe's (gbuffer_glossy_share over STALE_GLOSSY): its
+ * light moves with a moved light, and over its surface as the view turns. */
+static inline int mostly_glossy(const gbuffer *g, size_t i) {
+    return gbuffer_glossy_share(g->gloss[i], g->alpha[i]) > STALE_GLOSSY;
 }
 
 static inline vec3 get3(const float *a, size_t i) { return v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }

@@ -117,9 +117,12 @@ static void write(display *d, const float *value, const unsigned char *skip) {
     display_take_samples(d);
 }
 
-static void check_plan(void) {
-    scene *s = ts_new("extra");
-    int m = ts_lambert(s, v3s(0.5f), v3s(0.0f), 0);
+/* The plane z = 0 filling a PW x PH view from (0, 0, 5), Lambert (albedo 0.5) or, phong_n > 0,
+ * Phong of that exponent; its display at that view, or NULL (the scene freed). */
+static display *plane_display(float phong_n, scene **out) {
+    scene *s = ts_new("extra plane");
+    int m = phong_n > 0.0f ? ts_material(s, ts_phong(v3s(0.3f), v3s(0.3f), phong_n))
+                           : ts_lambert(s, v3s(0.5f), v3s(0.0f), 0);
     ts_quad(s, v3(-50, -50, 0), v3(50, -50, 0), v3(50, 50, 0), v3(-50, 50, 0), m);
     ts_point_light(s, v3(0, 0, 10));
     ts_finalize(s);
@@ -127,8 +130,19 @@ static void check_plan(void) {
     char err[256];
     display *d = display_create(PW, PH, 2, err, sizeof err);
     CHECK(d != NULL, "display: %s", err);
-    if (!d) return;
+    if (!d) {
+        scene_destroy(s);
+        return NULL;
+    }
     display_change_view(d, s, &cam, DISPLAY_RESTART);
+    *out = s;
+    return d;
+}
+
+static void check_plan(void) {
+    scene *s;
+    display *d = plane_display(0.0f, &s);
+    if (!d) return;
     const int spread = 10 * PW + 10, hole = 10 * PW + 11, calm = 5 * PW + 25;
     static float value[PW * PH];
     static unsigned char skip[PW * PH];
@@ -177,17 +191,9 @@ static void check_plan(void) {
  * neighbours' agree. The neighbours on its surface may have missed the speck: the plan gives them
  * samples too, and none to the pixels beyond (with four samples each, check_plan, they get none). */
 static void check_young(void) {
-    scene *s = ts_new("extra young");
-    int m = ts_lambert(s, v3s(0.5f), v3s(0.0f), 0);
-    ts_quad(s, v3(-50, -50, 0), v3(50, -50, 0), v3(50, 50, 0), v3(-50, 50, 0), m);
-    ts_point_light(s, v3(0, 0, 10));
-    ts_finalize(s);
-    camera cam = camera_look_at(v3(0, 0, 5), v3(0, 0, 0), v3(0, 1, 0), 0.7f);
-    char err[256];
-    display *d = display_create(PW, PH, 2, err, sizeof err);
-    CHECK(d != NULL, "display: %s", err);
+    scene *s;
+    display *d = plane_display(0.0f, &s);
     if (!d) return;
-    display_change_view(d, s, &cam, DISPLAY_RESTART);
     const int speck = 10 * PW + 10, beside = 11 * PW + 11, beyond = 10 * PW + 13;
     static float value[PW * PH];
     static unsigned char skip[PW * PH];
@@ -219,18 +225,9 @@ static void check_young(void) {
  * which the carry's bilinear taps mix in). Returns the ratio of the samples per pixel beside the
  * speck to those of the pixels beyond (0.5 at least). */
 static double turned_planned(float phong_n) {
-    scene *s = ts_new("extra turned");
-    int m = phong_n > 0.0f ? ts_material(s, ts_phong(v3s(0.3f), v3s(0.3f), phong_n))
-                           : ts_lambert(s, v3s(0.5f), v3s(0.0f), 0);
-    ts_quad(s, v3(-50, -50, 0), v3(50, -50, 0), v3(50, 50, 0), v3(-50, 50, 0), m);
-    ts_point_light(s, v3(0, 0, 10));
-    ts_finalize(s);
-    camera cam = camera_look_at(v3(0, 0, 5), v3(0, 0, 0), v3(0, 1, 0), 0.7f);
-    char err[256];
-    display *d = display_create(PW, PH, 2, err, sizeof err);
-    CHECK(d != NULL, "display: %s", err);
+    scene *s;
+    display *d = plane_display(phong_n, &s);
     if (!d) return -1.0;
-    display_change_view(d, s, &cam, DISPLAY_RESTART);
     const int speck = 10 * PW + 16;
     static float value[PW * PH];
     static unsigned char skip[PW * PH];
