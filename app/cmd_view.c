@@ -235,11 +235,12 @@ int cmd_view(int argc, char **argv) {
         u.last_time = now;
         int news = fetch_published(&u);
         if (news & VIEW_NEW_IMAGE) u.need_tonemap = 1;
-        int script_was = u.script_pos, shot_asked = u.window_shot[0] != 0;
+        unsigned long long shown_was = u.script_shown;
+        int shot_asked = u.window_shot[0] != 0;
         run_script(&u);
         update_status(&u);
-        if (u.input_events != u.drawn_events) u.redraw_until = now + REDRAW_AFTER_INPUT;
-        int settle = u.settle, acted = u.script_pos != script_was || u.window_shot[0] || now < u.redraw_until;
+        if (u.input_events != u.drawn_events && !view_dragging(&u)) u.redraw_until = now + REDRAW_AFTER_INPUT;
+        int settle = u.settle, acted = u.script_shown != shown_was || u.window_shot[0] || now < u.redraw_until;
         int draw = news || u.need_tonemap || acted || settle || now - u.drawn_at >= IDLE_REDRAW_SECONDS;
 
         if (draw) {

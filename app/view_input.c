@@ -218,6 +218,16 @@ void note_input_callbacks(GLFWwindow *win) {
     glfwSetWindowRefreshCallback(win, on_refresh);
 }
 
+static int button_held(ui_thread *u) {
+    return glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS ||
+           glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
+           glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS;
+}
+
+/* Set by handle_input once a held button has moved the camera or a light: the press itself is
+ * drawn (the panel decides whether it is its own), the drag's moves are not. */
+int view_dragging(ui_thread *u) { return u->dragging_view && button_held(u); }
+
 /* Keys, mouse and the panel's actions. Returns 1 when the camera changed. */
 int handle_input(ui_thread *u, double dt) {
     int changed = 0;
@@ -269,8 +279,10 @@ int handle_input(ui_thread *u, double dt) {
     }
     if (!left) u->dragging_light = 0;
     u->left_was_down = left;
+    if (!button_held(u)) u->dragging_view = 0;
     if (u->dragging_light) {
         int g = u->ctl.light;
+        u->dragging_view = 1;
         if ((dx != 0.0 || dy != 0.0) && light_movable(u, g)) {
             camera c = ctl_camera(&u->cam);
             float z = dot3(sub3(light_position(u, g), c.position), c.forward);
@@ -285,11 +297,11 @@ int handle_input(ui_thread *u, double dt) {
         float scale = 1.0f / (float)(wh > 0 ? wh : 1);
         if (left) {
             nav_orbit(u, (float)dx * 3.0f * scale, (float)-dy * 3.0f * scale);
-            changed = 1;
+            changed = u->dragging_view = 1;
         } else if (glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
                    glfwGetMouseButton(u->win, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) {
             nav_pan(u, (float)-dx * scale, (float)dy * scale);
-            changed = 1;
+            changed = u->dragging_view = 1;
         }
     }
     if (u->scroll != 0.0) {

@@ -156,6 +156,12 @@ static int key_from_name(const char *name, int *mods) {
 /* Whether the last load asked for has been tried and its outcome (a new scene) taken in. */
 static int load_settled(ui_thread *u) { return controller_load_settled(u->vc, u->script_load_target, u->info_serial); }
 
+/* Actions that only move the camera or a light, or wait. */
+static int moves_only(int kind) {
+    return kind == ACT_ORBIT || kind == ACT_PAN || kind == ACT_ZOOM || kind == ACT_MOVE_LIGHT || kind == ACT_SLEEP ||
+           kind == ACT_WAIT || kind == ACT_WAIT_FILE;
+}
+
 /* Runs script actions until one has to wait. */
 void run_script(ui_thread *u) {
     if (u->window_shot[0]) return; /* later actions wait for the capture (a frame or two on) */
@@ -314,6 +320,8 @@ void run_script(ui_thread *u) {
             if (!panel_script_action(u, a)) return;
             break;
         }
+        /* a move is shown by the image it brings, as a mouse drag's is; the rest by a frame drawn */
+        if (!moves_only(a->kind)) u->script_shown++;
         u->script_pos++;
     }
 }

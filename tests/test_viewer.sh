@@ -306,6 +306,49 @@ capture moved-rest.exr
 stats
 sleep 2
 stats
+resume
+stats
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+orbit 1 0
+sleep 0.05
+stats
 quit
 EOF
 rm -f still*.exr moved*.exr soon*.exr
@@ -345,6 +388,11 @@ i1=$(field 1 images) i4=$(field 4 images) f4=$(field 4 images_full)
 d4=$(field 4 frames_drawn) d5=$(field 5 frames_drawn)
 [ -n "$d4" ] && [ -n "$d5" ] && [ $((d5 - d4)) -ge 1 ] && [ $((d5 - d4)) -le 16 ] ||
   fail "frames drawn in 2 s at rest: ${d4:-?} -> ${d5:-?} (want 1 to 16)"
+# Moving, the window is drawn for the images the moves bring, not for each step of the drag (a
+# scripted orbit as a mouse drag): 20 steps draw at most the images published and a few more.
+d6=$(field 6 frames_drawn) d7=$(field 7 frames_drawn) i6=$(field 6 images) i7=$(field 7 images)
+[ -n "$d6" ] && [ -n "$d7" ] && [ -n "$i6" ] && [ -n "$i7" ] && [ $((d7 - d6)) -le $((i7 - i6 + 8)) ] ||
+  fail "frames drawn during 20 orbit steps: ${d6:-?} -> ${d7:-?}, images ${i6:-?} -> ${i7:-?} (want at most images + 8)"
 
 # A reference rendered with a light moved is not of the scene as loaded: refused with the reason.
 "$glint" render --size 64x36 --spp 1 --quiet --move-light 0,0.5,0,0 --out ref-moved.exr ||

@@ -306,6 +306,36 @@ else
   echo "xdotool not installed: real X events not checked"
 fi
 
+# ---- a mouse drag orbits the camera; its moves come 30 a second and more, but once the drag is
+# under way the window is drawn for the images they bring, not for every move (llvmpipe draws on the
+# renderer's cores). Counted from the drag's 10th move (the press is drawn: the panel may claim it).
+if command -v xdotool >/dev/null; then
+  cat >orbitdrag.txt <<'EOF'
+wait 1
+stats
+screenshot ready.png
+wait-file begun
+stats
+wait-file dragged
+stats
+quit
+EOF
+  rm -f begun dragged
+  view_bg ready.png --size 480x270 --script orbitdrag.txt
+  if [ -n "$win" ]; then
+    xdotool mousemove --window "$win" 240 135 sleep 0.3 mousedown 1 sleep 0.1
+    for i in $(seq 1 50); do
+      xdotool mousemove --window "$win" $((240 + 2 * i)) 135 sleep 0.03
+      [ "$i" = 10 ] && touch begun && stats_lines 2
+    done
+    xdotool mouseup 1
+  fi
+  view_end "the orbit drag session" begun dragged
+  [ "$(field 3 cam)" != "$(field 2 cam)" ] || fail "the drag did not orbit: $(field 2 cam) -> $(field 3 cam)"
+  d=$(($(field 3 frames_drawn) - $(field 2 frames_drawn))) n=$(($(field 3 images) - $(field 2 images)))
+  [ "$d" -le $((n + 6)) ] || fail "40 moves of a drag drew $d frames for $n images (want at most images + 6)"
+fi
+
 # ---- HiDPI: the window's content scale (X11 takes it from the Xft.dpi resource) sizes the font,
 # the panel and the light markers; a click lands on the scaled pause button, a ctrl+drag moves the
 # light with the cursor. At 96 dpi (scale 1) and 192 (scale 2), the same session.
