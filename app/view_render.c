@@ -637,8 +637,7 @@ static void *render_main(void *arg) {
             /* every accumulation its own random numbers, or the display would take the same samples twice */
             render_params p = params;
             p.seed = accumulation_seed(params.seed, rt->accumulations++);
-            session_set_params(rs, &p);
-            session_set_camera(rs, &cam);
+            session_restart(rs, &p, &cam);
             if (change) display_change_view(rt->disp, rt->scene, &cam, change);
             rt->params_applied = params;
             rt->cam_applied = cam;

@@ -837,7 +837,7 @@ void session_set_camera(render_session *rs, const camera *cam) {
 
 const camera *session_camera(const render_session *rs) { return &rs->cam; }
 
-void session_set_params(render_session *rs, const render_params *params) {
+static void take_params(render_session *rs, const render_params *params) {
     render_params p = *params;
     p.width = rs->params.width;
     p.height = rs->params.height;
@@ -845,6 +845,16 @@ void session_set_params(render_session *rs, const render_params *params) {
     p = render_params_resolve_frame(&p);
     rs->params = p;
     rs->plan = session_make_plan(rs);
+}
+
+void session_set_params(render_session *rs, const render_params *params) {
+    take_params(rs, params);
+    session_reset(rs);
+}
+
+void session_restart(render_session *rs, const render_params *params, const camera *cam) {
+    take_params(rs, params);
+    rs->cam = *cam;
     session_reset(rs);
 }
 
