@@ -220,6 +220,9 @@ def cmd_table(root, refs, glint, out):
                 row.update({"updates_per_s": "%.2f" % rates["updates_per_s"], "full_per_s": "%.2f" % rates["full_per_s"],
                             "pixel_share": "%.3f" % rates["pixel_share"], "orbit_s": "%.2f" % rates["seconds"],
                             "last_image": rates["last_image"]})
+            free = orbit_rates(os.path.join(os.path.dirname(os.path.dirname(path)), "rate"))
+            if free:  # the same orbit in a session without captures
+                row.update({"free_per_s": "%.2f" % free["updates_per_s"], "free_full_per_s": "%.2f" % free["full_per_s"]})
         rows.append(row)
     def when_key(w):  # at rest after opening, the orbit's steps, then seconds after the stop
         if w.startswith("opened-"):
@@ -229,7 +232,7 @@ def cmd_table(root, refs, glint, out):
     rows.sort(key=lambda r: (r["scene"], r["method"], r["scenario"], when_key(r["when"])))
     fields = ["scene", "method", "scenario", "when", "capture", "since_change", "preview", "image", "latest", "frames",
               "pose", "ref_spp", "rel_l2", "ref_noise", "net", "updates_per_s", "full_per_s", "pixel_share", "orbit_s",
-              "last_image"]
+              "last_image", "free_per_s", "free_full_per_s"]
     with open(out + ".csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -249,17 +252,19 @@ def cmd_table(root, refs, glint, out):
             f.write("| %s | %s | %s | %s | %.2f | %s | %s | %s |\n" % (
                 r["scene"], r["method"], r["scenario"], r["when"], r["since_change"], shown, net,
                 "%.4f" % float(r["ref_noise"]) if r["ref_noise"] != "" else "-"))
-        f.write("\nDuring the orbit (15 degrees at 15 degrees a second), from the stats lines before and after it:\n\n"
-                "| scene | method | updates/s | full-resolution updates/s | mean pixels an update (of full) | "
-                "orbit seconds | last image |\n|---|---|---|---|---|---|---|\n")
+        f.write("\nDuring the orbit (15 degrees at 15 degrees a second), from the stats lines before and after it; "
+                "`no captures`: the same orbit in a session of its own without captures (scenario rate), what a "
+                "person gets:\n\n"
+                "| scene | method | updates/s | full-resolution updates/s | full-resolution updates/s, no captures | "
+                "mean pixels an update (of full) | orbit seconds | last image |\n|---|---|---|---|---|---|---|---|\n")
         seen = set()
         for r in rows:
             key = (r["scene"], r["method"])
             if r["scenario"] == "orbit" and "updates_per_s" in r and key not in seen:
                 seen.add(key)
-                f.write("| %s | %s | %s | %s | %s | %s | %s |\n" % (
-                    r["scene"], r["method"], r["updates_per_s"], r["full_per_s"], r["pixel_share"], r["orbit_s"],
-                    r["last_image"]))
+                f.write("| %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
+                    r["scene"], r["method"], r["updates_per_s"], r["full_per_s"], r.get("free_full_per_s", "-"),
+                    r["pixel_share"], r["orbit_s"], r["last_image"]))
 
 
 if __name__ == "__main__":

@@ -12,6 +12,10 @@
 #          10 s after the last step (after-T.exr); window shots (panel included, for the docs)
 #          during the orbit (after step 9) and 1 s after it (window-during.png, window-after-1.png).
 #   jump   sleep 4; set camera 1 (the scene's second glTF camera); captures 0.25, 1, 3, 5, 10 s on.
+#   rate   the orbit again (sleep 10, its 10 steps, stats before and after), with no capture or
+#          window shot: each capture writes an EXR on the window's thread, on the renderer's two
+#          cores (the orbit session made 6 updates in 1.1 s where this one makes 9 to 10); the
+#          updates a second a person gets.
 #   light  sleep 10; light 0 dragged across its room in 10 steps over 1 s (move-light 0 DX DY DZ;
 #          sleep 0.1); captures 0.25, 1 and 3 s after. atelier: the torchiere's spot from the
 #          back-left corner (-2.4, 1.89, -1.7) 4.8 m along +x to the back-right (2.4, 1.89, -1.7);
@@ -36,7 +40,7 @@
 #          [--methods "vsl vsl+hl"] [--out DIR] [--refs DIR] [--ref-spp-rest 2048]
 #          [--ref-spp-motion 256] [--ref-shards 8] [--glint build/app/glint]
 # (add pt to --methods as a comparison; SCENARIOS="orbit light" in the environment runs only those
-# of orbit, jump and light). A measurement, not a test: use a release build on an otherwise idle
+# of orbit, rate, jump and light). A measurement, not a test: use a release build on an otherwise idle
 # machine; the issue's aims are in docs/benchmarks.md.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -101,6 +105,14 @@ script() {
     echo "stats"
     shots=1 rest_captures 0.25 1 3 5 10
     ;;
+  rate)
+    printf 'sleep 10\nstats\n'
+    for i in 1 2 3 4 5 6 7 8 9 10; do
+      echo "orbit 1.5 0"
+      [ $i = 10 ] || echo "sleep 0.1"
+    done
+    echo "stats"
+    ;;
   jump)
     printf 'sleep 4\nset camera 1\n'
     rest_captures 0.25 1 3 5 10
@@ -129,7 +141,7 @@ run_captures() {
   echo "captures: $size, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), into $out"
   for scene in $scenes; do
     for method in $methods; do
-      for scenario in ${SCENARIOS:-orbit jump light}; do
+      for scenario in ${SCENARIOS:-orbit rate jump light}; do
         dir=$out/$scene/$method/$scenario
         rm -rf "$dir"
         mkdir -p "$dir"
