@@ -115,8 +115,7 @@ int session_scene_changed(render_session *rs);
 /* Takes new estimator parameters (method, max_depth, seed; the size and thread count stay) and
  * resets the accumulation. */
 void session_set_params(render_session *rs, const render_params *params);
-/* Both, with one reset: a reset clears the film (about 90 MB at 960x540, a tenth of an update while
- * the camera moves). */
+/* Both, with one reset: a reset clears the film (about 90 MB at 960x540). */
 void session_restart(render_session *rs, const render_params *params, const camera *cam);
 
 long long session_frames(const render_session *rs);

@@ -308,49 +308,10 @@ sleep 2
 stats
 resume
 stats
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-orbit 1 0
-sleep 0.05
-stats
-quit
 EOF
+# 20 steps of a scripted drag, then the count
+for i in $(seq 20); do printf 'orbit 1 0\nsleep 0.05\n'; done >>capture.txt
+printf 'stats\nquit\n' >>capture.txt
 rm -f still*.exr moved*.exr soon*.exr
 view --size 160x90 --denoise off --script capture.txt
 rc=$?
