@@ -333,7 +333,7 @@ EOF
   view_end "the orbit drag session" begun dragged
   [ "$(field 3 cam)" != "$(field 2 cam)" ] || fail "the drag did not orbit: $(field 2 cam) -> $(field 3 cam)"
   d=$(($(field 3 frames_drawn) - $(field 2 frames_drawn))) n=$(($(field 3 images) - $(field 2 images)))
-  [ "$d" -le $((n + 6)) ] || fail "40 moves of a drag drew $d frames for $n images (want at most images + 6)"
+  [ "$d" -le $((n + 10)) ] || fail "40 moves of a drag drew $d frames for $n images (want at most images + 10)"
 fi
 
 # ---- HiDPI: the window's content scale (X11 takes it from the Xft.dpi resource) sizes the font,
