@@ -14,7 +14,7 @@
 #   jump   sleep 4; set camera 1 (the scene's second glTF camera); captures 0.25, 1, 3, 5, 10 s on.
 #   rate   the orbit again (sleep 10, its 10 steps, stats before and after), with no capture or
 #          window shot: each capture writes an EXR on the window's thread, on the renderer's two
-#          cores (the orbit session made 6 updates in 1.1 s where this one makes 9 to 10); the
+#          cores (the orbit session made 6 updates in 1.1 s where this one made 8 to 9); the
 #          updates a second a person gets.
 #   light  sleep 10; light 0 dragged across its room in 10 steps over 1 s (move-light 0 DX DY DZ;
 #          sleep 0.1); captures 0.25, 1 and 3 s after. atelier: the torchiere's spot from the
