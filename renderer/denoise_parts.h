@@ -18,6 +18,7 @@
 
 #include "denoise.h"
 #include "gbuffer.h"
+#include "vecmath.h"
 
 #define CHUNK 128
 #define MARGIN (2 << (DENOISE_MAX_LEVELS - 2)) /* the farthest tap of the half grid's last pass */
@@ -40,10 +41,8 @@
 #define EPS_Z 1e-5f
 #define EPS_L 1e-6f
 #define EPS_TINY 1e-20f
-/* Weights are handled as their base-2 logarithms. One below 2^EXP2_FLOOR (2e-35) is taken as that:
- * it counts for nothing (times a count it may be too small for a normal float: see row_task). */
-#define EXP2_FLOOR (-115.0f)
-#define LOG2E 1.44269504f
+/* Weights are handled as their base-2 logarithms. One below 2^EXP2_FLOOR (vecmath.h) is taken as
+ * that: it counts for nothing (times a count it may be too small for a normal float: see row_task). */
 /* An escaped ray's depth: no hit's depth is near it, so the depth stop keeps the two apart (and
  * escaped rays together, compared by direction through the stored normal). */
 #define DEPTH_SKY (-1e20f)
@@ -56,33 +55,6 @@ static const float B1[5] = {0.0f, 0.25f, 0.5f, 0.25f, 0.0f}; /* a 3x3 pass: B1 w
 static const float K4[4] = {0.125f, 0.375f, 0.375f, 0.125f}; /* B1 over a 2x2 block */
 /* The input is read in runs of RUN pixels, CHUNK of each parity. */
 #define RUN (2 * CHUNK)
-
-/* The inner loops hold no conversion between int and float and no nested ?: : either keeps gcc
- * from vectorising a loop. An integer k, |k| < 2^22, is the low bits of the float k + ROUNDER. */
-#define ROUNDER 0x1.8p23f
-#define ROUNDER_BITS 0x4b400000u
-
-static inline uint32_t bits_of(float f) {
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
-static inline float float_of(uint32_t u) {
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-/* 2^x for x <= 0: 2^k from the exponent bits times 2^f, |f| <= 1/2, by a degree-3 fit exact at
- * f = 0 (so 2^0 is 1). Relative error under 1.0e-4 + 1e-7 |x| (the fit; the rounding of x): ample
- * for a weight. Below EXP2_FLOOR, and for NaN, it is 2^EXP2_FLOOR. */
-static inline float exp2_neg(float x) {
-    x = x > EXP2_FLOOR ? x : EXP2_FLOOR;
-    float kr = x + ROUNDER; /* x rounded to an integer k, held as k + ROUNDER */
-    float f = x - (kr - ROUNDER);
-    float p = 1.0f + f * (0.69328293f + f * (0.242210964f + f * 0.0550089153f));
-    return float_of(bits_of(p) + ((bits_of(kr) - ROUNDER_BITS) << 23));
-}
 
 /* log2 x for x in [1e-30, 1]: x = 2^e m with m in [2/3, 4/3), log2 m = r P(r) with r = m - 1 and
  * P a degree-5 fit of log2(1 + r) / r (relative error 7.2e-6): under 1e-6 on [0.9, 1], where it

@@ -6,6 +6,7 @@
 
 #include "clock.h"
 #include "display_parts.h"
+#include "vecmath.h"
 
 display *display_create(int width, int height, int threads, char *err, size_t errlen) {
     display *d = calloc(1, sizeof *d);
@@ -37,6 +38,8 @@ display *display_create(int width, int height, int threads, char *err, size_t er
     if (ok) ok = (d->need_gain = calloc(packets, sizeof(float))) != NULL;
     if (ok) ok = (d->spread = malloc(sizeof(float) * n)) != NULL;
     if (ok) ok = (d->spread_own = malloc(sizeof(float) * n)) != NULL;
+    if (ok) ok = (d->plan_n = malloc(sizeof(float) * n)) != NULL;
+    if (ok) ok = (d->plan_kind = malloc(n)) != NULL;
     if (ok) ok = (d->extra_pixels = malloc(sizeof(int) * n)) != NULL;
     if (ok) ok = (d->dn = denoiser_create(width, height)) != NULL;
     if (!ok) {
@@ -79,6 +82,8 @@ void display_destroy(display *d) {
     free(d->need_gain);
     free(d->spread);
     free(d->spread_own);
+    free(d->plan_n);
+    free(d->plan_kind);
     free(d->extra_pixels);
     free(d->extra_hist);
     free(d);
@@ -97,52 +102,36 @@ typedef struct {
     pixel_history *now;
     unsigned change;
     int same_camera;
-    float footprint;            /* a pixel's width per unit distance in the new view */
+    float plane_tol;            /* how far off its plane a point may lie, per unit of its depth */
     gbuffer_projector old_view; /* into the old image */
     atomic_llong carried, lost;
 } carry_job;
 
-/* How much of a glossy lobe's light, gathered a turn t of the view ago, still holds: the reflected
- * lobe turns about twice as far as the view, and its width is about its microfacet alpha, so the
- * light falls off as exp(-(t / alpha)^2 / 2). A move from turn t0 to t1 keeps G(t1) / G(t0) of what
- * is left: many small turns cost what one turn as large does. */
-static float glossy_keep(float t0, float t1, float alpha) {
-    float a = fmaxf(alpha, 1e-3f);
-    return expf(-0.5f * (t1 * t1 - t0 * t0) / (a * a));
+/* The new view's pixel whose point the carry looks for in the old view, read once. */
+typedef struct {
+    int32_t material;
+    vec3 normal, pos;
+    float tol; /* how far off its plane an old point may lie */
+} carry_point;
+
+/* Whether old pixel q shows the surface point p (positions, normals, materials). */
+static int same_point(const gbuffer *old, const carry_point *p, size_t q) {
+    if (p->material != old->material[q]) return 0;
+    vec3 nq = get3(old->normal, q);
+    float c = dot3(p->normal, nq);
+    if (p->material < 0) return c > 0.99999f; /* the sky: the same direction */
+    return c >= REPROJECT_MIN_COS && fabsf(dot3(sub3(p->pos, get3(old->pos, q)), nq)) <= p->tol;
 }
 
-/* The most samples history may count as where a share `held` of its light still holds since its
- * samples were taken, per unit of one sample's relative variance (s / L)^2: what no longer holds is
- * a bias of about (1 - held) of the light L, which the mean of n samples of spread s matches in its
- * noise at n = (s / L)^2 / (1 - held)^2. Many samples (the display's extra ones) of a highlight that
- * has since moved would otherwise outweigh the new ones for seconds. */
-static float keep_cap(float held) {
-    float lost = 1.0f - held;
-    return lost > 1e-3f ? 1.0f / (lost * lost) : INFINITY;
-}
-
-/* Whether old pixel q shows the surface point of new pixel i (positions, normals, materials). */
-static int same_point(const carry_job *j, size_t i, size_t q) {
-    const gbuffer *a = j->to, *b = j->from;
-    if (a->material[i] != b->material[q]) return 0;
-    vec3 na = get3(a->normal, i), nb = get3(b->normal, q);
-    if (a->material[i] < 0) return dot3(na, nb) > 0.99999f; /* the sky: the same direction */
-    if (dot3(na, nb) < REPROJECT_MIN_COS) return 0;
-    float tol = REPROJECT_PLANE_PIXELS * j->footprint * a->depth[i];
-    return fabsf(dot3(sub3(get3(a->pos, i), get3(b->pos, q)), nb)) <= tol;
-}
-
-/* The old pixels around where new pixel i's point was seen, bilinear taps, each kept only if it
- * shows the same point. Returns how many (weights normalised), 0 when none does. */
-static int find_taps(const carry_job *j, int x, int y, size_t taps[4], float weights[4]) {
+/* The old pixels around where new pixel i's point was seen, (fx, fy) in the old image's pixel
+ * centres' coordinates (project_chunk), bilinear taps, each kept only if it shows the same point.
+ * Returns how many (weights normalised), 0 when none does. */
+static int find_taps(const carry_job *j, size_t i, float fx, float fy, size_t taps[4], float weights[4]) {
     int w = j->d->width, h = j->d->height;
-    size_t i = (size_t)y * (size_t)w + (size_t)x;
     int n = 0;
-    float ox, oy;
     if (j->same_camera) {
         taps[0] = i, weights[0] = 1.0f, n = 1;
-    } else if (gbuffer_project_with(&j->old_view, get3(j->to->pos, i), &ox, &oy)) {
-        float fx = ox - 0.5f, fy = oy - 0.5f;
+    } else if (fx > -2.0f && fy > -2.0f && fx < (float)w + 1.0f && fy < (float)h + 1.0f) {
         int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
         float ax = fx - (float)x0, ay = fy - (float)y0;
         for (int k = 0; k < 4; k++) {
@@ -153,10 +142,12 @@ static int find_taps(const carry_job *j, int x, int y, size_t taps[4], float wei
             n++;
         }
     }
+    const gbuffer *a = j->to;
+    carry_point p = {a->material[i], get3(a->normal, i), get3(a->pos, i), j->plane_tol * a->depth[i]};
     int kept = 0;
     float total = 0.0f;
     for (int k = 0; k < n; k++) {
-        if (weights[k] > 0.0f && same_point(j, i, taps[k])) {
+        if (weights[k] > 0.0f && same_point(j->from, &p, taps[k])) {
             taps[kept] = taps[k], weights[kept] = weights[k], kept++;
             total += weights[k];
         }
@@ -166,66 +157,148 @@ static int find_taps(const carry_job *j, int x, int y, size_t taps[4], float wei
     return kept;
 }
 
+/* A chunk of a row's pixels: their taps, and what survives of each component there (keep_factors). */
+#define CARRY_CHUNK 64
+typedef struct {
+    int kept[CARRY_CHUNK]; /* taps that show the pixel's point, 0: lost */
+    size_t taps[CARRY_CHUNK][4];
+    float weights[CARRY_CHUNK][4];
+    /* keep_factors' input: the view's mean turn at the taps (out: with this move's), the point, its
+     * glossy lobe (gloss 0: none, or the camera did not move) */
+    float turn[CARRY_CHUNK], px[CARRY_CHUNK], py[CARRY_CHUNK], pz[CARRY_CHUNK];
+    float fx[CARRY_CHUNK], fy[CARRY_CHUNK]; /* where the point was in the old image (project_chunk) */
+    float gloss[CARRY_CHUNK], alpha[CARRY_CHUNK];
+    /* ...and its output: the share of the samples the highlights and the rest keep, their caps */
+    float glossy[CARRY_CHUNK], diffuse[CARRY_CHUNK], cap_glossy[CARRY_CHUNK], cap_all[CARRY_CHUNK];
+} carry_chunk;
+
+/* What survives of each component: all of its diffuse share, and of its glossy share (the
+ * highlights are all glossy) what the lobe allows. The reflected lobe turns about twice as far as
+ * the view, and its width is about its microfacet alpha, so light gathered a turn t of the view ago
+ * holds G(t) = exp(-(t / alpha)^2 / 2) of itself: a move from turn t0 to t1 keeps G(t1) / G(t0) of
+ * what is left, so many small turns cost what one turn as large does. The turn is the chord between
+ * the directions from the point to the two eyes, 2 sin(turn / 2) (within 2% of the turn to 40
+ * degrees), from sin^2 and cos (chord^2 = 2 sin^2 / (1 + cos)), which keep their precision for a
+ * drag's small steps.
+ * What no longer holds caps what the history may count: where a share `held` of its light holds
+ * since its samples were taken, a bias of about (1 - held) of the light L, which the mean of n
+ * samples of spread s matches in its noise at n = (s / L)^2 / (1 - held)^2; the cap is that per unit
+ * of one sample's relative variance (s / L)^2. Many samples (the display's extra ones) of a
+ * highlight that has since moved would otherwise outweigh the new ones for seconds.
+ * Vector code (vecmath.h's rules): one pixel at a time, with its taps, its roots, divisions and
+ * exponentials were a third of the carry's time. */
+static void keep_factors(carry_chunk *restrict k, vec3 from, vec3 to) {
+    const float cap = DISPLAY_MAX_CARRIED;
+    for (int x = 0; x < CARRY_CHUNK; x++) {
+        float ux = from.x - k->px[x], uy = from.y - k->py[x], uz = from.z - k->pz[x];
+        float vx = to.x - k->px[x], vy = to.y - k->py[x], vz = to.z - k->pz[x];
+        float uv = (ux * ux + uy * uy + uz * uz) * (vx * vx + vy * vy + vz * vz);
+        uv = uv > FLT_MIN ? uv : FLT_MIN;
+        float cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
+        float s2 = (cx * cx + cy * cy + cz * cz) / uv, c = (ux * vx + uy * vy + uz * vz) / sqrtf(uv);
+        float opposite = 1.0f + c > 1e-3f ? 1.0f + c : 1e-3f;
+        float gloss = k->gloss[x], alpha = k->alpha[x];
+        float step = gloss > 0.0f ? sqrtf(2.0f * s2 / opposite) : 0.0f;
+        float t0 = k->turn[x], t1 = t0 + step, a2 = alpha * alpha;
+        float e = -0.5f * LOG2E / (a2 > 1e-6f ? a2 : 1e-6f);                            /* alpha 1e-3 at least */
+        float held = exp2_neg(e * t1 * t1), glossy = exp2_neg(e * (t1 * t1 - t0 * t0)); /* G(t1), G(t1) / G(t0) */
+        float share = gbuffer_glossy_share(gloss, alpha);
+        int turned = step > 0.0f;
+        held = turned ? held : 1.0f;
+        glossy = turned ? glossy : 1.0f;
+        share = turned ? share : 0.0f;
+        float lost = 1.0f - held, lost_all = share * lost;
+        float cap_glossy = 1.0f / (lost * lost), cap_all = 1.0f / (lost_all * lost_all);
+        k->turn[x] = t1;
+        k->glossy[x] = glossy;
+        k->diffuse[x] = (1.0f - share) + share * glossy;
+        k->cap_glossy[x] = lost > 1e-3f && cap_glossy < cap ? cap_glossy : cap;
+        k->cap_all[x] = lost_all > 1e-3f && cap_all < cap ? cap_all : cap;
+    }
+}
+
+/* Where the chunk's points were in the old image, in its pixel centres' coordinates (x - 0.5, y -
+ * 0.5); far outside it where a point was behind the old eye. gbuffer_project_with's arithmetic as
+ * vector code: one pixel at a time its division held up the taps. */
+static void project_chunk(const gbuffer_projector *pr, carry_chunk *restrict k) {
+    for (int x = 0; x < CARRY_CHUNK; x++) {
+        float dx = k->px[x] - pr->position.x, dy = k->py[x] - pr->position.y, dz = k->pz[x] - pr->position.z;
+        float z = dx * pr->forward.x + dy * pr->forward.y + dz * pr->forward.z;
+        float iz = 1.0f / (z > 1e-30f ? z : 1e-30f);
+        float ox = pr->half_w + (dx * pr->right.x + dy * pr->right.y + dz * pr->right.z) * iz * pr->sx;
+        float oy = pr->half_h - (dx * pr->up.x + dy * pr->up.y + dz * pr->up.z) * iz * pr->sy;
+        k->fx[x] = z > 0.0f ? ox - 0.5f : -1e30f;
+        k->fy[x] = z > 0.0f ? oy - 0.5f : -1e30f;
+    }
+}
+
+/* Pixels x0 .. x0 + n - 1 of row y: their points, where they were (project_chunk), their taps and
+ * their keep factors' input; the rest of the chunk with none. */
+static void find_chunk(const carry_job *j, int x0, int y, int n, carry_chunk *k) {
+    const gbuffer *to = j->to;
+    size_t i0 = (size_t)y * (size_t)j->d->width + (size_t)x0;
+    for (int x = 0; x < CARRY_CHUNK; x++) {
+        vec3 p = x < n ? get3(to->pos, i0 + (size_t)x) : v3(0, 0, 0);
+        k->px[x] = p.x, k->py[x] = p.y, k->pz[x] = p.z;
+    }
+    project_chunk(&j->old_view, k);
+    for (int x = 0; x < CARRY_CHUNK; x++) {
+        size_t i = i0 + (size_t)x;
+        int in = x < n;
+        k->kept[x] =
+            in && !(j->change & DISPLAY_RESTART) ? find_taps(j, i, k->fx[x], k->fy[x], k->taps[x], k->weights[x]) : 0;
+        float turn = 0.0f;
+        for (int t = 0; t < k->kept[x]; t++) turn += k->weights[x][t] * j->old[k->taps[x][t]].turn;
+        k->turn[x] = turn;
+        int glossy = in && !j->same_camera && to->material[i] >= 0 && to->gloss[i] > 0.0f;
+        k->gloss[x] = glossy ? to->gloss[i] : 0.0f;
+        k->alpha[x] = in ? to->alpha[i] : 1.0f;
+    }
+}
+
 static void carry_row(void *ctx, int y, int worker) {
     (void)worker;
     carry_job *j = ctx;
-    const gbuffer *to = j->to;
     int w = j->d->width;
     long long carried = 0, lost = 0;
-    float cap = DISPLAY_MAX_CARRIED;
-    for (int x = 0; x < w; x++) {
-        size_t i = (size_t)y * (size_t)w + (size_t)x;
-        pixel_history *now = &j->now[i];
-        memset(now, 0, sizeof *now);
-        if (j->change & DISPLAY_RESTART) continue;
-        size_t taps[4];
-        float weights[4];
-        int kept = find_taps(j, x, y, taps, weights);
-        if (!kept) {
-            lost++;
-            continue;
-        }
-        carried++;
-        /* What survives of each component: all of its diffuse share, of its glossy share what the
-         * lobe and the view's turn there since the samples were taken allow (the highlights are
-         * all glossy). */
-        float turn = 0.0f, step = 0.0f;
-        for (int k = 0; k < kept; k++) turn += weights[k] * j->old[taps[k]].turn;
-        if (!j->same_camera && to->material[i] >= 0 && to->gloss[i] > 0.0f) {
-            vec3 p = get3(to->pos, i);
-            vec3 a = normalize3(sub3(j->from->cam.position, p)), b = normalize3(sub3(to->cam.position, p));
-            step = length3(sub3(a, b)); /* the chord, 2 sin(turn / 2): within 2% of the turn to 40 degrees */
-        }
-        now->turn = turn + step;
-        float glossy = 1.0f, share = 0.0f, held = 1.0f; /* held: of the samples' light when taken */
-        if (step > 0.0f) {
-            glossy = glossy_keep(turn, turn + step, to->alpha[i]);
-            share = gbuffer_glossy_share(to->gloss[i], to->alpha[i]);
-            held = glossy_keep(0.0f, turn + step, to->alpha[i]);
-        }
-        float diffuse = (1.0f - share) + share * glossy;
-        float cap_glossy = fminf(cap, keep_cap(held)), cap_all = fminf(cap, keep_cap((1.0f - share) + share * held));
-        for (int c = 0; c < COMP_COUNT; c++) {
-            if (!j->d->active[c]) continue;
-            float count = 0.0f, m2 = 0.0f, m[3] = {0.0f, 0.0f, 0.0f};
-            for (int k = 0; k < kept; k++) {
-                const pixel_history *o = &j->old[taps[k]];
-                float wk = weights[k];
-                count += wk * o->c[c].count;
-                m2 += wk * o->c[c].m2;
-                for (int e = 0; e < 3; e++) m[e] += wk * o->c[c].mean[e];
+    const float cap = DISPLAY_MAX_CARRIED;
+    carry_chunk k;
+    for (int x0 = 0; x0 < w; x0 += CARRY_CHUNK) {
+        int n = w - x0 < CARRY_CHUNK ? w - x0 : CARRY_CHUNK;
+        find_chunk(j, x0, y, n, &k);
+        keep_factors(&k, j->from->cam.position, j->to->cam.position);
+        for (int x = 0; x < n; x++) {
+            pixel_history *now = &j->now[(size_t)y * (size_t)w + (size_t)(x0 + x)];
+            memset(now, 0, sizeof *now);
+            int kept = k.kept[x];
+            if (!kept) {
+                lost += !(j->change & DISPLAY_RESTART);
+                continue;
             }
-            /* the cap per unit of one sample's relative variance (keep_cap), one sample at least */
-            float at_most = c == COMP_HIGHLIGHTS ? cap_glossy : cap_all;
-            if (at_most < cap) {
-                float l = luminance3(v3(m[0], m[1], m[2])), rel = sample_variance(m2, l, count) / (l * l);
-                if (isfinite(rel)) at_most = fmaxf(rel * at_most, 1.0f);
+            carried++;
+            now->turn = k.turn[x];
+            for (int c = 0; c < COMP_COUNT; c++) {
+                if (!j->d->active[c]) continue;
+                float count = 0.0f, m2 = 0.0f, m[3] = {0.0f, 0.0f, 0.0f};
+                for (int t = 0; t < kept; t++) {
+                    const pixel_history *o = &j->old[k.taps[x][t]];
+                    float wt = k.weights[x][t];
+                    count += wt * o->c[c].count;
+                    m2 += wt * o->c[c].m2;
+                    for (int e = 0; e < 3; e++) m[e] += wt * o->c[c].mean[e];
+                }
+                /* the cap per unit of one sample's relative variance, one sample at least */
+                float at_most = c == COMP_HIGHLIGHTS ? k.cap_glossy[x] : k.cap_all[x];
+                if (at_most < cap) {
+                    float l = luminance3(v3(m[0], m[1], m[2])), rel = sample_variance(m2, l, count) / (l * l);
+                    if (isfinite(rel)) at_most = fmaxf(rel * at_most, 1.0f);
+                }
+                count = fminf(count * (c == COMP_HIGHLIGHTS ? k.glossy[x] : k.diffuse[x]), at_most);
+                if (!(count > 0.0f)) continue;
+                now->c[c].count = count;
+                now->c[c].m2 = m2;
+                for (int e = 0; e < 3; e++) now->c[c].mean[e] = m[e];
             }
-            count = fminf(count * (c == COMP_HIGHLIGHTS ? glossy : diffuse), at_most);
-            if (!(count > 0.0f)) continue;
-            now->c[c].count = count;
-            now->c[c].m2 = m2;
-            for (int e = 0; e < 3; e++) now->c[c].mean[e] = m[e];
         }
     }
     atomic_fetch_add(&j->carried, carried);
@@ -377,7 +450,7 @@ void display_change_view(display *d, const scene *s, const camera *cam, unsigned
                    .now = d->h[next],
                    .change = change,
                    .same_camera = memcmp(&d->g[prev].cam, cam, sizeof *cam) == 0,
-                   .footprint = 2.0f * tanf(0.5f * cam->yfov) / (float)d->height,
+                   .plane_tol = REPROJECT_PLANE_PIXELS * 2.0f * tanf(0.5f * cam->yfov) / (float)d->height,
                    .old_view = gbuffer_projector_of(&d->g[prev])};
     threadpool_run(d->pool, carry_row, &j, d->height);
     d->cur = next;

@@ -56,17 +56,36 @@ static float pixel_spread(const display *d, size_t i) {
     return isfinite(s) ? s : 0.0f;
 }
 
-/* Every pixel's own spread into d->spread_own (0: none to plan for, -1: a hole to plan for), a row
- * a task; their sum and count per worker. */
+/* Whether pixel i's light is mostly its glossy lobe's and the view has turned at it since its
+ * samples were taken by more than the lobe is wide: what they say of its light is mostly stale (a
+ * light's speck in a mirror has moved), and the plan takes it as it takes a hole. */
+static int turned(const display *d, size_t i) {
+    const gbuffer *g = &d->g[d->cur];
+    float a = fmaxf(g->alpha[i], 1e-3f), t = d->h[d->cur][i].turn;
+    return t > a && mostly_glossy(g, i);
+}
+
+/* What the plan reads of each pixel's history, once: its own spread into d->spread_own (0: none to
+ * plan for, -1: a hole to plan for), the samples it reckons (d->plan_n) and whether it plans for it
+ * as a hole or a young pixel (d->plan_kind), a row a task; the spreads' sum and count per worker.
+ * The passes after it read these, not the history: a pixel's history is a cache line, and reading
+ * it again in each was most of the plan's time. */
+enum { PLAN_HOLE = 1, PLAN_YOUNG = 2 };
 static void spread_row(void *ctx, int y, int worker) {
     display *d = ctx;
     const gbuffer *g = &d->g[d->cur];
+    const pixel_history *h = d->h[d->cur];
     extra_histogram *k = &d->extra_hist[worker];
     for (size_t i = (size_t)y * (size_t)d->width; i < (size_t)(y + 1) * (size_t)d->width; i++) {
         /* while a light change is judged, a tile not yet judged has its history set aside: none */
         int unjudged = d->judging && d->tiles[tile_of(d, i)].state == TILE_UNKNOWN;
-        d->spread_own[i] = g->material[i] < 0 || unjudged ? 0.0f : pixel_spread(d, i);
-        if (d->spread_own[i] > 0.0f) k->spread_sum += (double)d->spread_own[i], k->spread_n++;
+        float own = g->material[i] < 0 || unjudged ? 0.0f : pixel_spread(d, i);
+        d->spread_own[i] = own;
+        if (own > 0.0f) k->spread_sum += (double)own, k->spread_n++;
+        int hole = own < 0.0f || turned(d, i);
+        int young = !hole && g->material[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= SPREAD_YOUNG) && !unjudged;
+        d->plan_kind[i] = (uint8_t)((hole ? PLAN_HOLE : 0) | (young ? PLAN_YOUNG : 0));
+        d->plan_n[i] = plan_count(&h[i]);
     }
 }
 
@@ -81,27 +100,15 @@ static void spread_row(void *ctx, int y, int worker) {
  * bright neighbour, and the largest spreads the budget over all of them). Then each pixel's ratio
  * into its worker's histogram. */
 
-/* Whether pixel i's light is mostly its glossy lobe's and the view has turned at it since its
- * samples were taken by more than the lobe is wide: what they say of its light is mostly stale (a
- * light's speck in a mirror has moved), and the plan takes it as it takes a hole. */
-static int turned(const display *d, size_t i) {
-    const gbuffer *g = &d->g[d->cur];
-    float a = fmaxf(g->alpha[i], 1e-3f), t = d->h[d->cur][i].turn;
-    return t > a && mostly_glossy(g, i);
-}
-
 static void hole_row(void *ctx, int y, int worker) {
     display *d = ctx;
-    const pixel_history *h = d->h[d->cur];
     const int32_t *mat = d->g[d->cur].material;
     const float *own = d->spread_own;
     int w = d->width, y0 = y > 0 ? y - 1 : y, y1 = y + 1 < d->height ? y + 1 : y;
     extra_histogram *k = &d->extra_hist[worker];
     for (int x = 0; x < w; x++) {
         size_t i = (size_t)y * (size_t)w + (size_t)x;
-        int hole = own[i] < 0.0f || turned(d, i),
-            young = !hole && mat[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= SPREAD_YOUNG);
-        if (young && d->judging) young = d->tiles[tile_of(d, i)].state != TILE_UNKNOWN;
+        int hole = d->plan_kind[i] & PLAN_HOLE, young = d->plan_kind[i] & PLAN_YOUNG;
         float s = own[i] > 0.0f ? own[i] : 0.0f;
         if (hole || young) {
             int x0 = x > 0 ? x - 1 : x, x1 = x + 1 < w ? x + 1 : x, m = 0;
@@ -119,7 +126,7 @@ static void hole_row(void *ctx, int y, int worker) {
         }
         d->spread[i] = s;
         if (!(s > 0.0f)) continue;
-        float pn = plan_count(&h[i]);
+        float pn = d->plan_n[i];
         int b = extra_bin(s / pn);
         k->count[b]++, k->s[b] += (double)s, k->n[b] += (double)pn;
     }
@@ -127,7 +134,7 @@ static void hole_row(void *ctx, int y, int worker) {
 
 /* The samples pixel i wants at multiplier mu: as many more as bring its count to s mu. */
 static double extra_wanted(const display *d, size_t i, double mu) {
-    double k = (double)d->spread[i] * mu - (double)plan_count(&d->h[d->cur][i]);
+    double k = (double)d->spread[i] * mu - (double)d->plan_n[i];
     return k > 0.0 ? k : 0.0;
 }
 
@@ -140,7 +147,6 @@ static double extra_total(const display *d, const int *pixels, int m, double mu)
 
 int display_plan_extra(display *d, int budget, extra_request *req, int max) {
     if (budget <= 0 || max <= 0) return 0;
-    const pixel_history *h = d->h[d->cur];
     const gbuffer *g = &d->g[d->cur];
     size_t np = (size_t)d->width * (size_t)d->height;
     int workers = threadpool_size(d->pool);
@@ -182,7 +188,7 @@ int display_plan_extra(display *d, int budget, extra_request *req, int max) {
     m = 0;
     int *cand = d->extra_pixels;
     for (size_t i = 0; i < np && m < max; i++)
-        if (d->spread[i] > 0.0f && extra_bin(d->spread[i] / plan_count(&h[i])) >= b) cand[m++] = (int)i;
+        if (d->spread[i] > 0.0f && extra_bin(d->spread[i] / d->plan_n[i]) >= b) cand[m++] = (int)i;
     double lo = 0.0, hi = 2.0 / extra_edge(b);
     for (int it = 0; it < 64 && extra_total(d, cand, m, hi) < (double)budget; it++) lo = hi, hi *= 2.0;
     for (int it = 0; it < 40; it++) {

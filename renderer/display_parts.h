@@ -89,7 +89,9 @@ struct display {
     light_tile *tiles;
     uint8_t *need;               /* per packet (display_packet_need)... */
     float *need_gain;            /* ...and its scratch */
-    float *spread, *spread_own;  /* per pixel, display_plan_extra's scratch... */
+    float *spread, *spread_own;  /* per pixel, display_plan_extra's scratch: spreads... */
+    float *plan_n;               /* ...the samples it reckons (plan_count)... */
+    uint8_t *plan_kind;          /* ...whether a hole or young (PLAN_HOLE, PLAN_YOUNG)... */
     int *extra_pixels;           /* ...the pixels it plans for... */
     extra_histogram *extra_hist; /* ...a histogram per thread... */
     float spread_mean;           /* ...and the average pixel's spread */
