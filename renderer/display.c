@@ -200,8 +200,11 @@ static void keep_factors(carry_chunk *restrict k, vec3 from, vec3 to) {
         float gloss = k->gloss[x], alpha = k->alpha[x];
         float step = gloss > 0.0f ? sqrtf(2.0f * s2 / opposite) : 0.0f;
         float t0 = k->turn[x], t1 = t0 + step, a2 = alpha * alpha;
-        float e = -0.5f * LOG2E / (a2 > 1e-6f ? a2 : 1e-6f);                            /* alpha 1e-3 at least */
-        float held = exp2_neg(e * t1 * t1), glossy = exp2_neg(e * (t1 * t1 - t0 * t0)); /* G(t1), G(t1) / G(t0) */
+        float e = -0.5f * LOG2E / (a2 > 1e-6f ? a2 : 1e-6f); /* alpha 1e-3 at least */
+        float xh = e * t1 * t1, xg = e * (t1 * t1 - t0 * t0);
+        float held = exp2_neg(xh), glossy = exp2_neg(xg); /* G(t1), G(t1) / G(t0) */
+        held = xh > EXP2_FLOOR ? held : 0.0f; /* nothing holds: the history goes (exp2_neg stops at its floor) */
+        glossy = xg > EXP2_FLOOR ? glossy : 0.0f;
         float share = gbuffer_glossy_share(gloss, alpha);
         int turned = step > 0.0f;
         held = turned ? held : 1.0f;
