@@ -74,6 +74,7 @@ uint64_t controller_change(view_controller *c, const camera *cam, const render_p
     uint64_t gen = ++sh->generation;
     sh->requests++;
     sh->changed_at = cli_now();
+    if (sh->preemptible && !sh->export_pending) atomic_store(&sh->abort_frame, 1);
     pthread_mutex_unlock(&sh->lock);
     return gen;
 }

@@ -531,6 +531,7 @@ static void *render_main(void *arg) {
     pthread_mutex_lock(&sh->lock);
     for (;;) {
         render_session *rs = rt->session;
+        if (!sh->quit) atomic_store(&sh->abort_frame, 0); /* a change stopped a part: it is taken below */
         /* Exports and loads first: a quit right after an export request still writes it. The film
          * is a mean only between frames: an export waits for the frame under way to end. */
         if (sh->export_pending && !rt->film_partial && session_frame_parts(rs) > 0) {
@@ -598,6 +599,8 @@ static void *render_main(void *arg) {
         int look_changed = sh->show_mask != rt->shown_mask || sh->denoise != rt->shown_denoise;
         int own_samples = sh->denoise; /* the display's own samples go with its filter */
         sh->stats.standing = held;
+        /* a change stops a rest update's part, not a young one's (abort_frame) */
+        sh->preemptible = !held && age >= YOUNG_SECONDS;
         pthread_mutex_unlock(&sh->lock);
         update_info up = {.measure = measure, .resets_seen = resets_seen, .gen = gen};
         double began_at = cli_now();
@@ -660,7 +663,7 @@ static void *render_main(void *arg) {
             r = session_render_part(rs, parts, &up.frame_done);
             double ms = 1e3 * (cli_now() - t0);
             spent += ms;
-            if (r == 1) rt->film_partial = 1; /* stopped by quitting */
+            if (r == 1) rt->film_partial = 1; /* stopped: quitting, or a change at rest */
             if (r < 0) set_message(rt, "%s%s", session_error(rs), "");
             if (r != 0) break;
             up.rendered = 1;
@@ -682,6 +685,12 @@ static void *render_main(void *arg) {
             if (asked || spent + rt->frame_ms / session_frame_parts(rs) > film_budget) break;
         }
         display_take_samples(rt->disp);
+        pthread_mutex_lock(&sh->lock);
+        sh->preemptible = 0;
+        int preempted = r == 1 && !sh->quit;
+        sh->stats.preempted_parts += (uint64_t)preempted;
+        if (preempted) continue; /* the change's first image is the next one shown, not this view's */
+        pthread_mutex_unlock(&sh->lock);
         if (r == 0 && up.rendered && own_samples) spent += add_extra_samples(rt, EXTRA_SHARE * budget);
         publish(rt, &up);
         learn_display(rt, 1e3 * (cli_now() - began_at) - spent);

@@ -34,10 +34,13 @@ typedef struct {
     light_edits lights;      /* wanted */
     image_rgb reference_new; /* a new reference for the error, handed over (the render thread frees it) */
     int reference_pending;
-    /* Set when the viewer quits: the part in flight stops at its next chunk of pixels. A change
-     * does not stop it: a part is short, and its samples, of the view before, are the display's
-     * to carry over. */
+    /* Set when the viewer quits, and by a change while a rest update's part is in flight
+     * (preemptible): the part stops at its next chunk of pixels, its finished pixels' samples still
+     * the display's. A part at rest may be long (the first frame's, its cost not yet known, is a
+     * 64th of a frame: a tenth of a second and more at 960x540), and a drag's first step waited for
+     * it; while things move a part is short, and a drag's many steps would stop every one. */
     atomic_int abort_frame;
+    int preemptible;
     /* The reference's camera (when its description gives one): frames from elsewhere are not
      * measured against it, so the error plot pauses while the view is away. */
     int reference_cam_valid;

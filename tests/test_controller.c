@@ -3,8 +3,9 @@
  * is shown with its own generation and carries history over; pausing stops refinement between
  * frames (nothing more is rendered while it stands); an export written after two whole frames is,
  * bit for bit, the film a session makes of the same two frames (the display never touches the
- * estimate); a load that fails changes nothing and says why; quitting reports its counts. Waits are
- * for what happens, counted, never for a time. */
+ * estimate); a load that fails changes nothing and says why; quitting reports its counts; a change
+ * at rest stops the part in flight, those while things move do not. Waits are for what happens,
+ * counted, never for a time. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdlib.h>
@@ -42,6 +43,53 @@ static int finite_image(const image_buf *img) {
     return 1;
 }
 
+/* A change while the image is at rest stops the part in flight (its first image comes sooner), and
+ * the accumulation after it runs whole frames; changes while things move (each within 20 ms of
+ * the last, after the first) stop none: a drag's steps would stop every part. At rest an update renders parts for
+ * most of its time, so a change lands in one in all but a few of its tries. */
+static void check_preemption(void) {
+    char err[1200];
+    scene *s = scene_load("builtin:atelier", NULL, NULL, err, sizeof err); /* the controller's to free */
+    CHECK(s != NULL, "builtin:atelier: %s", err);
+    if (!s) return;
+    camera cam = scene_camera(s, 0, 240.0f / 136.0f);
+    render_params p = {.method = METHOD_VSL, .max_depth = 4, .seed = 6, .threads = 2};
+    view_start start = {.cam = cam, .params = p, .width = 240, .height = 136, .denoise = 1};
+    view_controller *c = controller_start(s, &start, err, sizeof err);
+    CHECK(c != NULL, "controller_start: %s", err);
+    if (!c) return;
+    light_edits none;
+    clear_light_edits(&none);
+    uint64_t serial = 0, gen = 0;
+    image_buf img = {0};
+    wait_for(c, &serial, &img, 0, 0);
+    view_stats st;
+    camera moved = cam;
+    for (int k = 0; k < 20; k++) { /* at rest: a change after more than YOUNG_SECONDS (0.5 s) */
+        nanosleep(&(struct timespec){0, 700 * 1000 * 1000}, NULL);
+        moved.position = add3(moved.position, v3(0.005f, 0.0f, 0.0f));
+        gen = controller_change(c, &moved, &p, &none, 0);
+        wait_for(c, &serial, &img, gen, 0);
+        controller_stats(c, &st);
+        if (st.preempted_parts > 0) break;
+    }
+    CHECK(st.preempted_parts > 0, "no change at rest stopped the part in flight in 20 tries");
+    wait_for(c, &serial, &img, gen, 1);
+    CHECK(img.generation == gen && finite_image(&img), "after a stopped part: a whole frame of the change");
+    uint64_t preempted = st.preempted_parts;
+    for (int k = 0; k < 20; k++) { /* moving: the first change may find the image at rest, no other */
+        moved.position = add3(moved.position, v3(0.005f, 0.0f, 0.0f));
+        gen = controller_change(c, &moved, &p, &none, 0);
+        nap();
+    }
+    wait_for(c, &serial, &img, gen, 0);
+    controller_stats(c, &st);
+    CHECK(st.preempted_parts <= preempted + 1, "changes 20 ms apart stopped %llu parts",
+          (unsigned long long)(st.preempted_parts - preempted));
+    controller_stop(c, NULL);
+    free(img.rgb);
+}
+
 int main(void) {
     char err[1200], path[1100];
     if (scratch_open("controller") != 0) return fprintf(stderr, "no scratch directory\n"), 1;
@@ -51,6 +99,7 @@ int main(void) {
     camera cam = scene_camera(s, 0, (float)W / (float)H);
     render_params p = {.method = METHOD_VSL, .max_depth = 4, .seed = 5, .threads = 2};
     view_start start = {.cam = cam, .params = p, .width = W, .height = H, .denoise = 1};
+    check_preemption();
     view_controller *c = controller_start(s, &start, err, sizeof err);
     CHECK(c != NULL, "controller_start: %s", err);
     if (!c) return check_exit("test_controller");

@@ -44,6 +44,7 @@
     X(DBL, hl_merge_share, NULL, "its share of the render threads' time spent merging")                                \
     X(U64, late_parts, "late_parts",                                                                                   \
       "parts that ran to their end though a request (a change, a load, quit) came while they rendered")                \
+    X(U64, preempted_parts, "preempted_parts", "rest updates' parts a change stopped (shown sooner)")                  \
     X(INT, error_paused, "error_paused", "the last update was not of the reference's view: no error")                  \
     X(INT, standing, NULL, "refinement held: the image stands still")
 
