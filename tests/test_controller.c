@@ -44,9 +44,9 @@ static int finite_image(const image_buf *img) {
 }
 
 /* A change while the image is at rest stops the part in flight (its first image comes sooner), and
- * the accumulation after it runs whole frames; changes while things move (each within 20 ms of
- * the last, after the first) stop none: a drag's steps would stop every part. At rest an update renders parts for
- * most of its time, so a change lands in one in all but a few of its tries. */
+ * the accumulation after it runs whole frames; changes while things move (each within 20 ms of the
+ * last, after the first) stop none: a drag's steps would stop every part. At rest an update renders
+ * parts for most of its time, so a change lands in one in all but a few of its tries. */
 static void check_preemption(void) {
     char err[1200];
     scene *s = scene_load("builtin:atelier", NULL, NULL, err, sizeof err); /* the controller's to free */
