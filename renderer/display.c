@@ -221,15 +221,11 @@ static void keep_factors(carry_chunk *restrict k, vec3 from, vec3 to) {
 }
 
 /* Where the chunk's points were in the old image, in its pixel centres' coordinates (x - 0.5, y -
- * 0.5); far outside it where a point was behind the old eye. gbuffer_project_with's arithmetic as
- * vector code: one pixel at a time its division held up the taps. */
+ * 0.5); far outside it where a point was behind the old eye. Vector code: one pixel at a time the
+ * projection's division held up the taps. */
 static void project_chunk(const gbuffer_projector *pr, carry_chunk *restrict k) {
     for (int x = 0; x < CARRY_CHUNK; x++) {
-        float dx = k->px[x] - pr->position.x, dy = k->py[x] - pr->position.y, dz = k->pz[x] - pr->position.z;
-        float z = dx * pr->forward.x + dy * pr->forward.y + dz * pr->forward.z;
-        float iz = 1.0f / (z > 1e-30f ? z : 1e-30f);
-        float ox = pr->half_w + (dx * pr->right.x + dy * pr->right.y + dz * pr->right.z) * iz * pr->sx;
-        float oy = pr->half_h - (dx * pr->up.x + dy * pr->up.y + dz * pr->up.z) * iz * pr->sy;
+        float ox, oy, z = gbuffer_project_raw(pr, v3(k->px[x], k->py[x], k->pz[x]), &ox, &oy);
         k->fx[x] = z > 0.0f ? ox - 0.5f : -1e30f;
         k->fy[x] = z > 0.0f ? oy - 0.5f : -1e30f;
     }

@@ -53,13 +53,19 @@ typedef struct {
     float half_w, half_h; /* the image's centre */
 } gbuffer_projector;
 gbuffer_projector gbuffer_projector_of(const gbuffer *g);
-static inline int gbuffer_project_with(const gbuffer_projector *pr, vec3 p, float *x, float *y) {
+/* The arithmetic alone, without a test (a loop over many points stays vector code): (x, y), and
+ * the depth along the view as the result; (x, y) mean nothing where it is not above 0. */
+static inline float gbuffer_project_raw(const gbuffer_projector *pr, vec3 p, float *x, float *y) {
     vec3 d = sub3(p, pr->position);
-    float z = dot3(d, pr->forward);
-    if (!(z > 0.0f)) return 0;
-    float iz = 1.0f / z;
+    float z = dot3(d, pr->forward), iz = 1.0f / (z > 0.0f ? z : 1.0f);
     *x = pr->half_w + dot3(d, pr->right) * iz * pr->sx;
     *y = pr->half_h - dot3(d, pr->up) * iz * pr->sy;
+    return z;
+}
+static inline int gbuffer_project_with(const gbuffer_projector *pr, vec3 p, float *x, float *y) {
+    float ox, oy;
+    if (!(gbuffer_project_raw(pr, p, &ox, &oy) > 0.0f)) return 0;
+    *x = ox, *y = oy;
     return isfinite(*x) && isfinite(*y);
 }
 int gbuffer_project(const gbuffer *g, vec3 p, float *x, float *y);
