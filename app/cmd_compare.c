@@ -15,13 +15,18 @@
 #include "metrics.h"
 #include "reference.h"
 
+/* The pixels whose share of the error compare reports: a thousandth, a light's speck and its rim. */
+#define PEAK_FRACTION 1e-3
+
 static void print_compare_help(void) {
     printf("usage: glint compare IMAGE.exr REFERENCE.exr [--layer NAME]\n"
            "\n"
-           "Prints one line, rel_l2=X ref_noise=Y net=Z: the relative L2 error ||I - R|| / ||R|| of the\n"
-           "image against the reference, the reference's own noise from its description (0 when it\n"
-           "has none, and for a layer), and the error with that noise taken out in quadrature,\n"
-           "sqrt(max(0, X^2 - Y^2)). Refuses images of different sizes and, when both carry glint\n"
+           "Prints one line, rel_l2=X ref_noise=Y net=Z peak_share=P: the relative L2 error\n"
+           "||I - R|| / ||R|| of the image against the reference, the reference's own noise from its\n"
+           "description (0 when it has none, and for a layer), the error with that noise taken out in\n"
+           "quadrature, sqrt(max(0, X^2 - Y^2)), and the share of the squared error in the 0.1%% of the\n"
+           "pixels where it is largest (near 1: a few pixels, such as a light's speck in a mirror,\n"
+           "carry the error). Refuses images of different sizes and, when both carry glint\n"
            "descriptions, of another scene, camera, material variant, environment or light edits.\n"
            "\n"
            "options:\n"
@@ -120,11 +125,18 @@ int cmd_compare(int argc, char **argv) {
         if (w[0] != w[1] || h[0] != h[1]) {
             cli_error("%s: %dx%d, but %s is %dx%d", files[0], w[0], h[0], files[1], w[1], h[1]);
         } else {
-            double e = metric_rel_l2(img, ref, 3 * (size_t)w[0] * (size_t)h[0]);
+            size_t pixels = (size_t)w[0] * (size_t)h[0];
+            double e = metric_rel_l2(img, ref, 3 * pixels);
             /* The noise a description gives is the whole image's: a layer's is unknown. */
             double noise = described[1] && info[1].has_noise && !layer[0] ? info[1].rel_l2_noise : 0.0;
-            printf("rel_l2=%.6g ref_noise=%.6g net=%.6g\n", e, noise, metric_without_noise(e, noise));
-            status = EXIT_OK;
+            double peak = metric_peak_share(img, ref, pixels, 3, PEAK_FRACTION);
+            if (peak < 0.0) {
+                cli_error("%s: out of memory", files[0]);
+            } else {
+                printf("rel_l2=%.6g ref_noise=%.6g net=%.6g peak_share=%.4f\n", e, noise,
+                       metric_without_noise(e, noise), peak);
+                status = EXIT_OK;
+            }
         }
     }
     free(img);

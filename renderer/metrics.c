@@ -1,6 +1,7 @@
 #include "metrics.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 double metric_rel_l2(const float *img, const float *ref, size_t n) {
     double err = 0.0, norm = 0.0;
@@ -11,6 +12,32 @@ double metric_rel_l2(const float *img, const float *ref, size_t n) {
     }
     if (norm > 0.0) return sqrt(err / norm);
     return err > 0.0 ? (double)INFINITY : 0.0;
+}
+
+static int descending(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x < y) - (x > y);
+}
+
+double metric_peak_share(const float *img, const float *ref, size_t pixels, int channels, double fraction) {
+    if (pixels == 0 || channels <= 0) return 0.0;
+    double *e = malloc(sizeof(double) * pixels), all = 0.0, top = 0.0;
+    if (!e) return -1.0;
+    for (size_t i = 0; i < pixels; i++) {
+        double s = 0.0;
+        for (int c = 0; c < channels; c++) {
+            double d = (double)img[i * (size_t)channels + (size_t)c] - (double)ref[i * (size_t)channels + (size_t)c];
+            s += d * d;
+        }
+        e[i] = s;
+        all += s;
+    }
+    double want = ceil(fmin(fmax(fraction, 0.0), 1.0) * (double)pixels);
+    size_t k = (size_t)want;
+    qsort(e, pixels, sizeof *e, descending);
+    for (size_t i = 0; i < k; i++) top += e[i];
+    free(e);
+    return all > 0.0 ? fmin(top / all, 1.0) : 0.0;
 }
 
 double metric_relmse(const float *img, const float *ref, size_t n) {

@@ -14,6 +14,11 @@ double metric_rel_l2(const float *img, const float *ref, size_t n);
  * metric_noise_bias takes it: sqrt(max(0, rel_l2^2 - ref_noise^2)); rel_l2 itself for ref_noise 0. */
 double metric_without_noise(double rel_l2, double ref_noise);
 
+/* The share of ||I - R||^2 that the ceil(fraction x pixels) pixels of largest squared error hold
+ * (each pixel `channels` values): near 1 when a few pixels carry the error (a light's speck in a
+ * mirror), near fraction when it is spread evenly. 0 for no error; -1 when out of memory. */
+double metric_peak_share(const float *img, const float *ref, size_t pixels, int channels, double fraction);
+
 /* Relative mean squared error: mean of (I - R)^2 / (R^2 + METRIC_RELMSE_EPS). The epsilon keeps
  * black reference pixels from dominating. n = 0 gives 0. */
 #define METRIC_RELMSE_EPS 1e-2

@@ -26,14 +26,15 @@ static void expect_failure(const char *args, int code, const char *needle) {
     CHECK(strstr(err_text, needle), "'%s': error '%s' lacks '%s'", args, err_text, needle);
 }
 
-/* Runs glint compare ARGS, which must succeed; its three numbers into v. */
-static void compare(const char *args, double v[3]) {
+/* Runs glint compare ARGS, which must succeed; its four numbers into v. */
+static void compare(const char *args, double v[4]) {
     char cmd[600];
     snprintf(cmd, sizeof cmd, "compare %s", args);
     int rc = run(cmd);
-    v[0] = v[1] = v[2] = NAN;
+    v[0] = v[1] = v[2] = v[3] = NAN;
     CHECK(rc == 0, "'%s': exit %d (%s)", cmd, rc, err_text);
-    CHECK(sscanf(out_text, "rel_l2=%lf ref_noise=%lf net=%lf", &v[0], &v[1], &v[2]) == 3 && !strchr(out_text, '\n')[1],
+    CHECK(sscanf(out_text, "rel_l2=%lf ref_noise=%lf net=%lf peak_share=%lf", &v[0], &v[1], &v[2], &v[3]) == 4 &&
+              !strchr(out_text, '\n')[1],
           "'%s': output '%s'", cmd, out_text);
 }
 
@@ -78,28 +79,57 @@ static double rel_l2_here(const char *a, const char *b, const char *prefix) {
     return rel_l2_here_layers(a, prefix, b, prefix);
 }
 
-/* A w x h image of value v * (1 + pixel index / 100) in every channel, no description. */
-static void write_ramp(const char *name, int w, int h, float v) {
+/* A w x h image of value v * (1 + pixel index / 100) in every channel, no description; pixel
+ * `speck` (if in it) `extra` brighter. */
+static void write_ramp_speck(const char *name, int w, int h, float v, int speck, float extra) {
     char p[1024], err[1024];
     float *rgb = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
     for (int i = 0; i < w * h; i++)
-        for (int k = 0; k < 3; k++) rgb[3 * i + k] = v * (1.0f + (float)i / 100.0f);
+        for (int k = 0; k < 3; k++) rgb[3 * i + k] = v * (1.0f + (float)i / 100.0f) + (i == speck ? extra : 0.0f);
     snprintf(p, sizeof p, "%s/%s", tmp, name);
     exr_layer l = {"", rgb};
     CHECK(exr_save_layers(p, w, h, &l, 1, WRITE_REPLACE, err, sizeof err) == 0, "%s", err);
     free(rgb);
 }
 
+static void write_ramp(const char *name, int w, int h, float v) { write_ramp_speck(name, w, h, v, -1, 0.0f); }
+
+/* The largest pixel's share of ||a - b||^2 (the pixels' squared errors summed over channels). */
+static double top_share_here(const char *a, const char *b) {
+    int w, h, w2, h2;
+    float *x = layer(a, "", &w, &h), *y = layer(b, "", &w2, &h2);
+    int ok = x && y && w == w2 && h == h2;
+    double all = 0.0, top = 0.0;
+    for (size_t i = 0; ok && i < (size_t)w * (size_t)h; i++) {
+        double e = 0.0;
+        for (size_t k = 3 * i; k < 3 * i + 3; k++) e += ((double)x[k] - y[k]) * ((double)x[k] - y[k]);
+        all += e;
+        top = fmax(top, e);
+    }
+    free(x);
+    free(y);
+    return ok && all > 0.0 ? top / all : NAN;
+}
+
 static void test_numbers(void) {
-    double v[3];
+    double v[4];
     /* Made to a known error: 1.1 times the reference everywhere is 0.1 off. */
     write_ramp("ramp.exr", 8, 4, 2.0f);
     write_ramp("ramp-more.exr", 8, 4, 2.2f);
     compare("ramp-more.exr ramp.exr", v);
     CHECK_NEAR(v[0], 0.1, 1e-5, "1.1 times the reference");
     CHECK(v[1] == 0.0 && v[2] == v[0], "no description: no noise to take out (%g, %g)", v[1], v[2]);
+    /* 32 pixels: the peak is one pixel (a thousandth, rounded up), the brightest: its error is
+     * 0.2 (1 + 31/100) in each channel, the others' 0.2 (1 + i/100). */
+    double ramp_all = 0.0;
+    for (int i = 0; i < 32; i++) ramp_all += (1.0 + i / 100.0) * (1.0 + i / 100.0);
+    CHECK_NEAR(v[3], 1.31 * 1.31 / ramp_all, 1e-4, "the ramp's peak share");
+    /* The error all in one pixel: all of it in the peak. */
+    write_ramp_speck("ramp-speck.exr", 8, 4, 2.0f, 13, 500.0f);
+    compare("ramp-speck.exr ramp.exr", v);
+    CHECK_NEAR(v[3], 1.0, 1e-6, "a speck's share");
     compare("ramp.exr ramp.exr", v);
-    CHECK(v[0] == 0.0 && v[2] == 0.0, "an image against itself: %g %g", v[0], v[2]);
+    CHECK(v[0] == 0.0 && v[2] == 0.0 && v[3] == 0.0, "an image against itself: %g %g %g", v[0], v[2], v[3]);
     /* Two renders: the sum done here, and the reference's noise (its description's) taken out. */
     if (render("--method pt --spp 2 --seed 1 --out a.exr") || render("--method pt --spp 16 --seed 2 --out b.exr"))
         return;
@@ -113,6 +143,7 @@ static void test_numbers(void) {
     CHECK_NEAR(v[1], noise, 1e-5 * noise, "the reference's noise");
     CHECK_NEAR(v[2], sqrt(fmax(v[0] * v[0] - noise * noise, 0.0)), 1e-5, "net: the noise out in quadrature");
     CHECK(v[2] < v[0], "net %g below rel_l2 %g", v[2], v[0]);
+    CHECK_NEAR(v[3], top_share_here("a.exr", "b.exr"), 1e-4, "the peak share (576 pixels: the largest one's)");
     /* A layer: its own error, and no noise known for it. */
     compare("a.exr b.exr --layer direct", v);
     CHECK_NEAR(v[0], rel_l2_here("a.exr", "b.exr", "direct"), 1e-5 * v[0], "the direct layer");
@@ -145,7 +176,7 @@ static void test_refusals(void) {
     CHECK(at != NULL, "a.exr's description has an empty lights field: %s", desc);
     if (at) memmove(at, at + strlen("  \"lights\": \"\",\n"), strlen(at + strlen("  \"lights\": \"\",\n")) + 1);
     CHECK(write_reference("a.exr", "old.exr", desc, 0) == 0, "old.exr written");
-    double v[3];
+    double v[4];
     compare("old.exr a.exr", v);
     CHECK(v[0] == 0.0, "an older description, the same image: %g", v[0]);
     expect_failure("compare old.exr moved.exr", 1, "as loaded");
@@ -164,7 +195,7 @@ static void test_refusals(void) {
 }
 
 static void test_render_poses(void) {
-    double v[3];
+    double v[4];
     /* Two moves of one light add up to one move; the recorded edit is the same, the image too. */
     if (render("--spp 2 --seed 3 --move-light 0,0.25,0,0 --move-light 0,0.25,0,0 --out twice.exr") ||
         render("--spp 2 --seed 3 --move-light 0,0.5,0,0 --out once.exr") || render("--spp 2 --seed 3 --out still.exr"))
@@ -222,7 +253,7 @@ static void test_denoise_layer(void) {
         CHECK(rel_l2_here("dn.exr", "raw.exr", layers[k]) == 0.0, "--denoise changed the estimate's layer '%s'",
               layers[k]);
     /* the errors against the truth, the long render's own noise (its description's) taken out */
-    double v[3];
+    double v[4];
     compare("raw.exr long.exr", v);
     double noise2 = v[1] * v[1], filtered = rel_l2_here_layers("dn.exr", "denoised", "long.exr", "");
     double raw = rel_l2_here("raw.exr", "long.exr", "");

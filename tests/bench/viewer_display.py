@@ -205,7 +205,8 @@ def cmd_table(root, refs, glint, out):
                "capture": name, "since_change": desc["capture"]["since_change"],
                "preview": desc["capture"]["preview"], "image": "%dx%d" % tuple(desc["capture"]["image_size"]),
                "latest": desc["capture"]["latest"], "frames": desc["spp"], "pose": i,
-               "ref_spp": poses[i]["spp"] if i >= 0 else "", "rel_l2": "", "ref_noise": "", "net": ""}
+               "ref_spp": poses[i]["spp"] if i >= 0 else "", "rel_l2": "", "ref_noise": "", "net": "",
+               "peak_share": ""}
         if ref and os.path.exists(ref):
             r = subprocess.run([glint, "compare", path, ref], capture_output=True, text=True)
             if r.returncode == 0:
@@ -231,7 +232,7 @@ def cmd_table(root, refs, glint, out):
 
     rows.sort(key=lambda r: (r["scene"], r["method"], r["scenario"], when_key(r["when"])))
     fields = ["scene", "method", "scenario", "when", "capture", "since_change", "preview", "image", "latest", "frames",
-              "pose", "ref_spp", "rel_l2", "ref_noise", "net", "updates_per_s", "full_per_s", "pixel_share", "orbit_s",
+              "pose", "ref_spp", "rel_l2", "ref_noise", "net", "peak_share", "updates_per_s", "full_per_s", "pixel_share", "orbit_s",
               "last_image", "free_per_s", "free_full_per_s"]
     with open(out + ".csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
@@ -242,16 +243,19 @@ def cmd_table(root, refs, glint, out):
                 "by scene, method and scenario; `when`: seconds after the stop, during-N: at the end of the orbit's step N of 10 (0.1 s after it), opened-10: 10 s after "
                 "opening, before the orbit (plain accumulation at rest); "
                 "`s after change`: when the capture was taken, after the last change (a step); `stale`: the image shown "
-                "was not yet of the last change (its own pose is the one measured).\n\n")
-        f.write("| scene | method | scenario | when | s after change | shown | net error | ref noise |\n"
-                "|---|---|---|---|---|---|---|---|\n")
+                "was not yet of the last change (its own pose is the one measured); `peak`: the share of the squared "
+                "error in the 0.1% of the pixels where it is largest (near 1: a light's speck in a mirror decides "
+                "the figure).\n\n")
+        f.write("| scene | method | scenario | when | s after change | shown | net error | ref noise | peak |\n"
+                "|---|---|---|---|---|---|---|---|---|\n")
         for r in rows:
             shown = ("preview " + r["image"] if r["preview"] else "full, %s frames" % r["frames"]) + \
                     ("" if r["latest"] else ", stale")
             net = r["net"] if isinstance(r["net"], str) and not r["net"][:1].isdigit() else "%.4f" % float(r["net"])
-            f.write("| %s | %s | %s | %s | %.2f | %s | %s | %s |\n" % (
+            f.write("| %s | %s | %s | %s | %.2f | %s | %s | %s | %s |\n" % (
                 r["scene"], r["method"], r["scenario"], r["when"], r["since_change"], shown, net,
-                "%.4f" % float(r["ref_noise"]) if r["ref_noise"] != "" else "-"))
+                "%.4f" % float(r["ref_noise"]) if r["ref_noise"] != "" else "-",
+                "%.2f" % float(r["peak_share"]) if r["peak_share"] != "" else "-"))
         f.write("\nDuring the orbit (15 degrees at 15 degrees a second), from the stats lines before and after it; "
                 "`no captures`: the same orbit in a session of its own without captures (scenario rate), what a "
                 "person gets:\n\n"
