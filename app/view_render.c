@@ -25,11 +25,13 @@
 #include "view_render.h"
 
 /* An update (a part and the display's work) takes about UPDATE_MS while things move and for
- * YOUNG_SECONDS after a change, so the image follows motion about 10 times a second; once the
+ * YOUNG_SECONDS after a change, so the image follows motion 10 times a second: 90 ms, as what an
+ * update costs beside its budget varies (a part's cost, the window's share of the cores), and at
+ * 100 ms the viewer made 9 a second (docs/benchmarks.md); once the
  * steps of a drag have stopped coming, REST_UPDATE_MS: the display's fixed cost (about half of a
  * young update's) paid half as often, so that more of the first seconds after a stop go to
  * samples. A new estimator's first frame, its cost unknown, comes in FIRST_PARTS parts. */
-#define UPDATE_MS 100.0
+#define UPDATE_MS 90.0
 #define REST_UPDATE_MS 200.0
 #define YOUNG_SECONDS 0.5
 #define FIRST_PARTS 64
