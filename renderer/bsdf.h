@@ -32,6 +32,9 @@ extern "C" {
  * bsdf_pass_through), and a transmission does not count as a scattering event toward a path's
  * depth (docs/design.md). */
 enum { BSDF_DIFFUSE = 1, BSDF_GLOSSY = 2, BSDF_NOT_HIGHLIGHT = 4, BSDF_TRANSMIT = 8, BSDF_ALL = 11 };
+/* The lobes whose light moves over a surface as the view turns: what a display (display.h) keeps
+ * apart from the rest of a pixel's light, the glossy part of a sample. */
+enum { BSDF_VIEW_DEPENDENT = BSDF_GLOSSY | BSDF_TRANSMIT };
 
 /* The path-space split (docs/design.md): camera - glossy - glossy - light paths belong to the
  * highlight estimator when both glossy lobes are sharper than this roughness (microfacet alpha).

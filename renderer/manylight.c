@@ -328,26 +328,36 @@ static vec3 camera_gather(const manylight *m, const scene *s, const shading_poin
     return manylight_shade(m, s, x, VL_TERMS_NO_HIGHLIGHTS, m->candidates, rng, st);
 }
 
-vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, vec3 *highlights, int max_depth,
-                        int split_first, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st) {
-    vec3 sum = v3(0, 0, 0), beta = v3s(1.0f), sigma = v3s(0.0f);
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x0, vec3 *highlights, vec3 *glossy,
+                        int max_depth, int split_first, qmc_run seq, pixel_record *rec, rng_state *rng,
+                        render_stats *st) {
+    vec3 sum = v3(0, 0, 0), beta = v3s(1.0f), sigma = v3s(0.0f), g = v3(0, 0, 0);
     shading_point x = *x0;
-    if (!m->glass && !traced_lobes(m, &x.b)) return camera_gather(m, s, &x, highlights, rng, st);
-    int through = 0; /* x was reached through a transmission */
+    if (glossy) *glossy = g;
+    if (!m->glass && !traced_lobes(m, &x.b)) {
+        vec3 l = camera_gather(m, s, &x, highlights, rng, st);
+        if (glossy && bsdf_lobes(&x.b) & BSDF_GLOSSY) *glossy = l;
+        return l;
+    }
+    int through = 0;   /* x was reached through a transmission */
+    int traced_on = 0; /* the path left the camera hit through its traced lobes: its light is glossy */
     /* x is scattering event k: gathering there makes paths of k + 1 events or more. A
      * transmission leaves k as it is (pt.c counts depth so). */
     for (int k = 1, vertex = 0; k + 1 <= max_depth && vertex <= max_depth + PT_MAX_TRANSMISSIONS; vertex++) {
         /* Only at the camera hit do the highlights own part of the gathered paths. */
         int at_camera = k == 1 && !through;
+        vec3 before = sum;
         int traced = traced_lobes(m, &x.b);
         shading_point gathered = x;
         gathered.b = bsdf_only(&x.b, BSDF_ALL & ~traced);
         int gather = bsdf_lobes(&gathered.b) != 0;
         int candidates = at_camera ? m->candidates : m->candidates_beyond;
-        if (gather)
-            sum =
-                add3(sum, mul3(beta, at_camera ? camera_gather(m, s, &gathered, highlights, rng, st)
-                                               : manylight_shade(m, s, &gathered, VL_TERMS_ALL, candidates, rng, st)));
+        if (gather) {
+            vec3 l = mul3(beta, at_camera ? camera_gather(m, s, &gathered, highlights, rng, st)
+                                          : manylight_shade(m, s, &gathered, VL_TERMS_ALL, candidates, rng, st));
+            sum = add3(sum, l);
+            if (at_camera && bsdf_lobes(&gathered.b) & BSDF_GLOSSY) g = add3(g, l);
+        }
         /* The gathered lobes' paths through glass (scenes with glass only), and the traced lobes',
          * each carry the path on with probability 1/2 when both are there. */
         int glass = gather && m->glass;
@@ -390,6 +400,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
             if (at_camera && rec) pixel_record_add(rec, avg3(add3(t, t_hl)));
             if (!ok) continue;
             sum = madd3(sum, t, 1.0f / (float)split);
+            if (at_camera) g = madd3(g, t, 1.0f / (float)split);
             if (split_hl) *highlights = madd3(*highlights, t_hl, 1.0f / (float)split);
             if (j == chosen && !via_glass)
                 next_beta = b, next = h, next_wi = wi, next_sigma = sg, next_lobe = lobe, have_next = 1;
@@ -402,6 +413,8 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
                 if (via_glass) next_beta = b, next = h, next_wi = wi, next_sigma = sg, next_lobe = 0, have_next = 1;
             }
         }
+        if (!at_camera && traced_on) g = add3(g, sub3(sum, before));
+        if (at_camera) traced_on = !via_glass;
         if (!have_next) break;
         beta = scale3(next_beta, pick);
         sigma = next_sigma;
@@ -413,6 +426,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         }
         x = shading_point_at(s, &next, next_wi);
     }
+    if (glossy) *glossy = g;
     return sum;
 }
 

@@ -66,9 +66,13 @@ vec3 manylight_shade(const manylight *m, const scene *s, const shading_point *x,
  * represent the incoming light: that lobe is sampled, and the path picks up the direct light at
  * the next hit and gathers there (the same rule again). At the camera hit the lobe is sampled in
  * `split` directions, the first `split` points of seq (the pixel's run); rec, when not NULL,
- * records each one's light. */
-vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, vec3 *highlights, int max_depth,
-                        int split, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st);
+ * records each one's light. With glossy (not NULL), the part of the result whose path left x through
+ * its traced lobes (a glossy lobe sharper than trace_alpha, a transmission) goes there too: the
+ * part that moves over x as the view turns, for a display. So does all the gathered lobes' light
+ * where they hold a glossy lobe (rougher than trace_alpha): a rough lobe that reflects a bright
+ * patch moves it too, and the gather does not tell the lobes apart (docs/design.md). */
+vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point *x, vec3 *highlights, vec3 *glossy,
+                        int max_depth, int split, qmc_run seq, pixel_record *rec, rng_state *rng, render_stats *st);
 
 /* The camera hit as a shading point (BSDF looked up, wo toward the viewer). */
 shading_point shading_point_at(const scene *s, const surface_hit *h, vec3 ray_dir);

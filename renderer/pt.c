@@ -18,16 +18,35 @@ static void add_split(vec3 out[COMP_COUNT], vec3 c, vec3 hl) {
     out[COMP_INDIRECT] = add3(out[COMP_INDIRECT], v3(fmaxf(rest.x, 0.0f), fmaxf(rest.y, 0.0f), fmaxf(rest.z, 0.0f)));
 }
 
+/* Where a path's light goes: out per component, and with glossy (not NULL) the part of it that left
+ * the camera hit through a view-dependent lobe (BSDF_VIEW_DEPENDENT) there too, for a display. Each
+ * contribution c comes with that part g. */
+typedef struct {
+    vec3 *out, *glossy;
+} path_sink;
+
+static void put(path_sink o, int comp, vec3 c, vec3 g) {
+    o.out[comp] = add3(o.out[comp], c);
+    if (o.glossy) o.glossy[comp] = add3(o.glossy[comp], g);
+}
+
+/* add_split for a path_sink: the highlights' part hl left the camera hit through a glossy lobe. */
+static void put_split(path_sink o, vec3 c, vec3 g, vec3 hl) {
+    add_split(o.out, c, hl);
+    if (o.glossy) add_split(o.glossy, g, hl);
+}
+
 /* Emission le reached at vertex `depth` (glass that shadow rays pass after the second scattering
  * event not counted) with MIS weight w: to its component, split into highlights for the paths
  * that reach the light at their third vertex (`before`: the scattering events before the ray's
  * origin, 1 for a continuation, which the split counts). */
-static void add_emission(vec3 out[COMP_COUNT], int depth, int events, int before, int split_highlights, vec3 beta,
+static void add_emission(path_sink out, int depth, int events, int before, int split_highlights, vec3 beta, vec3 beta_g,
                          vec3 beta_hl, vec3 le, float w) {
+    vec3 c = scale3(mul3(beta, le), w), g = scale3(mul3(beta_g, le), w);
     if (split_highlights && depth + before == 2 && events + before == 2)
-        add_split(out, scale3(mul3(beta, le), w), scale3(mul3(beta_hl, le), w));
+        put_split(out, c, g, scale3(mul3(beta_hl, le), w));
     else
-        out[component_of(events)] = add3(out[component_of(events)], scale3(mul3(beta, le), w));
+        put(out, component_of(events), c, g);
 }
 
 /* A BSDF's lobes as next-event estimation sees them: their value, and the pdf of the lobes the
@@ -85,10 +104,16 @@ typedef struct {
  * on), up to PT_MAX_TRANSMISSIONS more vertices. reg widens glossy lobes (pt_regularize; zero:
  * none); fv fixes what first_vertex says. */
 static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma, const surface_hit *first,
-                       rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT], int continuation,
+                       rng_state *rng, path_sink out, uint64_t rays[RAY_KIND_COUNT], int continuation,
                        int split_highlights, first_vertex fv, pt_regularize reg) {
-    for (int c = 0; c < COMP_COUNT; c++) out[c] = v3(0, 0, 0);
+    for (int c = 0; c < COMP_COUNT; c++) {
+        out.out[c] = v3(0, 0, 0);
+        if (out.glossy) out.glossy[c] = v3(0, 0, 0);
+    }
     vec3 beta = v3s(1.0f);
+    /* beta's part that left the first vertex through its view-dependent lobes (only with out.glossy;
+     * a continuation has none: its caller splits) */
+    vec3 beta_g = v3s(0.0f);
     /* the throughput through highlight lobes only (of the first two scattering events) */
     vec3 beta_hl = v3s(split_highlights && continuation ? 1.0f : 0.0f);
     /* The last scattering vertex (prev_p): the pdf of the BSDF sample that left it and whether
@@ -115,18 +140,20 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             vec3 le = env_eval(s, d);
             if (!is_black3(le) && (events > 0 || !continuation)) {
                 float w = prev_nee ? nee_emission_weight(s, prev_p, NULL, d, prev_pdf) : 1.0f;
-                add_emission(out, depth - passes, events, continuation, split_highlights,
-                             mul3(beta, medium_transmittance(sigma, INFINITY)), beta_hl, le, w);
+                vec3 tr = medium_transmittance(sigma, INFINITY);
+                add_emission(out, depth - passes, events, continuation, split_highlights, mul3(beta, tr),
+                             mul3(beta_g, tr), beta_hl, le, w);
             }
             break;
         }
-        beta = mul3(beta, medium_transmittance(sigma, h.t));
+        vec3 tr = medium_transmittance(sigma, h.t);
+        beta = mul3(beta, tr), beta_g = mul3(beta_g, tr);
         vec3 le = material_emission(s, &h);
         /* A continuation's light before its first scattering event is the direct light of the
          * vertex it left (through glass too), which that path has. */
         if (!is_black3(le) && (events > 0 || !continuation)) {
             float w = prev_nee ? nee_emission_weight(s, prev_p, &h, d, prev_pdf) : 1.0f;
-            add_emission(out, depth - passes, events, continuation, split_highlights, beta, beta_hl, le, w);
+            add_emission(out, depth - passes, events, continuation, split_highlights, beta, beta_g, beta_hl, le, w);
         }
         if (depth >= max_depth + PT_MAX_TRANSMISSIONS) break;
 
@@ -153,7 +180,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
          * pass only smooth unbent glass), and lights beyond rough glass through its transmission,
          * at a capped vertex too (a transmission is no scattering event). The share held for the
          * highlights is the path's at a vertex's own light. */
-        vec3 nee_beta = add3(beta, held);
+        vec3 nee_beta = add3(beta, held), nee_beta_g = add3(beta_g, held); /* held: a glossy lobe's */
         int through = (lobes & BSDF_TRANSMIT) && bsdf_transmits_rough(&b) && (events > 0 || !continuation);
         if (through) {
             float u_sel = rng_float(rng);
@@ -164,8 +191,11 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             vec3 f;
             vec3 arrival = nee_direct(s, h.p, neg3(h.ng), beyond, u_sel, u_light, rng, bsdf_lobe_toward, &lobe,
                                       &rays[RAY_SHADOW], &f, &ls);
-            if (!is_black3(arrival))
-                out[component_of(events)] = add3(out[component_of(events)], mul3(mul3(nee_beta, f), arrival));
+            if (!is_black3(arrival)) {
+                vec3 c = mul3(mul3(nee_beta, f), arrival);
+                put(out, component_of(events), c,
+                    depth == 0 ? c : mul3(mul3(nee_beta_g, f), arrival)); /* transmitted */
+            }
         }
         if (!capped) {
             float u_sel = depth == 0 && fv.u_select >= 0.0f ? fv.u_select : rng_float(rng);
@@ -176,14 +206,19 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             vec3 arrival = nee_direct(s, h.p, h.ng, sigma, u_sel, u_light, rng, bsdf_lobe_toward, &lobe,
                                       &rays[RAY_SHADOW], &f, &ls);
             if (!is_black3(arrival)) {
-                vec3 c = mul3(mul3(nee_beta, f), arrival);
+                vec3 c = mul3(mul3(nee_beta, f), arrival), g = mul3(mul3(nee_beta_g, f), arrival);
+                bsdf store;
+                vec3 wi = to_local(fr, ls.wi);
+                if (out.glossy && depth == 0) /* the light's own direction through the view-dependent lobes */
+                    g = mul3(
+                        scale3(bsdf_eval(bsdf_lobe_for(&lobe, &ls, &store), wo, wi, lobe.lobes & BSDF_VIEW_DEPENDENT),
+                               fabsf(wi.z)),
+                        arrival);
                 if (split_highlights && depth + continuation == 1 && events + continuation == 1) {
-                    vec3 wi = to_local(fr, ls.wi);
-                    bsdf store;
                     vec3 fg = scale3(bsdf_eval(bsdf_lobe_for(&lobe, &ls, &store), wo, wi, hl_mask), wi.z);
-                    add_split(out, c, mul3(mul3(beta_hl, fg), arrival));
+                    put_split(out, c, g, mul3(mul3(beta_hl, fg), arrival));
                 } else {
-                    out[component_of(events + 1)] = add3(out[component_of(events + 1)], c);
+                    put(out, component_of(events + 1), c, g);
                 }
             }
         }
@@ -196,6 +231,11 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         vec3 wi = to_world(fr, bs.wi);
         if (!bsdf_side_ok(bs.wi, dot3(wi, h.ng))) break; /* the shading normal's side, not the surface's */
         vec3 weight = scale3(hold ? bsdf_eval(&b, wo, bs.wi, lobes & ~hold) : bs.f, fabsf(bs.wi.z) / bs.pdf);
+        if (out.glossy && depth == 0)
+            beta_g = mul3(
+                beta, scale3(bsdf_eval(&b, wo, bs.wi, lobes & ~hold & BSDF_VIEW_DEPENDENT), fabsf(bs.wi.z) / bs.pdf));
+        else
+            beta_g = mul3(beta_g, weight);
         int passed = bs.lobe == BSDF_TRANSMIT && !is_black3(material_pass_through(s, &h, &b, wo));
         if (hold) {
             held = mul3(beta, scale3(bsdf_eval(&b, wo, bs.wi, hold), fabsf(bs.wi.z) / bs.pdf));
@@ -203,7 +243,7 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
             if (passed)
                 held = mul3(held, weight);
             else
-                beta = add3(beta, held), held = v3s(0.0f);
+                beta = add3(beta, held), beta_g = add3(beta_g, held), held = v3s(0.0f);
         }
         if (split_highlights && depth + continuation <= 1) {
             vec3 fg = scale3(bsdf_eval(&b, wo, bs.wi, hl_mask), bs.wi.z / bs.pdf);
@@ -225,21 +265,26 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         o = offset_origin(s, h.p, h.ng, wi);
         d = wi;
 
-        if (depth >= RR_FIRST_VERTEX && is_black3(held) && !russian_roulette(&beta, rng_float(rng))) break;
+        if (depth >= RR_FIRST_VERTEX && is_black3(held)) {
+            float q = fminf(0.95f, max_comp3(beta)); /* russian_roulette's */
+            if (!russian_roulette(&beta, rng_float(rng))) break;
+            beta_g = scale3(beta_g, 1.0f / q);
+        }
     }
 }
 
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
-                 qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]) {
-    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, out, rays, 0, split_highlights,
+                 qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], vec3 *glossy, uint64_t rays[RAY_KIND_COUNT]) {
+    trace_path(s, max_depth, o, d, v3s(0.0f), first, rng, (path_sink){out, glossy}, rays, 0, split_highlights,
                (first_vertex){BSDF_ALL, &run, -1.0f}, (pt_regularize){0});
 }
 
-vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u_select, rng_state *rng,
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u_select, rng_state *rng, vec3 *glossy,
                uint64_t rays[RAY_KIND_COUNT]) {
-    vec3 out[COMP_COUNT];
-    trace_path(s, 1, o, d, v3s(0.0f), first, rng, out, rays, 0, 0, (first_vertex){BSDF_ALL, NULL, u_select},
-               (pt_regularize){0});
+    vec3 out[COMP_COUNT], g[COMP_COUNT];
+    trace_path(s, 1, o, d, v3s(0.0f), first, rng, (path_sink){out, glossy ? g : NULL}, rays, 0, 0,
+               (first_vertex){BSDF_ALL, NULL, u_select}, (pt_regularize){0});
+    if (glossy) *glossy = g[COMP_DIRECT];
     return out[COMP_DIRECT];
 }
 
@@ -247,7 +292,7 @@ int pt_reflected_direct(const scene *s, vec3 o, vec3 d, vec3 sigma, int lobes, p
                         vec3 *direct, vec3 *highlights, surface_hit *first, uint64_t rays[RAY_KIND_COUNT]) {
     vec3 out[COMP_COUNT];
     int hit = scene_intersect(s, o, d, INFINITY, first);
-    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, out, rays, 1, highlights != NULL,
+    trace_path(s, 1, o, d, sigma, hit ? first : NULL, rng, (path_sink){out, NULL}, rays, 1, highlights != NULL,
                (first_vertex){lobes, NULL, -1.0f}, reg);
     *direct = add3(out[COMP_DIRECT], out[COMP_INDIRECT]); /* INDIRECT: the split's rest */
     if (highlights) *highlights = out[COMP_HIGHLIGHTS];

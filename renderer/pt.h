@@ -15,10 +15,13 @@
  * seen directly and light arriving at the first hit directly from an emitter, out[COMP_INDIRECT]
  * the rest; with split_highlights, the paths camera - glossy lobe - glossy lobe - light go to
  * out[COMP_HIGHLIGHTS] instead (the highlight estimator's subset, docs/design.md). The direction
- * leaving the first hit is the first point of run (the pixel's run over frames). Counts rays into
- * rays[]. */
+ * leaving the first hit is the first point of run (the pixel's run over frames). With glossy (not
+ * NULL, COMP_COUNT of them) the part of each component's light that the first hit reflected or
+ * transmitted through its view-dependent lobes (BSDF_VIEW_DEPENDENT) goes there too: per sample,
+ * f_glossy / f of it, so that it adds up over samples to that lobe's light (a display's; the
+ * samples and the random numbers are the same either way). Counts rays into rays[]. */
 void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, vec3 d, const surface_hit *first,
-                 qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], uint64_t rays[RAY_KIND_COUNT]);
+                 qmc_run run, rng_state *rng, vec3 out[COMP_COUNT], vec3 *glossy, uint64_t rays[RAY_KIND_COUNT]);
 
 /* Vertices a path may add beyond its depth by transmission alone (panes, a glass's two faces). */
 #define PT_MAX_TRANSMISSIONS 32
@@ -26,8 +29,9 @@ void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, ve
 /* Emission seen directly plus direct light at the camera ray's first hit (the path tracer with
  * max depth 1, so every method shares one direct estimator): one estimate, whose next-event
  * estimation selects its light by u_select in [0, 1) (< 0: drawn), so that a caller taking several
- * can stratify the choice; first as for pt_radiance. Counts one camera ray. */
-vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u_select, rng_state *rng,
+ * can stratify the choice; first and glossy (its one value) as for pt_radiance. Counts one camera
+ * ray. */
+vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u_select, rng_state *rng, vec3 *glossy,
                uint64_t rays[RAY_KIND_COUNT]);
 
 /* How a many-light estimator's traced path widens the glossy lobes of the hit whose direct light it

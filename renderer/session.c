@@ -234,12 +234,12 @@ static qmc_run fresh_run(rng_state *rng) {
  * samples at one hit, each picking at random, repeated the same shadow ray (docs/design.md, "Where
  * the samples go"). rec, when not NULL, records each one. */
 static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                         const surface_hit *first, int samples, pixel_record *rec, rng_state *rng) {
+                         const surface_hit *first, int samples, pixel_record *rec, rng_state *rng, vec3 *glossy) {
     const scene *s = rs->scene;
     qmc_run run = pixel_run(rs, pixel, RUN_DIRECT_POINTS, rs->direct_taken[pixel], 1);
     if (samples > 1) rs->direct_taken[pixel] += (uint32_t)(samples - 1); /* one: nothing written (extra samples) */
     float u_select = rng_float(rng);
-    vec3 sum = v3(0, 0, 0);
+    vec3 sum = v3(0, 0, 0), sum_g = v3(0, 0, 0);
     for (int k = 0; k < samples; k++) {
         vec3 dir = d;
         surface_hit hit;
@@ -248,10 +248,13 @@ static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_rast
             h = pixel_hit(rs, st, raster, pixel, qmc_run_point(run, (uint32_t)(k - 1)), &dir, &hit);
         }
         float u = fminf(((float)k + u_select) / (float)samples, 0x1.fffffep-1f);
-        vec3 L = pt_direct(s, rs->cam.position, dir, h, u, rng, st->rays);
+        vec3 g;
+        vec3 L = pt_direct(s, rs->cam.position, dir, h, u, rng, glossy ? &g : NULL, st->rays);
         if (rec) pixel_record_add(rec, avg3(L));
         sum = add3(sum, L);
+        if (glossy) sum_g = add3(sum_g, g);
     }
+    if (glossy) *glossy = scale3(sum_g, 1.0f / (float)samples);
     return scale3(sum, 1.0f / (float)samples);
 }
 
@@ -326,18 +329,25 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
 }
 
 /* The sample the film took at a pixel, to the sink. */
-static void sink_put(const sample_sink *k, int pixel, const float sample[COMP_COUNT][3]) {
-    for (int c = 0; c < COMP_COUNT; c++) memcpy(k->rgb[c] + 3 * (size_t)pixel, sample[c], sizeof sample[c]);
+static void sink_put(const sample_sink *k, int pixel, const float sample[COMP_COUNT][3], const vec3 *glossy) {
+    for (int c = 0; c < COMP_COUNT; c++) {
+        memcpy(k->rgb[c] + 3 * (size_t)pixel, sample[c], sizeof sample[c]);
+        if (!glossy) continue;
+        float *g = k->glossy[c] + 3 * (size_t)pixel;
+        g[0] = glossy[c].x, g[1] = glossy[c].y, g[2] = glossy[c].z;
+    }
     k->stamp[pixel] = k->serial;
 }
 
 /* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL; its
- * highlights, when its block shared them, in shared_hl; into L. A display's extra sample (extra)
- * reads the pixel's records but writes none, takes its one direct sample at its own camera hit and
- * draws its runs afresh from rng. */
+ * highlights, when its block shared them, in shared_hl; into L, and with G (not NULL) the part of
+ * each component that left the camera hit through its view-dependent lobes into G (pt_radiance;
+ * the highlights are all such light). A display's extra sample (extra) reads the pixel's records
+ * but writes none, takes its one direct sample at its own camera hit and draws its runs afresh from
+ * rng. */
 static void estimate_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
                             const surface_hit *first, rng_state *rng, const vec3 *shared_hl, int extra,
-                            vec3 L[COMP_COUNT]) {
+                            vec3 L[COMP_COUNT], vec3 *G) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
     /* render_tile probed the pixel's highlight state */
@@ -347,6 +357,8 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
                          : rs->adapt                     ? rs->direct.samples[pixel]
                                                          : MANYLIGHT_DIRECT_SAMPLES;
     for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
+    if (G)
+        for (int c = 0; c < COMP_COUNT; c++) G[c] = v3(0, 0, 0);
     /* into the void (and its other points too): every component is zero */
     if (!first && !s->env && !spread && direct_samples == 1) {
         st->rays[RAY_CAMERA]++;
@@ -355,7 +367,8 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
     int depth = rs->plan.max_depth;
     if (p->method == METHOD_PT) {
         pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, first,
-                    extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, next_frame_index(rs), 0), rng, L, st->rays);
+                    extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, next_frame_index(rs), 0), rng, L, G,
+                    st->rays);
         return;
     }
     /* Many lights: the shared direct estimator, then the virtual lights at the hit and the
@@ -363,8 +376,8 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
     int record = rs->adapt && !extra;
     uint64_t t0 = clock_ns();
     if (!p->only || p->only & (1u << COMP_DIRECT))
-        L[COMP_DIRECT] =
-            pixel_direct(rs, st, raster, pixel, d, first, direct_samples, record ? &rs->direct.rec[pixel] : NULL, rng);
+        L[COMP_DIRECT] = pixel_direct(rs, st, raster, pixel, d, first, direct_samples,
+                                      record ? &rs->direct.rec[pixel] : NULL, rng, G ? &G[COMP_DIRECT] : NULL);
     else
         st->rays[RAY_CAMERA]++;
     uint64_t t1 = clock_ns();
@@ -374,9 +387,10 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
         int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
         /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
         uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : next_frame_index(rs) * (uint64_t)split;
-        L[COMP_INDIRECT] = manylight_indirect(&rs->ml, s, &sp, dim ? &L[COMP_HIGHLIGHTS] : NULL, depth, split,
-                                              extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
-                                              record ? &rs->glossy.rec[pixel] : NULL, rng, st);
+        L[COMP_INDIRECT] =
+            manylight_indirect(&rs->ml, s, &sp, dim ? &L[COMP_HIGHLIGHTS] : NULL, G ? &G[COMP_INDIRECT] : NULL, depth,
+                               split, extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
+                               record ? &rs->glossy.rec[pixel] : NULL, rng, st);
         uint64_t t2 = clock_ns();
         st->pass_ns[PASS_GATHER] += t2 - t1;
         t1 = t2;
@@ -385,14 +399,16 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
         L[COMP_HIGHLIGHTS] = shared_hl ? *shared_hl : pixel_highlights(rs, st, raster, pixel, d, first, rng, extra);
         st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
     }
+    if (G) G[COMP_HIGHLIGHTS] = L[COMP_HIGHLIGHTS];
 }
 
 /* The film's sample of a pixel (as estimate_sample), added, or dropped and counted when it is not
  * finite (a NaN or Inf never reaches the film); and to the sink. */
 static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
                           const surface_hit *first, rng_state *rng, const vec3 *shared_hl) {
-    vec3 L[COMP_COUNT];
-    estimate_sample(rs, st, raster, pixel, d, first, rng, shared_hl, 0, L);
+    vec3 L[COMP_COUNT], G[COMP_COUNT];
+    int split = rs->sink && rs->sink->glossy[0];
+    estimate_sample(rs, st, raster, pixel, d, first, rng, shared_hl, 0, L, split ? G : NULL);
     float sample[COMP_COUNT][3];
     int finite = 1;
     for (int c = 0; c < COMP_COUNT; c++) {
@@ -403,7 +419,7 @@ static void render_sample(render_session *rs, render_stats *st, const camera_ras
     }
     if (finite) {
         film_add(&rs->film, pixel, (const float(*)[3])sample);
-        if (rs->sink) sink_put(rs->sink, pixel, (const float(*)[3])sample);
+        if (rs->sink) sink_put(rs->sink, pixel, (const float(*)[3])sample, split ? G : NULL);
     } else {
         film_reject(&rs->film, pixel);
         st->rejected_samples++;
@@ -764,7 +780,7 @@ static void render_extra(void *ctx, int task, int worker) {
         vec3 d = camera_raster_dir(&raster, (float)x + u.x, (float)y + u.y), L[COMP_COUNT];
         surface_hit hit;
         const surface_hit *first = scene_intersect(rs->scene, rs->cam.position, d, INFINITY, &hit) ? &hit : NULL;
-        estimate_sample(rs, st, &raster, q->pixel, d, first, &rng, NULL, 1, L);
+        estimate_sample(rs, st, &raster, q->pixel, d, first, &rng, NULL, 1, L, NULL);
         int finite = 1;
         for (int c = 0; c < COMP_COUNT; c++) finite &= is_finite3(L[c]);
         if (!finite) {

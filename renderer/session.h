@@ -69,13 +69,16 @@ void session_set_packet_need(render_session *rs, const uint8_t *need);
 
 /* Where every sample the film takes also goes (whole frames or parts), for a display that reads
  * each part's fresh samples: per film component the sample's 3 floats at the pixel (zeros included;
- * arrays of the image's size), and the pixel's stamp set to serial. A sample the film drops (NaN or
+ * arrays of the image's size), with glossy (all set, or glossy[0] NULL: none) the part of it that
+ * left the camera hit through its view-dependent lobes (pt_radiance's glossy, manylight_indirect's;
+ * the highlights all of theirs), and the pixel's stamp set to serial. A sample the film drops (NaN or
  * Inf) writes nothing. The caller owns the memory and keeps the struct alive while it is set: the
  * render threads read it and write the arrays while a call renders, so the caller sets serial (and
  * reads the arrays) between calls. */
 typedef struct {
-    float *rgb[COMP_COUNT]; /* 3 floats a pixel each: the pixel's sample, per film component */
-    uint32_t *stamp;        /* one a pixel: set to serial where the pixel took a sample */
+    float *rgb[COMP_COUNT];    /* 3 floats a pixel each: the pixel's sample, per film component... */
+    float *glossy[COMP_COUNT]; /* ...and its view-dependent lobes' part */
+    uint32_t *stamp;           /* one a pixel: set to serial where the pixel took a sample */
     uint32_t serial;
 } sample_sink;
 /* NULL: none (the default). */

@@ -316,7 +316,7 @@ static vec3 direct_at_centre(scene *s, vec3 dir, const char *what) {
     CHECK(hit, "%s: no hit", what);
     rng_state rng = rng_for(3, 0, 0);
     uint64_t rays[RAY_KIND_COUNT] = {0};
-    if (hit) pt_radiance(s, 1, 0, o, d, &h, (qmc_run){0, 0, 0}, &rng, comp, rays);
+    if (hit) pt_radiance(s, 1, 0, o, d, &h, (qmc_run){0, 0, 0}, &rng, comp, NULL, rays);
     scene_destroy(s);
     return comp[COMP_DIRECT];
 }
