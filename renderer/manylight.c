@@ -339,14 +339,14 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         if (glossy && bsdf_lobes(&x.b) & BSDF_GLOSSY) *glossy = l;
         return l;
     }
-    int through = 0;   /* x was reached through a transmission */
-    int traced_on = 0; /* the path left the camera hit through its traced lobes: its light is glossy */
+    int through = 0;               /* x was reached through a transmission */
+    int traced_on = 0;             /* the path left the camera hit through its traced lobes: its light is glossy... */
+    vec3 at_leaving = v3(0, 0, 0); /* ...all it adds to sum after the camera hit */
     /* x is scattering event k: gathering there makes paths of k + 1 events or more. A
      * transmission leaves k as it is (pt.c counts depth so). */
     for (int k = 1, vertex = 0; k + 1 <= max_depth && vertex <= max_depth + PT_MAX_TRANSMISSIONS; vertex++) {
         /* Only at the camera hit do the highlights own part of the gathered paths. */
         int at_camera = k == 1 && !through;
-        vec3 before = sum;
         int traced = traced_lobes(m, &x.b);
         shading_point gathered = x;
         gathered.b = bsdf_only(&x.b, BSDF_ALL & ~traced);
@@ -413,8 +413,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
                 if (via_glass) next_beta = b, next = h, next_wi = wi, next_sigma = sg, next_lobe = 0, have_next = 1;
             }
         }
-        if (!at_camera && traced_on) g = add3(g, sub3(sum, before));
-        if (at_camera) traced_on = !via_glass;
+        if (at_camera) traced_on = !via_glass, at_leaving = sum;
         if (!have_next) break;
         beta = scale3(next_beta, pick);
         sigma = next_sigma;
@@ -426,7 +425,7 @@ vec3 manylight_indirect(const manylight *m, const scene *s, const shading_point 
         }
         x = shading_point_at(s, &next, next_wi);
     }
-    if (glossy) *glossy = g;
+    if (glossy) *glossy = traced_on ? add3(g, sub3(sum, at_leaving)) : g;
     return sum;
 }
 

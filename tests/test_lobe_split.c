@@ -5,8 +5,9 @@
  * (the same random numbers, the same arithmetic but for rounding), and its rest the one with the
  * glossy lobe taken out, for pt and for vsl's direct estimator; with indirect light (pt, depth 2)
  * their means agree within their noise, and not once the glossy part is scaled by 1.2 (the test can
- * fail). A diffuse scene has no glossy part at all; in a scene whose every lobe is a sharp glossy
- * one all of a sample is glossy, vsl's traced lobes included. */
+ * fail). A diffuse scene has no glossy part at all; where the camera sees only a sharp glossy
+ * lobe all of a sample is glossy, vsl's traced lobes and what its path gathers beyond them
+ * included. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -129,11 +130,13 @@ static void check_indirect(void) {
     scene_destroy(s), scene_destroy(g);
 }
 
-/* No glossy lobe: no glossy part. Only sharp glossy lobes: all of it glossy. */
-static void check_extremes(render_method method) {
+/* No glossy lobe: no glossy part. Only a sharp glossy lobe at the camera hits (the floor): all of
+ * it glossy, whatever the path meets after it (sharp walls, or Lambert walls, where vsl's path ends
+ * in a gather). */
+static void check_extremes(render_method method, float wall_kd) {
     static split_means m;
     const char *name = method == METHOD_PT ? "pt" : "vsl";
-    scene *diffuse = room(0.5f, 0.0f, 0.6f), *sharp = room(0.0f, 0.6f, -1.0f);
+    scene *diffuse = room(0.5f, 0.0f, 0.6f), *sharp = room(0.0f, 0.6f, wall_kd);
     render_split(diffuse, method, 4, 4, &m);
     double most = 0.0, lit = 0.0;
     for (int i = 0; i < N; i++) most = fmax(most, fabs(m.glossy[i])), lit += m.film[i];
@@ -141,8 +144,8 @@ static void check_extremes(render_method method) {
     render_split(sharp, method, 4, 4, &m);
     double off = 0.0, top = 0.0;
     for (int i = 0; i < N; i++) top = fmax(top, m.film[i]), off = fmax(off, fabs(m.rest[i]));
-    CHECK(top > 0.0 && off <= 1e-4 * top, "%s: in a room of sharp glossy lobes all light is glossy (rest %g of %g)",
-          name, off, top);
+    CHECK(top > 0.0 && off <= 1e-4 * top, "%s: a sharp glossy floor's light is all glossy (walls %g; rest %g of %g)",
+          name, wall_kd, off, top);
     scene_destroy(diffuse), scene_destroy(sharp);
 }
 
@@ -150,7 +153,9 @@ int main(void) {
     check_direct(METHOD_PT);
     check_direct(METHOD_VSL);
     check_indirect();
-    check_extremes(METHOD_PT);
-    check_extremes(METHOD_VSL);
+    check_extremes(METHOD_PT, -1.0f);
+    check_extremes(METHOD_VSL, -1.0f);
+    check_extremes(METHOD_PT, 0.6f);
+    check_extremes(METHOD_VSL, 0.6f);
     return check_exit("test_lobe_split");
 }
