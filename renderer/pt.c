@@ -266,9 +266,9 @@ static void trace_path(const scene *s, int max_depth, vec3 o, vec3 d, vec3 sigma
         d = wi;
 
         if (depth >= RR_FIRST_VERTEX && is_black3(held)) {
-            float q = fminf(0.95f, max_comp3(beta)); /* russian_roulette's */
+            float before = max_comp3(beta); /* > 0 where the path goes on */
             if (!russian_roulette(&beta, rng_float(rng))) break;
-            beta_g = scale3(beta_g, 1.0f / q);
+            beta_g = scale3(beta_g, max_comp3(beta) / before); /* the same 1 / q */
         }
     }
 }
