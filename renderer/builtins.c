@@ -10,6 +10,7 @@
 EMBEDDED(atelier)
 EMBEDDED(doorway)
 EMBEDDED(showcase)
+EMBEDDED(bay)
 #undef EMBEDDED
 
 /* The first is the default scene. */
@@ -20,6 +21,8 @@ static const builtin_scene builtins[] = {
      glint_scene_doorway_gltf, &glint_scene_doorway_gltf_size},
     {"showcase", "a small room of facing metals, a ceiling panel and a spot (the former default)",
      glint_scene_showcase_gltf, &glint_scene_showcase_gltf_size},
+    {"bay", "a ceiling panel lights half the room; a walled-off bay beside it is lit only indirectly",
+     glint_scene_bay_gltf, &glint_scene_bay_gltf_size},
 };
 
 const builtin_scene *scene_builtins(int *count) {
