@@ -23,15 +23,20 @@
 #   5. `plan`: what the effect plan saves, preset plan (vsl+hl with the plan and with every pass
 #      forced on, 2 seeds, 30 s) on the default scene and the shared Cornell box, about 4 minutes
 #      a scene plus the references.
+#   6. `suite`: where each method wins, the suite of issue 46 (an estimator that chooses per pixel
+#      must be checked on every regime): preset headline at 10 and 60 s (relative L2 and MSE,
+#      noise and bias from 2 seeds) on every built-in scene (bay: a directly lit half beside a bay
+#      lit only indirectly), the shared Cornell box, the punctual-lights lamp and the damaged
+#      helmet under the Venice sunset. About 8 minutes a scene plus the references.
 # Environment: GLINT (a glint binary: skips installing and building), SIZE (references and
 # benches, default 320x240), REF_SECONDS (default 1200), HL_REF_SECONDS (600), TIMES and SEEDS
 # (replace every preset's budgets and seed count, e.g. TIMES=0.2 SEEDS=1 for a smoke run),
 # LONG_SECONDS; for the throughput: TP_SIZE (640x360), TP_SPP (32), TP_DEPTH (8), TP_RUNS (3).
-# Usage: tests/bench/run.sh [vsl|hl|bench|plan] [SHARED_SCENES_DIR]
+# Usage: tests/bench/run.sh [vsl|hl|bench|plan|suite] [SHARED_SCENES_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 mode=pt
-case "${1:-}" in vsl | hl | bench | plan) mode=$1; shift ;; esac
+case "${1:-}" in vsl | hl | bench | plan | suite) mode=$1; shift ;; esac
 scenes=${1:-$root/../shared/scenes}
 build=$root/build
 if [ -n "${GLINT:-}" ]; then
@@ -55,15 +60,16 @@ cornell=$scenes/cornell-box/CornellBox-Original.gltf
 # References are stamped with the material model (glint bench refuses another's): it keys the cache.
 model=$("$glint" --version | sed -n 's/.*(material model \(.*\))$/\1/p')
 
-# reference NAME SCENE: the cached path-traced reference of SCENE (rendered when missing); its
-# path on stdout. The name holds the size and length, so a short smoke run never stands in for
-# a long one.
+# reference NAME SCENE [options]: the cached path-traced reference of SCENE (rendered when
+# missing, with the options: an environment map); its path on stdout. The name holds the size and
+# length, so a short smoke run never stands in for a long one.
 reference() {
-  local ref=$cache/$1-$size-pt${ref_seconds}s-$model.exr
+  local ref=$cache/$1-$size-pt${ref_seconds}s-$model.exr file=$2
+  shift 2
   if [ ! -f "$ref" ]; then
-    echo "rendering the path-traced reference of $1 for $ref_seconds s" >&2
-    "$glint" render "$2" --method pt --time "$ref_seconds" --size "$size" --seed 777 --highlights-layer \
-      --out "$ref" --quiet
+    echo "rendering the path-traced reference of $file for $ref_seconds s" >&2
+    "$glint" render "$file" --method pt --time "$ref_seconds" --size "$size" --seed 777 --highlights-layer \
+      "$@" --out "$ref" --quiet
   fi
   echo "$ref"
 }
@@ -115,6 +121,27 @@ if [ "$mode" = bench ]; then
     fi
   done
   bench showcase builtin:showcase "$(reference showcase builtin:showcase)" fig8
+  exit 0
+fi
+
+if [ "$mode" = suite ]; then
+  echo "## Where each method wins: the suite ($(nproc) threads, $(date +%F))"
+  lamp=$scenes/lights-punctual-lamp/glTF/LightsPunctualLamp.gltf
+  helmet=$scenes/damaged-helmet/glTF/DamagedHelmet.gltf
+  sunset=$scenes/envmaps/venice_sunset_1k.hdr
+  for entry in builtin:atelier:atelier builtin:doorway:doorway builtin:showcase:showcase builtin:bay:bay \
+    "$cornell:cornell" "$lamp:lamp" "$helmet:helmet"; do
+    file=${entry%:*}
+    name=${entry##*:}
+    have_scene "$file" || continue
+    env=()
+    if [ "$name" = helmet ]; then
+      [ -f "$sunset" ] || { echo "skipping $file: $sunset not found"; continue; }
+      env=(--env "$sunset")
+      name=helmet-sunset
+    fi
+    bench "$name" "$file" "$(reference "$name" "$file" "${env[@]}")" headline --times "${TIMES:-10,60}" "${env[@]}"
+  done
   exit 0
 fi
 
