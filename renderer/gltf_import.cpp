@@ -186,12 +186,6 @@ std::vector<float> to_float(const std::vector<double> &d) {
 
 // ---- materials and textures ---------------------------------------------------------------
 
-double number_or(const Value &obj, const char *key, double fallback) {
-    if (!obj.IsObject() || !obj.Has(key)) return fallback;
-    const Value &v = obj.Get(key);
-    return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
-}
-
 // An index in an extension's JSON: a whole number from 0 to INT_MAX, else an error naming it.
 int index_or(const Value &obj, const char *key, int fallback, const std::string &what) {
     if (!obj.IsObject() || !obj.Has(key)) return fallback;
@@ -212,19 +206,6 @@ float factor(double v, const std::string &what, const char *name) {
 
 vec3 factor3(const double c[3], const std::string &what, const char *name) {
     return v3(factor(c[0], what, name), factor(c[1], what, name), factor(c[2], what, name));
-}
-
-vec3 color_or(const Value &obj, const char *key, vec3 fallback, const std::string &what) {
-    if (!obj.IsObject() || !obj.Has(key)) return fallback;
-    const Value &v = obj.Get(key);
-    if (!v.IsArray() || v.ArrayLen() < 3) return fallback;
-    double c[3];
-    for (int i = 0; i < 3; i++) {
-        const Value &e = v.Get(i);
-        if (!e.IsNumber()) return fallback;
-        c[i] = e.GetNumberAsDouble();
-    }
-    return factor3(c, what, key);
 }
 
 vec3 vec3_from(const std::vector<double> &v, vec3 fallback) {
@@ -341,14 +322,44 @@ struct importer {
         return texture(e.Get(key), label + ": " + key);
     }
 
+    // The number under key in a material's JSON, or fallback where it is absent; anything there but a
+    // number is the file's mistake: said, and the fallback taken.
+    double number_or(const Value &obj, const char *key, double fallback, const std::string &what) {
+        if (!obj.IsObject() || !obj.Has(key)) return fallback;
+        const Value &v = obj.Get(key);
+        if (v.IsNumber()) return v.GetNumberAsDouble();
+        scene_warn(s, "%s: %s: %s is not a number, using %g", name.c_str(), what.c_str(), key, fallback);
+        return fallback;
+    }
+
+    // A colour (three numbers, each a factor) under key, the same way.
+    vec3 color_or(const Value &obj, const char *key, vec3 fallback, const std::string &what) {
+        if (!obj.IsObject() || !obj.Has(key)) return fallback;
+        const Value &v = obj.Get(key);
+        double c[3];
+        bool ok = v.IsArray() && v.ArrayLen() == 3;
+        for (int i = 0; ok && i < 3; i++) {
+            ok = v.Get(i).IsNumber();
+            if (ok) c[i] = v.Get(i).GetNumberAsDouble();
+        }
+        if (ok) return factor3(c, what, key);
+        scene_warn(s, "%s: %s: %s is not three numbers, using (%g, %g, %g)", name.c_str(), what.c_str(), key,
+                   (double)fallback.x, (double)fallback.y, (double)fallback.z);
+        return fallback;
+    }
+
     // ---- the material model's extensions (docs/design.md, "The glTF material") ----
 
     void ext_ior(material &mat, const Value &e, const std::string &label) {
-        mat.ext.ior = factor(number_or(e, "ior", 1.5), label, "ior");
+        mat.ext.ior = factor(number_or(e, "ior", 1.5, label), label, "ior");
+        if (mat.ext.ior < 1.0f) { // no dielectric's index is below vacuum's
+            scene_warn(s, "%s: %s: ior %g is below 1, clamped to 1", name.c_str(), label.c_str(), (double)mat.ext.ior);
+            mat.ext.ior = 1.0f;
+        }
     }
 
     void ext_specular(material &mat, const Value &e, const std::string &label) {
-        mat.ext.specular = factor(number_or(e, "specularFactor", 1.0), label, "specularFactor");
+        mat.ext.specular = factor(number_or(e, "specularFactor", 1.0, label), label, "specularFactor");
         mat.ext.specular_color = color_or(e, "specularColorFactor", v3s(1.0f), label);
         mat.ext.specular_tex = ext_texture(e, "specularTexture", label);
         mat.ext.specular_color_tex = ext_texture(e, "specularColorTexture", label);
@@ -356,15 +367,16 @@ struct importer {
 
     void ext_sheen(material &mat, const Value &e, const std::string &label) {
         mat.ext.sheen_color = color_or(e, "sheenColorFactor", v3s(0.0f), label);
-        mat.ext.sheen_roughness = factor(number_or(e, "sheenRoughnessFactor", 0.0), label, "sheenRoughnessFactor");
+        mat.ext.sheen_roughness =
+            factor(number_or(e, "sheenRoughnessFactor", 0.0, label), label, "sheenRoughnessFactor");
         mat.ext.sheen_color_tex = ext_texture(e, "sheenColorTexture", label);
         mat.ext.sheen_roughness_tex = ext_texture(e, "sheenRoughnessTexture", label);
     }
 
     void ext_clearcoat(material &mat, const Value &e, const std::string &label) {
-        mat.ext.clearcoat = factor(number_or(e, "clearcoatFactor", 0.0), label, "clearcoatFactor");
+        mat.ext.clearcoat = factor(number_or(e, "clearcoatFactor", 0.0, label), label, "clearcoatFactor");
         mat.ext.clearcoat_roughness =
-            factor(number_or(e, "clearcoatRoughnessFactor", 0.0), label, "clearcoatRoughnessFactor");
+            factor(number_or(e, "clearcoatRoughnessFactor", 0.0, label), label, "clearcoatRoughnessFactor");
         mat.ext.clearcoat_tex = ext_texture(e, "clearcoatTexture", label);
         mat.ext.clearcoat_roughness_tex = ext_texture(e, "clearcoatRoughnessTexture", label);
         mat.ext.clearcoat_normal_tex = ext_texture(e, "clearcoatNormalTexture", label);
@@ -440,14 +452,14 @@ struct importer {
             for (const auto &ext : gm.extensions) {
                 const Value &e = ext.second;
                 if (ext.first == "KHR_materials_emissive_strength") {
-                    float k = factor(number_or(e, "emissiveStrength", 1.0), label, "emissiveStrength");
+                    float k = factor(number_or(e, "emissiveStrength", 1.0, label), label, "emissiveStrength");
                     mat.emission = scale3(mat.emission, k);
                     double c[3] = {mat.emission.x, mat.emission.y, mat.emission.z};
                     factor3(c, label, "emissiveFactor x emissiveStrength");
                 } else if (ext.first == "KHR_materials_anisotropy") {
                     mat.anisotropy_strength =
-                        factor(number_or(e, "anisotropyStrength", 0.0), label, "anisotropyStrength");
-                    double rot = number_or(e, "anisotropyRotation", 0.0);
+                        factor(number_or(e, "anisotropyStrength", 0.0, label), label, "anisotropyStrength");
+                    double rot = number_or(e, "anisotropyRotation", 0.0, label);
                     if (!(std::fabs(rot) <= 1e6)) fail(label + ": anisotropyRotation " + num(rot) + " is not an angle");
                     mat.anisotropy_rotation = (float)rot;
                     if (e.Has("anisotropyTexture"))
@@ -479,10 +491,10 @@ struct importer {
                     mat.model = model == "phong" ? MATERIAL_PHONG : MATERIAL_WARD;
                     mat.kd = color_or(g, "kd", v3s(0.0f), label);
                     mat.ks = color_or(g, "ks", v3s(0.5f), label);
-                    mat.exponent = factor(number_or(g, "exponent", 64.0), label, "exponent");
-                    mat.alpha_x = factor(number_or(g, "alpha_x", 0.1), label, "alpha_x");
-                    mat.alpha_y = factor(number_or(g, "alpha_y", number_or(g, "alpha_x", 0.1)), label, "alpha_y");
-                    double rot = number_or(g, "rotation", 0.0);
+                    mat.exponent = factor(number_or(g, "exponent", 64.0, label), label, "exponent");
+                    mat.alpha_x = factor(number_or(g, "alpha_x", 0.1, label), label, "alpha_x");
+                    mat.alpha_y = factor(number_or(g, "alpha_y", mat.alpha_x, label), label, "alpha_y");
+                    double rot = number_or(g, "rotation", 0.0, label);
                     if (!(std::fabs(rot) <= 1e6)) fail(label + ": rotation " + num(rot) + " is not an angle");
                     mat.anisotropy_rotation = (float)rot;
                     // Textures other than emission do not apply to these lobes, except base colour tinting kd.

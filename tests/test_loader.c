@@ -350,6 +350,51 @@ static void test_materials(void) {
     scene_destroy(s);
 }
 
+/* A material number of the wrong type, or an ior below 1, loads with a warning naming the key and
+ * takes a value that makes sense: the default where the value is not a number (or a colour not
+ * three numbers), 1 for an ior below it. */
+static void test_bad_material_numbers(void) {
+    const struct {
+        const char *ext; /* the material's extensions */
+        const char *warning;
+        float ior, sheen; /* what the material gets */
+    } cases[] = {
+        {"\"KHR_materials_ior\":{\"ior\":0}", "ior 0 is below 1, clamped to 1", 1.0f, 0.0f},
+        {"\"KHR_materials_ior\":{\"ior\":1e-30}", "is below 1, clamped to 1", 1.0f, 0.0f},
+        {"\"KHR_materials_ior\":{\"ior\":\"NaN\"}", "ior is not a number, using 1.5", 1.5f, 0.0f},
+        {"\"KHR_materials_ior\":{\"ior\":\"1.5\"}", "ior is not a number, using 1.5", 1.5f, 0.0f},
+        /* tinygltf drops a null member: absent, the default (as the schema's default for a missing one) */
+        {"\"KHR_materials_ior\":{\"ior\":null}", NULL, 1.5f, 0.0f},
+        {"\"KHR_materials_ior\":{\"ior\":[1.33]}", "ior is not a number, using 1.5", 1.5f, 0.0f},
+        {"\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.5]}", "sheenColorFactor is not three numbers", 1.5f, 0.0f},
+        {"\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.5,\"x\",0.5]}", "sheenColorFactor is not three numbers",
+         1.5f, 0.0f},
+        {"\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.5,0.5,0.5]}", NULL, 1.5f, 0.5f},
+    };
+    const char *meshes = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,"
+                         "\"material\":0}]}]";
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char extra[512], err[512];
+        snprintf(extra, sizeof extra,
+                 "\"extensionsUsed\":[\"KHR_materials_ior\",\"KHR_materials_sheen\"],"
+                 "\"materials\":[{\"name\":\"odd\",\"extensions\":{%s}}]",
+                 cases[k].ext);
+        scene *s = load(write_gltf("odd.gltf", gltf_json(NULL, meshes, extra, NULL)), err, sizeof err);
+        CHECK(s != NULL, "%s: %s", cases[k].ext, err);
+        if (!s) continue;
+        const material *m = &s->materials[0];
+        if (cases[k].warning)
+            CHECK(strstr(all_warnings, cases[k].warning) && strstr(all_warnings, "odd.gltf"), "%s: no warning '%s': %s",
+                  cases[k].ext, cases[k].warning, all_warnings);
+        else /* (the scene has no light: that warning only) */
+            CHECK(!strstr(all_warnings, "ior") && !strstr(all_warnings, "sheen"), "%s warns: %s", cases[k].ext,
+                  all_warnings);
+        CHECK(m->ext.ior == cases[k].ior && m->ext.sheen_color.y == cases[k].sheen, "%s: ior %g, sheen %g",
+              cases[k].ext, (double)m->ext.ior, (double)m->ext.sheen_color.y);
+        scene_destroy(s);
+    }
+}
+
 static void test_glb(void) {
     char err[512];
     unsigned char buf[20000];
@@ -513,6 +558,7 @@ int main(void) {
     test_index_types();
     test_lights_cameras();
     test_materials();
+    test_bad_material_numbers();
     test_glb();
     test_malformed();
     test_env_errors();
