@@ -3,6 +3,7 @@
  * variances combined with the spread of the shards' means about the whole (Chan et al.'s
  * pairwise update), so a merge is a shard again and merges further. */
 #define _POSIX_C_SOURCE 200809L
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -238,6 +239,14 @@ static int write_merged(const char *path, const accumulator *a, const layer_set 
             for (int k = 0; k < 3; k++) {
                 double c = a->count[i], m = c > 0.0 ? a->sum[l][k][i] / c : 0.0;
                 double v = c > 0.0 ? a->sumsq[l][k][i] / c - m * m : 0.0;
+                /* each shard's numbers are finite floats; the spread of their means need not be */
+                const double most = (double)FLT_MAX;
+                if (!(fabs(m) <= most && v <= most)) {
+                    cli_error("%s: pixel %zu: the merged %s %g does not fit in a float (the shards' means lie too "
+                              "far apart)",
+                              path, i, fabs(m) <= most ? "variance" : "mean", fabs(m) <= most ? v : m);
+                    goto done;
+                }
                 mean[3 * i + (size_t)k] = (float)m;
                 var[3 * i + (size_t)k] = v > 0.0 ? (float)v : 0.0f; /* rounding takes a constant pixel's below 0 */
             }

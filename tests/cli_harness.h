@@ -56,6 +56,7 @@ static inline size_t read_reference(const char *name, char *buf, size_t cap) {
  * `to`: with description (NULL: none) in its glint.reference header attribute or, when sidecar
  * is set, with none in the header and description in the file TO.json beside it, as glint wrote
  * references before they carried it. Returns 0, or -1 after printing why. */
+static inline int write_reference_image(const exr_image *image, const char *to, const char *description, int sidecar);
 static inline int write_reference(const char *from, const char *to, const char *description, int sidecar) {
     char p[1024], err[1024];
     snprintf(p, sizeof p, "%s/%s", tmp, from);
@@ -64,6 +65,15 @@ static inline int write_reference(const char *from, const char *to, const char *
         fprintf(stderr, "%s\n", err);
         return -1;
     }
+    int status = write_reference_image(&ex, to, description, sidecar);
+    exr_image_free(&ex);
+    return status;
+}
+
+/* The same from pixels in memory (an EXR as read, maybe changed). */
+static inline int write_reference_image(const exr_image *image, const char *to, const char *description, int sidecar) {
+    char p[1024], err[1024];
+    const exr_image ex = *image;
     size_t n = (size_t)ex.width * (size_t)ex.height;
     exr_layer layers[16];
     char prefixes[16][64];
@@ -96,7 +106,6 @@ static inline int write_reference(const char *from, const char *to, const char *
         if (f && fclose(f) != 0) status = -1;
     }
     for (int l = 0; l < nl; l++) free((void *)layers[l].rgb);
-    exr_image_free(&ex);
     return status;
 }
 

@@ -14,6 +14,7 @@
 
 #include "check.h"
 #include "cli_harness.h"
+#include "film.h"
 #include "image_io.h"
 #include "merge_stats.h"
 
@@ -190,11 +191,47 @@ static void test_refusals(void) {
     check_refused("render " SCENE " --spp 3 --shard 3/4 --out x.exr", "--spp 3 leaves shard 3 no frame", "x.exr");
 }
 
+/* Shard `from` again as `to` (its description kept), every mean set to value and every variance to
+ * 0: what a hostile or broken writer could hand to merge. */
+static int rewrite_shard(const char *from, const char *to, float value) {
+    char desc[16384];
+    exr_image ex;
+    if (!read_reference(from, desc, sizeof desc) || load(from, &ex) != 0) return -1;
+    for (int c = 0; c < ex.num_channels; c++) {
+        int var = strncmp(ex.names[c], MOMENTS_VAR_PREFIX, strlen(MOMENTS_VAR_PREFIX)) == 0;
+        if (!var && strncmp(ex.names[c], "moments.", 8) == 0) continue; /* the samples dropped: as they were */
+        for (size_t i = 0; i < (size_t)ex.width * (size_t)ex.height; i++) ex.planes[c][i] = var ? 0.0f : value;
+    }
+    int status = write_reference_image(&ex, to, desc, 0);
+    exr_image_free(&ex);
+    return status;
+}
+
+/* Shards whose means lie so far apart that the merged variance is past a float's range: refused
+ * (a merged reference must never hold a non-finite value, and its description must stay JSON). */
+static void test_far_apart(void) {
+    CHECK(run("render " SCENE " --spp 4 --shard 0/2 --out f0.exr") == 0 &&
+              run("render " SCENE " --spp 4 --shard 1/2 --out f1.exr") == 0,
+          "far-apart shards: %s", err_text);
+    const float far[] = {1e20f, 3.4028235e38f};
+    for (size_t k = 0; k < sizeof far / sizeof far[0]; k++) {
+        CHECK(rewrite_shard("f0.exr", "h0.exr", far[k]) == 0 && rewrite_shard("f1.exr", "h1.exr", -far[k]) == 0,
+              "rewriting the shards");
+        check_refused("merge h0.exr h1.exr --out r.exr", "does not fit in a float", "r.exr");
+    }
+    /* the same value in both: a merge as any other */
+    CHECK(rewrite_shard("f0.exr", "h0.exr", 1e20f) == 0 && rewrite_shard("f1.exr", "h1.exr", 1e20f) == 0,
+          "rewriting the shards");
+    CHECK(run("merge h0.exr h1.exr --out r.exr") == 0, "equal far means: %s", err_text);
+    CHECK(isfinite(described("r.exr", "mean_pixel_variance")), "the merge's noise is a number");
+}
+
 int main(int argc, char **argv) {
     int start = harness_start(argc, argv, "merge");
     if (start != 0) return start;
     test_exact();
     test_statistics();
     test_refusals();
+    test_far_apart();
     return check_exit("test_merge");
 }
