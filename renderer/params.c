@@ -90,7 +90,8 @@ static const param_choice merges[] = {{"on", HL_MERGE_ON, "on"}, {"off", HL_MERG
 /* In the help's order. Numbers' ranges are what the command line accepts; the panel's sliders span
  * the useful part of them. */
 static const param_desc table[] = {
-    {.name = "vsl-count", .type = PARAM_INT, .offset = F(count), .lo = 1, .hi = 50000000, .def = VL_DEFAULT_COUNT,
+    {.name = "vsl-count", .type = PARAM_INT, .offset = F(count), .lo = 1, .hi = 50000000,
+     .bytes_each = VL_BYTES_PER_LIGHT, .def = VL_DEFAULT_COUNT,
      .value_name = "N", .help = "virtual lights traced per frame", .label = "lights/frame",
      .unit = "lights per frame", .panel_lo = 16,
      .panel_hi = 1 << 20, .panel_log = 1, .panel_format = "%d"},
@@ -292,6 +293,12 @@ int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err,
         return snprintf(err, errlen, "expected %s in [%.15g, %.15g%s%s, got '%s'",
                         d->type == PARAM_INT ? "an integer" : "a number", d->lo, d->hi, d->below_hi ? ")" : "]", off,
                         text),
+               -1;
+    }
+    if (v * d->bytes_each > PARAM_MAX_BYTES) {
+        double gib = 1024.0 * 1024.0 * 1024.0;
+        return snprintf(err, errlen, "%s would take %.1f GiB (%.0f bytes each), over the limit of %.0f GiB", text,
+                        v * d->bytes_each / gib, d->bytes_each, PARAM_MAX_BYTES / gib),
                -1;
     }
     param_put(d, vl, d->zero_is_off && v == 0.0 ? -1.0 : v);

@@ -110,6 +110,22 @@ static void test_table(void) {
     CHECK(params_set(&v, "no-such-parameter", "1", err, sizeof err) == 0, "an unknown name was taken");
 }
 
+/* A parameter whose memory grows with it is refused beyond PARAM_MAX_BYTES, at once and saying what
+ * it would take: the most lights that fit are taken, one more is not. */
+static void test_memory_rule(void) {
+    const param_desc *d = param_find("vsl-count");
+    vl_params v = {0};
+    char err[256], text[32];
+    long long most = (long long)(PARAM_MAX_BYTES / d->bytes_each);
+    snprintf(text, sizeof text, "%lld", most);
+    CHECK(d->bytes_each > 0.0 && params_set(&v, "vsl-count", text, err, sizeof err) == 1 && v.count == most,
+          "vsl-count %s: %s", text, err);
+    snprintf(text, sizeof text, "%lld", most + 1);
+    CHECK(params_set(&v, "vsl-count", text, err, sizeof err) == -1 && v.count == most && strstr(err, "GiB") &&
+              strstr(err, "over the limit of 4 GiB"),
+          "vsl-count %s: %s", text, err);
+}
+
 /* Resolving is idempotent, leaves explicit values and "off" alone, and decides the clamp by method. */
 static void test_resolve(void) {
     const vl_params zero = {0};
@@ -150,6 +166,11 @@ static void test_options_doc(void) {
 static void test_program(void) {
     int n;
     const param_desc *t = params_table(&n);
+    /* One zero too many is one line at once, naming the option and the memory. */
+    CHECK(run("render --method vsl --vsl-count 50000000 --size 8x6 --spp 1 --png p.png") == 2 &&
+              strstr(err_text, "glint: error: --vsl-count: 50000000 would take 23.8 GiB") &&
+              strchr(err_text, '\n') == err_text + strlen(err_text) - 1,
+          "--vsl-count 50000000: %s", err_text);
     for (int i = 0; i < n; i++) {
         char text[64], args[512];
         example(&t[i], text, sizeof text);
@@ -163,6 +184,7 @@ static void test_program(void) {
 int main(int argc, char **argv) {
     test_table();
     test_resolve();
+    test_memory_rule();
     test_options_doc();
     if (argc >= 2 && harness_start(argc, argv, "params") == 0) test_program();
     return check_exit("test_params");
