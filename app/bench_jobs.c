@@ -14,6 +14,7 @@
 
 #include "bench.h"
 #include "cli.h"
+#include "image_io.h"
 
 #define ARGS_MAGIC "glint bench jobs 1"
 enum { MAX_ARGS_BYTES = 1 << 20 };
@@ -83,8 +84,8 @@ int bench_write_jobs(const char *dir, int argc, char **argv, int num_runs) {
 int bench_read_jobs(const char *dir, int *argc, char ***argv, char *cwd, size_t cwdlen) {
     char path[PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/args.txt", dir);
-    FILE *f = fopen(path, "rb");
-    if (!f) return cli_error("%s: %s (not a directory of glint bench --jobs)", path, strerror(errno)), -1;
+    FILE *f = open_regular_file(path);
+    if (!f) return cli_error("%s: %s (not a directory of glint bench --jobs)", path, open_regular_problem(errno)), -1;
     /* One block: the pointers, then the text they point into. */
     char *text = malloc(MAX_ARGS_BYTES + 1);
     size_t n = text ? fread(text, 1, MAX_ARGS_BYTES + 1, f) : 0;
@@ -163,8 +164,10 @@ static int next_line(csv_reader *c) {
 static int open_csv_of(csv_reader *c, const char *dir, int r, const char *name) {
     snprintf(c->path, sizeof c->path, "%s/run-%d/%s", dir, r, name);
     c->number = 0;
-    if (!(c->f = fopen(c->path, "rb")))
-        return cli_error("%s: %s (has job %d, line %d of jobs.txt, run?)", c->path, strerror(errno), r, r + 1), -1;
+    if (!(c->f = open_regular_file(c->path)))
+        return cli_error("%s: %s (has job %d, line %d of jobs.txt, run?)", c->path, open_regular_problem(errno), r,
+                         r + 1),
+               -1;
     if (!next_line(c)) {
         fclose(c->f);
         return cli_error("%s: empty", c->path), -1;

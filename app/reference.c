@@ -38,24 +38,6 @@ static uint64_t fnv1a64(uint64_t h, const unsigned char *p, size_t n) {
 }
 #define FNV_OFFSET 0xcbf29ce484222325ull
 
-/* Opens path for reading only when it is a regular file, without blocking on a FIFO. NULL with
- * errno set (EINVAL: not a regular file). */
-static FILE *open_regular(const char *path) {
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-    if (fd < 0) return NULL;
-    struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        close(fd);
-        errno = EINVAL;
-        return NULL;
-    }
-    FILE *f = fdopen(fd, "rb");
-    if (!f) close(fd);
-    return f;
-}
-
-static const char *open_problem(int e) { return e == EINVAL ? "not a regular file" : strerror(e); }
-
 int reference_hash_file(const char *path, char out[64], char *err, size_t errlen) {
     if (scene_builtin_name(path)) {
         const builtin_scene *b = scene_builtin_find(scene_builtin_name(path));
@@ -64,8 +46,8 @@ int reference_hash_file(const char *path, char out[64], char *err, size_t errlen
         snprintf(out, 64, "%s:fnv1a64:%016llx", path, (unsigned long long)h);
         return 0;
     }
-    FILE *f = open_regular(path);
-    if (!f) return fail(err, errlen, "%s: cannot open: %s", path, open_problem(errno));
+    FILE *f = open_regular_file(path);
+    if (!f) return fail(err, errlen, "%s: cannot open: %s", path, open_regular_problem(errno));
     uint64_t h = FNV_OFFSET;
     unsigned char buf[1 << 16];
     size_t n;
@@ -440,10 +422,10 @@ static int load_sidecar(const char *exr_path, reference_info *r, char *err, size
     char path[4200], label[4300];
     if (reference_sidecar_path(exr_path, path, sizeof path) != 0)
         return fail(err, errlen, "%s: name too long", exr_path);
-    FILE *f = open_regular(path);
+    FILE *f = open_regular_file(path);
     if (!f) {
         if (errno == ENOENT) return 1;
-        return fail(err, errlen, "%s: cannot open: %s", path, open_problem(errno));
+        return fail(err, errlen, "%s: cannot open: %s", path, open_regular_problem(errno));
     }
     char *text = malloc(MAX_DESCRIPTION + 2);
     if (!text) {

@@ -76,6 +76,22 @@ static int membuf_write_at(membuf *b, size_t offset, const void *src, size_t n) 
 
 /* ---- input files ----------------------------------------------------------------------------- */
 
+FILE *open_regular_file(const char *path) {
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0) return NULL;
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        errno = EINVAL;
+        return NULL;
+    }
+    FILE *f = fdopen(fd, "rb");
+    if (!f) close(fd);
+    return f;
+}
+
+const char *open_regular_problem(int e) { return e == EINVAL ? "not a regular file" : strerror(e); }
+
 /* Opens a regular file for reading; returns the descriptor and its size, or -1 with err set. */
 static int open_input(const char *path, int64_t *size, char *err, size_t errlen) {
     if (!path || !path[0]) return fail(err, errlen, path ? path : "", "empty file name");

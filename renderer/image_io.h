@@ -8,6 +8,7 @@
 #define GLINT_IMAGE_IO_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -38,6 +39,12 @@ typedef struct {
 } exr_image;
 
 int exr_image_load(const char *path, exr_image *out, char *err, size_t errlen);
+
+/* Opens path for reading only when it is a regular file, without blocking on a FIFO (every input
+ * file glint reads is one): NULL with errno set, EINVAL when it is not a regular file, which
+ * open_regular_problem words. */
+FILE *open_regular_file(const char *path);
+const char *open_regular_problem(int e);
 void exr_image_free(exr_image *img);
 /* The plane of the named channel, or NULL. */
 const float *exr_image_channel(const exr_image *img, const char *name);

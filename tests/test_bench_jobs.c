@@ -3,7 +3,7 @@
  * results.csv, summary.csv, the plots and report.md with the rows and sections a bench run in one
  * process writes (the numbers differ: they are timed renders). Refused: collecting before every
  * job ran, collecting twice, planning into a planned directory, --jobs with --out, a --job
- * beyond the plan, a directory no plan wrote.
+ * beyond the plan, a directory no plan wrote, a FIFO in place of a file --collect reads.
  * Usage: test_bench_jobs PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
@@ -65,13 +65,21 @@ int main(int argc, char **argv) {
     expect_refusal(BENCH " --jobs p2 --out x", "--jobs: the jobs choose their own --out");
     expect_usage(BENCH " --job 2 --out j2", "--job 2: the plan has 2 runs (0 to 1)");
     expect_refusal("bench --collect .", "args.txt");
-    /* Each line as a scheduler would run it: a shell command, from anywhere. */
+    /* A FIFO in place of a file it reads: refused, not waited on (it used to hang there). */
     char cmd[9000];
+    snprintf(cmd, sizeof cmd, "cd '%s' && cp -r plan fifo && rm fifo/args.txt && mkfifo fifo/args.txt", tmp);
+    CHECK(system(cmd) == 0, "making a FIFO");
+    expect_refusal("bench --collect fifo", "fifo/args.txt: not a regular file");
+    /* Each line as a scheduler would run it: a shell command, from anywhere. */
     for (char *line = jobs, *end; (end = strchr(line, '\n')); line = end + 1) {
         *end = '\0';
         snprintf(cmd, sizeof cmd, "cd / && %s >/dev/null 2>&1", line);
         CHECK(system(cmd) == 0, "job failed: %s", line);
     }
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && cp -r plan fifo2 && rm fifo2/run-1/summary.csv && mkfifo fifo2/run-1/summary.csv", tmp);
+    CHECK(system(cmd) == 0, "making a FIFO");
+    expect_refusal("bench --collect fifo2", "fifo2/run-1/summary.csv: not a regular file");
     CHECK(run("bench --collect plan") == 0, "--collect: %s", err_text);
     CHECK(run(BENCH " --out local --quiet") == 0, "local: %s", err_text);
     const char *files[] = {"results.csv", "summary.csv", "report.md", "error-vs-time.svg", "error-vs-time.png"};
