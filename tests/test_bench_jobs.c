@@ -3,7 +3,8 @@
  * results.csv, summary.csv, the plots and report.md with the rows and sections a bench run in one
  * process writes (the numbers differ: they are timed renders). Refused: collecting before every
  * job ran, collecting twice, planning into a planned directory, --jobs with --out, a --job
- * beyond the plan, a directory no plan wrote, a FIFO in place of a file --collect reads.
+ * beyond the plan, a directory no plan wrote, a FIFO in place of a file --collect reads, a
+ * run's CSV holding a value glint never writes (nan, inf, a count of 1e300 or none).
  * Usage: test_bench_jobs PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
@@ -80,6 +81,26 @@ int main(int argc, char **argv) {
              "cd '%s' && cp -r plan fifo2 && rm fifo2/run-1/summary.csv && mkfifo fifo2/run-1/summary.csv", tmp);
     CHECK(system(cmd) == 0, "making a FIFO");
     expect_refusal("bench --collect fifo2", "fifo2/run-1/summary.csv: not a regular file");
+    /* Values glint never writes: not counts, not finite numbers. */
+    const struct {
+        const char *file, *field, *value, *error;
+    } bad[] = {
+        {"results.csv", "5", "nan", "field 5 is not a number"},
+        {"results.csv", "5", "1e300", "not counts"},
+        {"results.csv", "5", "", "not counts"},
+        {"results.csv", "4", "inf", "field 4 is not a number"},
+        {"summary.csv", "7", "1e300", "not a run's"},
+        {"summary.csv", "8", "-inf", "field 8 is not a number"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        /* field F (1-based) of the file's second line set to the value */
+        snprintf(cmd, sizeof cmd,
+                 "cd '%s' && rm -rf bad && cp -r plan bad && sed -i '2s/^\\(\\([^,]*,\\)\\{%d\\}\\)[^,]*/\\1%s/' "
+                 "bad/run-0/%s",
+                 tmp, atoi(bad[k].field) - 1, bad[k].value, bad[k].file);
+        CHECK(system(cmd) == 0, "%s", cmd);
+        expect_refusal("bench --collect bad", bad[k].error);
+    }
     CHECK(run("bench --collect plan") == 0, "--collect: %s", err_text);
     CHECK(run(BENCH " --out local --quiet") == 0, "local: %s", err_text);
     const char *files[] = {"results.csv", "summary.csv", "report.md", "error-vs-time.svg", "error-vs-time.png"};
