@@ -115,6 +115,15 @@ int bench_read_jobs(const char *dir, int *argc, char ***argv, char *cwd, size_t 
         free(v);
         return cli_error("%s: not written by glint bench --jobs", path), -1;
     }
+    /* --jobs takes the plan's own options out of what it writes: there they would make --collect
+     * plan again, or run one job, in place of collecting */
+    static const char *const never[] = {"--jobs", "--job", "--collect", "--out"};
+    for (int i = 2; i < count; i++)
+        for (size_t k = 0; k < sizeof never / sizeof never[0]; k++)
+            if (strcmp(v[i], never[k]) == 0) {
+                free(v);
+                return cli_error("%s: holds %s, which glint bench --jobs never writes there", path, never[k]), -1;
+            }
     snprintf(cwd, cwdlen, "%s", v[1]);
     memmove(v, v + 2, sizeof(char *) * (size_t)(count - 2));
     *argc = count - 2;

@@ -4,7 +4,8 @@
  * process writes (the numbers differ: they are timed renders). Refused: collecting before every
  * job ran, collecting twice, planning into a planned directory, --jobs with --out, a --job
  * beyond the plan, a directory no plan wrote, a FIFO in place of a file --collect reads, a
- * run's CSV holding a value glint never writes (nan, inf, a count of 1e300 or none).
+ * run's CSV holding a value glint never writes (nan, inf, a count of 1e300 or none), an args.txt
+ * holding --jobs, --job or --out.
  * Usage: test_bench_jobs PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
@@ -81,6 +82,14 @@ int main(int argc, char **argv) {
              "cd '%s' && cp -r plan fifo2 && rm fifo2/run-1/summary.csv && mkfifo fifo2/run-1/summary.csv", tmp);
     CHECK(system(cmd) == 0, "making a FIFO");
     expect_refusal("bench --collect fifo2", "fifo2/run-1/summary.csv: not a regular file");
+    /* Options --jobs never writes into args.txt: collecting must not plan again or run a job. */
+    const char *const appended[] = {"--jobs\nD2", "--job\n0", "--out\nelsewhere"};
+    for (size_t k = 0; k < sizeof appended / sizeof appended[0]; k++) {
+        snprintf(cmd, sizeof cmd, "cd '%s' && rm -rf bad && cp -r plan bad && printf '%%s\\n' '%s' >>bad/args.txt", tmp,
+                 appended[k]);
+        CHECK(system(cmd) == 0, "%s", cmd);
+        expect_refusal("bench --collect bad", "which glint bench --jobs never writes there");
+    }
     /* Values glint never writes: not counts, not finite numbers. */
     const struct {
         const char *file, *field, *value, *error;
