@@ -6,6 +6,22 @@
 #include "cli.h"
 #include "commands.h"
 
+/* A sanitizer build (scripts/test.sh's build-test/) run as a user runs it: LeakSanitizer's
+ * suppressions built in, so that a real leak stands out. fontconfig keeps its configuration, read
+ * once when cairo first draws text (a plot's labels), until exit: a fixed few hundred bytes.
+ * tests/lsan.supp says the same for the test programs. */
+#if defined(__SANITIZE_ADDRESS__)
+#define GLINT_LSAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define GLINT_LSAN 1
+#endif
+#endif
+#ifdef GLINT_LSAN
+const char *__lsan_default_suppressions(void);
+const char *__lsan_default_suppressions(void) { return "leak:libfontconfig\n"; }
+#endif
+
 static void print_help(void) {
     printf("glint %s — progressive rendering of glossy global illumination\n"
            "\n"
