@@ -96,6 +96,16 @@ static void probe_light(const scene *s, scene_analysis *a, rng_state *rng) {
 }
 
 int scene_analyse(const scene *s, scene_analysis *a, char *err, size_t errlen) {
+    return scene_analyse_within(s, a, PLAN_PROBE_SECONDS, err, errlen);
+}
+
+/* Whether the probes have spent their budget (looked at every 64 probes: the clock costs). */
+static int spent(scene_analysis *a, uint64_t t0, double seconds) {
+    if (a->probe_rays % 64 == 0 && 1e-9 * (double)(clock_ns() - t0) >= seconds) a->cut = 1;
+    return a->cut;
+}
+
+int scene_analyse_within(const scene *s, scene_analysis *a, double seconds, char *err, size_t errlen) {
     uint64_t t0 = clock_ns();
     memset(a, 0, sizeof *a);
     a->num_materials = s->num_materials;
@@ -130,13 +140,13 @@ int scene_analyse(const scene *s, scene_analysis *a, char *err, size_t errlen) {
     }
     free(fill);
     rng_state rng = rng_for(0x9e3779b9u, 0, 0x706c616eu);
-    for (int g = 0; g < nm; g++) {
+    for (int g = 0; g < nm && !a->cut; g++) {
         int first = start[g], count = start[g + 1] - first;
         double area = 0.0;
         for (int k = 0; k < count; k++) cum[first + k] = area += triangle_area(s, order[first + k]);
         if (!(area > 0.0)) continue;
         int probes = PROBES_PER_MATERIAL + (int)(PROBES_TOTAL * (area / total_area));
-        for (int k = 0; k < probes; k++) {
+        for (int k = 0; k < probes && !spent(a, t0, seconds); k++) {
             /* A triangle by area: the first whose cumulative area exceeds u. */
             double u = rng_double(&rng) * area;
             int lo = 0, hi = count - 1;
@@ -150,7 +160,7 @@ int scene_analyse(const scene *s, scene_analysis *a, char *err, size_t errlen) {
             probe_surface(s, a, order[first + lo], &rng);
         }
     }
-    for (int k = 0; k < LIGHT_PROBES && s->num_lights > 0; k++) probe_light(s, a, &rng);
+    for (int k = 0; k < LIGHT_PROBES && s->num_lights > 0 && !spent(a, t0, seconds); k++) probe_light(s, a, &rng);
     free(start), free(order), free(cum);
 
     a->alpha_min = 0.0f;
@@ -188,7 +198,7 @@ void scene_analysis_free(scene_analysis *a) {
 effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mode) {
     effect_plan p;
     memset(&p, 0, sizeof p);
-    p.full = mode == PLAN_FULL;
+    p.full = mode == PLAN_FULL || a->cut; /* what a cut probe did not find may be there */
     p.max_depth = max_depth;
     int many = method == METHOD_VPL || method == METHOD_VSL || method == METHOD_VSL_HL;
     int vsl = method == METHOD_VSL || method == METHOD_VSL_HL;
@@ -204,11 +214,13 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
         p.vsl_all_strategies = vsl;
         p.highlights = method == METHOD_VSL_HL;
         p.env_prefilter = p.highlights && a->env;
-        const char *forced = "forced on (--plan full)";
-        snprintf(p.why_depth, sizeof p.why_depth, "%d, as asked (--plan full)", max_depth);
+        const char *why = mode == PLAN_FULL ? "--plan full" : "the scene's probe stopped at its time budget";
+        char forced[96];
+        snprintf(forced, sizeof forced, "forced on (%s)", why);
+        snprintf(p.why_depth, sizeof p.why_depth, "%d, as asked (%s)", max_depth, why);
         snprintf(p.why_virtual, sizeof p.why_virtual, "%s", many ? forced : "not this method");
         snprintf(p.why_kernel, sizeof p.why_kernel, "%s",
-                 vsl ? "three strategies for every pair (--plan full)" : "not this method");
+                 vsl ? "three strategies for every pair (every pass on)" : "not this method");
         snprintf(p.why_highlights, sizeof p.why_highlights, "%s", p.highlights ? forced : "not this method");
         snprintf(p.why_env, sizeof p.why_env, "%s",
                  p.env_prefilter ? forced
@@ -270,9 +282,9 @@ void plan_print(FILE *f, const scene *s, const scene_analysis *a, const effect_p
     fprintf(f, " materials\n");
     fprintf(f, "            emitters: %d punctual, %d emissive triangles, %s\n", a->punctual, a->area,
             a->env ? "an environment map" : "no environment map");
-    fprintf(f, "            indirect light %s; glossy-to-glossy transport %s (%ld probe rays, %.0f ms); scale %.3g\n",
+    fprintf(f, "            indirect light %s; glossy-to-glossy transport %s (%ld probe rays, %.0f ms%s); scale %.3g\n",
             a->indirect ? "possible" : "impossible", a->glossy_to_glossy ? "possible" : "not found", a->probe_rays,
-            1e3 * a->seconds, (double)s->diag);
+            1e3 * a->seconds, a->cut ? ", stopped at the time budget: a partial look" : "", (double)s->diag);
     char text[1200];
     plan_summary(p, text, sizeof text);
     const char *line = text;

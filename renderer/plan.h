@@ -37,6 +37,7 @@ typedef struct {
     int indirect;               /* a reflecting surface sees another: indirect light can exist */
     int glossy_to_glossy;       /* a glossy surface sees a glossy surface */
     long probe_rays;            /* rays the visibility probes traced */
+    int cut;                    /* the probes stopped at their time budget: what they found is partial */
     double seconds;             /* the analysis's wall time */
 } scene_analysis;
 
@@ -46,6 +47,11 @@ typedef struct {
  * finds what it passes light on to. Deterministic. Returns 0, or -1 (out of memory) with err set;
  * free with scene_analysis_free. */
 int scene_analyse(const scene *s, scene_analysis *a, char *err, size_t errlen);
+/* The same within a time budget: the probes stop once it is spent (cut set; a scene whose rays
+ * each test a million coincident triangles took two minutes), and a plan made from a cut analysis
+ * turns every pass on. scene_analyse's budget is PLAN_PROBE_SECONDS. */
+#define PLAN_PROBE_SECONDS 2.0
+int scene_analyse_within(const scene *s, scene_analysis *a, double seconds, char *err, size_t errlen);
 void scene_analysis_free(scene_analysis *a);
 
 enum { PLAN_AUTO = 0, PLAN_FULL };

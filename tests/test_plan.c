@@ -246,7 +246,26 @@ static void test_environment_only(void) {
     scene_destroy(s);
 }
 
+/* A probe cut short by its time budget (here none at all) says so, and its plan turns every pass
+ * on: the diffuse room, whose full probe switches the highlight pass off, gets it. */
+static void test_cut_probe(void) {
+    scene *s = room(ROOM_DIFFUSE);
+    scene_analysis a, whole = analyse(s);
+    char err[256];
+    CHECK(scene_analyse_within(s, &a, 0.0, err, sizeof err) == 0, "%s", err);
+    CHECK(a.cut && a.probe_rays == 0 && !whole.cut && whole.probe_rays > 0, "cut %d after %ld rays; whole %d, %ld",
+          a.cut, a.probe_rays, whole.cut, whole.probe_rays);
+    effect_plan p = plan_make(&a, METHOD_VSL_HL, 5, PLAN_AUTO), q = plan_make(&whole, METHOD_VSL_HL, 5, PLAN_AUTO);
+    CHECK(p.full && p.highlights && p.virtual_lights && p.vsl_all_strategies && !q.highlights,
+          "a cut probe's plan: full %d, highlights %d (the whole probe's %d)", p.full, p.highlights, q.highlights);
+    CHECK(strstr(p.why_highlights, "time budget") != NULL, "the plan does not say why: %s", p.why_highlights);
+    scene_analysis_free(&a);
+    scene_analysis_free(&whole);
+    scene_destroy(s);
+}
+
 int main(void) {
+    test_cut_probe();
     test_diffuse_then_glossy();
     test_glossy_without_glossy_transport();
     test_view_without_glossy_pixels();
