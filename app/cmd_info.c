@@ -123,7 +123,9 @@ int cmd_info(int argc, char **argv) {
     for (int i = 0; i < s->num_lights; i++) by_type[s->lights[i].type]++;
     vec3 ext = sub3(s->bounds.hi, s->bounds.lo);
     printf("scene:      %s\n", s->path);
-    printf("geometry:   %d triangles, %d vertices\n", s->num_triangles, s->num_vertices);
+    printf("geometry:   %d triangles, %d vertices", s->num_triangles, s->num_vertices);
+    if (s->coincident) printf(", %ld triangles repeating another's corners", s->coincident);
+    printf("\n");
     printf("size:       %.4g x %.4g x %.4g (diagonal %.4g), ray offset %.3g\n", (double)ext.x, (double)ext.y,
            (double)ext.z, (double)s->diag, (double)s->ray_eps);
     printf("materials:  %d (%d metallic-roughness, %d Phong, %d Ward; %d emissive)\n", s->num_materials,

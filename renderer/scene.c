@@ -378,6 +378,13 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
         s->tri_normal[t] = normalize3(cross3(sub3(s->positions[v[1]], p0), sub3(s->positions[v[2]], p0)));
     }
 
+    s->coincident = scene_count_coincident(s);
+    if (s->coincident < 0) return snprintf(err, errlen, "%s: out of memory", s->path), -1;
+    if (s->coincident > 0)
+        scene_warn(s,
+                   "%s: %ld triangles repeat another's three corners: they add nothing to the image and slow "
+                   "every ray through them",
+                   s->path, s->coincident);
     /* The BVH first: it decides which triangles no ray can see (alpha), and those emit nothing. */
     if (scene_build_bvh(s, err, errlen) != 0 || scene_emissive_analyse(s, err, errlen) != 0 ||
         scene_build_lights(s, err, errlen) != 0)

@@ -157,6 +157,7 @@ typedef struct scene {
     vec4 *tangents; /* xyz tangent, w = bitangent sign */
     vec2 *uv0, *uv1;
     int num_triangles, cap_triangles;
+    long coincident; /* triangles that repeat another's three corners (scene_count_coincident) */
     uint32_t *indices;
     int32_t *tri_material;
     int32_t *tri_light; /* light index of an emissive triangle, else -1 */
@@ -347,6 +348,9 @@ int scene_intersect(const scene *s, vec3 o, vec3 d, float tmax, surface_hit *h);
  * hit, and then h[i] is filled as scene_intersect fills it. */
 #define SCENE_PACKET 16
 unsigned scene_intersect_packet(const scene *s, vec3 o, const vec3 *d, int n, surface_hit *h);
+/* The triangles that repeat an earlier one's three corners (any order), or -1 out of memory:
+ * scene_finalize counts them into coincident and warns (coincident.c). */
+long scene_count_coincident(const scene *s);
 /* 1 if anything blocks o + t d for t in (0, tmax): glass too. */
 int scene_occluded(const scene *s, vec3 o, vec3 d, float tmax);
 /* What reaches o + tmax d from o along d for a shadow ray (docs/design.md, "Transmission and

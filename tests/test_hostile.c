@@ -292,6 +292,19 @@ static void test_node_graphs(void) {
                  "node hierarchy has a cycle at node 0");
 }
 
+/* One quad placed five times where it is and once beside: eight of the twelve triangles repeat
+ * another's corners, and the load says so (a million such made every ray test them all). */
+static void test_coincident(void) {
+    const char *nodes = "\"nodes\":[{\"children\":[1,2,3,4,5,6]},{\"mesh\":0},{\"mesh\":0},{\"mesh\":0},"
+                        "{\"mesh\":0},{\"mesh\":0},{\"mesh\":0,\"translation\":[2,0,0]}]";
+    char *json = quad_json(nodes, -1, NULL, NULL);
+    scene *s =
+        expect_warning("coincident", write_text("coincident.gltf", json), "8 triangles repeat another's three corners");
+    CHECK(s && s->num_triangles == 12 && s->coincident == 8, "coincident: %d triangles, %ld repeating",
+          s ? s->num_triangles : 0, s ? s->coincident : 0L);
+    scene_destroy(s);
+}
+
 /* FIFOs and devices, as the scene or behind a URI, are refused without being opened for long;
  * so are directories. */
 static void test_special_files(void) {
@@ -470,6 +483,7 @@ int main(void) {
     test_json_depth();
     test_coordinates();
     test_node_graphs();
+    test_coincident();
     test_special_files();
     test_image_budget();
     test_factors();
