@@ -99,6 +99,13 @@ int cli_parse_size(const char *option, const char *text, int *width, int *height
         cli_error("%s: expected WIDTHxHEIGHT (1..16384 each), got '%s'", option, text);
         return -1;
     }
+    /* what the film and the per-pixel records take grows with the pixels: refused at once, as a
+     * many-light parameter's memory is (params.h) */
+    double bytes = (double)w * (double)h * CLI_PIXEL_BYTES, gib = 1024.0 * 1024.0 * 1024.0;
+    if (bytes > CLI_MAX_IMAGE_BYTES)
+        return cli_error("%s: %s would take %.1f GiB (%.0f bytes a pixel), over the limit of %.0f GiB", option, text,
+                         bytes / gib, CLI_PIXEL_BYTES, CLI_MAX_IMAGE_BYTES / gib),
+               -1;
     *width = (int)w;
     *height = (int)h;
     return 0;

@@ -68,6 +68,9 @@ static void test_usage(void) {
     expect_failure("render --spp -3", 2, "--spp");
     expect_failure("render --spp 10x", 2, "--spp");
     expect_failure("render --size 0x5", 2, "--size");
+    /* an image whose film would not fit: at once, with what it would take */
+    expect_failure("render --size 16384x16384 --spp 1 --out big.exr", 2,
+                   "--size: 16384x16384 would take 32.0 GiB (128 bytes a pixel), over the limit of 16 GiB");
     expect_failure("render --size 100", 2, "--size");
     expect_failure("render --spp 4 --time 2", 2, NULL);
     expect_failure("render --method nope", 2, "nope");
