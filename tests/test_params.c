@@ -124,6 +124,16 @@ static void test_memory_rule(void) {
     CHECK(params_set(&v, "vsl-count", text, err, sizeof err) == -1 && v.count == most && strstr(err, "GiB") &&
               strstr(err, "over the limit of 4 GiB"),
           "vsl-count %s: %s", text, err);
+    /* clustering's matrix, rows x lights floats, under the same limit whichever option comes last */
+    vl_params m = {0};
+    CHECK(params_set(&m, "rows", "100000", err, sizeof err) == 1 &&
+              params_set(&m, "vsl-count", "8000000", err, sizeof err) == 1,
+          "rows and lights alone: %s", err);
+    CHECK(params_set(&m, "columns", "100", err, sizeof err) == -1 && m.columns == 0 && strstr(err, "matrix"),
+          "columns 100 with a 100000 x 8000000 matrix: %s", err);
+    CHECK(params_set(&m, "rows", "30", err, sizeof err) == 1 && params_set(&m, "columns", "100", err, sizeof err) == 1,
+          "a matrix of 30 rows: %s", err);
+    CHECK(params_set(&m, "rows", "100000", err, sizeof err) == -1 && m.rows == 30, "rows back to 100000: %s", err);
 }
 
 /* Resolving is idempotent, leaves explicit values and "off" alone, and decides the clamp by method. */
