@@ -295,13 +295,17 @@ int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err,
                         text),
                -1;
     }
+    return param_set_value(d, vl, d->zero_is_off && v == 0.0 ? -1.0 : v, text, err, errlen);
+}
+
+int param_set_value(const param_desc *d, vl_params *vl, double v, const char *text, char *err, size_t errlen) {
     double gib = 1024.0 * 1024.0 * 1024.0;
     if (v * d->bytes_each > PARAM_MAX_BYTES)
         return snprintf(err, errlen, "%s would take %.1f GiB (%.0f bytes each), over the limit of %.0f GiB", text,
                         v * d->bytes_each / gib, d->bytes_each, PARAM_MAX_BYTES / gib),
                -1;
     vl_params was = *vl;
-    param_put(d, vl, d->zero_is_off && v == 0.0 ? -1.0 : v);
+    param_put(d, vl, v);
     /* Clustering's matrix is rows x lights floats: the two together under the same limit. */
     vl_params r = vl_params_resolve(vl);
     double matrix = r.columns > 0 ? (double)r.rows * (double)r.count * sizeof(float) : 0.0;

@@ -274,6 +274,10 @@ const param_desc *params_table(int *count);
 const param_desc *param_find(const char *name);
 /* Sets d's field in vl from text. Returns 0, or -1 with err = "NAME: problem" and vl unchanged. */
 int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err, size_t errlen);
+/* Sets parameter d to v (in range, -1 for off) under the memory rules (bytes_each and
+ * clustering's matrix within PARAM_MAX_BYTES): 0, or -1 with vl unchanged and err saying what it
+ * would take (text: the value as the user gave it). param_parse and the panel both set through it. */
+int param_set_value(const param_desc *d, vl_params *vl, double v, const char *text, char *err, size_t errlen);
 /* Like param_parse by name: 1 applied, 0 no such parameter, -1 a bad value (err set). */
 int params_set(vl_params *vl, const char *name, const char *text, char *err, size_t errlen);
 /* The field's value as param_parse reads it back (a choice's name, the off word, a number). */

@@ -274,7 +274,9 @@ static void param_widgets(param_group group, vl_params *vl) {
             edited = -1.0;
         else
             edited = std::fmin(std::fmax(edited, d->lo), d->below_hi ? std::nextafter(d->hi, 0.0) : d->hi);
-        param_put(d, vl, edited);
+        char text[32], why[256];
+        std::snprintf(text, sizeof text, "%g", edited);
+        param_set_value(d, vl, edited, text, why, sizeof why); // refused: the slider stays where it was
     }
 }
 
