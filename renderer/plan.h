@@ -44,8 +44,8 @@ typedef struct {
 /* Analyses s (read-only, thread-safe queries): probes random surface points on both sides,
  * each material in proportion to its area with a floor per material, and the first hits of
  * light paths; from each point on a side that can be seen (or lit), one cosine-distributed ray
- * finds what it passes light on to. Deterministic. Returns 0, or -1 (out of memory) with err set;
- * free with scene_analysis_free. */
+ * finds what it passes light on to. Deterministic unless cut short (below). Returns 0, or -1 (out
+ * of memory) with err set; free with scene_analysis_free. */
 int scene_analyse(const scene *s, scene_analysis *a, char *err, size_t errlen);
 /* The same within a time budget: the probes stop once it is spent (cut set; a scene whose rays
  * each test a million coincident triangles took two minutes), and a plan made from a cut analysis
