@@ -156,7 +156,9 @@ static int field_number(const char *s, double *out) {
     return *end || errno == ERANGE || !isfinite(*out) ? -1 : 0;
 }
 
-/* A count read as a number: whole, from 0 to most (a NAN, 1e300 or -1 would wrap when converted). */
+/* A count read as a number: whole, from 0 to most (a NAN, 1e300 or -1 would wrap when converted);
+ * frames at most 2^53, the doubles that are all whole numbers. */
+#define MAX_FRAMES 9007199254740992.0
 static int whole(double v, double most) { return v >= 0.0 && v <= most && v == floor(v); }
 
 typedef struct {
@@ -213,7 +215,7 @@ static int read_results(csv_reader *c, const bench_options *o, bench_run *run) {
                 return cli_error("%s: line %d: seed %s, this plan's is %llu", c->path, c->number, f[2],
                                  (unsigned long long)(run->params.seed + (uint64_t)i)),
                        -1;
-            if (!whole(v[4], 9007199254740992.0) || !whole(v[7 + 2 * ERR_COUNT], 1 << 20))
+            if (!whole(v[4], MAX_FRAMES) || !whole(v[7 + 2 * ERR_COUNT], 1 << 20))
                 return cli_error("%s: line %d: frames %s, threads %s: not counts", c->path, c->number, f[4],
                                  f[7 + 2 * ERR_COUNT]),
                        -1;
@@ -242,7 +244,7 @@ static int read_summary(csv_reader *c, const bench_options *o, bench_run *run) {
             return cli_error("%s: line %d: not %s at %g s over %d seeds, as this plan has it", c->path, c->number,
                              bench_err_names[o->component], o->times[k], o->seeds),
                    -1;
-        if (!(v[5] >= 0.0) || !(v[6] >= 0.0 && v[6] <= 9007199254740992.0))
+        if (!(v[5] >= 0.0) || !(v[6] >= 0.0 && v[6] <= MAX_FRAMES))
             return cli_error("%s: line %d: seconds %s, frames %s: not a run's", c->path, c->number, f[5], f[6]), -1;
         run->seconds[k] = v[5];
         run->frames[k] = v[6];

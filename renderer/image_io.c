@@ -76,41 +76,44 @@ static int membuf_write_at(membuf *b, size_t offset, const void *src, size_t n) 
 
 /* ---- input files ----------------------------------------------------------------------------- */
 
-FILE *open_regular_file(const char *path) {
+/* The one way glint opens a file it reads: non-blocking, since opening a FIFO would otherwise wait
+ * for a writer, and only a regular file gets further (where the flag changes nothing). The
+ * descriptor and its size, or -1 with errno set: EISDIR for a directory, EINVAL for anything else
+ * that is not a regular file. */
+static int open_regular_fd(const char *path, int64_t *size) {
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-    if (fd < 0) return NULL;
+    if (fd < 0) return -1;
     struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    int e = fstat(fd, &st) != 0 ? errno : !S_ISREG(st.st_mode) ? (S_ISDIR(st.st_mode) ? EISDIR : EINVAL) : 0;
+    if (e) {
         close(fd);
-        errno = EINVAL;
-        return NULL;
+        errno = e;
+        return -1;
     }
+    *size = (int64_t)st.st_size;
+    return fd;
+}
+
+FILE *open_regular_file(const char *path) {
+    int64_t size;
+    int fd = open_regular_fd(path, &size);
+    if (fd < 0) return NULL;
     FILE *f = fdopen(fd, "rb");
     if (!f) close(fd);
     return f;
 }
 
-const char *open_regular_problem(int e) { return e == EINVAL ? "not a regular file" : strerror(e); }
+const char *open_regular_problem(int e) { return e == EINVAL || e == EISDIR ? "not a regular file" : strerror(e); }
 
 /* Opens a regular file for reading; returns the descriptor and its size, or -1 with err set. */
 static int open_input(const char *path, int64_t *size, char *err, size_t errlen) {
     if (!path || !path[0]) return fail(err, errlen, path ? path : "", "empty file name");
-    /* Non-blocking: opening a FIFO would otherwise wait for a writer. Only regular files get
-     * further (where the flag changes nothing). */
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-    if (fd < 0) return fail(err, errlen, path, "%s", strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) != 0) {
-        int e = errno;
-        close(fd);
-        return fail(err, errlen, path, "%s", strerror(e));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        close(fd);
+    int fd = open_regular_fd(path, size);
+    if (fd < 0)
         return fail(err, errlen, path, "%s",
-                    S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file (a pipe or a device?)");
-    }
-    *size = (int64_t)st.st_size;
+                    errno == EISDIR   ? "is a directory"
+                    : errno == EINVAL ? "not a regular file (a pipe or a device?)"
+                                      : strerror(errno));
     return fd;
 }
 

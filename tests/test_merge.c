@@ -199,7 +199,7 @@ static int rewrite_shard(const char *from, const char *to, float value) {
     if (!read_reference(from, desc, sizeof desc) || load(from, &ex) != 0) return -1;
     for (int c = 0; c < ex.num_channels; c++) {
         int var = strncmp(ex.names[c], MOMENTS_VAR_PREFIX, strlen(MOMENTS_VAR_PREFIX)) == 0;
-        if (!var && strncmp(ex.names[c], "moments.", 8) == 0) continue; /* the samples dropped: as they were */
+        if (strncmp(ex.names[c], MOMENTS_REJECTED, strlen(MOMENTS_REJECTED)) == 0) continue; /* as they were */
         for (size_t i = 0; i < (size_t)ex.width * (size_t)ex.height; i++) ex.planes[c][i] = var ? 0.0f : value;
     }
     int status = write_reference_image(&ex, to, desc, 0);
