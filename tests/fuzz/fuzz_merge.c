@@ -43,8 +43,8 @@ static void put(int k, const uint8_t *bytes, size_t size) {
     }
 }
 
-/* Where the merge writes: a folder of its own, made once, the output removed before each merge
- * (merge never replaces silently) and at exit. */
+/* Where the merge writes: a folder of its own, made once, the output removed before each merge (so
+ * that one found there is this input's) and at exit. */
 static char folder[64], out[96];
 static void remove_output(void) {
     remove(out);
