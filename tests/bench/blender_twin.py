@@ -4,10 +4,12 @@ scenes: the same scene, camera, size, environment and path depth, rendered by bo
 block of pixels (docs/benchmarks.md, "glint against Blender Cycles").
 
     blender_twin.py run GLINT OUTDIR [--size WxH] [--spp N] [--env MAP] [--block PX] [--scenes A,B]
+            [--scenes-dir DIR]
         Renders each scene with both (glint's path tracer, Cycles through scripts/blender_render.py)
         and prints, per scene, glint's luminance over Cycles' per block of PX pixels (40) and a
         summary, and for the sphere grid per grey sphere (metallic by roughness). The scenes: metal-rough-spheres as it is and as Lambert of its base colours (the
-        control: the same BRDF in both), the damaged helmet, the water bottle.
+        control: the same BRDF in both), the damaged helmet, the water bottle, from the shared
+        scenes' folder (not in the repository): --scenes-dir, else GLINT_SHARED_SCENES.
     blender_twin.py compare A.exr B.exr [--block PX]
         The same comparison of two EXRs (glint's or Blender's).
 
@@ -289,9 +291,15 @@ def render_pair(glint, scene, env, size, spp, out_dir, name, lambert):
     return g_exr, c_exr
 
 
-def scenes_dir():
-    """The shared scenes: GLINT_SHARED_SCENES (the test sets it), else ../shared/scenes beside the checkout."""
-    return os.environ.get("GLINT_SHARED_SCENES") or os.path.join(os.path.dirname(ROOT), "shared", "scenes")
+def scenes_dir(given=None):
+    """The shared scenes (glTF samples by others, not in the repository): --scenes-dir, else
+    GLINT_SHARED_SCENES (the test sets it from CMake's GLINT_SHARED_SCENES); no guess beside it."""
+    d = given or os.environ.get("GLINT_SHARED_SCENES")
+    if not d:
+        fail("the shared scenes' folder: give --scenes-dir DIR or set GLINT_SHARED_SCENES")
+    if not os.path.isdir(d):
+        fail(d + ": not a folder (the shared scenes')")
+    return d
 
 
 def options(args, defaults):
@@ -307,9 +315,10 @@ def options(args, defaults):
 
 
 def cmd_run(glint, out_dir, args):
-    sc = scenes_dir()
-    o = options(args, {"size": "320x320", "spp": "256", "env": os.path.join(sc, "envmaps", "blender_studio.exr"),
-                       "block": "40", "scenes": "mrs-lambert,mrs,helmet,bottle"})
+    o = options(args, {"size": "320x320", "spp": "256", "env": "", "block": "40",
+                       "scenes": "mrs-lambert,mrs,helmet,bottle", "scenes_dir": ""})
+    sc = scenes_dir(o["scenes_dir"])
+    o["env"] = o["env"] or os.path.join(sc, "envmaps", "blender_studio.exr")
     os.makedirs(out_dir, exist_ok=True)
     mrs = os.path.join(sc, "metal-rough-spheres-notextures", "glTF", "MetalRoughSpheresNoTextures.gltf")
     runs = [("mrs-lambert", rewritten_scene(mrs, os.path.join(out_dir, "mrs-lambert"), True), True),
