@@ -543,8 +543,11 @@ extern "C" int exr_read_string_fd(const char *path, int fd, int64_t size, const 
     return found ? 0 : 1;
 }
 
-extern "C" int exr_write_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers,
-                                const exr_text_attr *attrs, int num_attrs, write_mode mode, char *err, size_t errlen) {
+extern "C" int exr_encode_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers,
+                                 const exr_text_attr *attrs, int num_attrs, void **out, size_t *size, char *err,
+                                 size_t errlen) {
+    *out = nullptr;
+    *size = 0;
     const char *stage = "cannot encode OpenEXR";
     std::vector<char> data;
     int status = guarded(
@@ -557,5 +560,21 @@ extern "C" int exr_write_layers(const char *path, int width, int height, const e
         },
         [] { return std::string("out of memory"); });
     if (status != 0) return -1;
-    return write_file_atomic(path, data.data(), data.size(), mode, err, errlen);
+    if (!(*out = std::malloc(data.empty() ? 1 : data.size()))) return fail(err, errlen, path, "out of memory");
+    std::memcpy(*out, data.data(), data.size());
+    *size = data.size();
+    return 0;
+}
+
+/* Frees what exr_read_fd reads (declared in image_io.h, for every reader of an exr_image): here,
+ * beside the allocation, so that this file calls nothing of image_io.c's. */
+extern "C" void exr_image_free(exr_image *img) {
+    if (!img) return;
+    for (int i = 0; i < img->num_channels; i++) {
+        if (img->names) std::free(img->names[i]);
+        if (img->planes) std::free(img->planes[i]);
+    }
+    std::free(img->names);
+    std::free(img->planes);
+    std::memset(img, 0, sizeof *img);
 }

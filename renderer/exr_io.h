@@ -40,10 +40,12 @@ int exr_read_string_fd(const char *path, int fd, int64_t size, const char *name,
                        size_t errlen);
 
 /* Encodes the layers and attributes (arguments checked by the caller, exr_save_layers_attrs) as
- * a ZIP-compressed scanline EXR of 32-bit float channels in memory, then writes it to path with
- * write_file_atomic. Returns 0, or -1 with "PATH: problem" in err. */
-int exr_write_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers,
-                     const exr_text_attr *attrs, int num_attrs, write_mode mode, char *err, size_t errlen);
+ * a ZIP-compressed scanline EXR of 32-bit float channels in memory: *data (malloc'ed; the caller
+ * writes and frees it) of *size bytes. The file is written by image_io.c (write_file_atomic):
+ * this file reads and encodes, and calls nothing of image_io.c's. Returns 0, or -1 with "PATH:
+ * problem" in err (path is used in messages only). */
+int exr_encode_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers,
+                      const exr_text_attr *attrs, int num_attrs, void **data, size_t *size, char *err, size_t errlen);
 
 #ifdef __cplusplus
 }

@@ -152,17 +152,6 @@ int exr_image_load(const char *path, exr_image *out, char *err, size_t errlen) {
     return status;
 }
 
-void exr_image_free(exr_image *img) {
-    if (!img) return;
-    for (int i = 0; i < img->num_channels; i++) {
-        if (img->names) free(img->names[i]);
-        if (img->planes) free(img->planes[i]);
-    }
-    free(img->names);
-    free(img->planes);
-    memset(img, 0, sizeof *img);
-}
-
 const float *exr_image_channel(const exr_image *img, const char *name) {
     for (int i = 0; img && name && i < img->num_channels; i++)
         if (strcmp(img->names[i], name) == 0) return img->planes[i];
@@ -381,7 +370,13 @@ int exr_save_layers_attrs(const char *path, int width, int height, const exr_lay
             if (strcmp(attrs[i].name, attrs[j].name) == 0)
                 return fail(err, errlen, path, "header attribute %s given twice", attrs[i].name);
     }
-    return exr_write_layers(path, width, height, layers, num_layers, attrs, num_attrs, mode, err, errlen);
+    void *data;
+    size_t size;
+    if (exr_encode_layers(path, width, height, layers, num_layers, attrs, num_attrs, &data, &size, err, errlen) != 0)
+        return -1;
+    int status = write_file_atomic(path, data, size, mode, err, errlen);
+    free(data);
+    return status;
 }
 
 int exr_save_layers(const char *path, int width, int height, const exr_layer *layers, int num_layers, write_mode mode,
