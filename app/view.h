@@ -142,13 +142,41 @@ typedef struct {
     uint64_t variant_target;                           /* the load of a variant switch under way, or 0 */
 } ui_thread;
 
-/* view_camera.c: the free camera, the scene's cameras and the bookmarks file */
+/* The viewer's UI files, each calling only those above it here (view_display.c, the top, calls
+ * them all; view_script_run.c drives them for scripts). */
+
+/* view_camera.c: the free camera */
 camera ctl_camera(const cam_ctl *c);
 /* The free camera at cam, orbiting a centre in front of it. */
 cam_ctl ctl_from_camera(const camera *cam, const scene_info *info);
 void ctl_orbit(cam_ctl *c, float dyaw, float dpitch);
 void ctl_pan(cam_ctl *c, float dx, float dy);
 void ctl_zoom(cam_ctl *c, float factor);
+
+/* view_window.c: the image's place beside the panel, the requests made of the render side */
+/* The image's size beside the panel: in framebuffer pixels (the render size), in window units. */
+void view_image_size(ui_thread *u, int *w, int *h);
+void view_image_window_size(ui_thread *u, int *w, int *h);
+/* Where the image is drawn (x0, y0, x1, y1, window units): the place beside the panel, or, while
+ * the image shown was rendered for another size, the largest part of it of the image's shape. */
+void view_image_rect(ui_thread *u, float rect[4]);
+/* Sends the camera, estimator settings and lights: a change that resets the accumulation. */
+void send_change(ui_thread *u);
+long long frames_of_current_state(const ui_thread *u);
+void request_export(ui_thread *u, const char *name);
+/* kind: LOAD_SCENE, LOAD_ENV (path), LOAD_SKY, LOAD_NO_ENV. */
+void request_load(ui_thread *u, int kind, const char *path);
+/* The scene again with material variant v (-1: the defaults), the view kept. */
+void request_variant(ui_thread *u, int v);
+/* A full frame's time with the current estimator settings; 0 before one is measured. */
+double view_cost_ms(const ui_thread *u);
+
+/* view_image.c: the image shown, tone-mapped into the window's texture, and saved */
+void make_texture(ui_thread *u);
+void tonemap_and_upload(ui_thread *u);
+void take_screenshot(ui_thread *u, const char *name);
+
+/* view_nav.c: navigation that cannot get lost, resets and bookmarks, the reference, status */
 /* The camera chosen in the controls (or the scene's first, or one framing the scene). */
 void reset_view(ui_thread *u);
 void bookmarks_load(ui_thread *u);
@@ -156,31 +184,10 @@ int bookmark_save(ui_thread *u, int slot);
 int bookmark_restore(ui_thread *u, int slot);
 /* Which bookmarks are set, and where they live, for the panel. */
 void describe_bookmarks(ui_thread *u);
+/* A reference image for the error view and plot, measured from cam with lights (its description's;
+ * NULL: from any view); 0, or -1 with the message shown. */
+int load_reference(ui_thread *u, const char *path, const camera *cam, const char *lights);
 
-/* view_input.c: controls, lights, keys and mouse; the requests they make of the render thread */
-void send_change(ui_thread *u);
-void apply_controls(ui_thread *u, int camera_changed);
-long long frames_of_current_state(const ui_thread *u);
-void request_export(ui_thread *u, const char *name);
-/* kind: LOAD_SCENE, LOAD_ENV (path), LOAD_SKY, LOAD_NO_ENV. */
-void request_load(ui_thread *u, int kind, const char *path);
-/* The scene again with material variant v (-1: the defaults), the view kept. */
-void request_variant(ui_thread *u, int v);
-vec3 light_position(const ui_thread *u, int g);
-int light_movable(const ui_thread *u, int g);
-void update_light_screen(ui_thread *u);
-int move_light(ui_thread *u, int g, vec3 delta, char *err, size_t errlen);
-void reset_lights(ui_thread *u);
-void press_key(ui_thread *u, int key, int mods);
-void on_key(GLFWwindow *win, int key, int scancode, int action, int mods);
-void on_scroll(GLFWwindow *win, double dx, double dy);
-void on_drop(GLFWwindow *win, int count, const char **paths);
-void note_input_callbacks(GLFWwindow *win);
-int handle_input(ui_thread *u, double dt);
-/* Whether the mouse drags the camera or a light in the image (a button held, the panel not under it). */
-int view_dragging(ui_thread *u);
-
-/* view_nav.c: navigation that cannot get lost, the reference's description and camera, status */
 /* Distance to the first surface along o + t d, or INFINITY (also when the scene is busy). */
 float scene_distance(ui_thread *u, vec3 o, vec3 d);
 /* Zoom by factor (< 1 closer) about what is under the centre of the view, never through a wall. */
@@ -204,40 +211,13 @@ int reference_view(ui_thread *u);
 /* Refreshes u->status and its notes (every UI frame). */
 void update_status(ui_thread *u);
 
-/* view_script_run.c */
-void run_script(ui_thread *u);
-
-/* view_display.c: the image, its error against a reference, the panel */
-/* Takes what the render thread published: VIEW_NEW_IMAGE if an image, VIEW_NEW_NEWS if an error
- * measured, a message or a scene's description (0: nothing new to draw). */
-enum { VIEW_NEW_IMAGE = 1, VIEW_NEW_NEWS = 2 };
-int fetch_published(ui_thread *u);
-/* A reference image for the error view and plot, measured from cam with lights (its description's;
- * NULL: from any view); 0, or -1 with the message shown. */
-int load_reference(ui_thread *u, const char *path, const camera *cam, const char *lights);
-void tonemap_and_upload(ui_thread *u);
-void take_screenshot(ui_thread *u, const char *name);
-/* Saves the image shown, linear and at the render's size (a preview magnified as the window
- * draws it), as an EXR with its description (numbered, never overwriting), written by a thread
- * of its own; capture_finish waits for those under way (before the viewer exits). */
-void capture_image(ui_thread *u, const char *name);
-void capture_finish(ui_thread *u);
-void capture_window(ui_thread *u, int w, int h);
-void draw_image_and_panel(ui_thread *u);
-
-/* view_panel.c: the shortcut list, the image beside the docked panel, pause and limits */
+/* view_panel.c: the shortcut list, the window's fit to the image, pause and limits */
 typedef struct {
     const char *keys, *action;
 } view_shortcut;
 extern const view_shortcut view_shortcuts[];
 extern const int num_view_shortcuts;
 void print_shortcuts(FILE *f);
-/* The image's size beside the panel: in framebuffer pixels (the render size), in window units. */
-void view_image_size(ui_thread *u, int *w, int *h);
-void view_image_window_size(ui_thread *u, int *w, int *h);
-/* Where the image is drawn (x0, y0, x1, y1, window units): the place beside the panel, or, while
- * the image shown was rendered for another size, the largest part of it of the image's shape. */
-void view_image_rect(ui_thread *u, float rect[4]);
 /* Makes the window hold an image of image_w x image_h beside the panel. */
 void view_fit_window(ui_thread *u, int image_w, int image_h);
 /* Takes a new size of the place beside the panel as the render size (a new accumulation) once the
@@ -251,12 +231,42 @@ int panel_variant(ui_thread *u, const char *name, char *err, size_t errlen);
 int panel_set(ui_thread *u, const char *name, const char *value, char *err, size_t errlen);
 /* pause, resume, sleep. Returns 0 while the script has to wait. */
 int panel_script_action(ui_thread *u, const script_action *a);
-/* A full frame's time with the current estimator settings; 0 before one is measured. */
-double view_cost_ms(const ui_thread *u);
 /* More of a stats line: pause, limits, window, image and panel sizes. */
 void print_panel_stats(ui_thread *u);
 /* Before the panel: its keys, and the overlay's and help's part of st. After: its buttons. */
 void panel_frame(ui_thread *u, ui_stats *st);
 void panel_after(ui_thread *u);
+
+/* view_input.c: controls, lights, keys and mouse */
+void apply_controls(ui_thread *u, int camera_changed);
+vec3 light_position(const ui_thread *u, int g);
+int light_movable(const ui_thread *u, int g);
+void update_light_screen(ui_thread *u);
+int move_light(ui_thread *u, int g, vec3 delta, char *err, size_t errlen);
+void reset_lights(ui_thread *u);
+void press_key(ui_thread *u, int key, int mods);
+void on_key(GLFWwindow *win, int key, int scancode, int action, int mods);
+void on_scroll(GLFWwindow *win, double dx, double dy);
+void on_drop(GLFWwindow *win, int count, const char **paths);
+void note_input_callbacks(GLFWwindow *win);
+int handle_input(ui_thread *u, double dt);
+/* Whether the mouse drags the camera or a light in the image (a button held, the panel not under it). */
+int view_dragging(ui_thread *u);
+
+/* view_display.c: the published image, its error plot, captures, the panel drawn */
+/* Takes what the render thread published: VIEW_NEW_IMAGE if an image, VIEW_NEW_NEWS if an error
+ * measured, a message or a scene's description (0: nothing new to draw). */
+enum { VIEW_NEW_IMAGE = 1, VIEW_NEW_NEWS = 2 };
+int fetch_published(ui_thread *u);
+/* Saves the image shown, linear and at the render's size (a preview magnified as the window
+ * draws it), as an EXR with its description (numbered, never overwriting), written by a thread
+ * of its own; capture_finish waits for those under way (before the viewer exits). */
+void capture_image(ui_thread *u, const char *name);
+void capture_finish(ui_thread *u);
+void capture_window(ui_thread *u, int w, int h);
+void draw_image_and_panel(ui_thread *u);
+
+/* view_script_run.c */
+void run_script(ui_thread *u);
 
 #endif

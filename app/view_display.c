@@ -1,6 +1,6 @@
-/* glint view: what the window shows (UI thread). The newest published image, tone-mapped or as
- * its error against a reference, in a GL texture behind the panel; the error plot; screenshots
- * of the image and captures of the whole window. */
+/* glint view: what the window shows (UI thread). The newest published image (view_image.c tone-maps
+ * it into the texture drawn behind the panel), the error plot, captures of the image and of the
+ * whole window. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <pthread.h>
@@ -12,54 +12,7 @@
 #include "reference.h"
 #include "view.h"
 
-/* ---- the reference image and the error plot -------------------------------------------------- */
-
-/* Loads a reference for the error view and plot, measured from cam with lights when cam is not
- * NULL (its description's), else from any view: it must match the render size. Returns 0, or -1
- * with the message shown (the previous reference stays). */
-int load_reference(ui_thread *u, const char *path, const camera *cam, const char *lights) {
-    image_rgb img;
-    char err[1200];
-    if (image_rgb_load(path, &img, err, sizeof err) != 0) {
-        snprintf(u->message, sizeof u->message, "%s", err);
-        cli_error("%s", err);
-        return -1;
-    }
-    int w, h;
-    controller_size(u->vc, &w, &h);
-    image_rgb copy = {img.width, img.height, NULL};
-    size_t bytes = sizeof(float) * 3 * (size_t)img.width * (size_t)img.height;
-    if (img.width != w || img.height != h) {
-        snprintf(u->message, sizeof u->message, "%s: the reference is %dx%d but the render is %dx%d; not used", path,
-                 img.width, img.height, w, h);
-    } else if (!(copy.rgb = malloc(bytes))) {
-        snprintf(u->message, sizeof u->message, "%s: out of memory", path);
-    }
-    if (!copy.rgb) {
-        cli_error("%s", u->message);
-        image_rgb_free(&img);
-        return -1;
-    }
-    memcpy(copy.rgb, img.rgb, bytes);
-    u->reference_cam_valid = cam != NULL;
-    if (cam) u->reference_cam = *cam;
-    snprintf(u->reference_lights, sizeof u->reference_lights, "%s", cam ? lights : "");
-    /* the render side's own copy, for the errors of its images */
-    controller_set_reference(u->vc, &copy, cam, u->reference_lights);
-    image_rgb_free(&u->reference);
-    u->reference = img;
-    snprintf(u->reference_path, sizeof u->reference_path, "%s", path);
-    /* Its own noise, when glint render described it: the error plot's floor. */
-    reference_info info;
-    char why[1200];
-    u->reference_noise = reference_load(path, &info, why, sizeof why) == 0 && info.has_noise ? info.rel_l2_noise : -1.0;
-    u->rel_error = u->shown_error = -1.0;
-    u->num_curves = 0; /* errors against another image do not compare */
-    u->current_curve = -1;
-    u->need_tonemap = 1;
-    snprintf(u->message, sizeof u->message, "reference %s", path);
-    return 0;
-}
+/* ---- the error plot -------------------------------------------------------------------------- */
 
 /* The plot's name for the current method and settings. */
 static void curve_label(const ui_thread *u, char *out, size_t n) {
@@ -111,28 +64,6 @@ static void add_error_point(ui_thread *u, double seconds, double error, uint64_t
         u->rel_error = error;
 }
 
-/* Per-pixel relative error |I - R| / (|R| + eps) as colours on a log scale: blue 1%, green 10%,
- * red 100% and more. eps, a hundredth of the mean reference, keeps black pixels from glaring. */
-static void false_colour_error(const float *img, const float *ref, int num_pixels, unsigned char *out) {
-    size_t n = 3 * (size_t)num_pixels;
-    double mean = 0.0;
-    for (size_t i = 0; i < n; i++) mean += (double)ref[i];
-    float eps = (float)(0.01 * mean / (double)(n ? n : 1)) + 1e-20f;
-    for (int i = 0; i < num_pixels; i++) {
-        const float *a = img + 3 * (size_t)i, *r = ref + 3 * (size_t)i;
-        float d2 = 0.0f, r2 = 0.0f;
-        for (int k = 0; k < 3; k++) {
-            d2 += (a[k] - r[k]) * (a[k] - r[k]);
-            r2 += r[k] * r[k];
-        }
-        float e = sqrtf(d2) / (sqrtf(r2) + eps);
-        float t = isfinite(e) ? clampf(0.5f * (log10f(fmaxf(e, 1e-6f)) + 2.0f), 0.0f, 1.0f) : 1.0f;
-        float rgb[3] = {clampf(2.0f * t - 1.0f, 0.0f, 1.0f), 1.0f - fabsf(2.0f * t - 1.0f),
-                        clampf(1.0f - 2.0f * t, 0.0f, 1.0f)};
-        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
-    }
-}
-
 /* Takes the newest published image and statistics. Returns 1 when the image is new. */
 int fetch_published(ui_thread *u) {
     int fresh = controller_take_image(u->vc, &u->image_serial, &u->front);
@@ -169,76 +100,6 @@ int fetch_published(ui_thread *u) {
 }
 
 /* ---- the image and the panel ----------------------------------------------------------------- */
-
-/* The texture the image is drawn from; black until the first image (it has no storage yet).
- * Linear filtering: an image shown in a place of another size is scaled smoothly. */
-static void make_texture(ui_thread *u) {
-    if (u->texture) return;
-    GLuint t;
-    glGenTextures(1, &t);
-    u->texture = t;
-    glBindTexture(GL_TEXTURE_2D, t);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-}
-
-/* The image shown, tone-mapped (or its error in false colour), into the texture drawn. */
-void tonemap_and_upload(ui_thread *u) {
-    int w = u->front.width, h = u->front.height;
-    if (!u->front.rgb || w <= 0 || h <= 0) return;
-    if (w * h > u->pixels_cap) {
-        free(u->pixels);
-        u->pixels = malloc(3 * (size_t)w * (size_t)h);
-        u->pixels_cap = u->pixels ? w * h : 0;
-        if (!u->pixels) return;
-    }
-    const image_rgb *ref = &u->reference;
-    if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
-        false_colour_error(u->front.rgb, ref->rgb, w * h, u->pixels);
-    } else { /* also an image of another size than the reference's */
-        tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f, (tonemap_op)u->ctl.tonemap};
-        tonemap_apply(u->front.rgb, w * h, &tp, u->pixels);
-    }
-    make_texture(u);
-    glBindTexture(GL_TEXTURE_2D, u->texture);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    if (w != u->tex_w || h != u->tex_h) {
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, w, h, 0, GL_RGB, GL_UNSIGNED_BYTE, u->pixels);
-        u->tex_w = w;
-        u->tex_h = h;
-    } else {
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, u->pixels);
-    }
-}
-
-/* Saves the image as shown, without the panel, as a PNG (numbered, never overwriting). */
-void take_screenshot(ui_thread *u, const char *name) {
-    char path[1024], err[1200];
-    if (u->need_tonemap) { /* a newer image or exposure than the one drawn last: save what is current */
-        tonemap_and_upload(u);
-        u->need_tonemap = 0;
-    }
-    if (!u->front.rgb || !u->pixels) {
-        snprintf(u->message, sizeof u->message, "%s: nothing rendered yet", name);
-        cli_error("%s", u->message);
-        return;
-    }
-    if (unique_path(name, path, sizeof path) != 0) {
-        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
-        cli_error("%s", u->message);
-        return;
-    }
-    if (png_save_rgb8(path, u->front.width, u->front.height, u->pixels, WRITE_NO_REPLACE, err, sizeof err) != 0) {
-        snprintf(u->message, sizeof u->message, "%s", err);
-        cli_error("%s", err);
-        return;
-    }
-    snprintf(u->message, sizeof u->message, "wrote %s", path);
-    printf("glint: wrote %s\n", path);
-    fflush(stdout);
-}
 
 /* src (w x h, RGB) magnified to out (W x H) as the window draws it: a GL_LINEAR texture with
  * clamp-to-edge, texel centres at (i + 0.5) / w, stretched over the image. */

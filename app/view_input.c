@@ -10,7 +10,7 @@
 #include "image_io.h"
 #include "view.h"
 
-/* ---- the controls, and the requests they make ------------------------------------------------ */
+/* ---- the controls ---------------------------------------------------------------------------- */
 
 static unsigned show_mask_of(int show) {
     switch (show) {
@@ -19,20 +19,6 @@ static unsigned show_mask_of(int show) {
     case UI_SHOW_HIGHLIGHTS: return 1u << COMP_HIGHLIGHTS;
     default: return COMP_MASK_ALL;
     }
-}
-
-/* Sends the camera, estimator settings and lights to the render side; each call is a change that
- * resets the accumulation. */
-void send_change(ui_thread *u) {
-    camera cam = ctl_camera(&u->cam);
-    u->sent_generation = controller_change(u->vc, &cam, &u->ctl.params, &u->lights, u->info_serial);
-    u->sent_at = cli_now();
-    u->step_ms = -1.0;
-}
-
-/* Full-resolution frames rendered in the state the UI last asked for. */
-long long frames_of_current_state(const ui_thread *u) {
-    return u->stats.frames_generation == u->sent_generation ? u->stats.frames : 0;
 }
 
 /* Sends what changed in the controls since the last call: estimator settings reset the
@@ -61,26 +47,6 @@ void apply_controls(ui_thread *u, int camera_changed) {
         u->need_tonemap = 1;
     }
     u->applied_ctl = u->ctl;
-}
-
-void request_export(ui_thread *u, const char *name) {
-    char path[1024];
-    if (unique_path(name, path, sizeof path) != 0) {
-        snprintf(u->message, sizeof u->message, "%s: no free file name", name);
-        return;
-    }
-    controller_export(u->vc, path);
-}
-
-static void request(ui_thread *u, int kind, const char *path, const char *variant, int keep_view) {
-    u->script_load_target = controller_load(u->vc, kind, path, variant, keep_view);
-}
-
-void request_load(ui_thread *u, int kind, const char *path) { request(u, kind, path, "", 0); }
-
-void request_variant(ui_thread *u, int v) {
-    request(u, LOAD_SCENE, u->info.name, v >= 0 && v < u->info.num_variants ? u->info.variant_names[v] : "", 1);
-    u->variant_target = u->script_load_target;
 }
 
 /* ---- lights ---------------------------------------------------------------------------------- */

@@ -1,14 +1,19 @@
 /* glint view: navigation that cannot get lost (UI thread). Zoom and fly take their steps from the
  * distance to what the view looks at, found by tracing the render thread's scene under its lock,
- * and never step through a wall in one go; F frames the whole scene. Also the reference's
- * description (checked as glint bench checks it) and camera, and the standing notes the panel
- * shows: the error plot paused away from the reference's camera, a scene without light. */
+ * and never step through a wall in one go; F frames the whole scene, R resets the view, and camera
+ * bookmarks 1-9 are kept in a file beside the scene. Also the reference: its image (for the error
+ * view and plot), its description (checked as glint bench checks it) and camera, and the standing
+ * notes the panel shows: the error plot paused away from the reference's camera, a scene without
+ * light. */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "image_io.h"
 #include "reference.h"
 #include "view.h"
 
@@ -106,6 +111,53 @@ void frame_scene(ui_thread *u) {
 
 /* ---- the reference --------------------------------------------------------------------------- */
 
+/* Loads a reference for the error view and plot, measured from cam with lights when cam is not
+ * NULL (its description's), else from any view: it must match the render size. Returns 0, or -1
+ * with the message shown (the previous reference stays). */
+int load_reference(ui_thread *u, const char *path, const camera *cam, const char *lights) {
+    image_rgb img;
+    char err[1200];
+    if (image_rgb_load(path, &img, err, sizeof err) != 0) {
+        snprintf(u->message, sizeof u->message, "%s", err);
+        cli_error("%s", err);
+        return -1;
+    }
+    int w, h;
+    controller_size(u->vc, &w, &h);
+    image_rgb copy = {img.width, img.height, NULL};
+    size_t bytes = sizeof(float) * 3 * (size_t)img.width * (size_t)img.height;
+    if (img.width != w || img.height != h) {
+        snprintf(u->message, sizeof u->message, "%s: the reference is %dx%d but the render is %dx%d; not used", path,
+                 img.width, img.height, w, h);
+    } else if (!(copy.rgb = malloc(bytes))) {
+        snprintf(u->message, sizeof u->message, "%s: out of memory", path);
+    }
+    if (!copy.rgb) {
+        cli_error("%s", u->message);
+        image_rgb_free(&img);
+        return -1;
+    }
+    memcpy(copy.rgb, img.rgb, bytes);
+    u->reference_cam_valid = cam != NULL;
+    if (cam) u->reference_cam = *cam;
+    snprintf(u->reference_lights, sizeof u->reference_lights, "%s", cam ? lights : "");
+    /* the render side's own copy, for the errors of its images */
+    controller_set_reference(u->vc, &copy, cam, u->reference_lights);
+    image_rgb_free(&u->reference);
+    u->reference = img;
+    snprintf(u->reference_path, sizeof u->reference_path, "%s", path);
+    /* Its own noise, when glint render described it: the error plot's floor. */
+    reference_info info;
+    char why[1200];
+    u->reference_noise = reference_load(path, &info, why, sizeof why) == 0 && info.has_noise ? info.rel_l2_noise : -1.0;
+    u->rel_error = u->shown_error = -1.0;
+    u->num_curves = 0; /* errors against another image do not compare */
+    u->current_curve = -1;
+    u->need_tonemap = 1;
+    snprintf(u->message, sizeof u->message, "reference %s", path);
+    return 0;
+}
+
 static int refuse(ui_thread *u, const char *why) {
     snprintf(u->message, sizeof u->message, "%.1150s; reference not used", why);
     cli_error("%s", u->message);
@@ -200,4 +252,112 @@ void update_status(ui_thread *u) {
                          : "error plot paused: the lights differ from the reference's");
         u->error_paused_shown = paused;
     }
+}
+
+/* ---- resets and camera bookmarks ------------------------------------------------------------- */
+
+void reset_view(ui_thread *u) {
+    int w, h;
+    view_image_size(u, &w, &h); /* the image's shape, beside the panel */
+    float aspect = h > 0 ? (float)w / (float)h : 16.0f / 9.0f;
+    camera c = u->ctl.camera >= 0 && u->ctl.camera < u->info.num_cameras
+                   ? u->info.cameras[u->ctl.camera]
+                   : (u->info.num_cameras > 0 ? u->info.cameras[0] : camera_frame_bounds(u->info.bounds, 0.8f, aspect));
+    u->cam = ctl_from_camera(&c, &u->info);
+}
+
+/* Beside the scene file; a built-in scene has none, so NAME.glint-bookmarks in the current
+ * directory. */
+void bookmarks_load(ui_thread *u) {
+    memset(u->bookmark_set, 0, sizeof u->bookmark_set);
+    const char *builtin = scene_builtin_name(u->info.name);
+    if (builtin)
+        snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.glint-bookmarks", builtin);
+    else
+        snprintf(u->bookmarks_path, sizeof u->bookmarks_path, "%s.bookmarks", u->info.name);
+    FILE *f = fopen(u->bookmarks_path, "r");
+    if (!f) {
+        if (errno != ENOENT) {
+            snprintf(u->message, sizeof u->message, "%s: %s; no bookmarks", u->bookmarks_path, strerror(errno));
+            cli_warning("%s", u->message);
+        }
+        return;
+    }
+    cam_ctl marks[10];
+    int set[10] = {0}, bad = 0, lineno = 0;
+    char line[512];
+    while (!bad && fgets(line, sizeof line, f)) {
+        lineno++;
+        size_t len = strlen(line);
+        if (len == sizeof line - 1 && line[len - 1] != '\n') bad = lineno; /* too long to be ours */
+        const char *p = line + strspn(line, " \t");
+        if (bad || *p == '#' || *p == '\n' || *p == '\r' || *p == 0) continue;
+        int slot, used = 0;
+        float x, y, z, yaw, pitch, dist, yfov;
+        if (sscanf(p, "%d %f %f %f %f %f %f %f %n", &slot, &x, &y, &z, &yaw, &pitch, &dist, &yfov, &used) != 8 ||
+            p[used] != 0 || slot < 1 || slot > 9 || !is_finite3(v3(x, y, z)) || !isfinite(yaw) || !isfinite(pitch) ||
+            !(dist > 0.0f && dist < 1e30f) || !(yfov > 0.0f && yfov < 3.1f)) {
+            bad = lineno;
+            continue;
+        }
+        marks[slot] = (cam_ctl){v3(x, y, z), yaw, clampf(pitch, -1.55f, 1.55f), dist, yfov};
+        set[slot] = 1;
+    }
+    fclose(f);
+    if (bad) {
+        snprintf(u->message, sizeof u->message,
+                 "%s:%d: not a bookmark line (N x y z yaw pitch distance fov); file ignored", u->bookmarks_path, bad);
+        cli_warning("%s", u->message);
+        return;
+    }
+    for (int i = 1; i <= 9; i++)
+        if (set[i]) u->bookmarks[i] = marks[i], u->bookmark_set[i] = 1;
+}
+
+/* Saves the current view as bookmark slot (1-9), rewriting the file atomically. Returns 0 or -1. */
+int bookmark_save(ui_thread *u, int slot) {
+    u->bookmarks[slot] = u->cam;
+    u->bookmark_set[slot] = 1;
+    char buf[2048], err[1200];
+    int len = snprintf(buf, sizeof buf,
+                       "# glint camera bookmarks: N, position x y z, yaw and pitch (radians), orbit distance, "
+                       "vertical fov (radians)\n");
+    for (int i = 1; i <= 9; i++) {
+        const cam_ctl *c = &u->bookmarks[i];
+        if (u->bookmark_set[i] && len < (int)sizeof buf)
+            len += snprintf(buf + len, sizeof buf - (size_t)len, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", i,
+                            (double)c->pos.x, (double)c->pos.y, (double)c->pos.z, (double)c->yaw, (double)c->pitch,
+                            (double)c->dist, (double)c->yfov);
+    }
+    if (len >= (int)sizeof buf ||
+        write_file_atomic(u->bookmarks_path, buf, (size_t)len, WRITE_REPLACE, err, sizeof err) != 0) {
+        if (len >= (int)sizeof buf) snprintf(err, sizeof err, "%s: bookmarks too long", u->bookmarks_path);
+        snprintf(u->message, sizeof u->message, "%s", err);
+        cli_error("%s", err);
+        return -1;
+    }
+    snprintf(u->message, sizeof u->message, "bookmark %d saved to %s", slot, u->bookmarks_path);
+    return 0;
+}
+
+/* Returns 0, or -1 (message set) when the slot is empty. */
+int bookmark_restore(ui_thread *u, int slot) {
+    if (!u->bookmark_set[slot]) {
+        snprintf(u->message, sizeof u->message, "no bookmark %d (%s)", slot, u->bookmarks_path);
+        return -1;
+    }
+    u->cam = u->bookmarks[slot];
+    u->ctl.camera = u->applied_ctl.camera = -1; /* a free camera, not the scene's */
+    send_change(u);
+    snprintf(u->message, sizeof u->message, "bookmark %d", slot);
+    return 0;
+}
+
+void describe_bookmarks(ui_thread *u) {
+    int len = 0;
+    for (int i = 1; i <= 9; i++)
+        if (u->bookmark_set[i])
+            len += snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%d ", i);
+    snprintf(u->bookmarks_text + len, sizeof u->bookmarks_text - (size_t)len, "%s(%s)", len ? "" : "none ",
+             u->bookmarks_path);
 }

@@ -1,6 +1,7 @@
 /* glint view: what the panel adds to the viewer (UI thread, but for the render thread's hold):
- * the list of shortcuts the help overlay and --help share, the image's place beside the docked
- * panel, pausing and the spp and time limits, and the panel's own keys and buttons. */
+ * the list of shortcuts the help overlay and --help share, the window fitted and followed around
+ * the image beside the docked panel, pausing and the spp and time limits, and the panel's own keys
+ * and buttons. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <pthread.h>
@@ -42,45 +43,7 @@ void print_shortcuts(FILE *f) {
         fprintf(f, "  %-24s %s\n", view_shortcuts[i].keys, view_shortcuts[i].action);
 }
 
-/* ---- the image beside the panel ---------------------------------------------------------------- */
-
-void view_image_window_size(ui_thread *u, int *w, int *h) {
-    int ww, wh;
-    glfwGetWindowSize(u->win, &ww, &wh);
-    int dock = (int)(ui_dock_width(&u->ctl) + 0.5f);
-    *w = ww - dock > 1 ? ww - dock : 1;
-    *h = wh > 1 ? wh : 1;
-}
-
-void view_image_size(ui_thread *u, int *w, int *h) {
-    int ww, wh, fw, fh;
-    glfwGetWindowSize(u->win, &ww, &wh);
-    glfwGetFramebufferSize(u->win, &fw, &fh);
-    if (fw <= 0 || fh <= 0) { /* minimised */
-        *w = *h = 0;
-        return;
-    }
-    double ratio = ww > 0 ? (double)fw / ww : 1.0;
-    int dock = (int)(ratio * (double)ui_dock_width(&u->ctl) + 0.5);
-    *w = fw - dock > 1 ? fw - dock : 1;
-    *h = fh > 1 ? fh : 1;
-}
-
-void view_image_rect(ui_thread *u, float rect[4]) {
-    int w, h;
-    view_image_window_size(u, &w, &h);
-    float rw = (float)w, rh = (float)h, fit_w = rw, fit_h = rh;
-    if (u->front.full_w > 0 && u->front.full_h > 0) {
-        float aspect = (float)u->front.full_w / (float)u->front.full_h;
-        fit_w = fminf(rw, rh * aspect);
-        fit_h = fminf(rh, rw / aspect);
-    }
-    if (rw - fit_w < 1.0f && rh - fit_h < 1.0f) fit_w = rw, fit_h = rh; /* rounding: pixel for pixel */
-    rect[0] = 0.5f * (rw - fit_w);
-    rect[1] = 0.5f * (rh - fit_h);
-    rect[2] = rect[0] + fit_w;
-    rect[3] = rect[1] + fit_h;
-}
+/* ---- the image beside the panel -------------------------------------------------------------- */
 
 void view_fit_window(ui_thread *u, int image_w, int image_h) {
     float dock = ui_dock_width_beside(&u->ctl, (float)image_w);
@@ -187,11 +150,6 @@ void print_panel_stats(ui_thread *u) {
     printf(" variant=%s", u->info.variant >= 0 ? u->info.variant_names[u->info.variant] : "-");
 }
 
-double view_cost_ms(const ui_thread *u) {
-    return u->stats.frames_generation >= u->cost_generation && u->stats.full_frame_ms > 0.0 ? u->stats.full_frame_ms
-                                                                                            : 0.0;
-}
-
 /* ---- the panel's keys and buttons ------------------------------------------------------------ */
 
 /* Before the panel is drawn: F1 or ? (shift+/) toggles the help, Space pausing, N the display's
@@ -228,7 +186,7 @@ void panel_frame(ui_thread *u, ui_stats *st) {
     st->num_variants = u->info.num_variants;
 }
 
-/* ---- material variants ------------------------------------------------------------------------- */
+/* ---- material variants ----------------------------------------------------------------------- */
 
 /* Whether the variant switch asked for has been tried and its outcome taken in. */
 static int variant_settled(ui_thread *u) { return controller_load_settled(u->vc, u->variant_target, u->info_serial); }
