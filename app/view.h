@@ -1,8 +1,9 @@
 /* glint view: the interactive viewer's UI side, shared by its files (not a public interface).
  *
- * The UI thread owns the window: it handles input (view_input.c, view_camera.c, view_nav.c) and
+ * The UI thread owns the window: it handles input (view_input.c, view_nav.c, view_camera.c) and
  * scripts (view_script_run.c), tone-maps and draws the newest image with the panel
- * (view_display.c, view_panel.c), and never waits for a frame. Everything it asks of the renderer,
+ * (view_image.c, view_display.c, view_panel.c), and never waits for a frame; view_window.c holds
+ * the image's place in the window and sends what the UI asks. Everything it asks of the renderer,
  * and everything it shows of it, goes through the narrow interface of view_controller.h; the one
  * statistics record it shows and prints is ui/view_stats.h's.
  *
