@@ -49,6 +49,7 @@ struct render_session {
     const scene *scene;
     camera cam;
     render_params params;
+    vl_params vl; /* params.vl with its defaults, resolved once (take_params) */
     film film;
     long long frames;
     threadpool *pool;
@@ -101,6 +102,7 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
     rs->scene = s;
     rs->cam = *cam;
     rs->params = render_params_resolve_frame(params);
+    rs->vl = vl_params_resolve(&rs->params.vl);
     render_params *p = &rs->params;
     if (film_init(&rs->film, p->width, p->height) != 0) {
         snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height);
@@ -576,12 +578,12 @@ static void render_chunk(void *ctx, int chunk, int worker) {
 static int begin_frame(render_session *rs) {
     const render_params *p = &rs->params;
     const uint64_t frame = next_frame_index(rs);
-    rs->adapt = p->method != METHOD_PT && vl_params_resolve(&p->vl).adapt == VL_ADAPT_ON;
+    rs->adapt = p->method != METHOD_PT && rs->vl.adapt == VL_ADAPT_ON;
     if (rs->adapt) {
         pixel_alloc_plan(&rs->direct, MANYLIGHT_DIRECT_SAMPLES, MANYLIGHT_MAX_DIRECT_SAMPLES, frame,
                          p->seed ^ 0x646972656374ULL);
         if (rs->plan.virtual_lights)
-            pixel_alloc_plan(&rs->glossy, vl_params_resolve(&p->vl).glossy_rays, VL_MAX_GLOSSY_RAYS, frame, p->seed);
+            pixel_alloc_plan(&rs->glossy, rs->vl.glossy_rays, VL_MAX_GLOSSY_RAYS, frame, p->seed);
     }
     if (rs->plan.highlights) {
         if (rs->plan.env_prefilter && (!rs->envf || rs->envf_map != rs->scene->env)) {
@@ -860,6 +862,7 @@ static void take_params(render_session *rs, const render_params *params) {
     p.threads = rs->params.threads;
     p = render_params_resolve_frame(&p);
     rs->params = p;
+    rs->vl = vl_params_resolve(&p.vl);
     rs->plan = session_make_plan(rs);
 }
 
