@@ -419,26 +419,46 @@ bool read_string(const char *path, int fd, int64_t size, const char *name, char 
 class MemStream : public Imf::OStream {
   public:
     explicit MemStream(const char *path) : Imf::OStream(path) {}
+    ~MemStream() override { std::free(data_); }
+    MemStream(const MemStream &) = delete;
+    MemStream &operator=(const MemStream &) = delete;
 
     void write(const char c[], int n) override {
         if (n <= 0) return;
-        try {
-            if (pos_ + (size_t)n > data.size()) data.resize(pos_ + (size_t)n); // zero fills a gap
-        } catch (...) {
-            failed = true;
-            throw;
+        size_t end = pos_ + (size_t)n;
+        if (end > cap_) {
+            size_t cap = cap_ ? cap_ : (size_t)1 << 16;
+            while (cap < end) cap *= 2;
+            char *grown = static_cast<char *>(std::realloc(data_, cap));
+            if (!grown) {
+                failed = true;
+                throw std::bad_alloc();
+            }
+            data_ = grown;
+            cap_ = cap;
         }
-        std::memcpy(data.data() + pos_, c, (size_t)n);
-        pos_ += (size_t)n;
+        if (pos_ > size_) std::memset(data_ + size_, 0, pos_ - size_); // zero fills a gap
+        std::memcpy(data_ + pos_, c, (size_t)n);
+        pos_ = end;
+        size_ = end > size_ ? end : size_;
     }
     uint64_t tellp() override { return pos_; }
     void seekp(uint64_t pos) override { pos_ = (size_t)pos; }
 
-    std::vector<char> data;
+    // The bytes written, handed over as C memory (the caller frees them): no copy of the file.
+    char *release(size_t *size) {
+        char *d = data_;
+        *size = size_;
+        data_ = nullptr;
+        size_ = cap_ = pos_ = 0;
+        return d;
+    }
+
     bool failed = false;
 
   private:
-    size_t pos_ = 0;
+    char *data_ = nullptr;
+    size_t size_ = 0, cap_ = 0, pos_ = 0;
 };
 
 // Attributes the format defines or that OpenEXR sets itself: a string under one of these names
@@ -549,21 +569,16 @@ extern "C" int exr_encode_layers(const char *path, int width, int height, const 
     *out = nullptr;
     *size = 0;
     const char *stage = "cannot encode OpenEXR";
-    std::vector<char> data;
     int status = guarded(
         path, err, errlen, stage,
         [&] {
-            MemStream out(path);
-            encode(out, width, height, layers, num_layers, attrs, num_attrs); // complete once it returns
-            if (out.failed) throw std::bad_alloc();
-            data.swap(out.data);
+            MemStream stream(path);
+            encode(stream, width, height, layers, num_layers, attrs, num_attrs); // complete once it returns
+            if (stream.failed) throw std::bad_alloc();
+            *out = stream.release(size);
         },
         [] { return std::string("out of memory"); });
-    if (status != 0) return -1;
-    if (!(*out = std::malloc(data.empty() ? 1 : data.size()))) return fail(err, errlen, path, "out of memory");
-    std::memcpy(*out, data.data(), data.size());
-    *size = data.size();
-    return 0;
+    return status != 0 ? -1 : 0;
 }
 
 /* Frees what exr_read_fd reads (declared in image_io.h, for every reader of an exr_image): here,
