@@ -10,35 +10,18 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <unistd.h>
 
 #include "image_io.h"
+#include "memfile.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static char path[64];
-
-/* The memory file, holding exactly the input; its path in path. */
-static void put_input(const uint8_t *data, size_t size) {
-    static int fd = -1;
-    if (fd < 0) {
-        fd = memfd_create("fuzz_image", MFD_CLOEXEC);
-        if (fd < 0) perror("memfd_create"), abort();
-        snprintf(path, sizeof path, "/proc/self/fd/%d", fd);
-    }
-    if (ftruncate(fd, 0) != 0) perror("ftruncate"), abort();
-    for (size_t done = 0; done < size;) {
-        ssize_t n = pwrite(fd, data + done, size - done, (off_t)done);
-        if (n <= 0) perror("pwrite"), abort();
-        done += (size_t)n;
-    }
-}
+static memfile input = {-1, ""};
 
 /* The promise of a failure: one line, "PATH: something". */
 static void check_error(const char *what, const char *err) {
-    size_t n = strlen(path);
-    if (strncmp(err, path, n) != 0 || strncmp(err + n, ": ", 2) != 0 || !err[n + 2] || strchr(err, '\n')) {
+    size_t n = strlen(input.path);
+    if (strncmp(err, input.path, n) != 0 || strncmp(err + n, ": ", 2) != 0 || !err[n + 2] || strchr(err, '\n')) {
         fprintf(stderr, "%s: bad error message: '%s'\n", what, err);
         abort();
     }
@@ -57,11 +40,11 @@ static size_t step(size_t n) { return n <= ((size_t)1 << 20) ? 1 : 4099; }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     char err[1024];
-    put_input(data, size);
+    memfile_put(&input, data, size);
 
     image_rgb env;
     err[0] = 0;
-    if (image_rgb_load(path, &env, err, sizeof err) != 0) {
+    if (image_rgb_load(input.path, &env, err, sizeof err) != 0) {
         check_error("image_rgb_load", err);
     } else {
         check_size("image_rgb_load", env.width, env.height);
@@ -77,7 +60,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
     exr_image ref;
     err[0] = 0;
-    if (exr_image_load(path, &ref, err, sizeof err) != 0) {
+    if (exr_image_load(input.path, &ref, err, sizeof err) != 0) {
         check_error("exr_image_load", err);
     } else {
         check_size("exr_image_load", ref.width, ref.height);
@@ -96,7 +79,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     char *value = NULL;
     size_t len = 0;
     err[0] = 0;
-    int st = exr_header_string(path, "glint.reference", &value, &len, err, sizeof err);
+    int st = exr_header_string(input.path, "glint.reference", &value, &len, err, sizeof err);
     if (st < 0) check_error("exr_header_string", err);
     if (st == 0 && (!value || value[len] != '\0')) fprintf(stderr, "exr_header_string: bad value\n"), abort();
     if (st != 0 && value) fprintf(stderr, "exr_header_string: a value without success\n"), abort();

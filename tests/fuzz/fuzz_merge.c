@@ -12,11 +12,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <unistd.h>
 
 #include "commands.h"
 #include "image_io.h"
+#include "memfile.h"
 #include "reference.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -26,22 +26,8 @@ static void bad(const char *what) {
     abort();
 }
 
-/* The memory file k (0 or 1) holding exactly bytes; its path in path[k]. */
-static char path[2][64];
-static void put(int k, const uint8_t *bytes, size_t size) {
-    static int fd[2] = {-1, -1};
-    if (fd[k] < 0) {
-        fd[k] = memfd_create("fuzz_merge", MFD_CLOEXEC);
-        if (fd[k] < 0) bad("no memfd_create");
-        snprintf(path[k], sizeof path[k], "/proc/self/fd/%d", fd[k]);
-    }
-    if (ftruncate(fd[k], 0) != 0) bad("ftruncate failed");
-    for (size_t done = 0; done < size;) {
-        ssize_t n = pwrite(fd[k], bytes + done, size - done, (off_t)done);
-        if (n <= 0) bad("pwrite failed");
-        done += (size_t)n;
-    }
-}
+/* The two shards' memory files. */
+static memfile shard[2] = {{-1, ""}, {-1, ""}};
 
 /* Where the merge writes: a folder of its own, made once, the output removed before each merge (so
  * that one found there is this input's) and at exit. */
@@ -76,10 +62,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     make_folder();
     size_t first = (size_t)data[0] | (size_t)data[1] << 8 | (size_t)data[2] << 16 | (size_t)data[3] << 24;
     first = first < size - 4 ? first : size - 4;
-    put(0, data + 4, first);
-    put(1, data + 4 + first, size - 4 - first);
+    memfile_put(&shard[0], data + 4, first);
+    memfile_put(&shard[1], data + 4 + first, size - 4 - first);
     remove(out);
-    char *argv[] = {path[0], path[1], "--out", out, "--quiet", NULL};
+    char *argv[] = {shard[0].path, shard[1].path, "--out", out, "--quiet", NULL};
     if (cmd_merge(5, argv) == 0) check_merged();
     return 0;
 }
