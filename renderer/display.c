@@ -636,7 +636,25 @@ static void gap_row(void *ctx, int y, int worker) {
     }
 }
 
-/* How much of the filtered value pixel (x, y) takes of component c: the mix of its own mean x
+/* One neighbour of each pixel of a chunk (take_chunk): where it lies on the pixel's surface (mat,
+ * me) and has a gap (not -1), its variance into s2 and k, and its gap, times `other` (0 for the pixel
+ * itself), into gap and m. Not inlined: in take_chunk's loops gcc does not vectorise it. */
+__attribute__((noinline)) static void add_take_neighbour(const float *restrict gap_q, const float *restrict var_q,
+                                                         const int32_t *restrict mat, const int32_t *restrict me,
+                                                         float other, float *restrict s2, float *restrict k,
+                                                         float *restrict gap, float *restrict m) {
+    for (int x = 0; x < WINDOW_CHUNK; x++) {
+        float ok = mat[x] == me[x] ? gap_q[x] : -1.0f; /* another surface's: none */
+        int in = ok >= -0.5f;
+        s2[x] += in ? var_q[x] : 0.0f;
+        k[x] += in ? 1.0f : 0.0f;
+        gap[x] += in ? other * gap_q[x] : 0.0f;
+        m[x] += in ? other : 0.0f;
+    }
+}
+
+/* How much of the filtered value each pixel of a chunk of row y takes of component c (x0 to x0 +
+ * WINDOW_CHUNK - 1, past the image's edge anything): the mix of its own mean x
  * (unbiased, variance v_x) and the filter's f (variance v_f, bias b) with the least expected squared
  * error, v_x / (v_x + v_f + b^2). A noisy pixel takes the filter; a converged one, or one where the
  * filter blurs a feature its own samples resolve, keeps its own mean: the filter fades out as the
@@ -645,31 +663,35 @@ static void gap_row(void *ctx, int y, int worker) {
  * b^2 comes from the gaps (f - x)^2 of the pixel's neighbours on the same surface, less what their
  * noise puts in them, reckoned with the variance of the whole 3x3 neighbourhood: a pixel's own gap
  * would make the pixels whose few samples fell far keep them (a peppered image), and one pixel's
- * variance from a few samples misses the rare bright ones, which read as bias. */
-static float take_of(const display *d, const int32_t *mats, int c, int x, int y) {
+ * variance from a few samples misses the rare bright ones, which read as bias. Vector code
+ * (vecmath.h's rules): pixel by pixel, with its branches, it was a twentieth of the viewer's time. */
+static void take_chunk(const display *d, int c, int x0, int y, float *restrict take) {
     int w = d->width, h = d->height;
-    size_t i = (size_t)y * (size_t)w + (size_t)x;
-    float n = d->count[c][i];
-    if (!(n >= 2.0f)) return 1.0f;
-    int32_t me = mats[i];
-    int x0 = x > 0 ? x - 1 : x, x1 = x + 1 < w ? x + 1 : x, y0 = y > 0 ? y - 1 : y, y1 = y + 1 < h ? y + 1 : y;
-    float gap = 0.0f, s2 = 0.0f;
-    int m = 0, k = 0;
-    for (int qy = y0; qy <= y1; qy++) {
-        size_t row = (size_t)qy * (size_t)w;
-        const int32_t *mr = mats + row;
-        const float *br = d->gap[c] + row, *vr = d->variance[c] + row;
-        for (int qx = x0; qx <= x1; qx++) {
-            if (mr[qx] != me || br[qx] < -0.5f) continue;
-            s2 += vr[qx], k++;
-            if (qx != x || qy != y) gap += br[qx], m++;
-        }
+    float gap_w[3][WINDOW_SPAN], var_w[3][WINDOW_SPAN], n[WINDOW_SPAN], vown[WINDOW_SPAN], fn[WINDOW_SPAN];
+    int32_t mat[3][WINDOW_SPAN];
+    window_rows(gap_w, d->gap[c], w, h, x0, y, -1.0f); /* outside the image: no gap, not taken */
+    window_rows(var_w, d->variance[c], w, h, x0, y, 0.0f);
+    window_rows_int(mat, d->g[d->cur].material, w, h, x0, y, -1);
+    window_row_copy(n, d->count[c], w, h, x0, y, 0u);
+    window_row_copy(vown, d->variance[c], w, h, x0, y, 0u);
+    window_row_copy(fn, d->out_count[c], w, h, x0, y, 0u);
+    float s2[WINDOW_CHUNK] = {0}, k[WINDOW_CHUNK] = {0}, gap[WINDOW_CHUNK] = {0}, m[WINDOW_CHUNK] = {0};
+    for (int r = 0; r < 3; r++)
+        for (int dx = 0; dx < 3; dx++)
+            add_take_neighbour(gap_w[r] + dx, var_w[r] + dx, mat[r] + dx, mat[1] + 1, r == 1 && dx == 1 ? 0.0f : 1.0f,
+                               s2, k, gap, m);
+    for (int x = 0; x < WINDOW_CHUNK; x++) {
+        float nx = n[x + 1], v = s2[x] / (k[x] > 1.0f ? k[x] : 1.0f); /* k >= 1 where n >= 2: the pixel itself */
+        v = vown[x + 1] > v ? vown[x + 1] : v;
+        float vx = v / nx, vf = v / (fn[x + 1] > nx ? fn[x + 1] : nx);
+        float b2 = gap[x] / (m[x] > 1.0f ? m[x] : 1.0f) - vx + vf;
+        b2 = m[x] > 0.0f && b2 > 0.0f ? b2 : 0.0f;
+        float t = vx / (vx + vf + b2 + 1e-30f), finite = t - t; /* 0 unless t is infinite or NaN */
+        float clamped = t > 1.0f ? 1.0f : t;
+        clamped = clamped < 0.0f ? 0.0f : clamped;
+        t = finite == 0.0f ? clamped : 1.0f;
+        take[x] = nx >= 2.0f ? t : 1.0f;
     }
-    s2 = fmaxf(d->variance[c][i], s2 / (float)k); /* k >= 1: the pixel itself */
-    float vx = s2 / n, vf = s2 / fmaxf(d->out_count[c][i], n);
-    float b2 = m ? fmaxf(gap / (float)m - vx + vf, 0.0f) : 0.0f;
-    float t = vx / (vx + vf + b2 + 1e-30f);
-    return isfinite(t) ? clampf(t, 0.0f, 1.0f) : 1.0f;
 }
 
 static void modulate_row(void *ctx, int y, int worker) {
@@ -677,24 +699,29 @@ static void modulate_row(void *ctx, int y, int worker) {
     resolve_job *j = ctx;
     display *d = j->d;
     const gbuffer *g = &d->g[d->cur];
-    for (int x = 0; x < d->width; x++) {
-        size_t i = (size_t)y * (size_t)d->width + (size_t)x;
-        vec3 sum = v3(0, 0, 0);
-        for (int c = 0; c < COMP_COUNT; c++) {
-            if (!(j->mask >> c & 1u)) continue;
-            float count, m2;
-            const float *m;
-            if (j->filtered) {
-                vec3 own = get3(d->light[c], i), f = get3(d->out[c], i);
-                sum = add3(sum, madd3(own, sub3(f, own), take_of(d, g->material, c, x, y)));
-            } else if ((m = shown_history(d, i, c, &count, &m2)))
-                sum = add3(sum, v3(m[0], m[1], m[2]));
+    for (int x0 = 0; x0 < d->width; x0 += WINDOW_CHUNK) {
+        float take[COMP_COUNT][WINDOW_CHUNK];
+        for (int c = 0; c < COMP_COUNT; c++)
+            if (j->filtered && j->mask >> c & 1u) take_chunk(d, c, x0, y, take[c]);
+        for (int x = x0; x < x0 + WINDOW_CHUNK && x < d->width; x++) {
+            size_t i = (size_t)y * (size_t)d->width + (size_t)x;
+            vec3 sum = v3(0, 0, 0);
+            for (int c = 0; c < COMP_COUNT; c++) {
+                if (!(j->mask >> c & 1u)) continue;
+                float count, m2;
+                const float *m;
+                if (j->filtered) {
+                    vec3 own = get3(d->light[c], i), f = get3(d->out[c], i);
+                    sum = add3(sum, madd3(own, sub3(f, own), take[c][x - x0]));
+                } else if ((m = shown_history(d, i, c, &count, &m2)))
+                    sum = add3(sum, v3(m[0], m[1], m[2]));
+            }
+            vec3 v = mul3(sum, get3(g->albedo, i));
+            if (!is_finite3(v)) v = v3(0, 0, 0);
+            j->rgb[3 * i] = v.x;
+            j->rgb[3 * i + 1] = v.y;
+            j->rgb[3 * i + 2] = v.z;
         }
-        vec3 v = mul3(sum, get3(g->albedo, i));
-        if (!is_finite3(v)) v = v3(0, 0, 0);
-        j->rgb[3 * i] = v.x;
-        j->rgb[3 * i + 1] = v.y;
-        j->rgb[3 * i + 2] = v.z;
     }
 }
 

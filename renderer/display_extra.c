@@ -100,35 +100,59 @@ static void spread_row(void *ctx, int y, int worker) {
  * bright neighbour, and the largest spreads the budget over all of them). Then each pixel's ratio
  * into its worker's histogram. */
 
+/* One neighbour of each pixel of a chunk (hole_row): its own spread o where the neighbour lies on
+ * the pixel's surface (mat, me), into the largest of all and the sum and count of those. Not
+ * inlined: in hole_row's loops gcc does not vectorise it. */
+__attribute__((noinline)) static void add_neighbour(const float *restrict o, const int32_t *restrict mat,
+                                                    const int32_t *restrict me, float *restrict most,
+                                                    float *restrict sum, float *restrict m) {
+    for (int x = 0; x < WINDOW_CHUNK; x++) {
+        most[x] = o[x] > most[x] ? o[x] : most[x];
+        float mine = mat[x] == me[x] ? o[x] : -1.0f; /* another surface's: none */
+        sum[x] += mine >= 0.0f ? mine : 0.0f;
+        m[x] += mine >= 0.0f ? 1.0f : 0.0f;
+    }
+}
+
 static void hole_row(void *ctx, int y, int worker) {
     display *d = ctx;
-    const int32_t *mat = d->g[d->cur].material;
-    const float *own = d->spread_own;
-    int w = d->width, y0 = y > 0 ? y - 1 : y, y1 = y + 1 < d->height ? y + 1 : y;
+    int w = d->width;
     extra_histogram *k = &d->extra_hist[worker];
-    for (int x = 0; x < w; x++) {
-        size_t i = (size_t)y * (size_t)w + (size_t)x;
-        int hole = d->plan_kind[i] & PLAN_HOLE, young = d->plan_kind[i] & PLAN_YOUNG;
-        float s = own[i] > 0.0f ? own[i] : 0.0f;
-        if (hole || young) {
-            int x0 = x > 0 ? x - 1 : x, x1 = x + 1 < w ? x + 1 : x, m = 0;
-            float most = 0.0f, sum = 0.0f;
-            for (int qy = y0; qy <= y1; qy++)
-                for (int qx = x0; qx <= x1; qx++) {
-                    size_t q = (size_t)qy * (size_t)w + (size_t)qx;
-                    if (own[q] >= 0.0f && (hole || mat[q] == mat[i])) /* not a hole's */
-                        most = fmaxf(most, own[q]), sum += own[q], m++;
-                }
-            if (hole)
-                s = fmaxf(s, most > 0.0f ? most : d->spread_mean);
-            else
-                s = fmaxf(s, sum / (float)m); /* m >= 1: the pixel itself */
+    for (int x0 = 0; x0 < w; x0 += WINDOW_CHUNK) {
+        /* outside the image: a hole's spread (-1), which neither kind of pixel takes */
+        float own[3][WINDOW_SPAN], spread[WINDOW_CHUNK];
+        int32_t mat[3][WINDOW_SPAN];
+        window_rows(own, d->spread_own, w, d->height, x0, y, -1.0f);
+        window_rows_int(mat, d->g[d->cur].material, w, d->height, x0, y, -1);
+        int n = w - x0 < WINDOW_CHUNK ? w - x0 : WINDOW_CHUNK;
+        float hole[WINDOW_CHUNK], young[WINDOW_CHUNK]; /* 1 or 0, floats as the loops below want */
+        for (int x = 0; x < WINDOW_CHUNK; x++) {
+            uint8_t kind = x < n ? d->plan_kind[(size_t)y * (size_t)w + (size_t)(x0 + x)] : 0;
+            hole[x] = kind & PLAN_HOLE ? 1.0f : 0.0f;
+            young[x] = kind & PLAN_YOUNG ? 1.0f : 0.0f;
         }
-        d->spread[i] = s;
-        if (!(s > 0.0f)) continue;
-        float pn = d->plan_n[i];
-        int b = extra_bin(s / pn);
-        k->count[b]++, k->s[b] += (double)s, k->n[b] += (double)pn;
+        /* a hole takes the largest of its neighbours' own spreads (holes' -1 and the sky's 0 add
+         * nothing to it), a young pixel the mean over those on its surface; neighbour by neighbour */
+        float mean_spread = d->spread_mean, most[WINDOW_CHUNK] = {0}, sum[WINDOW_CHUNK] = {0}, m[WINDOW_CHUNK] = {0};
+        for (int r = 0; r < 3; r++)
+            for (int dx = 0; dx < 3; dx++) add_neighbour(own[r] + dx, mat[r] + dx, mat[1] + 1, most, sum, m);
+        for (int x = 0; x < WINDOW_CHUNK; x++) {
+            float o = own[1][x + 1], s = o > 0.0f ? o : 0.0f;
+            float mean = sum[x] / (m[x] > 1.0f ? m[x] : 1.0f); /* m >= 1 for a young pixel: itself */
+            float largest = most[x] > 0.0f ? most[x] : mean_spread;
+            float as_young = mean > s ? mean : s, as_hole = largest > s ? largest : s;
+            s = young[x] > 0.0f ? as_young : s;
+            spread[x] = hole[x] > 0.0f ? as_hole : s;
+        }
+        for (int x = 0; x < n; x++) {
+            size_t i = (size_t)y * (size_t)w + (size_t)(x0 + x);
+            float s = spread[x];
+            d->spread[i] = s;
+            if (!(s > 0.0f)) continue;
+            float pn = d->plan_n[i];
+            int b = extra_bin(s / pn);
+            k->count[b]++, k->s[b] += (double)s, k->n[b] += (double)pn;
+        }
     }
 }
 

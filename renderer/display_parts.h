@@ -4,6 +4,8 @@
 #ifndef GLINT_DISPLAY_PARTS_H
 #define GLINT_DISPLAY_PARTS_H
 
+#include <string.h>
+
 #include "denoise.h"
 #include "display.h"
 #include "threadpool.h"
@@ -142,6 +144,31 @@ static inline float shown_spread(const pixel_history *p, int c, float a) {
     if (!(n >= 2.0f)) return -1.0f;
     float l = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2]));
     return sample_variance(p->c[c].m2, l, n) * a * a;
+}
+
+/* The 3x3 neighbourhood passes (the plan's holes, the image shown's mix) take a row WINDOW_CHUNK
+ * pixels at a time, a loop count gcc vectorises at -O2 (vecmath.h): the chunk's three rows are
+ * copied with a pixel more on either side, `pad` where the image ends, so that every pixel has
+ * nine neighbours and the loop no branch. */
+#define WINDOW_CHUNK 64
+#define WINDOW_SPAN (WINDOW_CHUNK + 2)
+static inline void window_row_copy(void *out, const void *a, int w, int h, int x0, int y, uint32_t pad) {
+    uint32_t *o = out;
+    int from = x0 - 1, n = WINDOW_SPAN, skip = from < 0 ? -from : 0;
+    int have = y >= 0 && y < h ? (w - from < n ? w - from : n) - skip : 0;
+    for (int x = 0; x < WINDOW_SPAN; x++) o[x] = pad;
+    if (have > 0)
+        memcpy(o + skip, (const uint32_t *)a + (size_t)y * (size_t)w + (size_t)(from + skip),
+               sizeof(uint32_t) * (size_t)have);
+}
+static inline void window_rows(float out[3][WINDOW_SPAN], const float *a, int w, int h, int x0, int y, float pad) {
+    uint32_t bits;
+    memcpy(&bits, &pad, sizeof bits);
+    for (int r = 0; r < 3; r++) window_row_copy(out[r], a, w, h, x0, y - 1 + r, bits);
+}
+static inline void window_rows_int(int32_t out[3][WINDOW_SPAN], const int32_t *a, int w, int h, int x0, int y,
+                                   int32_t pad) {
+    for (int r = 0; r < 3; r++) window_row_copy(out[r], a, w, h, x0, y - 1 + r, (uint32_t)pad);
 }
 
 #endif
