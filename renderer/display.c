@@ -624,7 +624,7 @@ static float filter_gap(const display *d, int c, size_t i) {
     return diff * diff;
 }
 
-/* Each pixel's gap, once: take_of reads nine. */
+/* Each pixel's gap, once: take_chunk reads nine. */
 static void gap_row(void *ctx, int y, int worker) {
     (void)worker;
     resolve_job *j = ctx;
@@ -636,20 +636,51 @@ static void gap_row(void *ctx, int y, int worker) {
     }
 }
 
-/* One neighbour of each pixel of a chunk (take_chunk): where it lies on the pixel's surface (mat,
- * me) and has a gap (not -1), its variance into s2 and k, and its gap, times `other` (0 for the pixel
- * itself), into gap and m. Not inlined: in take_chunk's loops gcc does not vectorise it. */
-__attribute__((noinline)) static void add_take_neighbour(const float *restrict gap_q, const float *restrict var_q,
-                                                         const int32_t *restrict mat, const int32_t *restrict me,
-                                                         float other, float *restrict s2, float *restrict k,
-                                                         float *restrict gap, float *restrict m) {
+/* One neighbour q of a pixel (take_window): where it lies on the pixel's surface (mat_q == me) and
+ * has a gap (not -1), its variance into s2 and k, and its gap, times `other` (0 for the pixel
+ * itself), into gap and m. */
+static inline void take_tap(float gap_q, float var_q, int32_t mat_q, int32_t me, float other, float *s2, float *k,
+                            float *gap, float *m) {
+    float ok = mat_q == me ? gap_q : -1.0f; /* another surface's: none */
+    int in = ok >= -0.5f;
+    *s2 += in ? var_q : 0.0f;
+    *k += in ? 1.0f : 0.0f;
+    *gap += in ? other * gap_q : 0.0f;
+    *m += in ? other : 0.0f;
+}
+
+/* take_chunk's arithmetic: the rows of gaps, variances and materials about the chunk, and its own
+ * row's counts, variances and the filter's counts, all from pixel x0 - 1 (window_row). Not inlined:
+ * in take_chunk's loops gcc does not vectorise it. */
+__attribute__((noinline)) static void take_window(const float *const gap_w[3], const float *const var_w[3],
+                                                  const int32_t *const mat[3], const float *restrict n,
+                                                  const float *restrict vown, const float *restrict fn,
+                                                  float *restrict take) {
+    const float *restrict g0 = gap_w[0], *restrict g1 = gap_w[1], *restrict g2 = gap_w[2];
+    const float *restrict v0 = var_w[0], *restrict v1 = var_w[1], *restrict v2 = var_w[2];
+    const int32_t *restrict m0 = mat[0], *restrict m1 = mat[1], *restrict m2 = mat[2];
     for (int x = 0; x < WINDOW_CHUNK; x++) {
-        float ok = mat[x] == me[x] ? gap_q[x] : -1.0f; /* another surface's: none */
-        int in = ok >= -0.5f;
-        s2[x] += in ? var_q[x] : 0.0f;
-        k[x] += in ? 1.0f : 0.0f;
-        gap[x] += in ? other * gap_q[x] : 0.0f;
-        m[x] += in ? other : 0.0f;
+        float s2 = 0.0f, k = 0.0f, gap = 0.0f, m = 0.0f;
+        int32_t me = m1[x + 1];
+        take_tap(g0[x], v0[x], m0[x], me, 1.0f, &s2, &k, &gap, &m);
+        take_tap(g0[x + 1], v0[x + 1], m0[x + 1], me, 1.0f, &s2, &k, &gap, &m);
+        take_tap(g0[x + 2], v0[x + 2], m0[x + 2], me, 1.0f, &s2, &k, &gap, &m);
+        take_tap(g1[x], v1[x], m1[x], me, 1.0f, &s2, &k, &gap, &m);
+        take_tap(g1[x + 1], v1[x + 1], me, me, 0.0f, &s2, &k, &gap, &m);
+        take_tap(g1[x + 2], v1[x + 2], m1[x + 2], me, 1.0f, &s2, &k, &gap, &m);
+        take_tap(g2[x], v2[x], m2[x], me, 1.0f, &s2, &k, &gap, &m);
+        take_tap(g2[x + 1], v2[x + 1], m2[x + 1], me, 1.0f, &s2, &k, &gap, &m);
+        take_tap(g2[x + 2], v2[x + 2], m2[x + 2], me, 1.0f, &s2, &k, &gap, &m);
+        float nx = n[x + 1], v = s2 / (k > 1.0f ? k : 1.0f); /* k >= 1 where n >= 2: the pixel itself */
+        v = vown[x + 1] > v ? vown[x + 1] : v;
+        float vx = v / nx, vf = v / (fn[x + 1] > nx ? fn[x + 1] : nx);
+        float b2 = gap / (m > 1.0f ? m : 1.0f) - vx + vf;
+        b2 = m > 0.0f && b2 > 0.0f ? b2 : 0.0f;
+        float t = vx / (vx + vf + b2 + 1e-30f), finite = t - t; /* 0 unless t is infinite or NaN */
+        float clamped = t > 1.0f ? 1.0f : t;
+        clamped = clamped < 0.0f ? 0.0f : clamped;
+        t = finite == 0.0f ? clamped : 1.0f;
+        take[x] = nx >= 2.0f ? t : 1.0f;
     }
 }
 
@@ -667,31 +698,18 @@ __attribute__((noinline)) static void add_take_neighbour(const float *restrict g
  * (vecmath.h's rules): pixel by pixel, with its branches, it was a twentieth of the viewer's time. */
 static void take_chunk(const display *d, int c, int x0, int y, float *restrict take) {
     int w = d->width, h = d->height;
-    float gap_w[3][WINDOW_SPAN], var_w[3][WINDOW_SPAN], n[WINDOW_SPAN], vown[WINDOW_SPAN], fn[WINDOW_SPAN];
-    int32_t mat[3][WINDOW_SPAN];
-    window_rows(gap_w, d->gap[c], w, h, x0, y, -1.0f); /* outside the image: no gap, not taken */
-    window_rows(var_w, d->variance[c], w, h, x0, y, 0.0f);
-    window_rows_int(mat, d->g[d->cur].material, w, h, x0, y, -1);
-    window_row_copy(n, d->count[c], w, h, x0, y, 0u);
-    window_row_copy(vown, d->variance[c], w, h, x0, y, 0u);
-    window_row_copy(fn, d->out_count[c], w, h, x0, y, 0u);
-    float s2[WINDOW_CHUNK] = {0}, k[WINDOW_CHUNK] = {0}, gap[WINDOW_CHUNK] = {0}, m[WINDOW_CHUNK] = {0};
-    for (int r = 0; r < 3; r++)
-        for (int dx = 0; dx < 3; dx++)
-            add_take_neighbour(gap_w[r] + dx, var_w[r] + dx, mat[r] + dx, mat[1] + 1, r == 1 && dx == 1 ? 0.0f : 1.0f,
-                               s2, k, gap, m);
-    for (int x = 0; x < WINDOW_CHUNK; x++) {
-        float nx = n[x + 1], v = s2[x] / (k[x] > 1.0f ? k[x] : 1.0f); /* k >= 1 where n >= 2: the pixel itself */
-        v = vown[x + 1] > v ? vown[x + 1] : v;
-        float vx = v / nx, vf = v / (fn[x + 1] > nx ? fn[x + 1] : nx);
-        float b2 = gap[x] / (m[x] > 1.0f ? m[x] : 1.0f) - vx + vf;
-        b2 = m[x] > 0.0f && b2 > 0.0f ? b2 : 0.0f;
-        float t = vx / (vx + vf + b2 + 1e-30f), finite = t - t; /* 0 unless t is infinite or NaN */
-        float clamped = t > 1.0f ? 1.0f : t;
-        clamped = clamped < 0.0f ? 0.0f : clamped;
-        t = finite == 0.0f ? clamped : 1.0f;
-        take[x] = nx >= 2.0f ? t : 1.0f;
+    float buf_gap[3][WINDOW_SPAN], buf_var[3][WINDOW_SPAN], buf_n[WINDOW_SPAN], buf_fn[WINDOW_SPAN];
+    int32_t buf_mat[3][WINDOW_SPAN];
+    const float *gap_w[3], *var_w[3];
+    const int32_t *mat[3];
+    for (int r = 0; r < 3; r++) {
+        gap_w[r] = window_row(buf_gap[r], d->gap[c], w, h, x0, y - 1 + r, -1.0f); /* no gap: not taken */
+        var_w[r] = window_row(buf_var[r], d->variance[c], w, h, x0, y - 1 + r, 0.0f);
+        mat[r] = window_row_int(buf_mat[r], d->g[d->cur].material, w, h, x0, y - 1 + r, -1);
     }
+    const float *n = window_row(buf_n, d->count[c], w, h, x0, y, 0.0f), *vown = var_w[1];
+    const float *fn = window_row(buf_fn, d->out_count[c], w, h, x0, y, 0.0f);
+    take_window(gap_w, var_w, mat, n, vown, fn, take);
 }
 
 static void modulate_row(void *ctx, int y, int worker) {

@@ -100,17 +100,39 @@ static void spread_row(void *ctx, int y, int worker) {
  * bright neighbour, and the largest spreads the budget over all of them). Then each pixel's ratio
  * into its worker's histogram. */
 
-/* One neighbour of each pixel of a chunk (hole_row): its own spread o where the neighbour lies on
- * the pixel's surface (mat, me), into the largest of all and the sum and count of those. Not
- * inlined: in hole_row's loops gcc does not vectorise it. */
-__attribute__((noinline)) static void add_neighbour(const float *restrict o, const int32_t *restrict mat,
-                                                    const int32_t *restrict me, float *restrict most,
-                                                    float *restrict sum, float *restrict m) {
+/* One neighbour of a pixel (hole_window): its own spread o into the largest of all, and where it
+ * lies on the pixel's surface (mat == me) into the sum and count of those. */
+static inline void hole_tap(float o, int32_t mat, int32_t me, float *most, float *sum, float *m) {
+    *most = o > *most ? o : *most;
+    float mine = mat == me ? o : -1.0f; /* another surface's: none */
+    *sum += mine >= 0.0f ? mine : 0.0f;
+    *m += mine >= 0.0f ? 1.0f : 0.0f;
+}
+
+/* A chunk's pixels' spreads as a hole and as a young pixel (hole_row), from the rows of own spreads
+ * and materials about it (window_row). Not inlined: in hole_row's loops gcc does not vectorise it. */
+__attribute__((noinline)) static void hole_window(const float *const own[3], const int32_t *const mat[3],
+                                                  float spread_mean, float *restrict as_hole,
+                                                  float *restrict as_young) {
+    const float *restrict o0 = own[0], *restrict o1 = own[1], *restrict o2 = own[2];
+    const int32_t *restrict m0 = mat[0], *restrict m1 = mat[1], *restrict m2 = mat[2];
     for (int x = 0; x < WINDOW_CHUNK; x++) {
-        most[x] = o[x] > most[x] ? o[x] : most[x];
-        float mine = mat[x] == me[x] ? o[x] : -1.0f; /* another surface's: none */
-        sum[x] += mine >= 0.0f ? mine : 0.0f;
-        m[x] += mine >= 0.0f ? 1.0f : 0.0f;
+        float most = 0.0f, sum = 0.0f, m = 0.0f;
+        int32_t me = m1[x + 1];
+        hole_tap(o0[x], m0[x], me, &most, &sum, &m);
+        hole_tap(o0[x + 1], m0[x + 1], me, &most, &sum, &m);
+        hole_tap(o0[x + 2], m0[x + 2], me, &most, &sum, &m);
+        hole_tap(o1[x], m1[x], me, &most, &sum, &m);
+        hole_tap(o1[x + 1], me, me, &most, &sum, &m);
+        hole_tap(o1[x + 2], m1[x + 2], me, &most, &sum, &m);
+        hole_tap(o2[x], m2[x], me, &most, &sum, &m);
+        hole_tap(o2[x + 1], m2[x + 1], me, &most, &sum, &m);
+        hole_tap(o2[x + 2], m2[x + 2], me, &most, &sum, &m);
+        float s = o1[x + 1] > 0.0f ? o1[x + 1] : 0.0f;
+        float mean = sum / (m > 1.0f ? m : 1.0f); /* m >= 1 for a young pixel: itself */
+        float largest = most > 0.0f ? most : spread_mean;
+        as_young[x] = mean > s ? mean : s;
+        as_hole[x] = largest > s ? largest : s;
     }
 }
 
@@ -119,34 +141,22 @@ static void hole_row(void *ctx, int y, int worker) {
     int w = d->width;
     extra_histogram *k = &d->extra_hist[worker];
     for (int x0 = 0; x0 < w; x0 += WINDOW_CHUNK) {
-        /* outside the image: a hole's spread (-1), which neither kind of pixel takes */
-        float own[3][WINDOW_SPAN], spread[WINDOW_CHUNK];
-        int32_t mat[3][WINDOW_SPAN];
-        window_rows(own, d->spread_own, w, d->height, x0, y, -1.0f);
-        window_rows_int(mat, d->g[d->cur].material, w, d->height, x0, y, -1);
-        int n = w - x0 < WINDOW_CHUNK ? w - x0 : WINDOW_CHUNK;
-        float hole[WINDOW_CHUNK], young[WINDOW_CHUNK]; /* 1 or 0, floats as the loops below want */
-        for (int x = 0; x < WINDOW_CHUNK; x++) {
-            uint8_t kind = x < n ? d->plan_kind[(size_t)y * (size_t)w + (size_t)(x0 + x)] : 0;
-            hole[x] = kind & PLAN_HOLE ? 1.0f : 0.0f;
-            young[x] = kind & PLAN_YOUNG ? 1.0f : 0.0f;
+        float buf_own[3][WINDOW_SPAN];
+        int32_t buf_mat[3][WINDOW_SPAN];
+        const float *own[3];
+        const int32_t *mat[3];
+        for (int r = 0; r < 3; r++) { /* outside the image: a hole's spread (-1), which neither kind takes */
+            own[r] = window_row(buf_own[r], d->spread_own, w, d->height, x0, y - 1 + r, -1.0f);
+            mat[r] = window_row_int(buf_mat[r], d->g[d->cur].material, w, d->height, x0, y - 1 + r, -1);
         }
         /* a hole takes the largest of its neighbours' own spreads (holes' -1 and the sky's 0 add
-         * nothing to it), a young pixel the mean over those on its surface; neighbour by neighbour */
-        float mean_spread = d->spread_mean, most[WINDOW_CHUNK] = {0}, sum[WINDOW_CHUNK] = {0}, m[WINDOW_CHUNK] = {0};
-        for (int r = 0; r < 3; r++)
-            for (int dx = 0; dx < 3; dx++) add_neighbour(own[r] + dx, mat[r] + dx, mat[1] + 1, most, sum, m);
-        for (int x = 0; x < WINDOW_CHUNK; x++) {
-            float o = own[1][x + 1], s = o > 0.0f ? o : 0.0f;
-            float mean = sum[x] / (m[x] > 1.0f ? m[x] : 1.0f); /* m >= 1 for a young pixel: itself */
-            float largest = most[x] > 0.0f ? most[x] : mean_spread;
-            float as_young = mean > s ? mean : s, as_hole = largest > s ? largest : s;
-            s = young[x] > 0.0f ? as_young : s;
-            spread[x] = hole[x] > 0.0f ? as_hole : s;
-        }
-        for (int x = 0; x < n; x++) {
+         * nothing to it), a young pixel the mean over those on its surface */
+        float as_hole[WINDOW_CHUNK], as_young[WINDOW_CHUNK];
+        hole_window(own, mat, d->spread_mean, as_hole, as_young);
+        for (int x = 0; x < WINDOW_CHUNK && x0 + x < w; x++) {
             size_t i = (size_t)y * (size_t)w + (size_t)(x0 + x);
-            float s = spread[x];
+            float s = own[1][x + 1] > 0.0f ? own[1][x + 1] : 0.0f;
+            s = d->plan_kind[i] & PLAN_HOLE ? as_hole[x] : d->plan_kind[i] & PLAN_YOUNG ? as_young[x] : s;
             d->spread[i] = s;
             if (!(s > 0.0f)) continue;
             float pn = d->plan_n[i];

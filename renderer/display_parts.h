@@ -147,28 +147,34 @@ static inline float shown_spread(const pixel_history *p, int c, float a) {
 }
 
 /* The 3x3 neighbourhood passes (the plan's holes, the image shown's mix) take a row WINDOW_CHUNK
- * pixels at a time, a loop count gcc vectorises at -O2 (vecmath.h): the chunk's three rows are
- * copied with a pixel more on either side, `pad` where the image ends, so that every pixel has
- * nine neighbours and the loop no branch. */
+ * pixels at a time, a loop count gcc vectorises at -O2 (vecmath.h), each pixel with nine
+ * neighbours and the loop with no branch: a chunk reads pixels x0 - 1 .. x0 + WINDOW_CHUNK of rows
+ * y - 1 .. y + 1 where they lie in the image, and a copy padded with `pad` (which the pass must not
+ * take) where they pass its edge. */
 #define WINDOW_CHUNK 64
 #define WINDOW_SPAN (WINDOW_CHUNK + 2)
-static inline void window_row_copy(void *out, const void *a, int w, int h, int x0, int y, uint32_t pad) {
-    uint32_t *o = out;
-    int from = x0 - 1, n = WINDOW_SPAN, skip = from < 0 ? -from : 0;
-    int have = y >= 0 && y < h ? (w - from < n ? w - from : n) - skip : 0;
-    for (int x = 0; x < WINDOW_SPAN; x++) o[x] = pad;
+static inline void window_row_copy(void *out, const void *a, int w, int h, int x0, int y, const void *pad) {
+    char *o = out;
+    int from = x0 - 1, skip = from < 0 ? -from : 0;
+    int have = y >= 0 && y < h ? (w - from < WINDOW_SPAN ? w - from : WINDOW_SPAN) - skip : 0;
+    for (int x = 0; x < WINDOW_SPAN; x++) memcpy(o + 4 * x, pad, 4);
     if (have > 0)
-        memcpy(o + skip, (const uint32_t *)a + (size_t)y * (size_t)w + (size_t)(from + skip),
-               sizeof(uint32_t) * (size_t)have);
+        memcpy(o + 4 * skip, (const char *)a + 4 * ((size_t)y * (size_t)w + (size_t)(from + skip)), 4 * (size_t)have);
 }
-static inline void window_rows(float out[3][WINDOW_SPAN], const float *a, int w, int h, int x0, int y, float pad) {
-    uint32_t bits;
-    memcpy(&bits, &pad, sizeof bits);
-    for (int r = 0; r < 3; r++) window_row_copy(out[r], a, w, h, x0, y - 1 + r, bits);
+static inline int window_inside(int w, int h, int x0, int y) {
+    return x0 >= 1 && x0 + WINDOW_CHUNK < w && y >= 0 && y < h;
 }
-static inline void window_rows_int(int32_t out[3][WINDOW_SPAN], const int32_t *a, int w, int h, int x0, int y,
-                                   int32_t pad) {
-    for (int r = 0; r < 3; r++) window_row_copy(out[r], a, w, h, x0, y - 1 + r, (uint32_t)pad);
+/* Row y of plane a from pixel x0 - 1, in the plane or in buf. */
+static inline const float *window_row(float buf[WINDOW_SPAN], const float *a, int w, int h, int x0, int y, float pad) {
+    if (window_inside(w, h, x0, y)) return a + (size_t)y * (size_t)w + (size_t)(x0 - 1);
+    window_row_copy(buf, a, w, h, x0, y, &pad);
+    return buf;
+}
+static inline const int32_t *window_row_int(int32_t buf[WINDOW_SPAN], const int32_t *a, int w, int h, int x0, int y,
+                                            int32_t pad) {
+    if (window_inside(w, h, x0, y)) return a + (size_t)y * (size_t)w + (size_t)(x0 - 1);
+    window_row_copy(buf, a, w, h, x0, y, &pad);
+    return buf;
 }
 
 #endif
