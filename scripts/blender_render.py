@@ -3,6 +3,7 @@
 
     blender -b --factory-startup -P scripts/blender_render.py -- SCENE.gltf OUT.exr \\
         --size WxH --samples N --camera STATS.json [--env MAP.hdr] [--max-depth D] [--lambert] [--seed S]
+        [--time-limit SECONDS]
 
 SCENE is imported with Blender's own glTF importer. The camera is the one `glint render --stats`
 recorded (position, forward, up, yfov_degrees; glTF's Y up becomes Blender's Z up as the
@@ -12,6 +13,13 @@ is set to match glint's path tracer: up to D bounces of every kind (glint's --ma
 default 16), no clamping, no glossy filter, caustics on, a box pixel filter one pixel wide,
 no denoising. OUT.exr is linear float RGB. --lambert replaces every material by a Diffuse BSDF
 (Lambert) of its base colour: the control, where the two renderers should agree exactly.
+--time-limit renders for that many seconds (Cycles' time limit, its scene set-up not counted)
+rather than a number of samples. glint's own lobes (a material's extras "glint": the papers'
+modified Phong, anisotropic Ward), which Blender's importer leaves as their glTF fallback, become
+the nearest Cycles lobes: a Diffuse BSDF of kd plus a Glossy BSDF (Beckmann) of ks as wide (Phong's
+exponent n as Beckmann's alpha sqrt(2 / (n + 2)), Ward's two alphas as their geometric mean): close,
+not the same BRDF. An emitter that glTF does not call double-sided emits from its front only, as
+in glint.
 """
 import json
 import math
@@ -30,9 +38,9 @@ def parse_args(argv):
     args = argv[argv.index("--") + 1:] if "--" in argv else []
     if len(args) < 2:
         fail("usage: blender -b -P blender_render.py -- SCENE.gltf OUT.exr --size WxH --samples N "
-             "--camera STATS.json [--env MAP] [--max-depth D] [--lambert] [--seed S]")
+             "--camera STATS.json [--env MAP] [--max-depth D] [--lambert] [--seed S] [--time-limit SECONDS]")
     opts = {"scene": args[0], "out": args[1], "size": "320x240", "samples": 64, "camera": None, "env": None,
-            "max_depth": 16, "lambert": False, "seed": 1}
+            "max_depth": 16, "lambert": False, "seed": 1, "time_limit": 0}
     i = 2
     while i < len(args):
         a = args[i]
@@ -116,6 +124,68 @@ def make_lambert():
         links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
 
 
+def glint_lobes():
+    """Materials with glint's own lobes (extras "glint") as a Diffuse plus a Glossy BSDF; their count."""
+    n = 0
+    for mat in bpy.data.materials:
+        model = mat.get("glint")
+        if model is None or not mat.use_nodes:
+            continue
+        model = model.to_dict() if hasattr(model, "to_dict") else dict(model)
+        if model.get("model") == "phong":
+            alpha = math.sqrt(2.0 / (float(model["exponent"]) + 2.0))
+        elif model.get("model") == "ward":
+            alpha = math.sqrt(float(model["alpha_x"]) * float(model["alpha_y"]))
+        else:
+            continue
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        output = next((n for n in nodes if n.type == "OUTPUT_MATERIAL"), None)
+        if output is None:
+            continue
+        diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+        diffuse.inputs["Color"].default_value = list(model["kd"]) + [1.0]
+        diffuse.inputs["Roughness"].default_value = 0.0
+        glossy = nodes.new("ShaderNodeBsdfGlossy")
+        glossy.distribution = "BECKMANN"
+        glossy.inputs["Color"].default_value = list(model["ks"]) + [1.0]
+        glossy.inputs["Roughness"].default_value = math.sqrt(alpha)  # Cycles squares it
+        add = nodes.new("ShaderNodeAddShader")
+        links.new(diffuse.outputs["BSDF"], add.inputs[0])
+        links.new(glossy.outputs["BSDF"], add.inputs[1])
+        links.new(add.outputs["Shader"], output.inputs["Surface"])
+        n += 1
+    return n
+
+
+def one_sided_emission():
+    """Emission from the front face only where glTF says the material is not double-sided, as
+    glint emits (Cycles emits from both): the importer marks those with backface culling. The back
+    face is black (an emitter's glTF base colour is black). Their count."""
+    n = 0
+    for mat in bpy.data.materials:
+        if not mat.use_nodes or not mat.use_backface_culling:
+            continue
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        principled = next((n for n in nodes if n.type == "BSDF_PRINCIPLED"), None)
+        output = next((n for n in nodes if n.type == "OUTPUT_MATERIAL"), None)
+        if principled is None or output is None or not output.inputs["Surface"].is_linked:
+            continue
+        emission = principled.inputs["Emission"]
+        if not emission.is_linked and max(emission.default_value[:3]) <= 0.0:
+            continue
+        surface = output.inputs["Surface"].links[0].from_socket
+        back = nodes.new("ShaderNodeBsdfDiffuse")
+        back.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        geometry = nodes.new("ShaderNodeNewGeometry")
+        mix = nodes.new("ShaderNodeMixShader")
+        links.new(geometry.outputs["Backfacing"], mix.inputs["Fac"])
+        links.new(surface, mix.inputs[1])
+        links.new(back.outputs["BSDF"], mix.inputs[2])
+        links.new(mix.outputs["Shader"], output.inputs["Surface"])
+        n += 1
+    return n
+
+
 def configure(opts):
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
@@ -125,6 +195,9 @@ def configure(opts):
     cy = scene.cycles
     cy.device = "CPU"
     cy.samples = int(opts["samples"])
+    if float(opts["time_limit"]) > 0:
+        cy.time_limit = float(opts["time_limit"])
+        cy.samples = 1 << 24  # the time limit stops it
     cy.use_adaptive_sampling = False
     cy.use_denoising = False
     cy.seed = int(opts["seed"])
@@ -165,6 +238,13 @@ def main():
         fail(opts["scene"] + ": Blender's glTF importer failed")
     if opts["lambert"]:
         make_lambert()
+    else:
+        lobes = glint_lobes()
+        if lobes:
+            print("blender_render: %d materials with glint's own lobes, as Cycles' nearest" % lobes)
+    one_sided = one_sided_emission()
+    if one_sided:
+        print("blender_render: %d one-sided emitters" % one_sided)
     w, h = (int(x) for x in opts["size"].split("x"))
     add_camera(opts["camera"], w / h)
     set_world(opts["env"])

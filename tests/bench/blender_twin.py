@@ -378,4 +378,5 @@ def main():
         fail("usage: blender_twin.py run GLINT OUTDIR [options] | compare A.exr B.exr | test GLINT")
 
 
-main()
+if __name__ == "__main__":
+    main()

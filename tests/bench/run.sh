@@ -28,6 +28,9 @@
 #      noise and bias from 2 seeds) on every built-in scene (bay: a directly lit half beside a bay
 #      lit only indirectly), the shared Cornell box, the punctual-lights lamp and the damaged
 #      helmet under the Venice sunset. About 8 minutes a scene plus the references.
+#   With GLINT_BLENDER=1 (and Blender installed: scripts/deps.sh), `bench` and `suite` add each
+#   scene's Blender Cycles row (tests/bench/cycles_row.py): the same camera, budgets, threads and
+#   seeds, Cycles on the CPU with unbiased settings; 2 to 3 minutes more a scene.
 # Environment: GLINT (a glint binary: skips installing and building), SIZE (references and
 # benches, default 320x240), REF_SECONDS (default 1200), HL_REF_SECONDS (600), TIMES and SEEDS
 # (replace every preset's budgets and seed count, e.g. TIMES=0.2 SEEDS=1 for a smoke run),
@@ -84,6 +87,18 @@ bench() {
   cat "$out/report.md"
 }
 
+# cycles NAME SCENE REF TIMES [--env MAP]: with GLINT_BLENDER=1 and Blender installed, the
+# headline's Blender Cycles row for SCENE (tests/bench/cycles_row.py: the same camera, budgets,
+# threads and seed count, unbiased settings; its noise and bias against REF), printed.
+cycles() {
+  [ "${GLINT_BLENDER:-}" = 1 ] || return 0
+  command -v blender >/dev/null || { echo "GLINT_BLENDER=1 but blender is not installed: no Cycles row"; return 0; }
+  local name=$1 file=$2 ref=$3 times=$4
+  shift 4
+  python3 "$root/tests/bench/cycles_row.py" "$glint" "$file" "$ref" "$results/$name-cycles-$stamp" --size "$size" \
+    --times "$times" --seeds "${SEEDS:-2}" --threads "$(nproc)" "$@"
+}
+
 have_scene() { case "$1" in builtin:*) ;; *) [ -f "$1" ] || { echo "skipping $1: not found"; return 1; } ;; esac; }
 
 if [ "$mode" = vsl ]; then
@@ -119,6 +134,7 @@ if [ "$mode" = bench ]; then
     else
       bench "$name" "$file" "$ref" headline
     fi
+    cycles "$name" "$file" "$ref" "${TIMES:-2,10,60}${LONG_SECONDS:+,$LONG_SECONDS}"
   done
   bench showcase builtin:showcase "$(reference showcase builtin:showcase)" fig8
   exit 0
@@ -140,7 +156,9 @@ if [ "$mode" = suite ]; then
       env=(--env "$sunset")
       name=helmet-sunset
     fi
-    bench "$name" "$file" "$(reference "$name" "$file" "${env[@]}")" headline --times "${TIMES:-10,60}" "${env[@]}"
+    ref=$(reference "$name" "$file" "${env[@]}")
+    bench "$name" "$file" "$ref" headline --times "${TIMES:-10,60}" "${env[@]}"
+    cycles "$name" "$file" "$ref" "${TIMES:-10,60}" "${env[@]}"
   done
   exit 0
 fi
