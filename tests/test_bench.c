@@ -61,7 +61,7 @@ static void ink(const unsigned char *rgb, int w, int h, int x0, int y0, int x1, 
 }
 
 /* The PNG plot has words where the SVG has them: title, axis labels, the curves' names and the
- * readings' in the legend. The regions hold nothing else (app/plot.c's layout: the plot area
+ * readings' in the legend. The regions hold nothing else (app/bench/plot.c's layout: the plot area
  * 80..580 x 40..430, the legend from x 600, a row every 20 px from y 50). A digit alone, as the
  * PNG once had beside its legend swatches, is narrower than the names asked for (unhinted 12 px
  * text: "vsl" 14 px of ink). */

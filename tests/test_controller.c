@@ -1,4 +1,4 @@
-/* The viewer's render side through its narrow interface (app/view_controller.h), headless: it
+/* The viewer's render side through its narrow interface (app/view/view_controller.h), headless: it
  * links no window and no GL. Every image is at the render's full size and finite; a camera change
  * is shown with its own generation and carries history over; pausing stops refinement between
  * frames (nothing more is rendered while it stands); an export written after two whole frames is,

@@ -1,4 +1,4 @@
-/* glint tests — the bench's plots (app/plot.c, compiled in): one description saved as SVG and as
+/* glint tests — the bench's plots (app/bench/plot.c, compiled in): one description saved as SVG and as
  * PNG. The PNG is decoded and the SVG read as XML (well-formed, the figure's size, its paths and
  * glyphs); where the data must land is computed here from the axes' ranges, independently of the
  * plot's code. Both files show each series in one colour at its points, the legend's swatches in

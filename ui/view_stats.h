@@ -1,5 +1,5 @@
 /* glint view: what the viewer's render side reports of its updates, frames and the image shown.
- * One record, declared once, here: the render side (app/view_controller.c) fills it, the panel
+ * One record, declared once, here: the render side (app/view/view_controller.c) fills it, the panel
  * (ui.h, ui_stats.render) shows it, and a script's `stats` line prints it (view_stats_print) under
  * the names given below. */
 #ifndef GLINT_VIEW_STATS_H
