@@ -264,6 +264,19 @@ static void progress_update(progress *pg, const render_options *o, long long fra
     pg->last = now;
 }
 
+/* The counters of one section of the list (params.h, RENDER_COUNTERS), each after sep. */
+static void json_counters(FILE *f, const render_stats *st, stats_section section, const char *sep) {
+#define JSON_COUNTER(field, name, in, scale)                                                                           \
+    if ((in) == section) {                                                                                             \
+        if ((scale) == 1.0)                                                                                            \
+            fprintf(f, "%s\"%s\": %llu", sep, name, (unsigned long long)st->field);                                    \
+        else                                                                                                           \
+            fprintf(f, "%s\"%s\": %.6f", sep, name, (scale) * (double)st->field);                                      \
+    }
+    RENDER_COUNTERS(JSON_COUNTER)
+#undef JSON_COUNTER
+}
+
 /* Highlights are a layer of their own when they are split off (vsl+hl, --highlights-layer). */
 static unsigned exr_layers(const render_options *o) {
     int split = o->params.pt_highlights || o->params.method == METHOD_VSL_HL;
@@ -299,32 +312,23 @@ static int write_stats(const char *path, const render_options *o, const render_s
         fprintf(f, "\"%s\": %llu, ", ray_kind_names[k], (unsigned long long)st.rays[k]);
     fprintf(f, "\"total\": %llu},\n", (unsigned long long)total);
     fprintf(f, "  \"rays_per_second\": %.1f,\n", seconds > 0 ? (double)total / seconds : 0.0);
-    fprintf(f, "  \"rejected_samples\": %llu,\n", (unsigned long long)st.rejected_samples);
     fprintf(f, "  \"values_clamped_to_float\": %zu", clamped);
+    json_counters(f, &st, STATS_ALL, ",\n  ");
     if (p->method != METHOD_PT) {
         const vl_params vp = vl_params_resolve(&p->vl); /* the values the frames used */
-        fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"virtual_lights_total\": %llu,\n", vp.count,
-                (unsigned long long)st.virtual_lights);
-        fprintf(f, "  \"light_paths_total\": %llu,\n  \"connections\": %llu,\n  \"vsl_samples\": %llu,\n",
-                (unsigned long long)st.light_paths, (unsigned long long)st.vl_connections,
-                (unsigned long long)st.vsl_samples);
-        fprintf(f, "  \"glossy_bounces\": %llu,\n", (unsigned long long)st.glossy_bounces);
-        fprintf(f, "  \"pixel_points\": %llu,\n", (unsigned long long)st.pixel_points);
-        fprintf(f, "  \"clamped\": %llu,\n  \"rows\": %d,\n  \"columns\": %d", (unsigned long long)st.clamped,
+        fprintf(f, ",\n  \"virtual_lights_per_frame\": %d,\n  \"rows\": %d,\n  \"columns\": %d", vp.count,
                 vp.columns > 0 ? vp.rows : 0, vp.columns);
+        json_counters(f, &st, STATS_MANY_LIGHT, ",\n  ");
     }
     if (p->method == METHOD_VSL_HL) {
         hl_setup hl = hl_setup_from(s, &p->vl, NULL);
-        fprintf(f, ",\n  \"highlights\": {\"secondary_rays\": %d, \"clusters\": %d, \"merge\": %s, ", hl.secondary_rays,
+        fprintf(f, ",\n  \"highlights\": {\"secondary_rays\": %d, \"clusters\": %d, \"merge\": %s", hl.secondary_rays,
                 hl.clusters,
                 hl.mode == HL_MERGED     ? (hl.choose ? "\"auto\"" : "\"on\"")
                 : hl.mode == HL_UNMERGED ? "\"off\""
                                          : "\"trace\"");
-        fprintf(f, "\"points\": %llu, \"secondary_rays_total\": %llu, \"lobes_lit\": %llu, \"merge_seconds\": %.6f, ",
-                (unsigned long long)st.hl_points, (unsigned long long)st.hl_secondary_rays,
-                (unsigned long long)st.hl_lobes, 1e-9 * (double)st.hl_merge_ns);
-        fprintf(f, "\"traced_pixels\": %llu, \"env_filter_bytes\": %llu}", (unsigned long long)st.hl_traced_pixels,
-                (unsigned long long)st.env_filter_bytes);
+        json_counters(f, &st, STATS_HIGHLIGHTS, ", ");
+        fputc('}', f);
     }
     /* The effect plan and what each pass cost: a skipped pass shows zero seconds. */
     const effect_plan *plan = session_plan(rs);

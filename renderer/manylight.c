@@ -186,13 +186,6 @@ static void compute_row(void *ctx, int r, int worker) {
         row[j] = luminance3(shade_one(job->m, job->s, &job->m->set.v[j], &sp, job->m->terms, &rng, st));
 }
 
-static void add_stats(render_stats *to, const render_stats *from) {
-    for (int k = 0; k < RAY_KIND_COUNT; k++) to->rays[k] += from->rays[k];
-    to->vl_connections += from->vl_connections;
-    to->vsl_samples += from->vsl_samples;
-    to->clamped += from->clamped;
-}
-
 static int reserve_entries(manylight *m, int n) {
     if (n <= m->cap_entries) return 0;
     ml_entry *e = realloc(m->entries, sizeof(ml_entry) * (size_t)n);
@@ -214,7 +207,7 @@ static int cluster_lights(manylight *m, const scene *s, const camera *cam, const
     if (matrix && row_stats && clusters && reserve_entries(m, p->vl.columns) == 0) {
         row_job job = {m, s, cam, p, frame, rows, matrix, row_stats};
         threadpool_run(pool, compute_row, &job, rows);
-        for (int r = 0; r < rows; r++) add_stats(st, &row_stats[r]);
+        for (int r = 0; r < rows; r++) render_stats_add(st, &row_stats[r]);
         rng_state rng = rng_for(0x636c7573ULL, (uint64_t)frame, p->seed);
         int k = mrcs_cluster_columns(matrix, rows, n, p->vl.columns, &rng, clusters);
         if (k >= 0) {

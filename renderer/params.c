@@ -386,3 +386,11 @@ const char *params_help(void) {
     }
     return text;
 }
+
+void render_stats_add(render_stats *to, const render_stats *from) {
+    for (int k = 0; k < RAY_KIND_COUNT; k++) to->rays[k] += from->rays[k];
+#define RENDER_COUNTER_ADD(field, name, section, scale) to->field += from->field;
+    RENDER_COUNTERS(RENDER_COUNTER_ADD)
+#undef RENDER_COUNTER_ADD
+    for (int k = 0; k < PASS_COUNT; k++) to->pass_ns[k] += from->pass_ns[k];
+}

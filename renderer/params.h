@@ -186,24 +186,41 @@ extern const char *const ray_kind_names[RAY_KIND_COUNT];
 typedef enum { PASS_PATHS = 0, PASS_DIRECT, PASS_VIRTUAL_LIGHTS, PASS_GATHER, PASS_HIGHLIGHTS, PASS_COUNT } pass_kind;
 extern const char *const pass_names[PASS_COUNT];
 
+/* The counters a session keeps, declared once: X(field, name, section, scale), the field of
+ * render_stats, its name in `glint render --stats` (inside its "highlights" object for
+ * STATS_HIGHLIGHTS), the methods that report it (STATS_ALL every one, STATS_MANY_LIGHT vpl, vsl and
+ * vsl+hl, STATS_HIGHLIGHTS vsl+hl) and what the JSON multiplies it by (1: a count; 1e-9: nanoseconds
+ * as seconds). render_stats, its sum (render_stats_add: over threads, over rows) and the JSON's
+ * counters are made from this list: a counter added here is summed and reported with nothing else
+ * to change. */
+typedef enum { STATS_ALL, STATS_MANY_LIGHT, STATS_HIGHLIGHTS } stats_section;
+#define RENDER_COUNTERS(X)                                                                                             \
+    X(rejected_samples, "rejected_samples", STATS_ALL, 1.0)             /* samples dropped: NaN or Inf */              \
+    X(virtual_lights, "virtual_lights_total", STATS_MANY_LIGHT, 1.0)    /* deposited, over frames */                   \
+    X(light_paths, "light_paths_total", STATS_MANY_LIGHT, 1.0)          /* traced to deposit them */                   \
+    X(vl_connections, "connections", STATS_MANY_LIGHT, 1.0)             /* shading point - virtual light */            \
+    X(vsl_samples, "vsl_samples", STATS_MANY_LIGHT, 1.0)                /* integration samples of the VSL integrals */ \
+    X(clamped, "clamped", STATS_MANY_LIGHT, 1.0)                        /* contributions the clamp cut down */         \
+    X(glossy_bounces, "glossy_bounces", STATS_MANY_LIGHT, 1.0)          /* camera paths on through a sharp lobe */     \
+    X(pixel_points, "pixel_points", STATS_MANY_LIGHT, 1.0)              /* camera rays past a pixel's one a frame */   \
+    X(hl_points, "points", STATS_HIGHLIGHTS, 1.0)                       /* camera hits the highlights worked at */     \
+    X(hl_secondary_rays, "secondary_rays_total", STATS_HIGHLIGHTS, 1.0) /* rays from their glossy lobes */             \
+    X(hl_lobes, "lobes_lit", STATS_HIGHLIGHTS, 1.0)                     /* merged, or one per secondary hit */         \
+    X(hl_merge_ns, "merge_seconds", STATS_HIGHLIGHTS, 1e-9)             /* clustering and merging (thread time) */     \
+    X(hl_traced_pixels, "traced_pixels", STATS_HIGHLIGHTS, 1.0)         /* --merge auto: at the last judgement */      \
+    X(env_filter_bytes, "env_filter_bytes", STATS_HIGHLIGHTS, 1.0)      /* the prefiltered map's memory */
+
+/* Rays by kind, the list's counters and each pass's time; summed over the frames since the last reset. */
 typedef struct {
     uint64_t rays[RAY_KIND_COUNT];
-    uint64_t rejected_samples;  /* samples dropped because they were NaN or Inf */
-    uint64_t virtual_lights;    /* deposited, summed over frames (the effective light count) */
-    uint64_t light_paths;       /* traced to deposit them */
-    uint64_t vl_connections;    /* shading point - virtual light evaluations */
-    uint64_t vsl_samples;       /* integration samples of the VSL integrals */
-    uint64_t clamped;           /* contributions the clamp cut down */
-    uint64_t glossy_bounces;    /* camera paths continued through a sharp glossy lobe (--trace-glossy) */
-    uint64_t pixel_points;      /* camera rays past a pixel's one a frame: its direct and highlight points */
-    uint64_t hl_points;         /* camera hits the highlight estimator worked at */
-    uint64_t hl_secondary_rays; /* rays sampled from their glossy lobes */
-    uint64_t hl_lobes;          /* lobes lit (merged, or one per secondary hit without merging) */
-    uint64_t hl_merge_ns;       /* thread time spent clustering and merging (the paper's Table 1, C) */
-    uint64_t hl_traced_pixels;  /* --merge auto: pixels judged to take the trace, at the last judgement */
-    uint64_t env_filter_bytes;  /* memory of the prefiltered environment map (vsl+hl under a map; 0: none) */
+#define RENDER_COUNTER_FIELD(field, name, section, scale) uint64_t field;
+    RENDER_COUNTERS(RENDER_COUNTER_FIELD)
+#undef RENDER_COUNTER_FIELD
     uint64_t pass_ns[PASS_COUNT];
 } render_stats;
+
+/* from's counts added to to's, every one of them. */
+void render_stats_add(render_stats *to, const render_stats *from);
 
 /* ---- defaults ---------------------------------------------------------------------------------- */
 

@@ -616,23 +616,9 @@ static int begin_frame(render_session *rs) {
 
 /* The workers' counters into the totals, and cleared. */
 static void gather_stats(render_session *rs) {
-    int n = threadpool_size(rs->pool);
-    for (int w = 0; w < n; w++) {
-        render_stats *st = &rs->workers[w].st;
-        render_stats *t = &rs->totals;
-        for (int k = 0; k < RAY_KIND_COUNT; k++) t->rays[k] += st->rays[k];
-        t->rejected_samples += st->rejected_samples;
-        t->vl_connections += st->vl_connections;
-        t->vsl_samples += st->vsl_samples;
-        t->clamped += st->clamped;
-        t->glossy_bounces += st->glossy_bounces;
-        t->pixel_points += st->pixel_points;
-        t->hl_points += st->hl_points;
-        t->hl_secondary_rays += st->hl_secondary_rays;
-        t->hl_lobes += st->hl_lobes;
-        t->hl_merge_ns += st->hl_merge_ns;
-        for (int k = 0; k < PASS_COUNT; k++) t->pass_ns[k] += st->pass_ns[k];
-        memset(st, 0, sizeof *st);
+    for (int w = 0; w < threadpool_size(rs->pool); w++) {
+        render_stats_add(&rs->totals, &rs->workers[w].st);
+        memset(&rs->workers[w].st, 0, sizeof rs->workers[w].st);
     }
 }
 

@@ -1,8 +1,9 @@
 /* glint tests — the parameter table (params.h): every entry is accepted by the command line's
  * parser and by the script's `set` (both through the table), listed in the help, complete for the
  * panel; its default is what vl_params_resolve gives; every vl_params field has an entry; the
- * option list in docs/methods.md is the help's. With the glint program as argument, each entry is
- * also given to `glint render` as a user would. */
+ * option list in docs/methods.md is the help's. The counters' list (RENDER_COUNTERS) is all of
+ * render_stats and all of it is summed. With the glint program as argument, each entry is also
+ * given to `glint render` as a user would, and --stats reports every counter. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -159,6 +160,36 @@ static void test_resolve(void) {
     }
 }
 
+/* The counters' list (RENDER_COUNTERS) is the whole of render_stats beside the rays and the passes,
+ * and render_stats_add sums every one of them. */
+static void test_counters(void) {
+    int listed = 0;
+#define COUNT_ONE(field, name, section, scale) listed++;
+    RENDER_COUNTERS(COUNT_ONE)
+#undef COUNT_ONE
+    CHECK(sizeof(render_stats) == sizeof(uint64_t) * (size_t)(RAY_KIND_COUNT + listed + PASS_COUNT),
+          "render_stats has a field outside the list");
+    render_stats a, b;
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
+    uint64_t v = 1;
+    for (int k = 0; k < RAY_KIND_COUNT; k++) b.rays[k] = v++;
+#define SET_ONE(field, name, section, scale) b.field = v++;
+    RENDER_COUNTERS(SET_ONE)
+#undef SET_ONE
+    for (int k = 0; k < PASS_COUNT; k++) b.pass_ns[k] = v++;
+    render_stats_add(&a, &b);
+    render_stats_add(&a, &b);
+    v = 1;
+    for (int k = 0; k < RAY_KIND_COUNT; k++, v++) CHECK(a.rays[k] == 2 * v, "rays[%d] not summed", k);
+#define CHECK_ONE(field, name, section, scale)                                                                         \
+    CHECK(a.field == 2 * v, "render_stats_add does not sum %s", name);                                                 \
+    v++;
+    RENDER_COUNTERS(CHECK_ONE)
+#undef CHECK_ONE
+    for (int k = 0; k < PASS_COUNT; k++, v++) CHECK(a.pass_ns[k] == 2 * v, "pass_ns[%d] not summed", k);
+}
+
 /* docs/methods.md lists the options as --help prints them. */
 static void test_options_doc(void) {
     static char text[1 << 20];
@@ -181,6 +212,15 @@ static void test_program(void) {
               strstr(err_text, "glint: error: --vsl-count: 50000000 would take 23.8 GiB") &&
               strchr(err_text, '\n') == err_text + strlen(err_text) - 1,
           "--vsl-count 50000000: %s", err_text);
+    /* --stats reports every counter of the list (vsl+hl reports every section) */
+    static char json[16384];
+    CHECK(run("render builtin:showcase --method vsl+hl --size 16x12 --spp 1 --vsl-count 16 --quiet --png p.png "
+              "--stats s.json") == 0 &&
+              read_file("s.json", json, sizeof json) > 0,
+          "vsl+hl --stats: %s", err_text);
+#define IN_JSON(field, name, section, scale) CHECK(strstr(json, "\"" name "\": ") != NULL, "--stats lacks %s", name);
+    RENDER_COUNTERS(IN_JSON)
+#undef IN_JSON
     for (int i = 0; i < n; i++) {
         char text[64], args[512];
         example(&t[i], text, sizeof text);
@@ -196,6 +236,7 @@ int main(int argc, char **argv) {
     test_resolve();
     test_memory_rule();
     test_options_doc();
+    test_counters();
     if (argc >= 2 && harness_start(argc, argv, "params") == 0) test_program();
     return check_exit("test_params");
 }
