@@ -19,7 +19,7 @@ modified Phong, anisotropic Ward), which Blender's importer leaves as their glTF
 the nearest Cycles lobes: a Diffuse BSDF of kd plus a Glossy BSDF (Beckmann) of ks as wide (Phong's
 exponent n as Beckmann's alpha sqrt(2 / (n + 2)), Ward's two alphas as their geometric mean): close,
 not the same BRDF. An emitter that glTF does not call double-sided emits from its front only, as
-in glint.
+in glint, and punctual lights have glint's units (a candela as a watt per steradian).
 """
 import json
 import math
@@ -233,9 +233,19 @@ def main():
     if "bool" not in numpy.__dict__:
         numpy.bool = bool
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    result = bpy.ops.import_scene.gltf(filepath=opts["scene"])
+    # Punctual lights in glint's units: glTF's candela as W/sr (scene.h), which is a Blender point or
+    # spot light of 4 pi times as many watts; the importer's default (physical) mode divides by
+    # 683 lm/W instead, its raw mode takes the number as watts. Lux stays W/m^2 (a sun's strength).
+    raw = "convert_lighting_mode" in bpy.ops.import_scene.gltf.get_rna_type().properties
+    result = bpy.ops.import_scene.gltf(filepath=opts["scene"], **({"convert_lighting_mode": "RAW"} if raw else {}))
     if "FINISHED" not in result:
         fail(opts["scene"] + ": Blender's glTF importer failed")
+    if not raw and any(o.type == "LIGHT" for o in bpy.data.objects):
+        fail("this Blender's glTF importer cannot import lights in raw units")
+    for obj in bpy.data.objects:
+        if obj.type == "LIGHT" and obj.data.type in ("POINT", "SPOT"):
+            obj.data.energy *= 4.0 * math.pi
+            obj.data.shadow_soft_size = 0.0  # a point, as glTF's and glint's (Blender's default is a ball)
     if opts["lambert"]:
         make_lambert()
     else:
