@@ -341,13 +341,18 @@ def cmd_run(glint, out_dir, args):
             print_spheres(compare_spheres(g, c, sphere_grid(scene, g[:-4] + ".json", o["size"])))
 
 
-def cmd_test(glint):
+def skip_without_blender(name):
+    """An opt-in Blender test's start: exits 77, ctest's skip, unless GLINT_BLENDER=1 and blender is there."""
     if os.environ.get("GLINT_BLENDER") != "1":
-        print("blender_twin: skipped (opt-in: set GLINT_BLENDER=1; it needs Blender, a large install)")
+        print("%s: skipped (opt-in: set GLINT_BLENDER=1; it needs Blender, a large install)" % name)
         sys.exit(77)
     if shutil.which("blender") is None:
-        print("blender_twin: skipped: blender is not installed (GLINT_BLENDER=1 scripts/test.sh installs it)")
+        print("%s: skipped: blender is not installed (GLINT_BLENDER=1 scripts/test.sh installs it)" % name)
         sys.exit(77)
+
+
+def cmd_test(glint):
+    skip_without_blender("blender_twin")
     sc = os.environ.get("GLINT_SHARED_SCENES", "")  # the test's: without the shared scenes it skips
     mrs = os.path.join(sc, "metal-rough-spheres-notextures", "glTF", "MetalRoughSpheresNoTextures.gltf")
     if not sc or not os.path.exists(mrs):

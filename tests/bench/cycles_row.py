@@ -25,12 +25,11 @@ Standard library only; the EXR reader and the way Blender is run are blender_twi
 import math
 import os
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
 
-from blender_twin import BLENDER_SCRIPT, ROOT, fail, read_exr, run_cmd
+from blender_twin import BLENDER_SCRIPT, ROOT, fail, read_exr, run_cmd, skip_without_blender
 
 RELMSE_EPS = 1e-2  # renderer/metrics.h's METRIC_RELMSE_EPS
 
@@ -142,12 +141,7 @@ def report(o, rows):
 
 
 def test(glint):
-    if os.environ.get("GLINT_BLENDER") != "1":
-        print("cycles_row: skipped (opt-in: set GLINT_BLENDER=1; it needs Blender, a large install)")
-        sys.exit(77)
-    if shutil.which("blender") is None:
-        print("cycles_row: skipped: blender is not installed (GLINT_BLENDER=1 scripts/test.sh installs it)")
-        sys.exit(77)
+    skip_without_blender("cycles_row")
     with tempfile.TemporaryDirectory() as tmp:
         ref = os.path.join(tmp, "ref.exr")
         run_cmd([glint, "render", "builtin:bay", "--method", "pt", "--size", "64x48", "--spp", "256", "--out", ref,
