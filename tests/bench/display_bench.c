@@ -12,8 +12,9 @@
  * the scene's centre (as the viewer's orbit turns) before each of the first M updates; it begins
  * DEG x M short of the scene's first camera, so that it ends there and a reference of that camera
  * (glint render) serves every orbit. With --rest R the orbit begins after R updates at rest (history
- * to carry over); --orbit 12 --orbit-updates 1 is then a jump (on atelier beyond 14 degrees the
- * first camera leaves the room). --by-need 0 renders frames in the lattice's order, not the
+ * to carry over); --orbit 12 --orbit-updates 1 is then a jump. A start outside the room (on atelier
+ * 12 degrees of a negative DEG, on doorway 8 of a positive one) is refused after the rest: it would
+ * measure a cold start, not the history carried. --by-need 0 renders frames in the lattice's order, not the
  * display's need's (session_set_packet_need). --light drags the scene's light 0 by (DX, DY, DZ) in
  * M equal steps (--orbit-updates M, the camera still) after the rest, as the viewer's light drag
  * does, and makes the plan again after the last step (the viewer does 0.3 s later); the reference
@@ -42,6 +43,12 @@ static camera orbit(camera c, float degrees, vec3 target) {
     vec3 d = sub3(c.position, target);
     vec3 r = v3(cs * d.x + sn * d.z, d.y, -sn * d.x + cs * d.z);
     return camera_look_at(add3(target, r), target, v3(0, 1, 0), c.yfov);
+}
+
+static int any_light(const float *rgb, size_t n) {
+    for (size_t i = 0; i < n; i++)
+        if (rgb[i] > 0.0f) return 1;
+    return 0;
 }
 
 #define EXTRA_REQUESTS 4096
@@ -146,6 +153,12 @@ int main(int argc, char **argv) {
         double resolve_cpu = cpu_ms() - cpu0;
         display_stats ds = display_get_stats(d);
         double e_shown = -1.0, e_film = -1.0;
+        if (u + 1 == rest && orbit_updates > 0 && !any_light(shown, n)) {
+            /* an orbit or jump whose start sees nothing would measure a cold start, not what history carries */
+            fprintf(stderr, "display_bench: the view before the move shows no light (a camera outside the room?): "
+                            "move the other way or less far\n");
+            return 1;
+        }
         int at_ref = ref.rgb && ref.width == w && ref.height == h && u >= rest + orbit_updates;
         if (at_ref) e_shown = metric_rel_l2(shown, ref.rgb, n);
         if (at_ref && session_frames(rs) > 0 && session_frame_parts(rs) == 0) {
