@@ -168,8 +168,11 @@ typedef struct {
     float turn[CARRY_CHUNK], px[CARRY_CHUNK], py[CARRY_CHUNK], pz[CARRY_CHUNK];
     float fx[CARRY_CHUNK], fy[CARRY_CHUNK]; /* where the point was in the old image (project_chunk) */
     float gloss[CARRY_CHUNK], alpha[CARRY_CHUNK];
-    /* ...and its output: the share of the samples the highlights and the rest keep, their caps */
+    float spread2[CARRY_CHUNK]; /* the squared turn of the normal across the pixel (normal_spread2) */
+    /* ...and its output: the share of the samples the highlights and the rest keep, their caps, and
+     * whether either holds enough to be kept at all (DISPLAY_MIN_HELD) */
     float glossy[CARRY_CHUNK], diffuse[CARRY_CHUNK], cap_glossy[CARRY_CHUNK], cap_all[CARRY_CHUNK];
+    float drop_glossy[CARRY_CHUNK], drop_all[CARRY_CHUNK]; /* 1: the history goes */
 } carry_chunk;
 
 /* What survives of each component: all of its diffuse share, and of its glossy share (the
@@ -185,6 +188,13 @@ typedef struct {
  * samples of spread s matches in its noise at n = (s / L)^2 / (1 - held)^2; the cap is that per unit
  * of one sample's relative variance (s / L)^2. Many samples (the display's extra ones) of a
  * highlight that has since moved would otherwise outweigh the new ones for seconds.
+ * Whether a history is kept at all asks what share of the pixel's light still holds: the lobe's
+ * albedo share g (not the worst case: an oak floor keeps its diffuse half) of the light the pixel
+ * sees over its footprint, whose normals turn by the spread (a curved surface's highlight stays in
+ * its pixel as the view turns: the lobe there is as wide as alpha and the spread together). Less
+ * than DISPLAY_MIN_HELD, and the history is more wrong than right: it goes (a steel panel's
+ * reflection of a lit wall stayed where it had been through an orbit, outweighing the new samples
+ * around it in the filter).
  * Vector code (vecmath.h's rules): one pixel at a time, with its taps, its roots, divisions and
  * exponentials were a third of the carry's time. */
 static void keep_factors(carry_chunk *restrict k, vec3 from, vec3 to) {
@@ -206,7 +216,13 @@ static void keep_factors(carry_chunk *restrict k, vec3 from, vec3 to) {
         held = xh > EXP2_FLOOR ? held : 0.0f; /* nothing holds: the history goes (exp2_neg stops at its floor) */
         glossy = xg > EXP2_FLOOR ? glossy : 0.0f;
         float share = gbuffer_glossy_share(gloss, alpha);
+        float wide2 = a2 + k->spread2[x], xw = -0.5f * LOG2E * t1 * t1 / (wide2 > 1e-6f ? wide2 : 1e-6f);
+        float held_wide = exp2_neg(xw); /* G(t1) over the pixel */
+        held_wide = xw > EXP2_FLOOR ? held_wide : 0.0f;
         int turned = step > 0.0f;
+        float held_all = (1.0f - gloss) + gloss * held_wide;
+        k->drop_glossy[x] = turned && held_wide < DISPLAY_MIN_HELD ? 1.0f : 0.0f;
+        k->drop_all[x] = turned && held_all < DISPLAY_MIN_HELD ? 1.0f : 0.0f;
         held = turned ? held : 1.0f;
         glossy = turned ? glossy : 1.0f;
         share = turned ? share : 0.0f;
@@ -231,6 +247,46 @@ static void project_chunk(const gbuffer_projector *pr, carry_chunk *restrict k) 
     }
 }
 
+/* The cosine between pixel i's normal and pixel o's; 1 on another surface. */
+static inline float normal_cos(const float *nm, const int32_t *mat, ptrdiff_t i, ptrdiff_t o) {
+    float c = nm[3 * i] * nm[3 * o] + nm[3 * i + 1] * nm[3 * o + 1] + nm[3 * i + 2] * nm[3 * o + 2];
+    return mat[o] == mat[i] ? c : 1.0f;
+}
+
+/* The squared angle the normal turns across pixels x0 .. x0 + n - 1 of row y, about 2 (1 - cos) of
+ * its largest turn to a neighbour on the same surface; a neighbour beyond the image's edge is the
+ * pixel itself. A whole chunk inside the image's left and right edges in a loop of fixed length,
+ * which vectorises; the chunks at the edges pixel by pixel. */
+static void normal_spread2(const gbuffer *g, int w, int h, int x0, int y, int n, float *restrict out) {
+    ptrdiff_t row = (ptrdiff_t)y * w + x0, up = y > 0 ? -(ptrdiff_t)w : 0, down = y + 1 < h ? (ptrdiff_t)w : 0;
+    const float *nm = g->normal;
+    const int32_t *mat = g->material;
+    if (x0 > 0 && x0 + CARRY_CHUNK < w) {
+        const float *restrict n0 = nm + 3 * row, *restrict nu = n0 + 3 * up, *restrict nd = n0 + 3 * down;
+        const int32_t *restrict m0 = mat + row, *restrict mu = m0 + up, *restrict md = m0 + down;
+        for (int x = 0; x < CARRY_CHUNK; x++) {
+            float px = n0[3 * x], py = n0[3 * x + 1], pz = n0[3 * x + 2];
+            float cl = px * n0[3 * x - 3] + py * n0[3 * x - 2] + pz * n0[3 * x - 1];
+            float cr = px * n0[3 * x + 3] + py * n0[3 * x + 4] + pz * n0[3 * x + 5];
+            float cu = px * nu[3 * x] + py * nu[3 * x + 1] + pz * nu[3 * x + 2];
+            float cd = px * nd[3 * x] + py * nd[3 * x + 1] + pz * nd[3 * x + 2];
+            int32_t me = m0[x];
+            cl = m0[x - 1] == me ? cl : 1.0f, cr = m0[x + 1] == me ? cr : 1.0f;
+            cu = mu[x] == me ? cu : 1.0f, cd = md[x] == me ? cd : 1.0f;
+            float c = cl < cr ? cl : cr, c2 = cu < cd ? cu : cd;
+            c = c < c2 ? c : c2;
+            out[x] = 2.0f * (1.0f - c);
+        }
+        return;
+    }
+    for (int x = 0; x < n; x++) {
+        ptrdiff_t i = row + x, left = x0 + x > 0 ? i - 1 : i, right = x0 + x + 1 < w ? i + 1 : i;
+        float c = fminf(fminf(normal_cos(nm, mat, i, left), normal_cos(nm, mat, i, right)),
+                        fminf(normal_cos(nm, mat, i, i + up), normal_cos(nm, mat, i, i + down)));
+        out[x] = 2.0f * (1.0f - c);
+    }
+}
+
 /* Pixels x0 .. x0 + n - 1 of row y: their points, where they were (project_chunk), their taps and
  * their keep factors' input; the rest of the chunk with none. */
 static void find_chunk(const carry_job *j, int x0, int y, int n, carry_chunk *k) {
@@ -241,6 +297,7 @@ static void find_chunk(const carry_job *j, int x0, int y, int n, carry_chunk *k)
         k->px[x] = p.x, k->py[x] = p.y, k->pz[x] = p.z;
     }
     project_chunk(&j->old_view, k);
+    int any = 0; /* a pixel whose history may be dropped: a lobe of more than half the albedo, or the highlights */
     for (int x = 0; x < CARRY_CHUNK; x++) {
         size_t i = i0 + (size_t)x;
         int in = x < n;
@@ -252,7 +309,10 @@ static void find_chunk(const carry_job *j, int x0, int y, int n, carry_chunk *k)
         int glossy = in && !j->same_camera && to->material[i] >= 0 && to->gloss[i] > 0.0f;
         k->gloss[x] = glossy ? to->gloss[i] : 0.0f;
         k->alpha[x] = in ? to->alpha[i] : 1.0f;
+        any |= glossy && (to->gloss[i] > DISPLAY_MIN_HELD || j->d->active[COMP_HIGHLIGHTS]);
     }
+    memset(k->spread2, 0, sizeof k->spread2);
+    if (any) normal_spread2(to, j->d->width, j->d->height, x0, y, n, k->spread2);
 }
 
 static void carry_row(void *ctx, int y, int worker) {
@@ -277,7 +337,7 @@ static void carry_row(void *ctx, int y, int worker) {
             carried++;
             now->turn = k.turn[x];
             for (int c = 0; c < COMP_COUNT; c++) {
-                if (!j->d->active[c]) continue;
+                if (!j->d->active[c] || (c == COMP_HIGHLIGHTS ? k.drop_glossy[x] : k.drop_all[x]) > 0.0f) continue;
                 float count = 0.0f, m2 = 0.0f, m[3] = {0.0f, 0.0f, 0.0f};
                 for (int t = 0; t < kept; t++) {
                     const pixel_history *o = &j->old[k.taps[x][t]];

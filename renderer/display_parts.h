@@ -25,6 +25,10 @@ _Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line
 /* History a camera move carries over is capped at this many samples: each reprojection resamples
  * (blurs) it a little, and a cap lets new samples take over at a steady pace while moving. */
 #define DISPLAY_MAX_CARRIED 64.0f
+/* A component whose history holds less than this share of its light after a camera move is
+ * dropped, not kept at a low count: where no new sample is near, the filter would show it as it
+ * was (its weights are relative), and a stale reflection over a whole panel does not average away. */
+#define DISPLAY_MIN_HELD 0.5f
 /* A light change sets the history aside (stale) until new samples show, tile by tile, whether
  * the light there changed: a tile of TILE_PX x TILE_PX pixels is judged once it has
  * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "The display while things move"). Until then
