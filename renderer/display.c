@@ -170,9 +170,9 @@ typedef struct {
     float gloss[CARRY_CHUNK], alpha[CARRY_CHUNK];
     float spread2[CARRY_CHUNK]; /* the squared turn of the normal across the pixel (normal_spread2) */
     /* ...and its output: the share of the samples the highlights and the rest keep, their caps, and
-     * whether either holds enough to be kept at all (DISPLAY_MIN_HELD) */
+     * whether either holds too little to count (DISPLAY_MIN_HELD) */
     float glossy[CARRY_CHUNK], diffuse[CARRY_CHUNK], cap_glossy[CARRY_CHUNK], cap_all[CARRY_CHUNK];
-    float drop_glossy[CARRY_CHUNK], drop_all[CARRY_CHUNK]; /* 1: the history goes */
+    float last_glossy[CARRY_CHUNK], last_all[CARRY_CHUNK]; /* 1: the history is a last resort */
 } carry_chunk;
 
 /* What survives of each component: all of its diffuse share, and of its glossy share (the
@@ -192,9 +192,9 @@ typedef struct {
  * albedo share g (not the worst case: an oak floor keeps its diffuse half) of the light the pixel
  * sees over its footprint, whose normals turn by the spread (a curved surface's highlight stays in
  * its pixel as the view turns: the lobe there is as wide as alpha and the spread together). Less
- * than DISPLAY_MIN_HELD, and the history is more wrong than right: it goes (a steel panel's
- * reflection of a lit wall stayed where it had been through an orbit, outweighing the new samples
- * around it in the filter).
+ * than DISPLAY_MIN_HELD, and the history is more wrong than right: it is a last resort (a steel
+ * panel's reflection of a lit wall stayed where it had been through an orbit, outweighing the new
+ * samples around it in the filter).
  * Vector code (vecmath.h's rules): one pixel at a time, with its taps, its roots, divisions and
  * exponentials were a third of the carry's time. */
 static void keep_factors(carry_chunk *restrict k, vec3 from, vec3 to) {
@@ -221,8 +221,8 @@ static void keep_factors(carry_chunk *restrict k, vec3 from, vec3 to) {
         held_wide = xw > EXP2_FLOOR ? held_wide : 0.0f;
         int turned = step > 0.0f;
         float held_all = (1.0f - gloss) + gloss * held_wide;
-        k->drop_glossy[x] = turned && held_wide < DISPLAY_MIN_HELD ? 1.0f : 0.0f;
-        k->drop_all[x] = turned && held_all < DISPLAY_MIN_HELD ? 1.0f : 0.0f;
+        k->last_glossy[x] = turned && held_wide < DISPLAY_MIN_HELD ? 1.0f : 0.0f;
+        k->last_all[x] = turned && held_all < DISPLAY_MIN_HELD ? 1.0f : 0.0f;
         held = turned ? held : 1.0f;
         glossy = turned ? glossy : 1.0f;
         share = turned ? share : 0.0f;
@@ -297,7 +297,8 @@ static void find_chunk(const carry_job *j, int x0, int y, int n, carry_chunk *k)
         k->px[x] = p.x, k->py[x] = p.y, k->pz[x] = p.z;
     }
     project_chunk(&j->old_view, k);
-    int any = 0; /* a pixel whose history may be dropped: a lobe of more than half the albedo, or the highlights */
+    int any =
+        0; /* a pixel whose history may be a last resort: a lobe of more than half the albedo, or the highlights */
     for (int x = 0; x < CARRY_CHUNK; x++) {
         size_t i = i0 + (size_t)x;
         int in = x < n;
@@ -337,7 +338,7 @@ static void carry_row(void *ctx, int y, int worker) {
             carried++;
             now->turn = k.turn[x];
             for (int c = 0; c < COMP_COUNT; c++) {
-                if (!j->d->active[c] || (c == COMP_HIGHLIGHTS ? k.drop_glossy[x] : k.drop_all[x]) > 0.0f) continue;
+                if (!j->d->active[c]) continue;
                 float count = 0.0f, m2 = 0.0f, m[3] = {0.0f, 0.0f, 0.0f};
                 for (int t = 0; t < kept; t++) {
                     const pixel_history *o = &j->old[k.taps[x][t]];
@@ -353,6 +354,8 @@ static void carry_row(void *ctx, int y, int worker) {
                     if (isfinite(rel)) at_most = fmaxf(rel * at_most, 1.0f);
                 }
                 count = fminf(count * (c == COMP_HIGHLIGHTS ? k.glossy[x] : k.diffuse[x]), at_most);
+                int last_resort = (c == COMP_HIGHLIGHTS ? k.last_glossy[x] : k.last_all[x]) > 0.0f;
+                count = last_resort && count > 0.0f ? fminf(count, DISPLAY_LAST_RESORT) : count;
                 if (!(count > 0.0f)) continue;
                 now->c[c].count = count;
                 now->c[c].m2 = m2;

@@ -26,9 +26,12 @@ _Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line
  * (blurs) it a little, and a cap lets new samples take over at a steady pace while moving. */
 #define DISPLAY_MAX_CARRIED 64.0f
 /* A component whose history holds less than this share of its light after a camera move is
- * dropped, not kept at a low count: where no new sample is near, the filter would show it as it
- * was (its weights are relative), and a stale reflection over a whole panel does not average away. */
+ * kept only as a last resort, DISPLAY_LAST_RESORT samples: any new sample within the filter's reach
+ * outweighs a whole neighbourhood of it (at a low count that still counted, the filter, whose
+ * weights are relative, showed a stale reflection over a whole panel as it was), and where none is
+ * it is still shown, not a black hole. */
 #define DISPLAY_MIN_HELD 0.5f
+#define DISPLAY_LAST_RESORT 1e-6f
 /* A light change sets the history aside (stale) until new samples show, tile by tile, whether
  * the light there changed: a tile of TILE_PX x TILE_PX pixels is judged once it has
  * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "The display while things move"). Until then
