@@ -188,7 +188,7 @@ typedef struct {
  * samples of spread s matches in its noise at n = (s / L)^2 / (1 - held)^2; the cap is that per unit
  * of one sample's relative variance (s / L)^2. Many samples (the display's extra ones) of a
  * highlight that has since moved would otherwise outweigh the new ones for seconds.
- * Whether a history is kept at all asks what share of the pixel's light still holds: the lobe's
+ * Whether a history still counts at all asks what share of the pixel's light holds: the lobe's
  * albedo share g (not the worst case: an oak floor keeps its diffuse half) of the light the pixel
  * sees over its footprint, whose normals turn by the spread (a curved surface's highlight stays in
  * its pixel as the view turns: the lobe there is as wide as alpha and the spread together). Less
@@ -297,8 +297,8 @@ static void find_chunk(const carry_job *j, int x0, int y, int n, carry_chunk *k)
         k->px[x] = p.x, k->py[x] = p.y, k->pz[x] = p.z;
     }
     project_chunk(&j->old_view, k);
-    int any =
-        0; /* a pixel whose history may be a last resort: a lobe of more than half the albedo, or the highlights */
+    /* whether a pixel's history may become a last resort: a lobe of more than half the albedo, or the highlights */
+    int any = 0;
     for (int x = 0; x < CARRY_CHUNK; x++) {
         size_t i = i0 + (size_t)x;
         int in = x < n;
