@@ -232,6 +232,34 @@ static display *spread_history(const scene *s, camera a, int n) {
     return d;
 }
 
+/* The samples d's history counts for in pixels [x0, x1) x [y0, y1) of component mask, on average:
+ * one more sample of zero light everywhere, mean' = mean * count / (count + 1), tells the count
+ * (pixels that show nothing are left out). *shown, if asked, is the light shown before it,
+ * unfiltered, summed over the region. */
+static double carried_count(display *d, unsigned mask, int x0, int y0, int x1, int y1, double *shown) {
+    const gbuffer *g = display_gbuffer(d);
+    write_samples(d, 0.0f, -1, 0.0f);
+    float *before = malloc(sizeof(float) * 3 * W * H), *after = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, mask, 0, before);
+    display_take_samples(d);
+    display_resolve(d, mask, 0, after);
+    double sum = 0.0, lit = 0.0;
+    int m = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            size_t i = (size_t)(y * W + x);
+            lit += before[3 * i];
+            if (g->material[i] < 0 || !(before[3 * i] > 0.0f)) continue;
+            double q = after[3 * i] / before[3 * i];
+            sum += q / (1.0 - q);
+            m++;
+        }
+    free(before);
+    free(after);
+    if (shown) *shown = lit;
+    return m ? sum / m : 0.0;
+}
+
 static double count_after_orbit(float phong_n, float kd, float ks, float degrees, int steps, unsigned mask_component) {
     scene *s = plane_scene(0, phong_n, kd, ks);
     float r = 5.0f, n = 8;
@@ -242,28 +270,13 @@ static double count_after_orbit(float phong_n, float kd, float ks, float degrees
         camera b = view_from(v3(r * sinf(t), 0, r * cosf(t)), v3(0, 0, 0));
         display_change_view(d, s, &b, DISPLAY_CAMERA);
     }
-    double sum = 0.0;
-    int m = 0;
+    double count = 0.0;
     if (d) {
-        /* one more sample everywhere: its weight in the mean tells the count that was carried */
-        const gbuffer *g = display_gbuffer(d);
-        write_samples(d, 0.0f, -1, 0.0f); /* zero light: mean' = mean * count / (count + 1) */
-        float *before = malloc(sizeof(float) * 3 * W * H), *after = malloc(sizeof(float) * 3 * W * H);
-        display_resolve(d, mask_component, 0, before);
-        display_take_samples(d);
-        display_resolve(d, mask_component, 0, after);
-        for (int i = W * H / 4; i < 3 * W * H / 4; i++) {
-            if (g->material[i] < 0 || !(before[3 * i] > 0.0f)) continue;
-            double q = after[3 * i] / before[3 * i]; /* count / (count + 1) */
-            sum += q / (1.0 - q);
-            m++;
-        }
-        free(before);
-        free(after);
+        count = carried_count(d, mask_component, 0, H / 4, W, 3 * H / 4, NULL);
         display_destroy(d);
     }
     scene_destroy(s);
-    return m ? sum / m : 0.0;
+    return count;
 }
 
 static void check_glossy_history(void) {
@@ -301,8 +314,8 @@ static void check_glossy_history(void) {
 
 /* The samples a glossy plane's history counts for at its middle (8x8 pixels; Phong 400, diffuse kd,
  * glossy ks grey; normals tilted up to `bumps` radians by a normal map of texels about a pixel wide,
- * none at 0) after 8 samples and a turn of `degrees`: a sample of no light then shows it, as
- * count_after_orbit reads it. *shown is the direct light shown before that sample, unfiltered. */
+ * none at 0) after 8 samples and a turn of `degrees` (carried_count); *shown is the direct light
+ * shown before, unfiltered. */
 static double count_after_turn(float kd, float ks, float bumps, float degrees, double *shown) {
     scene *s = ts_new("display");
     material m = ts_phong(v3s(kd), v3s(ks), 400.0f);
@@ -323,20 +336,7 @@ static double count_after_turn(float kd, float ks, float bumps, float degrees, d
     if (d) {
         camera b = view_from(v3(r * sinf(t), 0, r * cosf(t)), v3(0, 0, 0));
         display_change_view(d, s, &b, DISPLAY_CAMERA);
-        float *before = malloc(sizeof(float) * 3 * W * H), *after = malloc(sizeof(float) * 3 * W * H);
-        display_resolve(d, 1u << COMP_DIRECT, 0, before);
-        write_samples(d, 0.0f, -1, 0.0f);
-        display_take_samples(d);
-        display_resolve(d, 1u << COMP_DIRECT, 0, after);
-        for (int y = H / 2 - 4; y < H / 2 + 4; y++)
-            for (int x = W / 2 - 4; x < W / 2 + 4; x++) {
-                size_t i = 3 * (size_t)(y * W + x);
-                double q = before[i] > 0.0f ? after[i] / before[i] : 0.0; /* count / (count + 1) */
-                count += q / (1.0 - q) / 64.0;
-                *shown += before[i];
-            }
-        free(before);
-        free(after);
+        count = carried_count(d, 1u << COMP_DIRECT, W / 2 - 4, H / 2 - 4, W / 2 + 4, H / 2 + 4, shown);
         display_destroy(d);
     }
     scene_destroy(s);
