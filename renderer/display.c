@@ -20,6 +20,7 @@ display *display_create(int width, int height, int threads, char *err, size_t er
     d->tiles_y = (height + TILE_PX - 1) / TILE_PX;
     if (ok) ok = (d->stale = calloc(n, sizeof(pixel_history))) != NULL;
     if (ok) ok = (d->tiles = calloc((size_t)d->tiles_x * (size_t)d->tiles_y, sizeof(light_tile))) != NULL;
+    if (ok) ok = (d->relit = calloc(n, 1)) != NULL;
     for (int c = 0; ok && c < COMP_COUNT; c++) {
         d->sink.rgb[c] = malloc(sizeof(float) * 3 * n);
         d->light[c] = malloc(sizeof(float) * 3 * n);
@@ -68,6 +69,8 @@ void display_destroy(display *d) {
     }
     free(d->stale);
     free(d->tiles);
+    free(d->relit);
+    free(d->seen);
     for (int c = 0; c < COMP_COUNT; c++) {
         free(d->sink.rgb[c]);
         free(d->light[c]);
@@ -367,134 +370,23 @@ static void carry_row(void *ctx, int y, int worker) {
     atomic_fetch_add(&j->lost, lost);
 }
 
-/* ---- light changes ------------------------------------------------------------------------- */
-
-/* Adds b's samples to a's, per component, b's counted at most cap each. */
-static void history_merge(pixel_history *a, const pixel_history *b, float cap) {
-    float da = a->c[COMP_DIRECT].count, db = fminf(b->c[COMP_DIRECT].count, cap);
-    if (da + db > 0.0f) a->turn = (da * a->turn + db * b->turn) / (da + db);
-    for (int c = 0; c < COMP_COUNT; c++) {
-        float nb = fminf(b->c[c].count, cap), na = a->c[c].count, n = na + nb;
-        if (!(nb > 0.0f)) continue;
-        for (int e = 0; e < 3; e++) a->c[c].mean[e] = (na * a->c[c].mean[e] + nb * b->c[c].mean[e]) / n;
-        a->c[c].m2 = (na * a->c[c].m2 + nb * b->c[c].m2) / n;
-        a->c[c].count = n;
-    }
-}
-
-static float total_luminance(const pixel_history *p, float *variance);
-
-/* Whether a pixel's new samples (h) disagree with its stale history (s) of many samples beyond
- * their noise (a new sample as spread as the stale ones, at least; the components' variances
- * summed COMP_COUNT times, as they may go together): a speck the light lit before (its reflection
- * in a mirror, with the many extra samples such a pixel takes) has moved, though its tile as a
- * whole has not changed. */
-#define STALE_MANY 8.0f
-static int pixel_changed(const pixel_history *h, const pixel_history *s) {
-    float n = h->c[COMP_DIRECT].count, m = s->c[COMP_DIRECT].count, vh, vs;
-    if (!(n >= 1.0f) || !(m >= STALE_MANY)) return 0;
-    float lh = total_luminance(h, &vh), ls = total_luminance(s, &vs), diff = fabsf(lh - ls);
-    float noise = sqrtf((float)COMP_COUNT * (vs / m + fmaxf(vh, vs) / n));
-    return diff > 3.0f * noise && diff > 0.1f * fmaxf(lh, ls);
-}
-
-/* A tile's verdict: where the light did not change its stale history comes back, but for pixels
- * whose new samples contradict it; where it did the stale history goes. A pixel with samples of its
- * own that agree takes it back in full; one without takes it back as one sample (the tile's verdict
- * is its sampled pixels', and a speck the light lit may have moved where none was sampled), and not
- * at all where its light is mostly its glossy lobe's, which moves with the light. */
-static void settle_tile(display *d, int t, int state) {
-    d->tiles[t].state = state;
-    int x0 = (t % d->tiles_x) * TILE_PX, y0 = (t / d->tiles_x) * TILE_PX;
-    pixel_history *h = d->h[d->cur];
-    const gbuffer *g = &d->g[d->cur];
-    for (int y = y0; y < y0 + TILE_PX && y < d->height; y++)
-        for (int x = x0; x < x0 + TILE_PX && x < d->width; x++) {
-            size_t i = (size_t)y * (size_t)d->width + (size_t)x;
-            if (state == TILE_SAME && !pixel_changed(&h[i], &d->stale[i])) {
-                if (h[i].c[COMP_DIRECT].count >= 1.0f)
-                    history_merge(&h[i], &d->stale[i], INFINITY);
-                else if (!mostly_glossy(g, i))
-                    history_merge(&h[i], &d->stale[i], 1.0f);
-            }
-            memset(&d->stale[i], 0, sizeof d->stale[i]);
-        }
-}
-
-/* The light changed: what the history says is set aside, to come back where new samples agree with
- * it. During a drag each step adds what came since the last one to what is set aside. */
-static void begin_judging(display *d) {
-    size_t n = (size_t)d->width * (size_t)d->height;
-    pixel_history *h = d->h[d->cur];
-    if (d->judging) {
-        for (size_t i = 0; i < n; i++) history_merge(&d->stale[i], &h[i], INFINITY);
-        memset(h, 0, n * sizeof *h);
-    } else {
-        d->h[d->cur] = d->stale;
-        d->stale = h;
-        memset(d->h[d->cur], 0, n * sizeof *h);
-    }
-    memset(d->tiles, 0, sizeof(light_tile) * (size_t)d->tiles_x * (size_t)d->tiles_y);
-    d->judging = 1;
-}
-
-/* The camera moves before every tile was judged: the stale history of tiles not judged changed
- * comes back as one sample's worth (it may be wrong), and the judgement ends. */
-static void end_judging(display *d, pixel_history *h) {
-    size_t n = (size_t)d->width * (size_t)d->height;
-    for (size_t i = 0; i < n; i++)
-        if (d->tiles[tile_of(d, i)].state != TILE_CHANGED) history_merge(&h[i], &d->stale[i], 1.0f);
-    memset(d->stale, 0, n * sizeof *d->stale);
-    d->judging = 0;
-}
-
-/* Each tile with enough new samples beside stale history: changed when their difference stands
- * well out of the noise and is a tenth of the light or more; the same when it does not. */
-static void judge_tiles(display *d) {
-    int nt = d->tiles_x * d->tiles_y, open = 0;
-    for (int t = 0; t < nt; t++) {
-        light_tile *k = &d->tiles[t];
-        if (k->state != TILE_UNKNOWN) continue;
-        open++;
-        if (k->n < JUDGE_MIN_SAMPLES) continue;
-        double z = fabs(k->diff) / sqrt(k->var + 1e-30), r = fabs(k->diff) / (k->base + 1e-30);
-        if (z > 3.0 && r > 0.1)
-            settle_tile(d, t, TILE_CHANGED), open--;
-        else if (z < 2.0 || r < 0.05 || k->n >= JUDGE_MAX_SAMPLES)
-            settle_tile(d, t, r > 0.1 ? TILE_CHANGED : TILE_SAME), open--;
-    }
-    if (!open) d->judging = 0;
-}
-
-/* Luminance of every component of a history entry, summed, and its samples' variance. */
-static float total_luminance(const pixel_history *p, float *variance) {
-    float l = 0.0f, v = 0.0f;
-    for (int c = 0; c < COMP_COUNT; c++) {
-        float lc = luminance3(v3(p->c[c].mean[0], p->c[c].mean[1], p->c[c].mean[2]));
-        l += lc;
-        v += fmaxf(p->c[c].m2 - lc * lc, 0.0f);
-    }
-    *variance = v;
-    return l;
-}
-
-/* A new sample e (each component's, divided by the albedo) at pixel i, as evidence for its tile. */
-static void gather_evidence(display *d, size_t i, const vec3 *e) {
-    const pixel_history *st = &d->stale[i];
-    if (!(st->c[COMP_DIRECT].count > 0.0f || st->c[COMP_INDIRECT].count > 0.0f)) return;
-    light_tile *k = &d->tiles[tile_of(d, i)];
-    if (k->state != TILE_UNKNOWN) return;
-    float var, old = total_luminance(st, &var), x = 0.0f;
-    for (int c = 0; c < COMP_COUNT; c++) x += luminance3(e[c]);
-    k->diff += (double)(x - old);
-    k->var += (double)var;
-    k->base += (double)old;
-    k->n++;
-}
-
 void display_change_view(display *d, const scene *s, const camera *cam, unsigned change) {
     uint64_t t0 = clock_ns();
     int prev = d->cur, next = 1 - d->cur;
+    light was[RELIGHT_MAX], now[RELIGHT_MAX];
+    int relight = (change & DISPLAY_LIGHTS) && !(change & DISPLAY_RESTART) && d->have_view
+                      ? changed_punctual(d, s, was, now)
+                      : -1;
+    if (change == DISPLAY_LIGHTS && relight >= 0 && !memcmp(&d->g[prev].cam, cam, sizeof *cam)) {
+        /* punctual lights alone changed, not the view nor a surface: the G-buffer and each pixel's
+         * history stand */
+        begin_judging(d, s, was, now, relight);
+        display_lights_seen(d, s);
+        d->sink.serial++;
+        d->st.gbuffer_ms = 0.0;
+        d->st.view_ms = 1e-6 * (double)(clock_ns() - t0);
+        return;
+    }
     gbuffer_trace(&d->g[next], s, cam, d->pool);
     uint64_t t1 = clock_ns();
     d->st.gbuffer_ms = 1e-6 * (double)(t1 - t0);
@@ -517,7 +409,8 @@ void display_change_view(display *d, const scene *s, const camera *cam, unsigned
     threadpool_run(d->pool, carry_row, &j, d->height);
     d->cur = next;
     d->have_view = 1;
-    if ((change & DISPLAY_LIGHTS) && !(change & DISPLAY_RESTART)) begin_judging(d);
+    if ((change & DISPLAY_LIGHTS) && !(change & DISPLAY_RESTART)) begin_judging(d, s, was, now, relight);
+    if (change & (DISPLAY_LIGHTS | DISPLAY_RESTART)) display_lights_seen(d, s);
     d->st.carried = atomic_load(&j.carried);
     d->st.lost = atomic_load(&j.lost);
     if (change & DISPLAY_RESTART) memset(d->active, 0, sizeof d->active);
@@ -631,13 +524,22 @@ typedef struct {
 /* Component c of pixel i's history as shown: its own, or, while a light change is judged and the
  * pixel has none of its own since, the stale history's counted as STALE_WEIGHT samples (where its
  * tile was not judged changed, and its light is not mostly its glossy lobe's: a light's reflection
- * moves with the light, and where it was stays bright until the tile is judged). NULL when there is
+ * moves with the light, and where it was stays bright until the tile is judged); a relit direct
+ * light (display_light.c) whole, with the pixel's own new samples, in *mix. NULL when there is
  * nothing. */
-static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2) {
-    const pixel_history *p = &d->h[d->cur][i];
+static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2, float mix[3]) {
+    const pixel_history *p = &d->h[d->cur][i], *st = &d->stale[i];
     const gbuffer *g = &d->g[d->cur];
-    if (!(p->c[c].count > 0.0f) && d->judging && d->stale[i].c[c].count > 0.0f && !mostly_glossy(g, i)) {
-        p = &d->stale[i];
+    if (c == COMP_DIRECT && d->judging && d->relit[i]) {
+        float n = p->c[c].count, m = st->c[c].count, t = n + m;
+        if (!(t > 0.0f)) return NULL;
+        for (int e = 0; e < 3; e++) mix[e] = (n * p->c[c].mean[e] + m * st->c[c].mean[e]) / t;
+        *count = t;
+        *m2 = (n * p->c[c].m2 + m * st->c[c].m2) / t;
+        return mix;
+    }
+    if (!(p->c[c].count > 0.0f) && d->judging && st->c[c].count > 0.0f && !mostly_glossy(g, i)) {
+        p = st;
         *count = fminf(p->c[c].count, STALE_WEIGHT);
     } else if (p->c[c].count > 0.0f) {
         *count = p->c[c].count;
@@ -661,8 +563,8 @@ static void split_row(void *ctx, int y, int worker) {
         int hole = 0;
         for (int c = 0; c < COMP_COUNT; c++) {
             if (!(j->mask >> c & 1u)) continue;
-            float count = 0.0f, m2 = 0.0f;
-            const float *m = shown_history(d, i, c, &count, &m2);
+            float count = 0.0f, m2 = 0.0f, mix[3];
+            const float *m = shown_history(d, i, c, &count, &m2, mix);
             static const float none[3] = {0.0f, 0.0f, 0.0f};
             if (!m) m = none;
             float l = luminance3(v3(m[0], m[1], m[2]));
@@ -789,12 +691,12 @@ static void modulate_row(void *ctx, int y, int worker) {
             vec3 sum = v3(0, 0, 0);
             for (int c = 0; c < COMP_COUNT; c++) {
                 if (!(j->mask >> c & 1u)) continue;
-                float count, m2;
+                float count, m2, mix[3];
                 const float *m;
                 if (j->filtered) {
                     vec3 own = get3(d->light[c], i), f = get3(d->out[c], i);
                     sum = add3(sum, madd3(own, sub3(f, own), take[c][x - x0]));
-                } else if ((m = shown_history(d, i, c, &count, &m2)))
+                } else if ((m = shown_history(d, i, c, &count, &m2, mix)))
                     sum = add3(sum, v3(m[0], m[1], m[2]));
             }
             vec3 v = mul3(sum, get3(g->albedo, i));

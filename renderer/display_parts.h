@@ -94,6 +94,10 @@ struct display {
     /* after a light change: the history before it, and per tile what new samples say of it */
     pixel_history *stale;
     int judging;
+    uint8_t *relit; /* per pixel: its stale direct light was moved by the punctual lights' change */
+    light *seen;    /* the scene's punctual lights as the display last saw them... */
+    int num_seen, cap_seen;
+    uint64_t seen_rest; /* ...and a fingerprint of its other light (display_light.c) */
     int tiles_x, tiles_y;
     light_tile *tiles;
     uint8_t *need;               /* per packet (display_packet_need)... */
@@ -106,6 +110,19 @@ struct display {
     float spread_mean;           /* ...and the average pixel's spread */
     display_stats st;
 };
+
+/* Light changes (display_light.c): the punctual lights that changed since the display last saw
+ * the scene, as they were (was) and are (now), how many (up to RELIGHT_MAX; -1 where more did, or
+ * other light changed too); the history set aside and judged from new samples, the direct light
+ * relit by that change (begin_judging), the judgement's evidence and verdicts, its end when the
+ * camera moves first; the lights the next change is measured against. */
+#define RELIGHT_MAX 8
+int changed_punctual(const display *d, const scene *s, light *was, light *now);
+void begin_judging(display *d, const scene *s, const light *was, const light *now, int changed);
+void end_judging(display *d, pixel_history *h);
+void gather_evidence(display *d, size_t i, const vec3 *e);
+void judge_tiles(display *d);
+void display_lights_seen(display *d, const scene *s);
 
 /* The light-change tile of pixel i. */
 static inline int tile_of(const display *d, size_t i) {

@@ -158,11 +158,10 @@ int light_sample_one(const scene *s, int li, vec3 p, vec2 u, light_sample *out) 
     return sample_light(s, li, 1.0f, p, u, out);
 }
 
-/* Light li chosen with probability pmf: the sample's pdf includes it. */
-static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light_sample *out) {
-    const light *l = &s->lights[li];
-    out->light = li;
-    out->delta = 0;
+int light_sample_punctual(const light *l, vec3 p, light_sample *out) {
+    out->light = -1;
+    out->delta = 1;
+    out->pdf = 1.0f;
     switch (l->type) {
     case LIGHT_POINT:
     case LIGHT_SPOT: {
@@ -177,8 +176,6 @@ static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light
         float falloff = l->type == LIGHT_SPOT ? spot_falloff(l, neg3(out->wi)) : 1.0f;
         if (falloff <= 0.0f) return 0;
         out->radiance = scale3(l->color, falloff / d2);
-        out->pdf = pmf;
-        out->delta = 1;
         return 1;
     }
     case LIGHT_DIRECTIONAL:
@@ -187,9 +184,25 @@ static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light
         out->p_light = p;
         out->n_light = l->direction;
         out->radiance = l->color;
-        out->pdf = pmf;
-        out->delta = 1;
         return 1;
+    default: return 0;
+    }
+}
+
+/* Light li chosen with probability pmf: the sample's pdf includes it. */
+static int sample_light(const scene *s, int li, float pmf, vec3 p, vec2 u, light_sample *out) {
+    const light *l = &s->lights[li];
+    out->light = li;
+    out->delta = 0;
+    switch (l->type) {
+    case LIGHT_POINT:
+    case LIGHT_SPOT:
+    case LIGHT_DIRECTIONAL: {
+        int ok = light_sample_punctual(l, p, out);
+        out->light = li;
+        out->pdf = pmf;
+        return ok;
+    }
     case LIGHT_TRIANGLE: {
         vec3 q, n;
         float area2;

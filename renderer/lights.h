@@ -29,6 +29,11 @@ int light_sample_direct(const scene *s, vec3 p, float u_select, vec2 u, light_sa
  * has no selection probability in it. */
 int light_sample_one(const scene *s, int light, vec3 p, vec2 u, light_sample *out);
 
+/* The same for a punctual light given as it is (its light index -1): the display asks what a light
+ * brought before an edit. 0 for another kind of light, or where nothing arrives (outside a spot's
+ * cone). */
+int light_sample_punctual(const light *l, vec3 p, light_sample *out);
+
 /* What of the sampled light reaches p (geometric normal ng), p in a medium of absorption sigma:
  * one shadow ray, offset off p's surface toward the light, ending short of the sampled point (off
  * the emitter) or unbounded for directional and environment light; it passes smooth unbent glass
