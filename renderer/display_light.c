@@ -260,7 +260,10 @@ void end_judging(display *d, pixel_history *h) {
 }
 
 /* Each tile with enough new samples beside stale history: changed when their difference stands
- * well out of the noise and is a tenth of the light or more; the same when it does not. */
+ * well out of the noise and is a tenth of the light or more; the same when it is shown to be less
+ * than a tenth (with twice its noise), or a twentieth; at JUDGE_MAX_SAMPLES by the difference. Not
+ * the same by a noisy difference's own size: where samples are noisy (a room lit only by virtual
+ * lights) a difference under a tenth by chance kept a light that had changed by far more. */
 void judge_tiles(display *d) {
     int nt = d->tiles_x * d->tiles_y, open = 0;
     for (int t = 0; t < nt; t++) {
@@ -269,9 +272,10 @@ void judge_tiles(display *d) {
         open++;
         if (k->n < JUDGE_MIN_SAMPLES) continue;
         double z = fabs(k->diff) / sqrt(k->var + 1e-30), r = fabs(k->diff) / (k->base + 1e-30);
+        double bound = (fabs(k->diff) + 2.0 * sqrt(k->var)) / (k->base + 1e-30); /* r, at most */
         if (z > 3.0 && r > 0.1)
             settle_tile(d, t, TILE_CHANGED), open--;
-        else if (z < 2.0 || r < 0.05 || k->n >= JUDGE_MAX_SAMPLES)
+        else if (bound < 0.1 || r < 0.05 || k->n >= JUDGE_MAX_SAMPLES)
             settle_tile(d, t, r > 0.1 ? TILE_CHANGED : TILE_SAME), open--;
     }
     if (!open) d->judging = 0;

@@ -473,6 +473,44 @@ static void check_light_judgement(float phong_n) {
     scene_destroy(s);
 }
 
+/* A tile whose new samples differ from its stale history by less than a tenth, but within a noise
+ * that allows far more, is not judged the same until they show the change to be small: the stale
+ * history (16 samples a pixel, one of them 16 times the light, the rest nothing) and one new sample
+ * at 16 pixels of each tile, the light down by 8%. Judged the same, the sampled pixels would show
+ * the old light again (0.995). */
+static void check_noisy_judgement(void) {
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    const sample_sink *sk = display_sink(d);
+    const gbuffer *g = display_gbuffer(d);
+    for (int k = 0; k <= 16; k++) {
+        if (k == 16) display_change_view(d, s, &a, DISPLAY_LIGHTS);
+        for (int i = 0; i < W * H; i++) {
+            int x = i % W, y = i / W;
+            if (k == 16 && (x % 4 || y % 4)) continue;
+            float v = k == 16 ? 0.92f : k == 15 ? 16.0f : 0.0f;
+            for (int c = 0; c < COMP_COUNT; c++)
+                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = v * g->albedo[3 * i + e];
+            sk->stamp[i] = sk->serial;
+        }
+        display_take_samples(d);
+    }
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_INDIRECT, 0, img);
+    double worst = 0.0;
+    for (int i = 0; i < W * H; i++)
+        if (i % W % 4 == 0 && i / W % 4 == 0) worst = fmax(worst, fabs(img[3 * i] / g->albedo[3 * i] - 0.92));
+    CHECK(worst < 1e-4, "a noisy tile's sampled pixels show their new light until it is judged: off by %g", worst);
+    free(img);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
 /* The filter as shown: an image whose pixels have no noise (three samples each, all the same, a
  * step of light across the plane) comes back as its own means, though the filter, seeing so few
  * samples, takes the step for noise; a noisy flat one comes back nearer its truth than its own
@@ -654,6 +692,7 @@ int main(void) {
     check_changes();
     check_light_judgement(0.0f);
     check_light_judgement(400.0f);
+    check_noisy_judgement();
     check_filter_fades();
     check_film_untouched();
     check_packet_need();
