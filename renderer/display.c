@@ -522,7 +522,7 @@ typedef struct {
 } resolve_job;
 
 /* Component c of pixel i's history as shown: its own, or, while a light change is judged and the
- * pixel has none of its own since, the stale history's counted as STALE_WEIGHT samples (where its
+ * pixel has none of its own since, the stale history's as a last resort (DISPLAY_LAST_RESORT samples: where its
  * tile was not judged changed, and its light is not mostly its glossy lobe's: a light's reflection
  * moves with the light, and where it was stays bright until the tile is judged); a relit direct
  * light (display_light.c) whole, with the pixel's own new samples, in *mix. NULL when there is
@@ -540,7 +540,7 @@ static const float *shown_history(const display *d, size_t i, int c, float *coun
     }
     if (!(p->c[c].count > 0.0f) && d->judging && st->c[c].count > 0.0f && !mostly_glossy(g, i)) {
         p = st;
-        *count = fminf(p->c[c].count, STALE_WEIGHT);
+        *count = fminf(p->c[c].count, DISPLAY_LAST_RESORT);
     } else if (p->c[c].count > 0.0f) {
         *count = p->c[c].count;
     } else {

@@ -35,12 +35,11 @@ _Static_assert(sizeof(pixel_history) == 64, "a pixel's history is one cache line
 /* A light change sets the history aside (stale) until new samples show, tile by tile, whether
  * the light there changed: a tile of TILE_PX x TILE_PX pixels is judged once it has
  * JUDGE_MIN_SAMPLES new samples beside stale history (docs/design.md, "The display while things move"). Until then
- * stale history counts as STALE_WEIGHT samples where a pixel has no new one: it fills holes, and
- * any new sample near it outweighs it. */
+ * stale history is a last resort where a pixel has no new sample (DISPLAY_LAST_RESORT samples): it
+ * fills holes that no new sample's light reaches. */
 #define TILE_PX 16
 #define JUDGE_MIN_SAMPLES 16
 #define JUDGE_MAX_SAMPLES 64
-#define STALE_WEIGHT 0.25f
 /* ...but not where a pixel's light is mostly its glossy lobe's (mostly_glossy): a light's
  * reflection moves with the light. */
 #define STALE_GLOSSY 0.5f

@@ -511,6 +511,44 @@ static void check_noisy_judgement(void) {
     scene_destroy(s);
 }
 
+/* While a light change is judged, a pixel without a new sample shows its stale light only where
+ * no new sample's light reaches: the filter fills it from its new neighbours (the light tripled;
+ * new samples at one pixel in 32, too few for a verdict). */
+static void check_stale_last_resort(void) {
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    const sample_sink *sk = display_sink(d);
+    const gbuffer *g = display_gbuffer(d);
+    rng_state rng = rng_for(5, 0, 0);
+    for (int k = 0; k <= 8; k++) { /* the light 1, then 3, each sample 0.5 to 1.5 times it */
+        if (k == 8) display_change_view(d, s, &a, DISPLAY_LIGHTS);
+        for (int i = 0; i < W * H; i++) {
+            if (k == 8 && (i % W % 4 || i / W % 8)) continue;
+            float v = (k == 8 ? 3.0f : 1.0f) * (0.5f + rng_float(&rng));
+            for (int c = 0; c < COMP_COUNT; c++)
+                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = v * g->albedo[3 * i + e];
+            sk->stamp[i] = sk->serial;
+        }
+        display_take_samples(d);
+    }
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_INDIRECT, 1, img);
+    double sum = 0.0;
+    int m = 0;
+    for (int y = 4; y < H - 4; y++)
+        for (int x = 4; x < W - 4; x++)
+            if (x % 4 || y % 8) sum += img[3 * (y * W + x)] / g->albedo[3 * (y * W + x)], m++;
+    CHECK(sum / m > 2.7, "pixels without a new sample show their new neighbours' light (3, the old 1): %g", sum / m);
+    free(img);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
 /* The filter as shown: an image whose pixels have no noise (three samples each, all the same, a
  * step of light across the plane) comes back as its own means, though the filter, seeing so few
  * samples, takes the step for noise; a noisy flat one comes back nearer its truth than its own
@@ -693,6 +731,7 @@ int main(void) {
     check_light_judgement(0.0f);
     check_light_judgement(400.0f);
     check_noisy_judgement();
+    check_stale_last_resort();
     check_filter_fades();
     check_film_untouched();
     check_packet_need();
