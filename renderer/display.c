@@ -432,7 +432,7 @@ long long display_take_samples(display *d) {
         taken++;
         vec3 a = get3(g->albedo, i), e[COMP_COUNT];
         for (int c = 0; c < COMP_COUNT; c++) e[c] = div3(get3(d->sink.rgb[c], i), a);
-        if (d->judging) gather_evidence(d, i, e);
+        if (d->judging) gather_evidence(d, i, e, 1.0f);
         float q[COMP_COUNT];
         for (int c = 0; c < COMP_COUNT; c++) q[c] = luminance3(e[c]) * luminance3(e[c]);
         history_add(d, &h[i], e, q, 1.0f);

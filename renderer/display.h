@@ -69,12 +69,13 @@ const uint8_t *display_packet_need(display *d);
  * samples errs by s^2 / n, and the least sum of that over the image for `budget` samples more has
  * each pixel's n + k in proportion to its s (k >= 0; docs/design.md, "Extra samples where the
  * image errs most"). A single sample's s is its own value; a hole (no sample yet) counts as half a
- * sample, its s its hardest neighbour's, or among holes only the average pixel's; the sky and, after
- * a light change, tiles not yet judged take none. Writes at most max requests (pixel, samples, luminance weights) and returns how many. The plan
+ * sample, its s its hardest neighbour's, or among holes only the average pixel's; the sky takes
+ * none. Writes at most max requests (pixel, samples, luminance weights) and returns how many. The plan
  * reads the samples so far, so the display's mean is no longer unbiased where it takes them: a
  * view, like the filter. */
 int display_plan_extra(display *d, int budget, extra_request *req, int max);
-/* Blends the requests' samples (session_render_extra's) into the history. */
+/* Blends the requests' samples (session_render_extra's) into the history; while a light change is
+ * judged they are evidence for their tiles, as the film's are. */
 void display_take_extra(display *d, const extra_request *req, int n);
 
 /* The image shown, of the components in mask (bit c = film component c), into rgb (3 floats a

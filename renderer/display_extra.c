@@ -77,13 +77,11 @@ static void spread_row(void *ctx, int y, int worker) {
     const pixel_history *h = d->h[d->cur];
     extra_histogram *k = &d->extra_hist[worker];
     for (size_t i = (size_t)y * (size_t)d->width; i < (size_t)(y + 1) * (size_t)d->width; i++) {
-        /* while a light change is judged, a tile not yet judged has its history set aside: none */
-        int unjudged = d->judging && d->tiles[tile_of(d, i)].state == TILE_UNKNOWN;
-        float own = g->material[i] < 0 || unjudged ? 0.0f : pixel_spread(d, i);
+        float own = g->material[i] < 0 ? 0.0f : pixel_spread(d, i);
         d->spread_own[i] = own;
         if (own > 0.0f) k->spread_sum += (double)own, k->spread_n++;
         int hole = own < 0.0f || turned(d, i);
-        int young = !hole && g->material[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= SPREAD_YOUNG) && !unjudged;
+        int young = !hole && g->material[i] >= 0 && !(h[i].c[COMP_DIRECT].count >= SPREAD_YOUNG);
         d->plan_kind[i] = (uint8_t)((hole ? PLAN_HOLE : 0) | (young ? PLAN_YOUNG : 0));
         d->plan_n[i] = plan_count(&h[i]);
     }
@@ -259,6 +257,7 @@ void display_take_extra(display *d, const extra_request *req, int n) {
             e[c] = div3(scale3(v3(q->sum[c][0], q->sum[c][1], q->sum[c][2]), 1.0f / k), get3(g->albedo, i));
             mean_sq[c] = q->sumsq[c] / k;
         }
+        if (d->judging) gather_evidence(d, i, e, k); /* a light change's tile waits for them too */
         history_add(d, &h[i], e, mean_sq, k);
         d->st.extra += (uint64_t)q->taken;
     }

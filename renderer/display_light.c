@@ -283,7 +283,7 @@ void judge_tiles(display *d) {
 
 /* A new sample e (each component's, divided by the albedo) at pixel i, as evidence for its tile:
  * of the components judged there; the light it is measured against is all of the pixel's. */
-void gather_evidence(display *d, size_t i, const vec3 *e) {
+void gather_evidence(display *d, size_t i, const vec3 *e, float k_samples) {
     const pixel_history *st = &d->stale[i];
     if (!(st->c[COMP_DIRECT].count > 0.0f || st->c[COMP_INDIRECT].count > 0.0f)) return;
     light_tile *k = &d->tiles[tile_of(d, i)];
@@ -291,8 +291,8 @@ void gather_evidence(display *d, size_t i, const vec3 *e) {
     int from = judged_from(d, i);
     float var, unused, old = total_luminance(st, from, &var), x = 0.0f;
     for (int c = from; c < COMP_COUNT; c++) x += luminance3(e[c]);
-    k->diff += (double)(x - old);
-    k->var += (double)var;
-    k->base += (double)(from ? total_luminance(st, 0, &unused) : old);
-    k->n++;
+    k->diff += (double)k_samples * (double)(x - old);
+    k->var += (double)k_samples * (double)var;
+    k->base += (double)k_samples * (double)(from ? total_luminance(st, 0, &unused) : old);
+    k->n += (int)k_samples;
 }

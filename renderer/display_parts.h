@@ -119,7 +119,7 @@ struct display {
 int changed_punctual(const display *d, const scene *s, light *was, light *now);
 void begin_judging(display *d, const scene *s, const light *was, const light *now, int changed);
 void end_judging(display *d, pixel_history *h);
-void gather_evidence(display *d, size_t i, const vec3 *e);
+void gather_evidence(display *d, size_t i, const vec3 *e, float k_samples);
 void judge_tiles(display *d);
 void display_lights_seen(display *d, const scene *s);
 

@@ -549,6 +549,50 @@ static void check_stale_last_resort(void) {
     scene_destroy(s);
 }
 
+/* While a light change is judged, the display's own samples are evidence for their tile, as the
+ * film's are: 32 of them at one pixel, where the light tripled, and the tile is judged changed (its
+ * other pixels, without new samples, no longer show the old light); the next tile, without any,
+ * still waits and shows it. */
+static void check_extra_evidence(void) {
+    scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
+    camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    CHECK(d != NULL, "display");
+    if (!d) return;
+    display_change_view(d, s, &a, DISPLAY_CAMERA);
+    const sample_sink *sk = display_sink(d);
+    const gbuffer *g = display_gbuffer(d);
+    rng_state rng = rng_for(3, 0, 0);
+    for (int k = 0; k < 8; k++) { /* the light 1, each sample 0.5 to 1.5 times it */
+        for (int i = 0; i < W * H; i++) {
+            float v = 0.5f + rng_float(&rng);
+            for (int c = 0; c < COMP_COUNT; c++)
+                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = v * g->albedo[3 * i + e];
+            sk->stamp[i] = sk->serial;
+        }
+        display_take_samples(d);
+    }
+    display_change_view(d, s, &a, DISPLAY_LIGHTS);
+    extra_request r = {.pixel = 5 * W + 5, .samples = 32, .taken = 32};
+    for (int c = 0; c < COMP_COUNT; c++) {
+        for (int e = 0; e < 3; e++) r.sum[c][e] = 32.0f * 3.0f * g->albedo[3 * r.pixel + e];
+        r.sumsq[c] = 32.0f * 9.0f;
+    }
+    display_take_extra(d, &r, 1);
+    display_take_samples(d); /* none: the tiles are judged */
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    display_resolve(d, 1u << COMP_INDIRECT, 0, img);
+    int other = 2 * W + 9, next = 2 * W + 20; /* in the extra samples' tile, and in the next one */
+    CHECK(img[3 * r.pixel] / g->albedo[3 * r.pixel] > 2.99f, "the extra samples' pixel: %g",
+          img[3 * r.pixel] / g->albedo[3 * r.pixel]);
+    CHECK(img[3 * other] == 0.0f, "their tile judged changed: its old light gone (%g)", img[3 * other]);
+    CHECK(img[3 * next] > 0.0f, "a tile without new samples still shows its old light");
+    free(img);
+    display_destroy(d);
+    scene_destroy(s);
+}
+
 /* The filter as shown: an image whose pixels have no noise (three samples each, all the same, a
  * step of light across the plane) comes back as its own means, though the filter, seeing so few
  * samples, takes the step for noise; a noisy flat one comes back nearer its truth than its own
@@ -732,6 +776,7 @@ int main(void) {
     check_light_judgement(400.0f);
     check_noisy_judgement();
     check_stale_last_resort();
+    check_extra_evidence();
     check_filter_fades();
     check_film_untouched();
     check_packet_need();
