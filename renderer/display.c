@@ -521,12 +521,11 @@ typedef struct {
     atomic_llong holes;   /* pixels with no sample of a component shown */
 } resolve_job;
 
-/* Component c of pixel i's history as shown: its own, or, while a light change is judged and the
- * pixel has none of its own since, the stale history's as a last resort (DISPLAY_LAST_RESORT samples: where its
- * tile was not judged changed, and its light is not mostly its glossy lobe's: a light's reflection
- * moves with the light, and where it was stays bright until the tile is judged); a relit direct
- * light (display_light.c) whole, with the pixel's own new samples, in *mix. NULL when there is
- * nothing. */
+/* Component c of pixel i's history as shown: its own; or, while a light change is judged and the
+ * pixel has none of its own since, the stale history's as a last resort (DISPLAY_LAST_RESORT
+ * samples), unless its light is mostly its glossy lobe's (a light's reflection moves with the light,
+ * and where it was would stay bright until the tile is judged); a relit direct light
+ * (display_light.c) whole, with the pixel's own new samples, in *mix. NULL when there is nothing. */
 static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2, float mix[3]) {
     const pixel_history *p = &d->h[d->cur][i], *st = &d->stale[i];
     const gbuffer *g = &d->g[d->cur];
