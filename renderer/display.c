@@ -381,7 +381,7 @@ void display_change_view(display *d, const scene *s, const camera *cam, unsigned
         /* punctual lights alone changed, not the view nor a surface: the G-buffer and each pixel's
          * history stand */
         begin_judging(d, s, was, now, relight);
-        display_lights_seen(d, s);
+        display_lights_seen(d, s, 1);
         d->sink.serial++;
         d->st.gbuffer_ms = 0.0;
         d->st.view_ms = 1e-6 * (double)(clock_ns() - t0);
@@ -410,7 +410,7 @@ void display_change_view(display *d, const scene *s, const camera *cam, unsigned
     d->cur = next;
     d->have_view = 1;
     if ((change & DISPLAY_LIGHTS) && !(change & DISPLAY_RESTART)) begin_judging(d, s, was, now, relight);
-    if (change & (DISPLAY_LIGHTS | DISPLAY_RESTART)) display_lights_seen(d, s);
+    if (change & (DISPLAY_LIGHTS | DISPLAY_RESTART)) display_lights_seen(d, s, relight >= 0);
     d->st.carried = atomic_load(&j.carried);
     d->st.lost = atomic_load(&j.lost);
     if (change & DISPLAY_RESTART) memset(d->active, 0, sizeof d->active);

@@ -122,8 +122,9 @@ static uint64_t other_light_print(const scene *s, int from) {
     return h;
 }
 
-void display_lights_seen(display *d, const scene *s) {
+void display_lights_seen(display *d, const scene *s, int rest_unchanged) {
     int n = punctual_count(s);
+    uint64_t rest = rest_unchanged && d->num_seen == n ? d->seen_rest : other_light_print(s, n);
     d->num_seen = -1; /* unknown, unless the copy below is made */
     if (n > d->cap_seen) {
         light *grown = realloc(d->seen, sizeof(light) * (size_t)n);
@@ -132,7 +133,7 @@ void display_lights_seen(display *d, const scene *s) {
         d->cap_seen = n;
     }
     if (n > 0) memcpy(d->seen, s->lights, sizeof(light) * (size_t)n);
-    d->seen_rest = other_light_print(s, n);
+    d->seen_rest = rest;
     d->num_seen = n;
 }
 

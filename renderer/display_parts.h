@@ -114,14 +114,15 @@ struct display {
  * the scene, as they were (was) and are (now), how many (up to RELIGHT_MAX; -1 where more did, or
  * other light changed too); the history set aside and judged from new samples, the direct light
  * relit by that change (begin_judging), the judgement's evidence and verdicts, its end when the
- * camera moves first; the lights the next change is measured against. */
+ * camera moves first; the lights the next change is measured against (rest_unchanged: their
+ * fingerprint is known to be the one kept, changed_punctual having found so, not taken again). */
 #define RELIGHT_MAX 8
 int changed_punctual(const display *d, const scene *s, light *was, light *now);
 void begin_judging(display *d, const scene *s, const light *was, const light *now, int changed);
 void end_judging(display *d, pixel_history *h);
 void gather_evidence(display *d, size_t i, const vec3 *e, float k_samples);
 void judge_tiles(display *d);
-void display_lights_seen(display *d, const scene *s);
+void display_lights_seen(display *d, const scene *s, int rest_unchanged);
 
 /* The light-change tile of pixel i. */
 static inline int tile_of(const display *d, size_t i) {
