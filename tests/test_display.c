@@ -59,6 +59,24 @@ static void write_samples(display *d, float gain, int mat, float value) {
     }
 }
 
+/* Pixel i's sample: light v in the components of mask (each times the albedo, as the film's samples
+ * are), none in the others. */
+static void put_grey(display *d, int i, float v, unsigned mask) {
+    const sample_sink *sk = display_sink(d);
+    const gbuffer *g = display_gbuffer(d);
+    for (int c = 0; c < COMP_COUNT; c++)
+        for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = mask >> c & 1u ? v * g->albedo[3 * i + e] : 0.0f;
+    sk->stamp[i] = sk->serial;
+}
+
+/* A display of scene s at camera a, its first view taken; NULL out of memory. */
+static display *display_at(const scene *s, const camera *a) {
+    char err[256];
+    display *d = display_create(W, H, 2, err, sizeof err);
+    if (d) display_change_view(d, s, a, DISPLAY_CAMERA);
+    return d;
+}
+
 static void check_projection(void) {
     scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     gbuffer g;
@@ -421,12 +439,9 @@ static void check_changes(void) {
 static void check_light_judgement(float phong_n) {
     scene *s = phong_n > 0.0f ? plane_scene(0, phong_n, 0.3f, 0.3f) : plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
-    char err[256];
-    display *d = display_create(W, H, 2, err, sizeof err);
+    display *d = display_at(s, &a);
     CHECK(d != NULL, "display");
     if (!d) return;
-    display_change_view(d, s, &a, DISPLAY_CAMERA);
-    const sample_sink *sk = display_sink(d);
     const gbuffer *g = display_gbuffer(d);
     rng_state rng = rng_for(7, 0, 0);
     /* noisy samples: 1 +- 0.5 times the light, 8 of them before the change */
@@ -437,9 +452,7 @@ static void check_light_judgement(float phong_n) {
             /* after the change: the right half's light triples; the bottom rows get no sample */
             if (k == 8 && y >= 32) continue;
             float gain = (k == 8 && x >= W / 2 ? 3.0f : 1.0f) * (0.5f + rng_float(&rng));
-            for (int c = 0; c < COMP_COUNT; c++)
-                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = gain * g->albedo[3 * i + e];
-            sk->stamp[i] = sk->serial;
+            put_grey(d, i, gain, COMP_MASK_ALL);
         }
         display_take_samples(d);
     }
@@ -481,12 +494,9 @@ static void check_light_judgement(float phong_n) {
 static void check_noisy_judgement(void) {
     scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
-    char err[256];
-    display *d = display_create(W, H, 2, err, sizeof err);
+    display *d = display_at(s, &a);
     CHECK(d != NULL, "display");
     if (!d) return;
-    display_change_view(d, s, &a, DISPLAY_CAMERA);
-    const sample_sink *sk = display_sink(d);
     const gbuffer *g = display_gbuffer(d);
     for (int k = 0; k <= 16; k++) {
         if (k == 16) display_change_view(d, s, &a, DISPLAY_LIGHTS);
@@ -494,9 +504,7 @@ static void check_noisy_judgement(void) {
             int x = i % W, y = i / W;
             if (k == 16 && (x % 4 || y % 4)) continue;
             float v = k == 16 ? 0.92f : k == 15 ? 16.0f : 0.0f;
-            for (int c = 0; c < COMP_COUNT; c++)
-                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = v * g->albedo[3 * i + e];
-            sk->stamp[i] = sk->serial;
+            put_grey(d, i, v, COMP_MASK_ALL);
         }
         display_take_samples(d);
     }
@@ -517,12 +525,9 @@ static void check_noisy_judgement(void) {
 static void check_stale_last_resort(void) {
     scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
-    char err[256];
-    display *d = display_create(W, H, 2, err, sizeof err);
+    display *d = display_at(s, &a);
     CHECK(d != NULL, "display");
     if (!d) return;
-    display_change_view(d, s, &a, DISPLAY_CAMERA);
-    const sample_sink *sk = display_sink(d);
     const gbuffer *g = display_gbuffer(d);
     rng_state rng = rng_for(5, 0, 0);
     for (int k = 0; k <= 8; k++) { /* the light 1, then 3, each sample 0.5 to 1.5 times it */
@@ -530,9 +535,7 @@ static void check_stale_last_resort(void) {
         for (int i = 0; i < W * H; i++) {
             if (k == 8 && (i % W % 4 || i / W % 8)) continue;
             float v = (k == 8 ? 3.0f : 1.0f) * (0.5f + rng_float(&rng));
-            for (int c = 0; c < COMP_COUNT; c++)
-                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = v * g->albedo[3 * i + e];
-            sk->stamp[i] = sk->serial;
+            put_grey(d, i, v, COMP_MASK_ALL);
         }
         display_take_samples(d);
     }
@@ -556,20 +559,15 @@ static void check_stale_last_resort(void) {
 static void check_extra_evidence(void) {
     scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
-    char err[256];
-    display *d = display_create(W, H, 2, err, sizeof err);
+    display *d = display_at(s, &a);
     CHECK(d != NULL, "display");
     if (!d) return;
-    display_change_view(d, s, &a, DISPLAY_CAMERA);
-    const sample_sink *sk = display_sink(d);
     const gbuffer *g = display_gbuffer(d);
     rng_state rng = rng_for(3, 0, 0);
     for (int k = 0; k < 8; k++) { /* the light 1, each sample 0.5 to 1.5 times it */
         for (int i = 0; i < W * H; i++) {
             float v = 0.5f + rng_float(&rng);
-            for (int c = 0; c < COMP_COUNT; c++)
-                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = v * g->albedo[3 * i + e];
-            sk->stamp[i] = sk->serial;
+            put_grey(d, i, v, COMP_MASK_ALL);
         }
         display_take_samples(d);
     }
@@ -600,19 +598,14 @@ static void check_extra_evidence(void) {
 static void check_filter_fades(void) {
     scene *s = plane_scene(0, 0.0f, 0.5f, 0.0f);
     camera a = view_from(v3(0, 0, 5), v3(0, 0, 0));
-    char err[256];
-    display *d = display_create(W, H, 2, err, sizeof err);
+    display *d = display_at(s, &a);
     CHECK(d != NULL, "display");
     if (!d) return;
-    display_change_view(d, s, &a, DISPLAY_CAMERA);
-    const sample_sink *sk = display_sink(d);
     const gbuffer *g = display_gbuffer(d);
     for (int k = 0; k < 3; k++) {
         for (int i = 0; i < W * H; i++) {
             float v = g->pos[3 * i] > 0.0f ? 4.0f : 1.0f; /* a step at x = 0 */
-            for (int c = 0; c < COMP_COUNT; c++)
-                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = c == COMP_DIRECT ? v * g->albedo[3 * i + e] : 0.0f;
-            sk->stamp[i] = sk->serial;
+            put_grey(d, i, v, 1u << COMP_DIRECT);
         }
         display_take_samples(d);
     }
@@ -628,9 +621,7 @@ static void check_filter_fades(void) {
     for (int k = 0; k < 3; k++) {
         for (int i = 0; i < W * H; i++) {
             float v = 0.5f + rng_float(&rng);
-            for (int c = 0; c < COMP_COUNT; c++)
-                for (int e = 0; e < 3; e++) sk->rgb[c][3 * i + e] = c == COMP_DIRECT ? v * g->albedo[3 * i + e] : 0.0f;
-            sk->stamp[i] = sk->serial;
+            put_grey(d, i, v, 1u << COMP_DIRECT);
         }
         display_take_samples(d);
     }
