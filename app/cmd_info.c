@@ -75,32 +75,23 @@ static int write_obj(const scene *s, const char *obj_path) {
 
 int cmd_info(int argc, char **argv) {
     const char *path = NULL, *env = NULL, *obj = NULL, *variant = NULL;
-    int method = DEFAULT_METHOD, max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
+    render_method method = DEFAULT_METHOD;
+    int max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
+    const cli_opt opts[] = {
+        {.name = "--env", .kind = CLI_TEXT, .out = &env},
+        {.name = "--variant", .kind = CLI_TEXT, .out = &variant},
+        {.name = "--method", .kind = CLI_METHOD, .out = &method},
+        {.name = "--max-depth", .kind = CLI_INT, .out = &max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
+        {.name = "--obj", .kind = CLI_TEXT, .out = &obj},
+        {.name = "--plan", .kind = CLI_PLAN, .out = &plan_mode},
+    };
     for (int i = 0; i < argc; i++) {
+        int r;
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             print_info_help();
             return EXIT_OK;
-        } else if (strcmp(argv[i], "--env") == 0) {
-            if (!(env = cli_value(argc, argv, &i))) return EXIT_USAGE;
-        } else if (strcmp(argv[i], "--variant") == 0) {
-            if (!(variant = cli_value(argc, argv, &i))) return EXIT_USAGE;
-        } else if (strcmp(argv[i], "--method") == 0) {
-            const char *v = cli_value(argc, argv, &i);
-            if (!v) return EXIT_USAGE;
-            if ((method = method_from_name(v)) < 0) {
-                cli_error("--method: expected pt, vpl, vsl or vsl+hl, got '%s'", v);
-                return EXIT_USAGE;
-            }
-        } else if (strcmp(argv[i], "--max-depth") == 0) {
-            const char *v = cli_value(argc, argv, &i);
-            long long n;
-            if (!v || cli_parse_int("--max-depth", v, 1, MAX_DEPTH_LIMIT, &n)) return EXIT_USAGE;
-            max_depth = (int)n;
-        } else if (strcmp(argv[i], "--obj") == 0) {
-            if (!(obj = cli_value(argc, argv, &i))) return EXIT_USAGE;
-        } else if (strcmp(argv[i], "--plan") == 0) {
-            const char *v = cli_value(argc, argv, &i);
-            if (!v || cli_parse_plan("--plan", v, &plan_mode)) return EXIT_USAGE;
+        } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0) {
+            if (r < 0) return EXIT_USAGE;
         } else if (cli_scene_argument("info", argv[i], &path) != 0) {
             return EXIT_USAGE;
         }

@@ -172,6 +172,18 @@ static void test_outputs(void) {
 
     rc = run("info");
     CHECK(rc == 0 && strstr(out_text, "triangles"), "glint info: %s%s", out_text, err_text);
+    /* info reads the method and depth as render does (one table of options): the same words */
+    rc = run("info --method vsl --max-depth 4");
+    CHECK(rc == 0 && strstr(out_text, "method:     vsl\n") && strstr(out_text, "max depth: 4"),
+          "info --method vsl: %s%s", out_text, err_text);
+    const char *commands[] = {"info", "render --spp 1 --size 8x8"};
+    for (int i = 0; i < 2; i++) {
+        char cmd[128];
+        snprintf(cmd, sizeof cmd, "%s --method bogus", commands[i]);
+        expect_failure(cmd, 2, "--method: unknown method 'bogus' (available: pt, vpl, vsl, vsl+hl)");
+        snprintf(cmd, sizeof cmd, "%s --max-depth 0", commands[i]);
+        expect_failure(cmd, 2, "--max-depth: expected an integer in [1, 10000], got '0'");
+    }
 }
 
 /* builtin:NAME: listed in the help, loaded by every command, an unknown name one error; a
