@@ -1,7 +1,8 @@
 /* The glint command line, run as a user would: exit codes (0, 1, 2), one-line errors naming the
  * file, the outputs (EXR layers that sum to the image, a PNG of the right size, stats JSON),
  * atomic and non-overwriting exports, progress lines when stderr is not a terminal; glint info's
- * OBJ export against its own summary, the camera in the stats.
+ * OBJ export against its own summary, its method and depth read (and refused) as render's, the
+ * camera in the stats.
  * Usage: test_cli PATH_TO_GLINT */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
