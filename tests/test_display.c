@@ -69,6 +69,15 @@ static void put_grey(display *d, int i, float v, unsigned mask) {
     sk->stamp[i] = sk->serial;
 }
 
+/* `frames` frames of noisy samples taken: every pixel's light `level` times 0.5 to 1.5, in the
+ * components of mask. */
+static void noisy_frames(display *d, rng_state *rng, int frames, float level, unsigned mask) {
+    for (int k = 0; k < frames; k++) {
+        for (int i = 0; i < W * H; i++) put_grey(d, i, level * (0.5f + rng_float(rng)), mask);
+        display_take_samples(d);
+    }
+}
+
 /* A display of scene s at camera a, its first view taken; NULL out of memory. */
 static display *display_at(const scene *s, const camera *a) {
     char err[256];
@@ -445,17 +454,15 @@ static void check_light_judgement(float phong_n) {
     const gbuffer *g = display_gbuffer(d);
     rng_state rng = rng_for(7, 0, 0);
     /* noisy samples: 1 +- 0.5 times the light, 8 of them before the change */
-    for (int k = 0; k < 9; k++) {
-        if (k == 8) display_change_view(d, s, &a, DISPLAY_LIGHTS);
-        for (int i = 0; i < W * H; i++) {
-            int x = i % W, y = i / W;
-            /* after the change: the right half's light triples; the bottom rows get no sample */
-            if (k == 8 && y >= 32) continue;
-            float gain = (k == 8 && x >= W / 2 ? 3.0f : 1.0f) * (0.5f + rng_float(&rng));
-            put_grey(d, i, gain, COMP_MASK_ALL);
-        }
-        display_take_samples(d);
+    noisy_frames(d, &rng, 8, 1.0f, COMP_MASK_ALL);
+    display_change_view(d, s, &a, DISPLAY_LIGHTS);
+    for (int i = 0; i < W * H; i++) {
+        int x = i % W, y = i / W;
+        /* after the change: the right half's light triples; the bottom rows get no sample */
+        if (y >= 32) continue;
+        put_grey(d, i, (x >= W / 2 ? 3.0f : 1.0f) * (0.5f + rng_float(&rng)), COMP_MASK_ALL);
     }
+    display_take_samples(d);
     float *img = malloc(sizeof(float) * 3 * W * H);
     display_resolve(d, 1u << COMP_DIRECT, 0, img);
     double left = 0.0, left2 = 0.0, right = 0.0, unjudged = 0.0;
@@ -530,15 +537,11 @@ static void check_stale_last_resort(void) {
     if (!d) return;
     const gbuffer *g = display_gbuffer(d);
     rng_state rng = rng_for(5, 0, 0);
-    for (int k = 0; k <= 8; k++) { /* the light 1, then 3, each sample 0.5 to 1.5 times it */
-        if (k == 8) display_change_view(d, s, &a, DISPLAY_LIGHTS);
-        for (int i = 0; i < W * H; i++) {
-            if (k == 8 && (i % W % 4 || i / W % 8)) continue;
-            float v = (k == 8 ? 3.0f : 1.0f) * (0.5f + rng_float(&rng));
-            put_grey(d, i, v, COMP_MASK_ALL);
-        }
-        display_take_samples(d);
-    }
+    noisy_frames(d, &rng, 8, 1.0f, COMP_MASK_ALL); /* the light 1, then 3, each sample 0.5 to 1.5 times it */
+    display_change_view(d, s, &a, DISPLAY_LIGHTS);
+    for (int i = 0; i < W * H; i++)
+        if (!(i % W % 4 || i / W % 8)) put_grey(d, i, 3.0f * (0.5f + rng_float(&rng)), COMP_MASK_ALL);
+    display_take_samples(d);
     float *img = malloc(sizeof(float) * 3 * W * H);
     display_resolve(d, 1u << COMP_INDIRECT, 1, img);
     double sum = 0.0;
@@ -564,13 +567,7 @@ static void check_extra_evidence(void) {
     if (!d) return;
     const gbuffer *g = display_gbuffer(d);
     rng_state rng = rng_for(3, 0, 0);
-    for (int k = 0; k < 8; k++) { /* the light 1, each sample 0.5 to 1.5 times it */
-        for (int i = 0; i < W * H; i++) {
-            float v = 0.5f + rng_float(&rng);
-            put_grey(d, i, v, COMP_MASK_ALL);
-        }
-        display_take_samples(d);
-    }
+    noisy_frames(d, &rng, 8, 1.0f, COMP_MASK_ALL); /* the light 1, each sample 0.5 to 1.5 times it */
     display_change_view(d, s, &a, DISPLAY_LIGHTS);
     extra_request r = {.pixel = 5 * W + 5, .samples = 32, .taken = 32};
     for (int c = 0; c < COMP_COUNT; c++) {
@@ -618,13 +615,7 @@ static void check_filter_fades(void) {
     /* noisy and flat: 3 samples of 1 +- 0.5 */
     display_change_view(d, s, &a, DISPLAY_RESTART);
     rng_state rng = rng_for(3, 0, 0);
-    for (int k = 0; k < 3; k++) {
-        for (int i = 0; i < W * H; i++) {
-            float v = 0.5f + rng_float(&rng);
-            put_grey(d, i, v, 1u << COMP_DIRECT);
-        }
-        display_take_samples(d);
-    }
+    noisy_frames(d, &rng, 3, 1.0f, 1u << COMP_DIRECT);
     display_resolve(d, COMP_MASK_ALL, 0, raw);
     display_resolve(d, COMP_MASK_ALL, 1, shown);
     double e_raw = 0.0, e_shown = 0.0;
