@@ -152,8 +152,8 @@ typedef struct {
     display *d;
     const scene *s;
     camera_raster raster;
-    const light *was, *now;
-    int n;
+    light lights[2 * RELIGHT_MAX]; /* the changed lights as they are, then as they were */
+    int n;                         /* how many changed */
 } relight_job;
 
 /* Pixel i's stale direct light, a mean over its albedo, moved by the change `delta` of the light
@@ -173,8 +173,8 @@ static void relight_pixel(display *d, size_t i, vec3 delta) {
 /* Whether a changed light reaches point p as it was or as it is. */
 static int reached(const relight_job *j, vec3 p) {
     light_sample ls;
-    for (int l = 0; l < j->n; l++)
-        if (light_sample_punctual(&j->was[l], p, &ls) || light_sample_punctual(&j->now[l], p, &ls)) return 1;
+    for (int l = 0; l < 2 * j->n; l++)
+        if (light_sample_punctual(&j->lights[l], p, &ls)) return 1;
     return 0;
 }
 
@@ -207,15 +207,11 @@ static void relight_row(void *ctx, int row, int worker) {
         unsigned hits = scene_intersect_packet(j->s, g->cam.position, dir, n, hit);
         for (int k = 0; k < n; k++) {
             if (!(hits >> k & 1u) || hit[k].material != g->material[idx[k]]) continue;
-            vec3 delta = v3s(0.0f), was, now;
+            vec3 delta = v3s(0.0f), got[2 * RELIGHT_MAX];
             uint64_t rays = 0;
-            int ok = 1;
-            for (int l = 0; ok && l < j->n; l++) {
-                ok = pt_punctual_direct(j->s, &j->now[l], dir[k], &hit[k], &now, &rays) &&
-                     pt_punctual_direct(j->s, &j->was[l], dir[k], &hit[k], &was, &rays);
-                delta = add3(delta, sub3(now, was));
-            }
-            if (ok && is_finite3(delta)) relight_pixel(d, idx[k], delta);
+            if (!pt_punctual_direct(j->s, j->lights, 2 * j->n, dir[k], &hit[k], got, &rays)) continue;
+            for (int l = 0; l < j->n; l++) delta = add3(delta, sub3(got[l], got[j->n + l]));
+            if (is_finite3(delta)) relight_pixel(d, idx[k], delta);
         }
     }
 }
@@ -241,7 +237,10 @@ void begin_judging(display *d, const scene *s, const light *was, const light *no
     memset(d->relit, 0, n);
     d->judging = 1;
     if (changed > 0) {
-        relight_job j = {d, s, camera_raster_make(&d->g[d->cur].cam, d->width, d->height), was, now, changed};
+        relight_job j = {
+            .d = d, .s = s, .raster = camera_raster_make(&d->g[d->cur].cam, d->width, d->height), .n = changed};
+        memcpy(j.lights, now, sizeof(light) * (size_t)changed);
+        memcpy(j.lights + changed, was, sizeof(light) * (size_t)changed);
         threadpool_run(d->pool, relight_row, &j, (d->height + 3) / 4);
     }
 }

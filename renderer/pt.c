@@ -288,19 +288,21 @@ vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u
     return out[COMP_DIRECT];
 }
 
-int pt_punctual_direct(const scene *s, const light *l, vec3 d, const surface_hit *first, vec3 *out,
+int pt_punctual_direct(const scene *s, const light *lights, int n, vec3 d, const surface_hit *first, vec3 *out,
                        uint64_t *shadow_rays) {
     frame3 fr;
     bsdf b = material_bsdf(s, first, &fr);
-    *out = v3s(0.0f);
+    for (int k = 0; k < n; k++) out[k] = v3s(0.0f);
     if (bsdf_transmits_rough(&b)) return 0;
-    light_sample ls;
-    if (!light_sample_punctual(l, first->p, &ls) || !(dot3(ls.wi, first->ng) > 0.0f)) return 1;
     bsdf_lobe lobe = {&b, fr, to_local(fr, neg3(d)), BSDF_ALL, BSDF_ALL, 0, 0.0f, 0.0f};
-    float unused;
-    vec3 f = bsdf_lobe_toward(&lobe, &ls, &unused);
-    if (is_black3(f)) return 1;
-    *out = mul3(mul3(f, ls.radiance), light_sample_visible(s, first->p, first->ng, &ls, v3s(0.0f), shadow_rays));
+    for (int k = 0; k < n; k++) {
+        light_sample ls;
+        if (!light_sample_punctual(&lights[k], first->p, &ls) || !(dot3(ls.wi, first->ng) > 0.0f)) continue;
+        float unused;
+        vec3 f = bsdf_lobe_toward(&lobe, &ls, &unused);
+        if (is_black3(f)) continue;
+        out[k] = mul3(mul3(f, ls.radiance), light_sample_visible(s, first->p, first->ng, &ls, v3s(0.0f), shadow_rays));
+    }
     return 1;
 }
 

@@ -34,12 +34,13 @@ void pt_radiance(const scene *s, int max_depth, int split_highlights, vec3 o, ve
 vec3 pt_direct(const scene *s, vec3 o, vec3 d, const surface_hit *first, float u_select, rng_state *rng, vec3 *glossy,
                uint64_t rays[RAY_KIND_COUNT]);
 
-/* What punctual light l (as given: the display asks what a light brought before an edit) brings to
- * a camera ray's first hit *first along d: the first vertex's next-event estimate of that light in
- * expectation (the lobes' value toward it, its arrival, one shadow ray). The same for every method:
- * they share pt_direct. 0 where the vertex also takes light through rough transmission, which this
- * does not reckon; 1 with *out (black where nothing arrives) otherwise. Counts the ray. */
-int pt_punctual_direct(const scene *s, const light *l, vec3 d, const surface_hit *first, vec3 *out,
+/* What each of n punctual lights (as given: the display asks what a light brought before an edit)
+ * brings to a camera ray's first hit *first along d: the first vertex's next-event estimate of that
+ * light in expectation (the lobes' value toward it, its arrival, one shadow ray), into out[k]. The
+ * same for every method: they share pt_direct. 0 where the vertex also takes light through rough
+ * transmission, which this does not reckon; 1 with out (black where nothing arrives) otherwise.
+ * Counts the rays; the hit's material is evaluated once for all of them. */
+int pt_punctual_direct(const scene *s, const light *lights, int n, vec3 d, const surface_hit *first, vec3 *out,
                        uint64_t *shadow_rays);
 
 /* How a many-light estimator's traced path widens the glossy lobes of the hit whose direct light it

@@ -54,16 +54,16 @@ static void check_punctual_direct(void) {
     vec3 out, d = v3(0, 0, -1);
     /* seen from above, beside the quad */
     CHECK(scene_intersect(s, v3(3, 0.5f, 5), d, INFINITY, &h) && h.material == 0, "the plane at (3, 0.5)");
-    CHECK(pt_punctual_direct(s, &s->lights[0], d, &h, &out, &rays) == 1, "a Lambert plane is reckoned");
+    CHECK(pt_punctual_direct(s, &s->lights[0], 1, d, &h, &out, &rays) == 1, "a Lambert plane is reckoned");
     CHECK_NEAR(out.y, lambert(h.p, s->lights[0].position, 0.5), 1e-5 * out.y, "Lambert's law beside the quad");
     /* under the quad, seen from the side: shadowed; a light moved aside (as given, not the scene's) is seen */
     vec3 from = v3(2, 0.1f, 0.5f), to = v3(0.1f, 0.1f, 0.0f), dir = normalize3(sub3(to, from));
     CHECK(scene_intersect(s, from, dir, INFINITY, &h) && h.material == 0, "the plane under the quad");
-    pt_punctual_direct(s, &s->lights[0], dir, &h, &out, &rays);
+    pt_punctual_direct(s, &s->lights[0], 1, dir, &h, &out, &rays);
     CHECK(is_black3(out), "the quad shadows the light: %g", (double)out.y);
     light aside = s->lights[0];
     aside.position = v3(5, 0, 10);
-    pt_punctual_direct(s, &aside, dir, &h, &out, &rays);
+    pt_punctual_direct(s, &aside, 1, dir, &h, &out, &rays);
     CHECK_NEAR(out.y, lambert(h.p, aside.position, 0.5), 1e-5 * out.y, "the light as given, moved aside");
     CHECK(rays == 3, "one shadow ray each: %llu", (unsigned long long)rays);
     scene_destroy(s);
@@ -79,9 +79,9 @@ static void check_punctual_direct(void) {
     vec3 o = v3(2, 0.5f, 3);
     dir = normalize3(sub3(v3(0.5f, 0.2f, 0), o));
     CHECK(scene_intersect(s, o, dir, INFINITY, &h), "the glossy plane");
-    vec3 a, b;
-    pt_punctual_direct(s, &s->lights[0], dir, &h, &a, &rays);
-    pt_punctual_direct(s, &s->lights[1], dir, &h, &b, &rays);
+    vec3 ab[2];
+    pt_punctual_direct(s, s->lights, 2, dir, &h, ab, &rays);
+    vec3 a = ab[0], b = ab[1];
     double want = (double)(a.y + b.y), sum = 0.0, sum2 = 0.0;
     rng_state rng = rng_for(11, 0, 0);
     const int n = 20000;
