@@ -525,17 +525,18 @@ typedef struct {
  * pixel has none of its own since, the stale history's as a last resort (DISPLAY_LAST_RESORT
  * samples), unless its light is mostly its glossy lobe's (a light's reflection moves with the light,
  * and where it was would stay bright until the tile is judged); a relit direct light
- * (display_light.c) whole, with the pixel's own new samples, in *mix. NULL when there is nothing. */
-static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2, float mix[3]) {
+ * (display_light.c) whole, merged with the pixel's own new samples in *mix. NULL when there is
+ * nothing. */
+static const float *shown_history(const display *d, size_t i, int c, float *count, float *m2, pixel_history *mix) {
     const pixel_history *p = &d->h[d->cur][i], *st = &d->stale[i];
     const gbuffer *g = &d->g[d->cur];
     if (c == COMP_DIRECT && d->judging && d->relit[i]) {
-        float n = p->c[c].count, m = st->c[c].count, t = n + m;
-        if (!(t > 0.0f)) return NULL;
-        for (int e = 0; e < 3; e++) mix[e] = (n * p->c[c].mean[e] + m * st->c[c].mean[e]) / t;
-        *count = t;
-        *m2 = (n * p->c[c].m2 + m * st->c[c].m2) / t;
-        return mix;
+        *mix = *p;
+        history_merge_one(mix, st, c, INFINITY);
+        if (!(mix->c[c].count > 0.0f)) return NULL;
+        *count = mix->c[c].count;
+        *m2 = mix->c[c].m2;
+        return mix->c[c].mean;
     }
     if (!(p->c[c].count > 0.0f) && d->judging && st->c[c].count > 0.0f && !mostly_glossy(g, i)) {
         p = st;
@@ -562,8 +563,9 @@ static void split_row(void *ctx, int y, int worker) {
         int hole = 0;
         for (int c = 0; c < COMP_COUNT; c++) {
             if (!(j->mask >> c & 1u)) continue;
-            float count = 0.0f, m2 = 0.0f, mix[3];
-            const float *m = shown_history(d, i, c, &count, &m2, mix);
+            float count = 0.0f, m2 = 0.0f;
+            pixel_history mix;
+            const float *m = shown_history(d, i, c, &count, &m2, &mix);
             static const float none[3] = {0.0f, 0.0f, 0.0f};
             if (!m) m = none;
             float l = luminance3(v3(m[0], m[1], m[2]));
@@ -690,12 +692,13 @@ static void modulate_row(void *ctx, int y, int worker) {
             vec3 sum = v3(0, 0, 0);
             for (int c = 0; c < COMP_COUNT; c++) {
                 if (!(j->mask >> c & 1u)) continue;
-                float count, m2, mix[3];
+                float count, m2;
+                pixel_history mix;
                 const float *m;
                 if (j->filtered) {
                     vec3 own = get3(d->light[c], i), f = get3(d->out[c], i);
                     sum = add3(sum, madd3(own, sub3(f, own), take[c][x - x0]));
-                } else if ((m = shown_history(d, i, c, &count, &m2, mix)))
+                } else if ((m = shown_history(d, i, c, &count, &m2, &mix)))
                     sum = add3(sum, v3(m[0], m[1], m[2]));
             }
             vec3 v = mul3(sum, get3(g->albedo, i));

@@ -10,15 +10,6 @@
 #include "lights.h"
 #include "pt.h"
 
-/* Component c of b's samples added to a's, counted at most cap. */
-static void history_merge_one(pixel_history *a, const pixel_history *b, int c, float cap) {
-    float nb = fminf(b->c[c].count, cap), na = a->c[c].count, n = na + nb;
-    if (!(nb > 0.0f)) return;
-    for (int e = 0; e < 3; e++) a->c[c].mean[e] = (na * a->c[c].mean[e] + nb * b->c[c].mean[e]) / n;
-    a->c[c].m2 = (na * a->c[c].m2 + nb * b->c[c].m2) / n;
-    a->c[c].count = n;
-}
-
 /* Adds b's samples to a's, per component, b's counted at most cap each; all but the direct light
  * where `but_direct` (a relit pixel's, which comes back whole). */
 static void history_merge(pixel_history *a, const pixel_history *b, float cap, int but_direct) {

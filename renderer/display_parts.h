@@ -155,6 +155,15 @@ static inline void history_add(display *d, pixel_history *p, const vec3 *e, cons
     }
 }
 
+/* Component c of b's samples added to a's, counted at most cap. */
+static inline void history_merge_one(pixel_history *a, const pixel_history *b, int c, float cap) {
+    float nb = fminf(b->c[c].count, cap), na = a->c[c].count, n = na + nb;
+    if (!(nb > 0.0f)) return;
+    for (int e = 0; e < 3; e++) a->c[c].mean[e] = (na * a->c[c].mean[e] + nb * b->c[c].mean[e]) / n;
+    a->c[c].m2 = (na * a->c[c].m2 + nb * b->c[c].m2) / n;
+    a->c[c].count = n;
+}
+
 /* One sample's variance from n samples' moments (their mean's luminance l, the mean of their squared
  * luminance m2): the moments give the population's, n / (n - 1) of it is unbiased; 0 below two. */
 static inline float sample_variance(float m2, float l, float n) {
