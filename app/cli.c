@@ -146,7 +146,6 @@ int cli_table_option(int argc, char **argv, int *i, const cli_opt *opts, int n) 
     const char *v = cli_value(argc, argv, i);
     if (!v) return -1;
     long long n_ll;
-    int m;
     switch (o->kind) {
     case CLI_INT:
         if (cli_parse_int(a, v, (long long)o->lo, (long long)o->hi, &n_ll)) return -1;
@@ -158,11 +157,7 @@ int cli_table_option(int argc, char **argv, int *i, const cli_opt *opts, int n) 
     case CLI_SIZE: return cli_parse_size(a, v, o->out, o->out2) ? -1 : 1;
     case CLI_TEXT: return *(const char **)o->out = v, 1;
     case CLI_PLAN: return cli_parse_plan(a, v, o->out) ? -1 : 1;
-    case CLI_METHOD:
-        if ((m = method_from_name(v)) < 0)
-            return cli_error("%s: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", a, v), -1;
-        *(render_method *)o->out = (render_method)m;
-        return 1;
+    case CLI_PARAM: return cli_set_param(a + 2, v, o->out, PARAM_GROUPS_ALL);
     case CLI_FLAG: break;
     }
     return 0;
@@ -231,24 +226,24 @@ int cli_check_roles(const cli_file *outputs, int num_outputs, const cli_file *in
     return 0;
 }
 
-/* ---- many-light parameters: the table in params.c ------------------------------------------- */
+/* ---- render parameters: the table in params.c ------------------------------------------------ */
 
 const char *cli_vl_help(void) { return params_help(); }
 
-int cli_set_vl_param(const char *name, const char *value, vl_params *vl) {
+int cli_set_param(const char *name, const char *value, render_params *p, unsigned groups) {
     char err[256];
-    int r = params_set(vl, name, value, err, sizeof err);
+    int r = params_set(p, groups, name, value, err, sizeof err);
     if (r < 0) cli_error("--%s: %s", name, err);
     return r;
 }
 
-int cli_vl_option(int argc, char **argv, int *i, vl_params *vl) {
+int cli_param_option(int argc, char **argv, int *i, render_params *p, unsigned groups) {
     const char *a = argv[*i];
     if (strncmp(a, "--", 2) != 0) return 0;
     const param_desc *d = param_find(a + 2);
-    if (!d) return 0;
-    if (d->flag) return cli_set_vl_param(d->name, "on", vl);
+    if (!d || !(groups >> d->group & 1u)) return 0;
+    if (d->flag) return cli_set_param(d->name, "on", p, groups);
     const char *v = cli_value(argc, argv, i);
     if (!v) return -1;
-    return cli_set_vl_param(d->name, v, vl);
+    return cli_set_param(d->name, v, p, groups);
 }

@@ -42,15 +42,15 @@ const char *cli_value(int argc, char **argv, int *i);
 /* One option of a command's table (cli_table_option): its name, what its value is, where it goes
  * (and, for sizes, where the height goes), its range, and a flag set when it was given. */
 typedef enum {
-    CLI_FLAG,   /* no value: *(int *)out = 1 */
-    CLI_INT,    /* an integer in [lo, hi]: int */
-    CLI_LONG,   /* ... long long */
-    CLI_U64,    /* uint64_t */
-    CLI_FLOAT,  /* a number in [lo, hi]: double */
-    CLI_SIZE,   /* WxH: int width at out, int height at out2 */
-    CLI_TEXT,   /* the value as given: const char * */
-    CLI_PLAN,   /* auto|full: int */
-    CLI_METHOD, /* pt, vpl, vsl, vsl+hl: render_method */
+    CLI_FLAG,  /* no value: *(int *)out = 1 */
+    CLI_INT,   /* an integer in [lo, hi]: int */
+    CLI_LONG,  /* ... long long */
+    CLI_U64,   /* uint64_t */
+    CLI_FLOAT, /* a number in [lo, hi]: double */
+    CLI_SIZE,  /* WxH: int width at out, int height at out2 */
+    CLI_TEXT,  /* the value as given: const char * */
+    CLI_PLAN,  /* auto|full: int */
+    CLI_PARAM, /* the parameter table's entry of the option's name: into the render_params at out */
 } cli_kind;
 typedef struct {
     const char *name;
@@ -66,14 +66,15 @@ typedef struct {
  * them, -1 a bad or missing value (reported). */
 int cli_table_option(int argc, char **argv, int *i, const cli_opt *opts, int n);
 
-/* The many-light parameters (params_table), shared by glint render, bench, the viewer's options
- * and its script's `set`. cli_set_vl_param takes a name without the leading "--" and a value
- * (a flag such as vpl-glossy: on/off). Returns 1 when applied, 0 when name is not one of them, -1
- * on a bad value (reported). cli_vl_option does the same for argv[*i] and its value (none for a
- * flag), advancing *i. */
-int cli_set_vl_param(const char *name, const char *value, vl_params *vl);
-int cli_vl_option(int argc, char **argv, int *i, vl_params *vl);
-/* Their help text, one option per line. */
+/* The render parameters (params_table: the method, the path depth, the many-light ones), shared by
+ * glint render, info, bench, the viewer's options and its script's `set`; each command takes those
+ * of the groups in `groups` (PARAM_GROUPS_*). cli_set_param takes a name without the leading "--"
+ * and a value (a flag such as vpl-glossy: on/off). Returns 1 when applied, 0 when name is not one
+ * of them, -1 on a bad value (reported). cli_param_option does the same for argv[*i] and its value
+ * (none for a flag), advancing *i. */
+int cli_set_param(const char *name, const char *value, render_params *p, unsigned groups);
+int cli_param_option(int argc, char **argv, int *i, render_params *p, unsigned groups);
+/* The many-light options' help text, one option per line (params_help). */
 const char *cli_vl_help(void);
 
 /* Seconds on a monotonic clock. */

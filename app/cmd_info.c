@@ -16,14 +16,20 @@ static void print_info_help(void) {
            "Prints a summary of SCENE: geometry, materials, lights, material variants, cameras, size\n"
            "(with --variant NAME, of that variant); then what the\n"
            "scene calls for (material classes, emitters, whether indirect and glossy-to-glossy\n"
-           "transport exist) and the passes method NAME would run (default %s, as the viewer's;\n"
-           "vsl+hl has every pass), each with its reason.\n"
+           "transport exist) and the passes the method would run (vsl+hl has every pass), each with\n"
+           "its reason.\n"
            "\n"
-           "--obj FILE.obj writes the triangles as loaded (world space, with normals) as Wavefront\n"
-           "OBJ, and beside it FILE.mtl with each material's diffuse colour (its base colour or\n"
-           "Phong/Ward kd; nothing else of the material): the same geometry for another renderer.\n"
+           "options (default in brackets):\n"
+           "%s"
+           "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
+           "  --env FILE           environment map, equirectangular .exr or .hdr [none]\n"
+           "  --variant NAME       the scene's material variant NAME [the file's default materials]\n"
+           "  --obj FILE.obj       the triangles as loaded (world space, with normals) as Wavefront\n"
+           "                       OBJ, and beside it FILE.mtl with each material's diffuse colour\n"
+           "                       (its base colour or Phong/Ward kd; nothing else of the material):\n"
+           "                       the same geometry for another renderer\n"
            "\n",
-           method_name(DEFAULT_METHOD));
+           params_render_help(method_name(DEFAULT_METHOD)));
     cli_print_scenes();
 }
 
@@ -75,15 +81,12 @@ static int write_obj(const scene *s, const char *obj_path) {
 
 int cmd_info(int argc, char **argv) {
     const char *path = NULL, *env = NULL, *obj = NULL, *variant = NULL;
-    render_method method = DEFAULT_METHOD;
-    int max_depth = DEFAULT_MAX_DEPTH, plan_mode = PLAN_AUTO;
+    render_params p = {.method = DEFAULT_METHOD, .max_depth = DEFAULT_MAX_DEPTH};
+    int plan_mode = PLAN_AUTO;
     const cli_opt opts[] = {
-        {.name = "--env", .kind = CLI_TEXT, .out = &env},
-        {.name = "--variant", .kind = CLI_TEXT, .out = &variant},
-        {.name = "--method", .kind = CLI_METHOD, .out = &method},
-        {.name = "--max-depth", .kind = CLI_INT, .out = &max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
-        {.name = "--obj", .kind = CLI_TEXT, .out = &obj},
-        {.name = "--plan", .kind = CLI_PLAN, .out = &plan_mode},
+        {.name = "--env", .kind = CLI_TEXT, .out = &env},   {.name = "--variant", .kind = CLI_TEXT, .out = &variant},
+        {.name = "--method", .kind = CLI_PARAM, .out = &p}, {.name = "--max-depth", .kind = CLI_PARAM, .out = &p},
+        {.name = "--obj", .kind = CLI_TEXT, .out = &obj},   {.name = "--plan", .kind = CLI_PLAN, .out = &plan_mode},
     };
     for (int i = 0; i < argc; i++) {
         int r;
@@ -159,8 +162,8 @@ int cmd_info(int argc, char **argv) {
         scene_destroy(s);
         return EXIT_FAILURE_;
     }
-    effect_plan plan = plan_make(&a, method, max_depth, plan_mode);
-    printf("method:     %s\n", method_name(method));
+    effect_plan plan = plan_make(&a, p.method, p.max_depth, plan_mode);
+    printf("method:     %s\n", method_name(p.method));
     plan_print(stdout, s, &a, &plan);
     scene_analysis_free(&a);
     scene_destroy(s);

@@ -47,13 +47,10 @@ static void print_render_help(void) {
            "built-in scene) progressively, one sample per pixel per frame, and writes the running mean.\n"
            "\n"
            "options (default in brackets):\n"
-           "  --method NAME        estimator: pt (path tracing, the reference), vpl (clamped virtual\n"
-           "                       point lights), vsl (virtual spherical lights), vsl+hl (VSLs plus\n"
-           "                       vMF-merged indirect highlights, in a highlights.* layer) [pt]\n"
+           "%s"
            "  --spp N              samples per pixel (frames) [%d]\n"
            "  --time SECONDS       render until this much time has passed instead of --spp\n"
            "  --size WxH           image size [%dx%d]\n"
-           "  --max-depth D        scattering events per path; 1 = direct light only [%d]\n"
            "  --plan auto|full     auto: only the passes the scene calls for (glint info shows\n"
            "                       them); full: every pass, for comparison [auto]\n"
            "  --env FILE           environment map, equirectangular .exr or .hdr [none]\n"
@@ -88,7 +85,7 @@ static void print_render_help(void) {
            "\n"
            "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
            "new file render.png (render-1.png, ... if taken).\n",
-           DEFAULT_SPP, DEFAULT_WIDTH, DEFAULT_HEIGHT, DEFAULT_MAX_DEPTH, cli_vl_help());
+           params_render_help(NULL), DEFAULT_SPP, DEFAULT_WIDTH, DEFAULT_HEIGHT, cli_vl_help());
 }
 
 /* Whether name ends in suffix, in either case. */
@@ -182,11 +179,9 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--quiet", .kind = CLI_FLAG, .out = &o->quiet},
         {.name = "--denoise", .kind = CLI_FLAG, .out = &o->denoise},
         {.name = "--highlights-layer", .kind = CLI_FLAG, .out = &p->pt_highlights},
-        {.name = "--method", .kind = CLI_METHOD, .out = &p->method},
         {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000, .given = &spp_given},
         {.name = "--time", .kind = CLI_FLOAT, .out = &o->seconds, .lo = 1e-3, .hi = 1e7, .given = &time_given},
         {.name = "--size", .kind = CLI_SIZE, .out = &p->width, .out2 = &p->height},
-        {.name = "--max-depth", .kind = CLI_INT, .out = &p->max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
         {.name = "--plan", .kind = CLI_PLAN, .out = &p->plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
@@ -210,7 +205,7 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
             const char *option = argv[i], *value = cli_value(argc, argv, &i);
             if (!value || parse_light_option(o, option, value) != 0) return -1;
         } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0 ||
-                   (r = cli_vl_option(argc, argv, &i, &p->vl)) != 0) {
+                   (r = cli_param_option(argc, argv, &i, p, PARAM_GROUPS_ALL)) != 0) {
             if (r < 0) return -1;
         } else if (cli_scene_argument("render", argv[i], &o->scene_path) != 0) {
             return -1;

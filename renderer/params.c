@@ -73,10 +73,13 @@ int vl_frame_per_pixel(const vl_params *vp, int clustering) {
 
 #define STR_(x) #x
 #define STR(x) STR_(x)
-#define F(field) offsetof(vl_params, field)
+#define F(field) offsetof(render_params, vl.field)
+_Static_assert(sizeof(render_method) == sizeof(int), "a method is stored as a choice, an int");
 
 /* One row per parameter reads better than one line per field. */
 /* clang-format off */
+static const param_choice methods[METHOD_COUNT] = {{"pt", METHOD_PT, "pt"}, {"vpl", METHOD_VPL, "vpl"},
+                                                  {"vsl", METHOD_VSL, "vsl"}, {"vsl+hl", METHOD_VSL_HL, "vsl+hl"}};
 static const param_choice on_off[] = {{"on", 1, "on"}, {"off", 0, "off"}};
 static const param_choice clamps[] = {{NULL, VL_CLAMP_DEFAULT, "method default"}, {"on", VL_CLAMP_ON, "on"},
                                       {"off", VL_CLAMP_OFF, "off"}};
@@ -90,6 +93,16 @@ static const param_choice merges[] = {{"on", HL_MERGE_ON, "on"}, {"off", HL_MERG
 /* In the help's order. Numbers' ranges are what the command line accepts; the panel's sliders span
  * the useful part of them. */
 static const param_desc table[] = {
+    {.name = "method", .type = PARAM_CHOICE, .group = PARAM_RENDER, .offset = offsetof(render_params, method),
+     .choices = methods, .num_choices = METHOD_COUNT, .def = METHOD_PT, .value_name = "NAME",
+     .help = "estimator: pt (path tracing, the reference), vpl (clamped virtual\n"
+             "point lights), vsl (virtual spherical lights), vsl+hl (VSLs plus\n"
+             "vMF-merged indirect highlights)",
+     .label = "method"},
+    {.name = "max-depth", .type = PARAM_INT, .group = PARAM_RENDER, .offset = offsetof(render_params, max_depth),
+     .lo = 1, .hi = MAX_DEPTH_LIMIT, .def = DEFAULT_MAX_DEPTH, .value_name = "D",
+     .help = "scattering events per path; 1 = direct light only", .label = "max depth",
+     .unit = "scattering events per path", .panel_lo = 1, .panel_hi = 64, .panel_format = "%d"},
     {.name = "vsl-count", .type = PARAM_INT, .offset = F(count), .lo = 1, .hi = 50000000,
      .bytes_each = VL_BYTES_PER_LIGHT, .def = VL_DEFAULT_COUNT,
      .value_name = "N", .help = "virtual lights traced per frame", .label = "lights/frame",
@@ -233,8 +246,8 @@ const param_desc *param_find(const char *name) {
     return NULL;
 }
 
-double param_get(const param_desc *d, const vl_params *vl) {
-    const char *field = (const char *)vl + d->offset;
+double param_get(const param_desc *d, const render_params *p) {
+    const char *field = (const char *)p + d->offset;
     if (d->type == PARAM_FLOAT) {
         float v;
         memcpy(&v, field, sizeof v);
@@ -245,8 +258,8 @@ double param_get(const param_desc *d, const vl_params *vl) {
     return v;
 }
 
-void param_put(const param_desc *d, vl_params *vl, double v) {
-    char *field = (char *)vl + d->offset;
+void param_put(const param_desc *d, render_params *p, double v) {
+    char *field = (char *)p + d->offset;
     if (d->type == PARAM_FLOAT) {
         float f = (float)v;
         memcpy(field, &f, sizeof f);
@@ -260,7 +273,7 @@ void param_put(const param_desc *d, vl_params *vl, double v) {
 static void value_words(const param_desc *d, const char *sep, char *out, size_t n) {
     out[0] = 0;
     size_t len = 0;
-    if (d->type == PARAM_CHOICE) {
+    if (d->type == PARAM_CHOICE && !d->value_name) {
         for (int c = 0; c < d->num_choices; c++) {
             if (!d->choices[c].name) continue;
             len += (size_t)snprintf(out + len, n - len, "%s%s", len ? sep : "", d->choices[c].name);
@@ -272,16 +285,18 @@ static void value_words(const param_desc *d, const char *sep, char *out, size_t 
     }
 }
 
-int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err, size_t errlen) {
+int param_parse(const param_desc *d, const char *text, render_params *p, char *err, size_t errlen) {
     if (d->type == PARAM_CHOICE) {
         for (int c = 0; c < d->num_choices; c++)
             if (d->choices[c].name && strcmp(text, d->choices[c].name) == 0)
-                return param_put(d, vl, d->choices[c].value), 0;
+                return param_put(d, p, d->choices[c].value), 0;
         char words[128];
-        value_words(d, ", ", words, sizeof words);
+        param_desc names = *d;
+        names.value_name = NULL; /* the choices, not their placeholder */
+        value_words(&names, ", ", words, sizeof words);
         return snprintf(err, errlen, "expected one of %s, got '%s'", words, text), -1;
     }
-    if (d->off_word && strcmp(text, d->off_word) == 0) return param_put(d, vl, -1.0), 0;
+    if (d->off_word && strcmp(text, d->off_word) == 0) return param_put(d, p, -1.0), 0;
     char *end = NULL;
     errno = 0;
     double v = d->type == PARAM_INT ? (double)strtoll(text, &end, 10) : strtod(text, &end);
@@ -295,22 +310,22 @@ int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err,
                         text),
                -1;
     }
-    return param_set_value(d, vl, d->zero_is_off && v == 0.0 ? -1.0 : v, text, err, errlen);
+    return param_set_value(d, p, d->zero_is_off && v == 0.0 ? -1.0 : v, text, err, errlen);
 }
 
-int param_set_value(const param_desc *d, vl_params *vl, double v, const char *text, char *err, size_t errlen) {
+int param_set_value(const param_desc *d, render_params *p, double v, const char *text, char *err, size_t errlen) {
     double gib = 1024.0 * 1024.0 * 1024.0;
     if (v * d->bytes_each > PARAM_MAX_BYTES)
         return snprintf(err, errlen, "%s would take %.1f GiB (%.0f bytes each), over the limit of %.0f GiB", text,
                         v * d->bytes_each / gib, d->bytes_each, PARAM_MAX_BYTES / gib),
                -1;
-    vl_params was = *vl;
-    param_put(d, vl, v);
+    render_params was = *p;
+    param_put(d, p, v);
     /* Clustering's matrix is rows x lights floats: the two together under the same limit. */
-    vl_params r = vl_params_resolve(vl);
+    vl_params r = vl_params_resolve(&p->vl);
     double matrix = r.columns > 0 ? (double)r.rows * (double)r.count * sizeof(float) : 0.0;
     if (matrix > PARAM_MAX_BYTES) {
-        *vl = was;
+        *p = was;
         return snprintf(err, errlen,
                         "%s: clustering's matrix of %d rows by %d lights would take %.1f GiB, over the limit of "
                         "%.0f GiB",
@@ -320,14 +335,14 @@ int param_set_value(const param_desc *d, vl_params *vl, double v, const char *te
     return 0;
 }
 
-int params_set(vl_params *vl, const char *name, const char *text, char *err, size_t errlen) {
+int params_set(render_params *p, unsigned groups, const char *name, const char *text, char *err, size_t errlen) {
     const param_desc *d = param_find(name);
-    if (!d) return 0;
-    return param_parse(d, text, vl, err, errlen) == 0 ? 1 : -1;
+    if (!d || !(groups >> d->group & 1u)) return 0;
+    return param_parse(d, text, p, err, errlen) == 0 ? 1 : -1;
 }
 
-void param_format(const param_desc *d, const vl_params *vl, char *out, size_t n) {
-    double v = param_get(d, vl);
+void param_format(const param_desc *d, const render_params *p, char *out, size_t n) {
+    double v = param_get(d, p);
     if (d->type == PARAM_CHOICE) {
         for (int c = 0; c < d->num_choices; c++)
             if (d->choices[c].value == (int)v) {
@@ -342,6 +357,48 @@ void param_format(const param_desc *d, const vl_params *vl, char *out, size_t n)
     }
 }
 
+/* One option's help into text (a line, or lines, each ending in a newline), def_given its default
+ * (NULL: the table's). Returns the length written (clipped to n). */
+static size_t help_line(const param_desc *d, const char *def_given, char *text, size_t n) {
+    char option[64], words[64], def[64];
+    value_words(d, "|", words, sizeof words);
+    int olen = d->flag ? snprintf(option, sizeof option, "  --%s", d->name)
+                       : snprintf(option, sizeof option, "  --%s %s", d->name, words);
+    if (def_given || d->def_text)
+        snprintf(def, sizeof def, "%s", def_given ? def_given : d->def_text);
+    else if (d->type == PARAM_INT)
+        snprintf(def, sizeof def, "%d", (int)d->def);
+    else if (d->type == PARAM_FLOAT)
+        snprintf(def, sizeof def, "%g", d->def);
+    else {
+        render_params v = {0};
+        param_put(d, &v, d->def);
+        param_format(d, &v, def, sizeof def);
+    }
+    /* Options in a column of 23, the help beside them; its later lines under its first. */
+    size_t len = (size_t)snprintf(text, n, "%s%*s", option, olen < 22 ? 23 - olen : olen == 22 ? 1 : 2, "");
+    for (const char *h = d->help; *h && len < n;) {
+        const char *nl = strchr(h, '\n');
+        int k = nl ? (int)(nl - h) : (int)strlen(h);
+        len += (size_t)snprintf(text + len, n - len, "%.*s", k, h);
+        if (!nl) break;
+        h = nl + 1;
+        if (len < n) len += (size_t)snprintf(text + len, n - len, "\n%23s", "");
+    }
+    if (len < n) len += (size_t)snprintf(text + len, n - len, " [%s]\n", def);
+    return len < n ? len : n;
+}
+
+const char *params_render_help(const char *method_default) {
+    static char text[2048];
+    size_t len = 0;
+    for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++)
+        if (table[i].group == PARAM_RENDER)
+            len += help_line(&table[i], table[i].offset == offsetof(render_params, method) ? method_default : NULL,
+                             text + len, sizeof text - len);
+    return text;
+}
+
 const char *params_help(void) {
     static char text[8192];
     static const char *const headings[] = {"many-light methods (vpl, vsl):\n", "indirect highlights (vsl+hl):\n"};
@@ -349,40 +406,12 @@ const char *params_help(void) {
     int group = -1;
     for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++) {
         const param_desc *d = &table[i];
+        if (d->group == PARAM_RENDER) continue; /* each command lists these with its own options */
         if ((int)d->group != group) {
             group = (int)d->group;
             len += (size_t)snprintf(text + len, sizeof text - len, "%s", headings[group]);
         }
-        char option[64], words[64], def[64];
-        value_words(d, "|", words, sizeof words);
-        int olen = d->flag ? snprintf(option, sizeof option, "  --%s", d->name)
-                           : snprintf(option, sizeof option, "  --%s %s", d->name, words);
-        if (d->def_text)
-            snprintf(def, sizeof def, "%s", d->def_text);
-        else if (d->type == PARAM_INT)
-            snprintf(def, sizeof def, "%d", (int)d->def);
-        else if (d->type == PARAM_FLOAT)
-            snprintf(def, sizeof def, "%g", d->def);
-        else {
-            vl_params v = {0};
-            param_put(d, &v, d->def);
-            param_format(d, &v, def, sizeof def);
-        }
-        /* Options in a column of 23, the help beside them; its later lines under its first. */
-        len += (size_t)snprintf(text + len, sizeof text - len, "%s%*s", option,
-                                olen < 22    ? 23 - olen
-                                : olen == 22 ? 1
-                                             : 2,
-                                "");
-        for (const char *h = d->help; *h && len < sizeof text;) {
-            const char *nl = strchr(h, '\n');
-            int n = nl ? (int)(nl - h) : (int)strlen(h);
-            len += (size_t)snprintf(text + len, sizeof text - len, "%.*s", n, h);
-            if (!nl) break;
-            h = nl + 1;
-            if (len < sizeof text) len += (size_t)snprintf(text + len, sizeof text - len, "\n%23s", "");
-        }
-        if (len < sizeof text) len += (size_t)snprintf(text + len, sizeof text - len, " [%s]\n", def);
+        if (len < sizeof text) len += help_line(d, NULL, text + len, sizeof text - len);
     }
     return text;
 }

@@ -1,8 +1,9 @@
 /* glint — what a render is asked to do: the method, its parameters and their defaults, and the
  * statistics a session reports. Every estimator and front end includes this header (not
- * session.h) for these types. The many-light parameters are described once, in a table
- * (params_table) that the command line, the viewer's script `set`, its panel and the help text
- * all read, so a new parameter is one vl_params field and one entry (docs/design.md, "Parameters"). */
+ * session.h) for these types. The method, the path depth and the many-light parameters are
+ * described once, in a table (params_table) that the command line, the viewer's script `set`, its
+ * panel and the help text all read, so a new parameter is one render_params (or vl_params) field
+ * and one entry (docs/design.md, "Parameters"). */
 #ifndef GLINT_PARAMS_H
 #define GLINT_PARAMS_H
 
@@ -251,8 +252,13 @@ int vl_frame_per_pixel(const vl_params *vp, int clustering);
 #define VL_BYTES_PER_LIGHT 512.0
 
 typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE } param_type;
-/* Which methods read a parameter: the panel shows it with them, the help groups by it. */
-typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS } param_group;
+/* Which methods read a parameter: the panel shows it with them, the help groups by it. PARAM_RENDER:
+ * every method (the method itself, the path depth), which each command's help lists with its own
+ * options and default (params_render_help), not in params_help's sections. */
+typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS, PARAM_RENDER } param_group;
+/* Masks of groups (1 << group) a front end takes. */
+#define PARAM_GROUPS_VL ((1u << PARAM_MANY_LIGHT) | (1u << PARAM_HIGHLIGHTS))
+#define PARAM_GROUPS_ALL (PARAM_GROUPS_VL | (1u << PARAM_RENDER))
 
 typedef struct {
     const char *name; /* the word on the command line and in scripts; NULL: the panel's only */
@@ -260,12 +266,13 @@ typedef struct {
     const char *label; /* the panel's */
 } param_choice;
 
-/* One many-light parameter: an int or float field of vl_params (a choice is an int field). */
+/* One parameter: an int or float field of render_params (a choice is an int field; the many-light
+ * ones are in its vl). */
 typedef struct {
     const char *name; /* the option without "--", and the script's `set` name */
     param_type type;
     param_group group;
-    size_t offset;        /* of the field in vl_params */
+    size_t offset;        /* of the field in render_params */
     double lo, hi;        /* numbers accepted */
     int below_hi;         /* hi itself is refused */
     double bytes_each;    /* the memory each unit of the value takes, if it grows with it (0: none) */
@@ -274,9 +281,9 @@ typedef struct {
     const param_choice *choices;
     int num_choices;
     int flag;               /* the command line takes it alone, as "on" */
-    double def;             /* the default, as vl_params_resolve gives it */
+    double def;             /* the default, as render_params_resolve gives it */
     const char *def_text;   /* the help's default when it is no one value */
-    const char *value_name; /* the help's name for the value */
+    const char *value_name; /* the help's name for the value (a choice's: its names, unless set) */
     const char *help;       /* lines for --help, '\n' between them */
     const char *label;      /* the panel's */
     const char *unit;       /* numbers: what the value counts or measures, for plots' axes */
@@ -289,21 +296,26 @@ typedef struct {
 const param_desc *params_table(int *count);
 /* The entry named name (without "--"), or NULL. */
 const param_desc *param_find(const char *name);
-/* Sets d's field in vl from text. Returns 0, or -1 with err = "NAME: problem" and vl unchanged. */
-int param_parse(const param_desc *d, const char *text, vl_params *vl, char *err, size_t errlen);
+/* Sets d's field in p from text. Returns 0, or -1 with err = "NAME: problem" and p unchanged. */
+int param_parse(const param_desc *d, const char *text, render_params *p, char *err, size_t errlen);
 /* Sets parameter d to v (in range, -1 for off) under the memory rules (bytes_each and
- * clustering's matrix within PARAM_MAX_BYTES): 0, or -1 with vl unchanged and err saying what it
+ * clustering's matrix within PARAM_MAX_BYTES): 0, or -1 with p unchanged and err saying what it
  * would take (text: the value as the user gave it). param_parse and the panel both set through it. */
-int param_set_value(const param_desc *d, vl_params *vl, double v, const char *text, char *err, size_t errlen);
-/* Like param_parse by name: 1 applied, 0 no such parameter, -1 a bad value (err set). */
-int params_set(vl_params *vl, const char *name, const char *text, char *err, size_t errlen);
+int param_set_value(const param_desc *d, render_params *p, double v, const char *text, char *err, size_t errlen);
+/* Like param_parse by name, of the groups in mask (PARAM_GROUPS_*): 1 applied, 0 no such
+ * parameter, -1 a bad value (err set). */
+int params_set(render_params *p, unsigned groups, const char *name, const char *text, char *err, size_t errlen);
 /* The field's value as param_parse reads it back (a choice's name, the off word, a number). */
-void param_format(const param_desc *d, const vl_params *vl, char *out, size_t n);
+void param_format(const param_desc *d, const render_params *p, char *out, size_t n);
 /* The field as a number (choices their value, off -1). */
-double param_get(const param_desc *d, const vl_params *vl);
-void param_put(const param_desc *d, vl_params *vl, double v);
-/* The options' help text, one section per group; the returned text is static. */
+double param_get(const param_desc *d, const render_params *p);
+void param_put(const param_desc *d, render_params *p, double v);
+/* The many-light options' help text, one section per group; the returned text is static. */
 const char *params_help(void);
+/* The options every method takes (PARAM_RENDER: the method, the path depth), as params_help words
+ * its own, for a command's help, with method_default as the method's default (NULL: the table's);
+ * the text is static until the next call. */
+const char *params_render_help(const char *method_default);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,7 @@
 /* glint tests — the parameter table (params.h): every entry is accepted by the command line's
  * parser and by the script's `set` (both through the table), listed in the help, complete for the
- * panel; its default is what vl_params_resolve gives; every vl_params field has an entry; the
- * option list in docs/methods.md is the help's. The counters' list (RENDER_COUNTERS) is all of
+ * panel; its default is what render_params_resolve gives; every vl_params field has an entry, and
+ * so have the method and the path depth; the option list in docs/methods.md is the help's. The counters' list (RENDER_COUNTERS) is all of
  * render_stats and all of it is summed. With the glint program as argument, each entry is also
  * given to `glint render` as a user would, and --stats reports every counter. */
 #include <stdlib.h>
@@ -35,47 +35,57 @@ static double example(const param_desc *d, char *text, size_t n) {
 static void test_entry(const param_desc *d, const char *help) {
     char text[64], err[256];
     double want = example(d, text, sizeof text);
-    const vl_params zero = {0};
+    const render_params zero = {0};
+    const unsigned all = PARAM_GROUPS_ALL;
 
-    /* The script's `set` (params_set) and the command line (cli_set_vl_param, cli_vl_option). */
-    vl_params a = zero, b = zero, c = zero;
-    CHECK(params_set(&a, d->name, text, err, sizeof err) == 1, "set %s %s: %s", d->name, text, err);
+    /* The script's `set` (params_set) and the command line (cli_set_param, cli_param_option). */
+    render_params a = zero, b = zero, c = zero;
+    CHECK(params_set(&a, all, d->name, text, err, sizeof err) == 1, "set %s %s: %s", d->name, text, err);
     CHECK(param_get(d, &a) == want, "set %s %s stored %g", d->name, text, param_get(d, &a));
-    vl_params other = a;
+    render_params other = a;
     param_put(d, &other, 0.0);
     CHECK(memcmp(&other, &zero, sizeof zero) == 0, "set %s changed another field", d->name);
-    CHECK(cli_set_vl_param(d->name, text, &b) == 1 && memcmp(&a, &b, sizeof a) == 0, "--%s %s", d->name, text);
+    CHECK(cli_set_param(d->name, text, &b, all) == 1 && memcmp(&a, &b, sizeof a) == 0, "--%s %s", d->name, text);
+    /* a command that does not take the entry's group (bench's methods and depth are its own) */
+    unsigned others = all & ~(1u << d->group);
+    CHECK(params_set(&b, others, d->name, text, err, sizeof err) == 0, "%s taken outside its group", d->name);
     char option[80];
     snprintf(option, sizeof option, "--%s", d->name);
     char *argv[] = {option, d->flag ? (char *)"--next" : text, NULL};
     int i = 0;
-    CHECK(cli_vl_option(2, argv, &i, &c) == 1, "cli_vl_option %s", option);
+    CHECK(cli_param_option(2, argv, &i, &c, all) == 1, "cli_param_option %s", option);
     CHECK(i == (d->flag ? 0 : 1), "%s took %d arguments", option, i);
     if (d->flag)
         CHECK(param_get(d, &c) == 1.0, "%s alone is not on", option);
     else
-        CHECK(memcmp(&a, &c, sizeof a) == 0, "cli_vl_option %s %s differs from set", option, text);
-    CHECK(strstr(help, option) != NULL, "the help does not list %s", option);
+        CHECK(memcmp(&a, &c, sizeof a) == 0, "cli_param_option %s %s differs from set", option, text);
+    /* the many-light sections list their own; each command lists the method and depth (test_program) */
+    CHECK((strstr(help, option) != NULL) == (d->group != PARAM_RENDER),
+          "the help does not list %s (or lists it "
+          "among the many-light options)",
+          option);
 
     /* A bad value is refused with a message and changes nothing; the off word is -1. */
-    vl_params bad = a;
-    CHECK(params_set(&bad, d->name, "banana", err, sizeof err) == -1 && memcmp(&bad, &a, sizeof a) == 0,
+    render_params bad = a;
+    CHECK(params_set(&bad, all, d->name, "banana", err, sizeof err) == -1 && memcmp(&bad, &a, sizeof a) == 0,
           "set %s banana accepted", d->name);
     if (d->off_word) {
-        CHECK(params_set(&bad, d->name, d->off_word, err, sizeof err) == 1 && param_get(d, &bad) == -1.0,
+        CHECK(params_set(&bad, all, d->name, d->off_word, err, sizeof err) == 1 && param_get(d, &bad) == -1.0,
               "set %s %s is not -1", d->name, d->off_word);
     }
     if (d->zero_is_off)
-        CHECK(params_set(&bad, d->name, "0", err, sizeof err) == 1 && param_get(d, &bad) == -1.0, "%s 0 is not off",
-              d->name);
+        CHECK(params_set(&bad, all, d->name, "0", err, sizeof err) == 1 && param_get(d, &bad) == -1.0,
+              "%s 0 is not off", d->name);
 
-    /* The default is what the renderer resolves a zero field to, and what is set reads back. */
-    vl_params r = vl_params_resolve(&zero);
+    /* The default is what the renderer resolves a zero field to (the clamp's, the method's choice,
+     * left open: vl_params_resolve), and what is set reads back. */
+    render_params r = render_params_resolve_frame(&zero);
+    r.vl = vl_params_resolve(&zero.vl);
     CHECK(param_get(d, &r) == (double)(d->type == PARAM_FLOAT ? (float)d->def : d->def),
           "%s: table default %g, resolved %g", d->name, d->def, param_get(d, &r));
     param_format(d, &a, text, sizeof text);
-    vl_params back = zero;
-    CHECK(params_set(&back, d->name, text, err, sizeof err) == 1 && param_get(d, &back) == param_get(d, &a),
+    render_params back = zero;
+    CHECK(params_set(&back, all, d->name, text, err, sizeof err) == 1 && param_get(d, &back) == param_get(d, &a),
           "%s: '%s' does not read back", d->name, text);
 
     /* The panel's widget. */
@@ -102,39 +112,51 @@ static void test_table(void) {
         for (int j = 0; j < i; j++)
             CHECK(strcmp(t[i].label, t[j].label) != 0 && t[i].offset != t[j].offset, "%s and %s share a label or field",
                   t[i].name, t[j].name);
-        covered += t[i].type == PARAM_FLOAT ? sizeof(float) : sizeof(int);
+        size_t vl_at = offsetof(render_params, vl);
+        int in_vl = t[i].offset >= vl_at && t[i].offset < vl_at + sizeof(vl_params);
+        CHECK(in_vl == (t[i].group != PARAM_RENDER), "%s: a field outside its group's struct", t[i].name);
+        if (in_vl) covered += t[i].type == PARAM_FLOAT ? sizeof(float) : sizeof(int);
     }
     /* A vl_params field without an entry would be out of reach of every front end. */
     CHECK(covered == sizeof(vl_params), "the table covers %zu of vl_params' %zu bytes", covered, sizeof(vl_params));
-    vl_params v = {0};
+    const param_desc *method = param_find("method"), *depth = param_find("max-depth");
+    CHECK(method && method->offset == offsetof(render_params, method) && depth &&
+              depth->offset == offsetof(render_params, max_depth) && depth->hi == MAX_DEPTH_LIMIT,
+          "the method and the path depth are not the table's");
+    render_params v = {0};
     char err[64];
-    CHECK(params_set(&v, "no-such-parameter", "1", err, sizeof err) == 0, "an unknown name was taken");
+    CHECK(params_set(&v, PARAM_GROUPS_ALL, "no-such-parameter", "1", err, sizeof err) == 0,
+          "an unknown name was taken");
 }
 
 /* A parameter whose memory grows with it is refused beyond PARAM_MAX_BYTES, at once and saying what
  * it would take: the most lights that fit are taken, one more is not. */
 static void test_memory_rule(void) {
     const param_desc *d = param_find("vsl-count");
-    vl_params v = {0};
+    render_params v = {0};
     char err[256], text[32];
     long long most = (long long)(PARAM_MAX_BYTES / d->bytes_each);
     snprintf(text, sizeof text, "%lld", most);
-    CHECK(d->bytes_each > 0.0 && params_set(&v, "vsl-count", text, err, sizeof err) == 1 && v.count == most,
+    CHECK(d->bytes_each > 0.0 && params_set(&v, PARAM_GROUPS_VL, "vsl-count", text, err, sizeof err) == 1 &&
+              v.vl.count == most,
           "vsl-count %s: %s", text, err);
     snprintf(text, sizeof text, "%lld", most + 1);
-    CHECK(params_set(&v, "vsl-count", text, err, sizeof err) == -1 && v.count == most && strstr(err, "GiB") &&
-              strstr(err, "over the limit of 4 GiB"),
+    CHECK(params_set(&v, PARAM_GROUPS_VL, "vsl-count", text, err, sizeof err) == -1 && v.vl.count == most &&
+              strstr(err, "GiB") && strstr(err, "over the limit of 4 GiB"),
           "vsl-count %s: %s", text, err);
     /* clustering's matrix, rows x lights floats, under the same limit whichever option comes last */
-    vl_params m = {0};
-    CHECK(params_set(&m, "rows", "100000", err, sizeof err) == 1 &&
-              params_set(&m, "vsl-count", "8000000", err, sizeof err) == 1,
+    render_params m = {0};
+    CHECK(params_set(&m, PARAM_GROUPS_VL, "rows", "100000", err, sizeof err) == 1 &&
+              params_set(&m, PARAM_GROUPS_VL, "vsl-count", "8000000", err, sizeof err) == 1,
           "rows and lights alone: %s", err);
-    CHECK(params_set(&m, "columns", "100", err, sizeof err) == -1 && m.columns == 0 && strstr(err, "matrix"),
+    CHECK(params_set(&m, PARAM_GROUPS_VL, "columns", "100", err, sizeof err) == -1 && m.vl.columns == 0 &&
+              strstr(err, "matrix"),
           "columns 100 with a 100000 x 8000000 matrix: %s", err);
-    CHECK(params_set(&m, "rows", "30", err, sizeof err) == 1 && params_set(&m, "columns", "100", err, sizeof err) == 1,
+    CHECK(params_set(&m, PARAM_GROUPS_VL, "rows", "30", err, sizeof err) == 1 &&
+              params_set(&m, PARAM_GROUPS_VL, "columns", "100", err, sizeof err) == 1,
           "a matrix of 30 rows: %s", err);
-    CHECK(params_set(&m, "rows", "100000", err, sizeof err) == -1 && m.rows == 30, "rows back to 100000: %s", err);
+    CHECK(params_set(&m, PARAM_GROUPS_VL, "rows", "100000", err, sizeof err) == -1 && m.vl.rows == 30,
+          "rows back to 100000: %s", err);
 }
 
 /* Resolving is idempotent, leaves explicit values and "off" alone, and decides the clamp by method. */
@@ -228,6 +250,21 @@ static void test_program(void) {
                  t[i].group == PARAM_HIGHLIGHTS ? "vsl+hl" : "vsl", t[i].name, t[i].flag ? "" : text);
         int rc = run(args);
         CHECK(rc == 0, "glint %s: exit %d: %s", args, rc, err_text);
+    }
+    /* Each command's help lists the method and the path depth as the table words them, with its
+     * own default (the viewer opens on vsl). */
+    const char *commands[] = {"render", "view", "info"};
+    for (int k = 0; k < 3; k++) {
+        char args[64];
+        snprintf(args, sizeof args, "%s --help", commands[k]);
+        CHECK(run(args) == 0, "glint %s: %s", args, err_text);
+        const char *lines = params_render_help(k > 0 ? method_name(DEFAULT_METHOD) : NULL);
+        CHECK(strstr(out_text, lines) != NULL, "glint %s does not list these as:\n%s", args, lines);
+        for (int i = 0; i < n; i++) {
+            char option[80];
+            snprintf(option, sizeof option, "  --%s ", t[i].name);
+            CHECK(t[i].group != PARAM_RENDER || strstr(lines, option), "the help's lines lack --%s", t[i].name);
+        }
     }
 }
 

@@ -231,16 +231,16 @@ static void help_tooltip(const char *help) {
     if (help && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", help);
 }
 
-// One widget per many-light parameter of the group, from the table (params.h): choices as combo
-// boxes, numbers as sliders whose lowest position stands for "off" where the parameter has one;
-// each explains itself on hover.
-static void param_widgets(param_group group, vl_params *vl) {
+// One widget per parameter of the group, from the table (params.h): choices as combo boxes, numbers
+// as sliders whose lowest position stands for "off" where the parameter has one; each explains
+// itself on hover.
+static void param_widgets(param_group group, render_params *p) {
     int n;
     const param_desc *table = params_table(&n);
     for (int i = 0; i < n; i++) {
         const param_desc *d = &table[i];
         if (d->group != group) continue;
-        double v = param_get(d, vl);
+        double v = param_get(d, p);
         if (d->type == PARAM_CHOICE) {
             const char *labels[8];
             int k = 0, cur = 0;
@@ -248,7 +248,7 @@ static void param_widgets(param_group group, vl_params *vl) {
                 labels[k] = d->choices[k].label;
                 if (d->choices[k].value == (int)v) cur = k;
             }
-            if (ImGui::Combo(d->label, &cur, labels, k)) param_put(d, vl, d->choices[cur].value);
+            if (ImGui::Combo(d->label, &cur, labels, k)) param_put(d, p, d->choices[cur].value);
             help_tooltip(d->help);
             continue;
         }
@@ -276,7 +276,7 @@ static void param_widgets(param_group group, vl_params *vl) {
             edited = std::fmin(std::fmax(edited, d->lo), d->below_hi ? std::nextafter(d->hi, 0.0) : d->hi);
         char text[32], why[256];
         std::snprintf(text, sizeof text, "%g", edited);
-        param_set_value(d, vl, edited, text, why, sizeof why); // refused: the slider stays where it was
+        param_set_value(d, p, edited, text, why, sizeof why); // refused: the slider stays where it was
     }
 }
 
@@ -430,12 +430,8 @@ static void panel(ui_controls *c, const ui_stats *s) {
     if (ImGui::CollapsingHeader("Progress", ImGuiTreeNodeFlags_DefaultOpen)) progress_section(c, s);
 
     if (ImGui::CollapsingHeader("Estimator", ImGuiTreeNodeFlags_DefaultOpen)) {
-        if (s->num_methods > 0) {
-            int m = (int)c->params.method;
-            if (ImGui::Combo("method", &m, s->method_names, s->num_methods)) c->params.method = (render_method)m;
-        }
-        ImGui::SliderInt("max depth", &c->params.max_depth, 1, 64);
-        if (s->many_light) param_widgets(PARAM_MANY_LIGHT, &c->params.vl);
+        param_widgets(PARAM_RENDER, &c->params);
+        if (s->many_light) param_widgets(PARAM_MANY_LIGHT, &c->params);
         // Cost and bias where known: the last full frame's time and the plan's reasons.
         if (s->cost_ms <= 0.0)
             note("cost: measuring (the first full frame of these settings)");
@@ -451,7 +447,7 @@ static void panel(ui_controls *c, const ui_stats *s) {
         }
     }
     if (s->highlights && ImGui::CollapsingHeader("Highlights", ImGuiTreeNodeFlags_DefaultOpen))
-        param_widgets(PARAM_HIGHLIGHTS, &c->params.vl);
+        param_widgets(PARAM_HIGHLIGHTS, &c->params);
 
     if (s->num_lights > 0 && ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) {
         int l = c->light;

@@ -20,8 +20,8 @@ struct GLFWwindow;
 enum { UI_SHOW_ALL = 0, UI_SHOW_DIRECT, UI_SHOW_INDIRECT, UI_SHOW_HIGHLIGHTS, UI_SHOW_ERROR, UI_SHOW_COUNT };
 
 typedef struct {
-    /* estimator settings: a change resets the accumulation. The panel edits method, max_depth and
-     * vl (its defaults resolved, vl_params_resolve), the many-light fields through params_table. */
+    /* estimator settings: a change resets the accumulation. The panel edits the method, max_depth
+     * and vl (its defaults resolved, vl_params_resolve) through params_table. */
     render_params params;
     int camera; /* scene camera index, -1 for the free camera */
     /* the selected light and its intensity: a change of intensity resets */
@@ -68,8 +68,6 @@ typedef struct {
     double cost_ms, cost_before_ms;
     int width, height; /* of the image shown */
     int num_cameras;
-    const char *const *method_names;
-    int num_methods;
     int many_light; /* the current method uses virtual lights: show their settings */
     int highlights; /* the current method is vsl+hl: show the highlight settings */
     const char *const *tonemap_names;

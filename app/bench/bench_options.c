@@ -157,7 +157,7 @@ unsigned bench_sweep_methods(const char *name) {
 
 int bench_apply_setting(const char *name, const char *value, render_params *p) {
     if (strcmp(name, "plan") == 0) return cli_parse_plan("--plan", value, &p->plan) ? -1 : 1;
-    return cli_set_vl_param(name, value, &p->vl);
+    return cli_set_param(name, value, p, PARAM_GROUPS_VL);
 }
 
 unsigned bench_err_mask(int component) {
@@ -266,6 +266,15 @@ static void append_base(bench_options *o, const char *a, const char *v) {
     snprintf(o->base_text + len, sizeof o->base_text - len, "%s%s%s%s", len ? " " : "", a, v ? " " : "", v ? v : "");
 }
 
+/* A many-light option of the table into vl (cli_param_option); the methods and the depth are
+ * bench's own options (--methods, --max-depth). */
+static int vl_option(int argc, char **argv, int *i, vl_params *vl) {
+    render_params p = {.vl = *vl};
+    int r = cli_param_option(argc, argv, i, &p, PARAM_GROUPS_VL);
+    if (r > 0) *vl = p.vl;
+    return r;
+}
+
 /* Parses argv into o. Returns 0, 1 (--help), -1 (reported), or 2 at the first --preset, its
  * index in *preset_at: the caller parses again with the preset's options first. */
 static int parse_pass(int argc, char **argv, bench_options *o, int *preset_at, const char **methods, const char **times,
@@ -327,7 +336,7 @@ static int parse_pass(int argc, char **argv, bench_options *o, int *preset_at, c
                 if (strcmp(v, bench_err_names[k]) == 0) c = k;
             if (c < 0) return cli_error("--component: expected all, direct, indirect or highlights, got '%s'", v), -1;
             o->component = c;
-        } else if ((r = cli_vl_option(argc, argv, &i, &o->vl)) != 0) {
+        } else if ((r = vl_option(argc, argv, &i, &o->vl)) != 0) {
             if (r < 0) return -1;
             append_base(o, a, i > at ? argv[i] : NULL);
         } else if (cli_scene_argument("bench", a, &o->scene_path) != 0) {

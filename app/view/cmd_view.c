@@ -33,8 +33,7 @@ static void print_view_help(void) {
            "\n"
            "options:\n"
            "  --size WxH           window and render size [%dx%d]\n"
-           "  --method NAME        estimator: pt, vpl, vsl, vsl+hl [%s]\n"
-           "  --max-depth D        scattering events per path [%d]\n"
+           "%s"
            "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
            "  --variant NAME       the scene's material variant NAME (the panel switches them)\n"
@@ -53,7 +52,7 @@ static void print_view_help(void) {
            "%s"
            "\n"
            "keys and mouse (F1 in the window shows them):\n",
-           DEFAULT_WIDTH, DEFAULT_HEIGHT, method_name(DEFAULT_METHOD), DEFAULT_MAX_DEPTH, cli_vl_help());
+           DEFAULT_WIDTH, DEFAULT_HEIGHT, params_render_help(method_name(DEFAULT_METHOD)), cli_vl_help());
     print_shortcuts(stdout);
 }
 
@@ -66,8 +65,6 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     o->params.method = DEFAULT_METHOD;
     const cli_opt opts[] = {
         {.name = "--size", .kind = CLI_SIZE, .out = &o->width, .out2 = &o->height},
-        {.name = "--method", .kind = CLI_METHOD, .out = &o->params.method},
-        {.name = "--max-depth", .kind = CLI_INT, .out = &o->params.max_depth, .lo = 1, .hi = MAX_DEPTH_LIMIT},
         {.name = "--plan", .kind = CLI_PLAN, .out = &o->params.plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
@@ -86,7 +83,7 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
             print_view_help();
             return 1;
         } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0 ||
-                   (r = cli_vl_option(argc, argv, &i, &o->params.vl)) != 0) {
+                   (r = cli_param_option(argc, argv, &i, &o->params, PARAM_GROUPS_ALL)) != 0) {
             if (r < 0) return -1;
         } else if (strcmp(a, "--denoise") == 0) {
             if (!(v = cli_value(argc, argv, &i))) return -1;

@@ -312,10 +312,6 @@ void draw_image_and_panel(ui_thread *u) {
                    .bookmarks = u->bookmarks_text,
                    .message = u->message,
                    .status = u->status};
-    const char *methods[METHOD_COUNT];
-    for (int m = 0; m < METHOD_COUNT; m++) methods[m] = method_name((render_method)m);
-    st.method_names = methods;
-    st.num_methods = METHOD_COUNT;
     panel_frame(u, &st);
     ui_panel(&u->ctl, &st); /* first: the image goes beside the panel as it is drawn now */
     float rect[4];

@@ -36,9 +36,8 @@ static void print_stats(ui_thread *u) {
         (double)lx, (double)ly, tonemap_names[u->ctl.tonemap], mean, u->rel_error, u->shown_error,
         seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
         nb ? marks : "-");
-    printf("scene=%s frames=%lld width=%d height=%d exposure=%g show=%d max_depth=%d method=%s ", u->info.name,
-           frames_of_current_state(u), u->front.width, u->front.height, (double)u->ctl.exposure, u->ctl.show,
-           u->ctl.params.max_depth, method_name(u->ctl.params.method));
+    printf("scene=%s frames=%lld width=%d height=%d exposure=%g show=%d ", u->info.name, frames_of_current_state(u),
+           u->front.width, u->front.height, (double)u->ctl.exposure, u->ctl.show);
     /* The environment, and the standing notes (the panel's status line) as flags. */
     char env[1024];
     controller_env(u->vc, env, sizeof env);
@@ -53,14 +52,14 @@ static void print_stats(ui_thread *u) {
     printf(" frames_drawn=%llu", u->frames_drawn); /* the window's: only when something changed */
     view_stats_print(&u->stats);                   /* the render side's record, as it names its fields */
     print_panel_stats(u);
-    /* Every many-light parameter, as `set` takes it (vsl-count=128 is vsl_count=128). */
+    /* Every parameter of the table, as `set` takes it (vsl-count=128 is vsl_count=128). */
     int nparams;
     const param_desc *table = params_table(&nparams);
     for (int i = 0; i < nparams; i++) {
         char name[64], value[64];
         snprintf(name, sizeof name, "%s", table[i].name);
         for (char *c = name; *c; c++) *c = *c == '-' ? '_' : *c;
-        param_format(&table[i], &u->ctl.params.vl, value, sizeof value);
+        param_format(&table[i], &u->ctl.params, value, sizeof value);
         printf(" %s=%s", name, value);
     }
     printf("\n");
@@ -74,22 +73,15 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     snprintf(opt, sizeof opt, "--%s", name);
     long long n;
     double x;
-    /* The many-light settings, as glint render's options (the parameter table). */
+    /* The method, the path depth and the many-light settings, as glint render's options (the
+     * parameter table). */
     char why[256];
     int limit = panel_set(u, name, value, err, errlen); /* spp, time */
     if (limit <= 0) return limit;
-    int applied = params_set(&u->ctl.params.vl, name, value, why, sizeof why);
+    int applied = params_set(&u->ctl.params, PARAM_GROUPS_ALL, name, value, why, sizeof why);
     if (applied < 0) return snprintf(err, errlen, "%s: %s", name, why), -1;
     if (applied > 0) return 0;
-    if (strcmp(name, "method") == 0) {
-        int m = method_from_name(value);
-        if (m < 0) return snprintf(err, errlen, "unknown method '%s'", value), -1;
-        u->ctl.params.method = (render_method)m;
-    } else if (strcmp(name, "max-depth") == 0) {
-        if (cli_parse_int(opt, value, 1, MAX_DEPTH_LIMIT, &n) != 0)
-            return snprintf(err, errlen, "bad value '%s'", value), -1;
-        u->ctl.params.max_depth = (int)n;
-    } else if (strcmp(name, "exposure") == 0) {
+    if (strcmp(name, "exposure") == 0) {
         if (cli_parse_float(opt, value, -30, 30, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
         u->ctl.exposure = (float)x;
     } else if (strcmp(name, "show") == 0) {
