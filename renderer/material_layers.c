@@ -1,20 +1,7 @@
-/* The glTF material extensions at a hit: factors times their textures, as each extension's
- * specification combines them, handed to make_bsdf_gltf_layered (docs/design.md, "The glTF
- * material"). */
+/* A surface hit's material: its BSDF and emission, and the glTF material extensions at the hit
+ * (factors times their textures, as each extension's specification combines them, handed to
+ * make_bsdf_gltf_layered; docs/design.md, "The glTF material"). */
 #include "scene.h"
-
-material_ext material_ext_default(void) {
-    material_ext x = {0};
-    x.ior = 1.5f;
-    x.specular = 1.0f;
-    x.specular_color = v3s(1.0f);
-    x.specular_tex = x.specular_color_tex = x.sheen_color_tex = x.sheen_roughness_tex = x.clearcoat_tex =
-        x.clearcoat_roughness_tex = x.clearcoat_normal_tex = x.transmission_tex = (texture_slot){.texture = -1};
-    x.clearcoat_normal_scale = 1.0f;
-    x.attenuation_distance = INFINITY;
-    x.attenuation_color = v3s(1.0f);
-    return x;
-}
 
 /* The texture's value at the hit, or 1 in every channel without one. */
 static vec4 lookup_or_one(const scene *s, texture_slot slot, const surface_hit *h, int srgb) {
@@ -64,4 +51,69 @@ vec3 material_absorption(const material *m) {
 vec3 material_medium_after(const material *m, int backface, int lobe, vec3 sigma) {
     if (lobe != BSDF_TRANSMIT || !material_is_volume(m)) return sigma;
     return backface ? v3s(0.0f) : material_absorption(m);
+}
+
+/* ---- materials at hits --------------------------------------------------------------------- */
+
+/* Rotates the frame's tangent by angle about n (toward b for positive angles). */
+static void rotate_tangent(frame3 *f, float c, float sn) {
+    vec3 t = add3(scale3(f->t, c), scale3(f->b, sn));
+    vec3 b = sub3(scale3(f->b, c), scale3(f->t, sn));
+    f->t = t;
+    f->b = b;
+}
+
+bsdf material_bsdf(const scene *s, const surface_hit *h, frame3 *frame) {
+    const material *m = &s->materials[h->material];
+    *frame = h->shading;
+    vec3 tint = v3s(1.0f);
+    if (m->base_color_tex.texture >= 0) {
+        vec4 c = texture_lookup(s, m->base_color_tex, h->uv0, h->uv1, 1);
+        tint = v3(c.x, c.y, c.z);
+    }
+    switch (m->model) {
+    case MATERIAL_PHONG: return make_bsdf_phong(mul3(m->kd, tint), m->ks, m->exponent);
+    case MATERIAL_WARD:
+        if (m->anisotropy_rotation != 0.0f)
+            rotate_tangent(frame, cosf(m->anisotropy_rotation), sinf(m->anisotropy_rotation));
+        return make_bsdf_ward(mul3(m->kd, tint), m->ks, m->alpha_x, m->alpha_y);
+    case MATERIAL_GLTF:
+    default: {
+        float metallic = m->metallic, roughness = m->roughness;
+        if (m->metal_rough_tex.texture >= 0) {
+            vec4 mr = texture_lookup(s, m->metal_rough_tex, h->uv0, h->uv1, 0);
+            roughness *= mr.y;
+            metallic *= mr.z;
+        }
+        float aniso = m->anisotropy_strength;
+        if (aniso > 0.0f) {
+            float dx = 1.0f, dy = 0.0f;
+            if (m->anisotropy_tex.texture >= 0) {
+                vec4 a = texture_lookup(s, m->anisotropy_tex, h->uv0, h->uv1, 0);
+                dx = 2.0f * a.x - 1.0f;
+                dy = 2.0f * a.y - 1.0f;
+                aniso *= a.z;
+            }
+            float c = cosf(m->anisotropy_rotation), sn = sinf(m->anisotropy_rotation);
+            float rx = c * dx - sn * dy, ry = sn * dx + c * dy;
+            float len = sqrtf(rx * rx + ry * ry);
+            if (len > 1e-6f) rotate_tangent(frame, rx / len, ry / len);
+        }
+        gltf_layers layers = material_layers(s, m, h);
+        bsdf b = make_bsdf_gltf_layered(mul3(m->base_color, tint), metallic, roughness, aniso, &layers);
+        if (b.coat > 0.0f) b.coat_n = to_local(*frame, h->coat_n);
+        return b;
+    }
+    }
+}
+
+vec3 material_emission(const scene *s, const surface_hit *h) {
+    const material *m = &s->materials[h->material];
+    if (is_black3(m->emission) || (h->backface && !m->double_sided)) return v3(0, 0, 0);
+    vec3 e = m->emission;
+    if (m->emissive_tex.texture >= 0) {
+        vec4 c = texture_lookup(s, m->emissive_tex, h->uv0, h->uv1, 1);
+        e = mul3(e, v3(c.x, c.y, c.z));
+    }
+    return e;
 }

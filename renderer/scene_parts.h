@@ -1,11 +1,29 @@
 /* glint — the scene module's parts that live in files of their own, one idea each: tangent
  * generation (tangents.c), the shading frame at a hit (shading_frame.c), the ray-traced geometry
  * with its alpha filters (alpha.c), what emissive textures make lights (emissive.c) and material
- * variants (variants.c). scene.c and lights.c call these; the estimators never do. */
+ * variants (variants.c); the scene's private record (scene_box). scene.c, what is built from it
+ * (scene_make.c, lights.c) and the ray queries (scene_query.c) use these; the estimators never do. */
 #ifndef GLINT_SCENE_PARTS_H
 #define GLINT_SCENE_PARTS_H
 
 #include "scene.h"
+
+/* A scene as scene_create allocates it: the warning sink and the light edits beside the public
+ * struct (scene.c makes it, scene_make.c edits and frees it). */
+typedef struct {
+    scene_warn_fn fn;
+    void *user;
+} warn_sink;
+
+typedef struct {
+    scene s;
+    warn_sink warn;
+    /* Per light group, made on the first change of intensity: the multiplier and what it
+     * multiplies (the colour or emission as loaded), so gains are exact, never compounded. */
+    int num_gains;
+    float *gains;
+    vec3 *gain_bases;
+} scene_box;
 
 /* The uv set uv (s->uv0 or s->uv1) of triangle t at barycentrics (b1, b2). */
 static inline vec2 triangle_uv(const scene *s, const vec2 *uv, int t, float b1, float b2) {
@@ -81,7 +99,7 @@ float material_coverage(const scene *s, const surface_hit *h);
 float alpha_ray_hash(vec3 o, vec3 d, int tri);
 /* Whether shadow rays may pass material m's glass (then bsdf_pass_through decides at a hit). */
 int scene_material_passes_shadows(const scene *s, int m);
-/* The context of every occlusion query (scene.c): Embree hands the filters its first member.
+/* The context of every occlusion query (scene_query.c): Embree hands the filters its first member.
  * With record set, the glass a shadow ray may pass is recorded here (each triangle once, at most
  * SCENE_MAX_GLASS; more blocks the ray) instead of blocking it; without, glass blocks. */
 typedef struct {

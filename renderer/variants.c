@@ -1,7 +1,7 @@
 /* KHR_materials_variants (docs/design.md, "Material variants"): the scene's named variants and,
  * per mesh primitive, which material each variant gives it; per primitive instance, its run of
- * triangles. Switching a variant rewrites those triangles' materials and rebuilds what depends on
- * materials. */
+ * triangles. Switching a variant rewrites those triangles' materials; scene_make.c then builds
+ * again what depends on them. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -136,16 +136,4 @@ int scene_apply_variant(scene *s, int variant) {
     free(pick);
     v->current = variant;
     return 0;
-}
-
-int scene_select_variant(scene *s, const char *name, char *err, size_t errlen) {
-    int v = scene_variant_find(s, name);
-    if (v >= 0) return scene_set_variant(s, v, err, errlen);
-    int n = scene_num_variants(s);
-    int len = snprintf(err, errlen, "%s: no material variant '%s' (%s", s->path, name,
-                       n ? "the scene has: " : "the scene has none");
-    for (int i = 0; i < n && len >= 0 && (size_t)len < errlen; i++)
-        len += snprintf(err + len, errlen - (size_t)len, "%s'%s'", i ? ", " : "", s->variants->names[i]);
-    if (len >= 0 && (size_t)len < errlen) snprintf(err + len, errlen - (size_t)len, ")");
-    return -1;
 }
