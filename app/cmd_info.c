@@ -29,7 +29,7 @@ static void print_info_help(void) {
            "                       (its base colour or Phong/Ward kd; nothing else of the material):\n"
            "                       the same geometry for another renderer\n"
            "\n",
-           params_render_help(method_name(DEFAULT_METHOD)));
+           params_render_help("method max-depth", method_name(DEFAULT_METHOD)));
     cli_print_scenes();
 }
 

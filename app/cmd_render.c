@@ -63,7 +63,6 @@ static void print_render_help(void) {
            "  --move-light G,DX,DY,DZ  move light G (as glint info numbers them) by a world-space\n"
            "                       offset, as the viewer does; repeatable, moves add up\n"
            "  --light-gain G,X     light G's intensity times X (as the viewer's panel sets it)\n"
-           "  --seed S             random seed; runs with the same seed reproduce [0]\n"
            "  --threads N          render threads, 0 = one per core [0]\n"
            "  --out FILE.exr       float EXR: R,G,B plus direct.*, indirect.* layers, and in its\n"
            "                       header the scene hash, camera, size, spp, noise: a reference\n"
@@ -85,7 +84,8 @@ static void print_render_help(void) {
            "\n"
            "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
            "new file render.png (render-1.png, ... if taken).\n",
-           params_render_help(NULL), DEFAULT_SPP, DEFAULT_WIDTH, DEFAULT_HEIGHT, cli_vl_help());
+           params_render_help("method max-depth seed", NULL), DEFAULT_SPP, DEFAULT_WIDTH, DEFAULT_HEIGHT,
+           cli_vl_help());
 }
 
 /* Whether name ends in suffix, in either case. */
@@ -187,7 +187,6 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
         {.name = "--env-rotation", .kind = CLI_FLOAT, .out = &o->env_rotation_deg, .lo = -36000.0, .hi = 36000.0},
         {.name = "--camera", .kind = CLI_LONG, .out = &o->camera_index, .lo = 0, .hi = CLI_CAMERA_MAX},
-        {.name = "--seed", .kind = CLI_U64, .out = &p->seed},
         {.name = "--threads", .kind = CLI_INT, .out = &p->threads, .lo = 0, .hi = CLI_THREADS_MAX},
         {.name = "--out", .kind = CLI_TEXT, .out = &o->out_exr},
         {.name = "--png", .kind = CLI_TEXT, .out = &o->out_png},

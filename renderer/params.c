@@ -103,6 +103,9 @@ static const param_desc table[] = {
      .lo = 1, .hi = MAX_DEPTH_LIMIT, .def = DEFAULT_MAX_DEPTH, .value_name = "D",
      .help = "scattering events per path; 1 = direct light only", .label = "max depth",
      .unit = "scattering events per path", .panel_lo = 1, .panel_hi = 64, .panel_format = "%d"},
+    {.name = "seed", .type = PARAM_U64, .group = PARAM_RENDER, .offset = offsetof(render_params, seed), .lo = 0,
+     .hi = 18446744073709551615.0, .def = 0, .value_name = "S", .help = "random seed; runs with the same seed reproduce",
+     .label = "seed", .no_panel = 1},
     {.name = "vsl-count", .type = PARAM_INT, .offset = F(count), .lo = 1, .hi = 50000000,
      .bytes_each = VL_BYTES_PER_LIGHT, .def = VL_DEFAULT_COUNT,
      .value_name = "N", .help = "virtual lights traced per frame", .label = "lights/frame",
@@ -248,6 +251,11 @@ const param_desc *param_find(const char *name) {
 
 double param_get(const param_desc *d, const render_params *p) {
     const char *field = (const char *)p + d->offset;
+    if (d->type == PARAM_U64) {
+        uint64_t v;
+        memcpy(&v, field, sizeof v);
+        return (double)v;
+    }
     if (d->type == PARAM_FLOAT) {
         float v;
         memcpy(&v, field, sizeof v);
@@ -260,7 +268,10 @@ double param_get(const param_desc *d, const render_params *p) {
 
 void param_put(const param_desc *d, render_params *p, double v) {
     char *field = (char *)p + d->offset;
-    if (d->type == PARAM_FLOAT) {
+    if (d->type == PARAM_U64) {
+        uint64_t u = v > 0.0 ? (v < 18446744073709551615.0 ? (uint64_t)v : UINT64_MAX) : 0;
+        memcpy(field, &u, sizeof u);
+    } else if (d->type == PARAM_FLOAT) {
         float f = (float)v;
         memcpy(field, &f, sizeof f);
     } else {
@@ -297,6 +308,18 @@ int param_parse(const param_desc *d, const char *text, render_params *p, char *e
         return snprintf(err, errlen, "expected one of %s, got '%s'", words, text), -1;
     }
     if (d->off_word && strcmp(text, d->off_word) == 0) return param_put(d, p, -1.0), 0;
+    if (d->type == PARAM_U64) { /* all 64 bits: not through a double */
+        char *end = NULL;
+        errno = 0;
+        unsigned long long u = text[0] >= '0' && text[0] <= '9' ? strtoull(text, &end, 10) : 0;
+        if (!end || errno || *end != '\0')
+            return snprintf(err, errlen, "expected an integer in [0, %llu], got '%s'", (unsigned long long)UINT64_MAX,
+                            text),
+                   -1;
+        uint64_t v = (uint64_t)u;
+        memcpy((char *)p + d->offset, &v, sizeof v);
+        return 0;
+    }
     char *end = NULL;
     errno = 0;
     double v = d->type == PARAM_INT ? (double)strtoll(text, &end, 10) : strtod(text, &end);
@@ -343,7 +366,11 @@ int params_set(render_params *p, unsigned groups, const char *name, const char *
 
 void param_format(const param_desc *d, const render_params *p, char *out, size_t n) {
     double v = param_get(d, p);
-    if (d->type == PARAM_CHOICE) {
+    if (d->type == PARAM_U64) {
+        uint64_t u;
+        memcpy(&u, (const char *)p + d->offset, sizeof u);
+        snprintf(out, n, "%llu", (unsigned long long)u);
+    } else if (d->type == PARAM_CHOICE) {
         for (int c = 0; c < d->num_choices; c++)
             if (d->choices[c].value == (int)v) {
                 snprintf(out, n, "%s", d->choices[c].name ? d->choices[c].name : "default");
@@ -370,6 +397,8 @@ static size_t help_line(const param_desc *d, const char *def_given, char *text, 
         snprintf(def, sizeof def, "%d", (int)d->def);
     else if (d->type == PARAM_FLOAT)
         snprintf(def, sizeof def, "%g", d->def);
+    else if (d->type == PARAM_U64)
+        snprintf(def, sizeof def, "%.0f", d->def);
     else {
         render_params v = {0};
         param_put(d, &v, d->def);
@@ -389,11 +418,24 @@ static size_t help_line(const param_desc *d, const char *def_given, char *text, 
     return len < n ? len : n;
 }
 
-const char *params_render_help(const char *method_default) {
+/* Whether name is one of the space-separated words of list. */
+static int listed(const char *list, const char *name) {
+    size_t n = strlen(name);
+    for (const char *w = list; *w;) {
+        size_t k = strcspn(w, " ");
+        if (k == n && strncmp(w, name, n) == 0) return 1;
+        w += k;
+        w += strspn(w, " ");
+    }
+    return 0;
+}
+
+const char *params_render_help(const char *names, const char *method_default) {
     static char text[2048];
     size_t len = 0;
+    text[0] = '\0';
     for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++)
-        if (table[i].group == PARAM_RENDER)
+        if (table[i].group == PARAM_RENDER && listed(names, table[i].name))
             len += help_line(&table[i], table[i].offset == offsetof(render_params, method) ? method_default : NULL,
                              text + len, sizeof text - len);
     return text;

@@ -251,10 +251,10 @@ int vl_frame_per_pixel(const vl_params *vp, int clustering);
  * light tree and selection entries (1,000,000 lights: 559 MB at peak, 100,000: 70 MB). */
 #define VL_BYTES_PER_LIGHT 512.0
 
-typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE } param_type;
+typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE, PARAM_U64 } param_type;
 /* Which methods read a parameter: the panel shows it with them, the help groups by it. PARAM_RENDER:
- * every method (the method itself, the path depth), which each command's help lists with its own
- * options and default (params_render_help), not in params_help's sections. */
+ * every method (the method itself, the path depth, the seed), which each command's help lists with
+ * its own options and default (params_render_help), not in params_help's sections. */
 typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS, PARAM_RENDER } param_group;
 /* Masks of groups (1 << group) a front end takes. */
 #define PARAM_GROUPS_VL ((1u << PARAM_MANY_LIGHT) | (1u << PARAM_HIGHLIGHTS))
@@ -266,8 +266,8 @@ typedef struct {
     const char *label; /* the panel's */
 } param_choice;
 
-/* One parameter: an int or float field of render_params (a choice is an int field; the many-light
- * ones are in its vl). */
+/* One parameter: an int, float or uint64_t field of render_params (a choice is an int field; the
+ * many-light ones are in its vl). */
 typedef struct {
     const char *name; /* the option without "--", and the script's `set` name */
     param_type type;
@@ -291,6 +291,7 @@ typedef struct {
     int panel_log; /* a logarithmic slider */
     const char *panel_format;
     const char *panel_lo_text; /* shown at or below panel_lo (off, none, all) */
+    int no_panel;              /* the panel has no widget for it (the seed) */
 } param_desc;
 
 const param_desc *params_table(int *count);
@@ -307,15 +308,17 @@ int param_set_value(const param_desc *d, render_params *p, double v, const char 
 int params_set(render_params *p, unsigned groups, const char *name, const char *text, char *err, size_t errlen);
 /* The field's value as param_parse reads it back (a choice's name, the off word, a number). */
 void param_format(const param_desc *d, const render_params *p, char *out, size_t n);
-/* The field as a number (choices their value, off -1). */
+/* The field as a number (choices their value, off -1; a seed beyond 2^53 rounded: param_format
+ * gives it exactly). */
 double param_get(const param_desc *d, const render_params *p);
 void param_put(const param_desc *d, render_params *p, double v);
 /* The many-light options' help text, one section per group; the returned text is static. */
 const char *params_help(void);
-/* The options every method takes (PARAM_RENDER: the method, the path depth), as params_help words
- * its own, for a command's help, with method_default as the method's default (NULL: the table's);
- * the text is static until the next call. */
-const char *params_render_help(const char *method_default);
+/* The options every method takes (PARAM_RENDER) that a command takes, named in `names` (separated by
+ * spaces: "method max-depth seed"), as params_help words its own, for the command's help, with
+ * method_default as the method's default (NULL: the table's); the text is static until the next
+ * call. */
+const char *params_render_help(const char *names, const char *method_default);
 
 #ifdef __cplusplus
 }

@@ -22,6 +22,7 @@ static double example(const param_desc *d, char *text, size_t n) {
             }
         return snprintf(text, n, "?"), 0.0;
     }
+    if (d->type == PARAM_U64) return snprintf(text, n, "7"), 7.0;
     if (d->type == PARAM_INT) {
         int v = (int)d->lo != (int)d->def ? (int)d->lo : (int)d->lo + 1;
         snprintf(text, n, "%d", v);
@@ -93,7 +94,7 @@ static void test_entry(const param_desc *d, const char *help) {
     if (d->type == PARAM_CHOICE) {
         for (int k = 0; k < d->num_choices; k++)
             CHECK(d->choices[k].label != NULL, "%s: a choice without a label", d->name);
-    } else {
+    } else if (!d->no_panel) {
         CHECK(d->panel_lo < d->panel_hi && d->panel_format, "%s: no slider range", d->name);
         CHECK(d->panel_hi <= d->hi, "%s: the slider goes past the accepted range", d->name);
         CHECK(d->unit && d->unit[0], "%s: no unit for a sweep plot's axis", d->name);
@@ -127,6 +128,16 @@ static void test_table(void) {
     char err[64];
     CHECK(params_set(&v, PARAM_GROUPS_ALL, "no-such-parameter", "1", err, sizeof err) == 0,
           "an unknown name was taken");
+    /* a seed keeps all of its 64 bits, which a double would round */
+    char text[32];
+    CHECK(params_set(&v, PARAM_GROUPS_ALL, "seed", "18446744073709551615", err, sizeof err) == 1 &&
+              v.seed == UINT64_MAX && (param_format(param_find("seed"), &v, text, sizeof text), 1) &&
+              strcmp(text, "18446744073709551615") == 0,
+          "seed 2^64 - 1: stored %llu", (unsigned long long)v.seed);
+    CHECK(params_set(&v, PARAM_GROUPS_ALL, "seed", "-1", err, sizeof err) == -1 &&
+              params_set(&v, PARAM_GROUPS_ALL, "seed", "18446744073709551616", err, sizeof err) == -1 &&
+              v.seed == UINT64_MAX,
+          "seeds out of range taken");
 }
 
 /* A parameter whose memory grows with it is refused beyond PARAM_MAX_BYTES, at once and saying what
@@ -253,19 +264,27 @@ static void test_program(void) {
     }
     /* Each command's help lists the method and the path depth as the table words them, with its
      * own default (the viewer opens on vsl). */
-    const char *commands[] = {"render", "view", "info"};
+    const char *commands[] = {"render", "view", "info"},
+               *takes[] = {"method max-depth seed", "method max-depth seed", "method max-depth"};
     for (int k = 0; k < 3; k++) {
         char args[64];
         snprintf(args, sizeof args, "%s --help", commands[k]);
         CHECK(run(args) == 0, "glint %s: %s", args, err_text);
-        const char *lines = params_render_help(k > 0 ? method_name(DEFAULT_METHOD) : NULL);
+        const char *lines = params_render_help(takes[k], k > 0 ? method_name(DEFAULT_METHOD) : NULL);
         CHECK(strstr(out_text, lines) != NULL, "glint %s does not list these as:\n%s", args, lines);
         for (int i = 0; i < n; i++) {
             char option[80];
             snprintf(option, sizeof option, "  --%s ", t[i].name);
-            CHECK(t[i].group != PARAM_RENDER || strstr(lines, option), "the help's lines lack --%s", t[i].name);
+            CHECK(t[i].group != PARAM_RENDER || !strstr(takes[k], t[i].name) || strstr(lines, option),
+                  "the help's lines lack --%s", t[i].name);
         }
     }
+    /* the seed, all 64 bits of it, as glint render takes it */
+    CHECK(run("render --size 8x6 --spp 1 --quiet --png p.png --seed 18446744073709551615") == 0, "--seed 2^64 - 1: %s",
+          err_text);
+    CHECK(run("render --size 8x6 --spp 1 --quiet --png p.png --seed -1") == 2 &&
+              strstr(err_text, "glint: error: --seed: expected an integer"),
+          "--seed -1: %s", err_text);
 }
 
 int main(int argc, char **argv) {

@@ -239,7 +239,7 @@ static void param_widgets(param_group group, render_params *p) {
     const param_desc *table = params_table(&n);
     for (int i = 0; i < n; i++) {
         const param_desc *d = &table[i];
-        if (d->group != group) continue;
+        if (d->group != group || d->no_panel) continue;
         double v = param_get(d, p);
         if (d->type == PARAM_CHOICE) {
             const char *labels[8];

@@ -38,7 +38,6 @@ static void print_view_help(void) {
            "  --env FILE           environment map (.exr or .hdr)\n"
            "  --variant NAME       the scene's material variant NAME (the panel switches them)\n"
            "  --camera INDEX       start from the scene's camera INDEX\n"
-           "  --seed S             random seed [0]\n"
            "  --exposure STOPS     display exposure [0]\n"
            "  --tonemap NAME       display tone mapper: reinhard, clamp, exponential [reinhard]\n"
            "  --denoise on|off     filter the image shown while it is young, and sample it more\n"
@@ -52,7 +51,8 @@ static void print_view_help(void) {
            "%s"
            "\n"
            "keys and mouse (F1 in the window shows them):\n",
-           DEFAULT_WIDTH, DEFAULT_HEIGHT, params_render_help(method_name(DEFAULT_METHOD)), cli_vl_help());
+           DEFAULT_WIDTH, DEFAULT_HEIGHT, params_render_help("method max-depth seed", method_name(DEFAULT_METHOD)),
+           cli_vl_help());
     print_shortcuts(stdout);
 }
 
@@ -69,7 +69,6 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
         {.name = "--camera", .kind = CLI_INT, .out = &o->camera, .lo = 0, .hi = CLI_CAMERA_MAX},
-        {.name = "--seed", .kind = CLI_U64, .out = &o->params.seed},
         {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -30.0, .hi = 30.0},
         {.name = "--reference", .kind = CLI_TEXT, .out = &o->reference_path},
         {.name = "--script", .kind = CLI_TEXT, .out = &o->script_path},
