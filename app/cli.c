@@ -85,30 +85,10 @@ int cli_parse_plan(const char *option, const char *text, int *plan) {
 }
 
 int cli_parse_size(const char *option, const char *text, int *width, int *height) {
-    char *end = NULL;
-    errno = 0;
-    long w = strtol(text, &end, 10);
-    long h = 0;
-    int ok = !errno && end != text && (*end == 'x' || *end == 'X');
-    if (ok) {
-        const char *hs = end + 1;
-        h = strtol(hs, &end, 10);
-        ok = !errno && end != hs && *end == '\0';
-    }
-    if (!ok || w < 1 || h < 1 || w > 16384 || h > 16384) {
-        cli_error("%s: expected WIDTHxHEIGHT (1..16384 each), got '%s'", option, text);
-        return -1;
-    }
-    /* what the film and the per-pixel records take grows with the pixels: refused at once, as a
-     * many-light parameter's memory is (params.h) */
-    double bytes = (double)w * (double)h * CLI_PIXEL_BYTES, gib = 1024.0 * 1024.0 * 1024.0;
-    if (bytes > CLI_MAX_IMAGE_BYTES)
-        return cli_error("%s: %s would take %.1f GiB (%.0f bytes a pixel), over the limit of %.0f GiB", option, text,
-                         bytes / gib, CLI_PIXEL_BYTES, CLI_MAX_IMAGE_BYTES / gib),
-               -1;
-    *width = (int)w;
-    *height = (int)h;
-    return 0;
+    char err[256];
+    if (params_parse_size(text, width, height, err, sizeof err) == 0) return 0;
+    cli_error("%s: %s", option, err);
+    return -1;
 }
 
 int cli_scene_argument(const char *command, const char *arg, const char **scene_path) {

@@ -21,12 +21,7 @@ int cli_parse_u64(const char *option, const char *text, uint64_t *out);
 int cli_parse_float(const char *option, const char *text, double lo, double hi, double *out);
 /* "auto" or "full" (PLAN_AUTO, PLAN_FULL). */
 int cli_parse_plan(const char *option, const char *text, int *plan);
-/* A render's memory per pixel, measured (the film's sums and moments and the per-pixel records:
- * vsl at 2000x1000 122 bytes a pixel, pt 80), and the most an image may take: an 8K render
- * fits, 16384x16384 (32 GiB) does not. */
-#define CLI_PIXEL_BYTES 128.0
-#define CLI_MAX_IMAGE_BYTES (16.0 * 1024 * 1024 * 1024)
-/* "WxH", each 1..16384, within CLI_MAX_IMAGE_BYTES. */
+/* "WxH" as params_parse_size takes it (the memory rule included), its error reported as option's. */
 int cli_parse_size(const char *option, const char *text, int *width, int *height);
 
 /* An argument no option of `command` took: an unknown option (anything starting with '-'), else

@@ -105,7 +105,7 @@ void reference_params_text(const render_params *p, char *out, size_t n) {
     int count = 0;
     const param_desc *table = params_table(&count);
     for (int k = 0; k < count; k++) {
-        if (table[k].group == PARAM_RENDER) continue; /* the method and depth are fields of their own */
+        if (!(PARAM_GROUPS_VL >> table[k].group & 1u)) continue; /* the method, size...: fields of their own */
         char v[64];
         param_format(&table[k], &r, v, sizeof v);
         len += (size_t)snprintf(out + len, len < n ? n - len : 0, " %s=%s", table[k].name, v);

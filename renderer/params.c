@@ -75,6 +75,8 @@ int vl_frame_per_pixel(const vl_params *vp, int clustering) {
 #define STR(x) STR_(x)
 #define F(field) offsetof(render_params, vl.field)
 _Static_assert(sizeof(render_method) == sizeof(int), "a method is stored as a choice, an int");
+_Static_assert(offsetof(render_params, height) == offsetof(render_params, width) + sizeof(int),
+               "a size is two ints, width then height");
 
 /* One row per parameter reads better than one line per field. */
 /* clang-format off */
@@ -103,6 +105,10 @@ static const param_desc table[] = {
      .lo = 1, .hi = MAX_DEPTH_LIMIT, .def = DEFAULT_MAX_DEPTH, .value_name = "D",
      .help = "scattering events per path; 1 = direct light only", .label = "max depth",
      .unit = "scattering events per path", .panel_lo = 1, .panel_hi = 64, .panel_format = "%d"},
+    {.name = "size", .type = PARAM_SIZE, .group = PARAM_SETUP, .offset = offsetof(render_params, width), .lo = 1,
+     .hi = PARAM_MAX_SIDE, .def = DEFAULT_WIDTH * 65536.0 + DEFAULT_HEIGHT,
+     .def_text = STR(DEFAULT_WIDTH) "x" STR(DEFAULT_HEIGHT), .value_name = "WxH",
+     .help = "the image's size in pixels (the viewer opens its window at it)", .label = "size", .no_panel = 1},
     {.name = "seed", .type = PARAM_U64, .group = PARAM_RENDER, .offset = offsetof(render_params, seed), .lo = 0,
      .hi = 18446744073709551615.0, .def = 0, .value_name = "S", .help = "random seed; runs with the same seed reproduce",
      .label = "seed", .no_panel = 1},
@@ -256,6 +262,11 @@ double param_get(const param_desc *d, const render_params *p) {
         memcpy(&v, field, sizeof v);
         return (double)v;
     }
+    if (d->type == PARAM_SIZE) {
+        int wh[2];
+        memcpy(wh, field, sizeof wh);
+        return wh[0] * 65536.0 + wh[1];
+    }
     if (d->type == PARAM_FLOAT) {
         float v;
         memcpy(&v, field, sizeof v);
@@ -271,6 +282,9 @@ void param_put(const param_desc *d, render_params *p, double v) {
     if (d->type == PARAM_U64) {
         uint64_t u = v > 0.0 ? (v < 18446744073709551615.0 ? (uint64_t)v : UINT64_MAX) : 0;
         memcpy(field, &u, sizeof u);
+    } else if (d->type == PARAM_SIZE) {
+        int wh[2] = {(int)(v / 65536.0), (int)fmod(v, 65536.0)};
+        memcpy(field, wh, sizeof wh);
     } else if (d->type == PARAM_FLOAT) {
         float f = (float)v;
         memcpy(field, &f, sizeof f);
@@ -308,6 +322,10 @@ int param_parse(const param_desc *d, const char *text, render_params *p, char *e
         return snprintf(err, errlen, "expected one of %s, got '%s'", words, text), -1;
     }
     if (d->off_word && strcmp(text, d->off_word) == 0) return param_put(d, p, -1.0), 0;
+    if (d->type == PARAM_SIZE) {
+        int *wh = (int *)((char *)p + d->offset);
+        return params_parse_size(text, &wh[0], &wh[1], err, errlen);
+    }
     if (d->type == PARAM_U64) { /* all 64 bits: not through a double */
         char *end = NULL;
         errno = 0;
@@ -358,6 +376,30 @@ int param_set_value(const param_desc *d, render_params *p, double v, const char 
     return 0;
 }
 
+int params_parse_size(const char *text, int *width, int *height, char *err, size_t errlen) {
+    char *end = NULL;
+    errno = 0;
+    long w = strtol(text, &end, 10), h = 0;
+    int ok = !errno && end != text && (*end == 'x' || *end == 'X');
+    if (ok) {
+        const char *hs = end + 1;
+        h = strtol(hs, &end, 10);
+        ok = !errno && end != hs && *end == '\0';
+    }
+    if (!ok || w < 1 || h < 1 || w > PARAM_MAX_SIDE || h > PARAM_MAX_SIDE)
+        return snprintf(err, errlen, "expected WIDTHxHEIGHT (1..%d each), got '%s'", PARAM_MAX_SIDE, text), -1;
+    /* what the film and the per-pixel records take grows with the pixels: refused at once, as a
+     * many-light parameter's memory is */
+    double bytes = (double)w * (double)h * PARAM_PIXEL_BYTES, gib = 1024.0 * 1024.0 * 1024.0;
+    if (bytes > PARAM_MAX_IMAGE_BYTES)
+        return snprintf(err, errlen, "%s would take %.1f GiB (%.0f bytes a pixel), over the limit of %.0f GiB", text,
+                        bytes / gib, PARAM_PIXEL_BYTES, PARAM_MAX_IMAGE_BYTES / gib),
+               -1;
+    *width = (int)w;
+    *height = (int)h;
+    return 0;
+}
+
 int params_set(render_params *p, unsigned groups, const char *name, const char *text, char *err, size_t errlen) {
     const param_desc *d = param_find(name);
     if (!d || !(groups >> d->group & 1u)) return 0;
@@ -370,6 +412,10 @@ void param_format(const param_desc *d, const render_params *p, char *out, size_t
         uint64_t u;
         memcpy(&u, (const char *)p + d->offset, sizeof u);
         snprintf(out, n, "%llu", (unsigned long long)u);
+    } else if (d->type == PARAM_SIZE) {
+        int wh[2];
+        memcpy(wh, (const char *)p + d->offset, sizeof wh);
+        snprintf(out, n, "%dx%d", wh[0], wh[1]);
     } else if (d->type == PARAM_CHOICE) {
         for (int c = 0; c < d->num_choices; c++)
             if (d->choices[c].value == (int)v) {
@@ -435,7 +481,7 @@ const char *params_render_help(const char *names, const char *method_default) {
     size_t len = 0;
     text[0] = '\0';
     for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++)
-        if (table[i].group == PARAM_RENDER && listed(names, table[i].name))
+        if (!(PARAM_GROUPS_VL >> table[i].group & 1u) && listed(names, table[i].name))
             len += help_line(&table[i], table[i].offset == offsetof(render_params, method) ? method_default : NULL,
                              text + len, sizeof text - len);
     return text;
@@ -448,7 +494,7 @@ const char *params_help(void) {
     int group = -1;
     for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++) {
         const param_desc *d = &table[i];
-        if (d->group == PARAM_RENDER) continue; /* each command lists these with its own options */
+        if (!(PARAM_GROUPS_VL >> d->group & 1u)) continue; /* each command lists these with its own */
         if ((int)d->group != group) {
             group = (int)d->group;
             len += (size_t)snprintf(text + len, sizeof text - len, "%s", headings[group]);

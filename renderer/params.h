@@ -250,15 +250,27 @@ int vl_frame_per_pixel(const vl_params *vp, int clustering);
 /* What one virtual light takes over a frame, measured: the light, its k-nearest-neighbour tree,
  * light tree and selection entries (1,000,000 lights: 559 MB at peak, 100,000: 70 MB). */
 #define VL_BYTES_PER_LIGHT 512.0
+/* A render's memory per pixel, measured (the film's sums and moments and the per-pixel records:
+ * vsl at 2000x1000 122 bytes a pixel, pt 80), and the most an image may take: an 8K render
+ * fits, 16384x16384 (32 GiB) does not. */
+#define PARAM_PIXEL_BYTES 128.0
+#define PARAM_MAX_IMAGE_BYTES (16.0 * 1024 * 1024 * 1024)
+#define PARAM_MAX_SIDE 16384
+/* "WxH", each 1..PARAM_MAX_SIDE, within PARAM_MAX_IMAGE_BYTES: 0, or -1 with err set and the size
+ * unchanged. */
+int params_parse_size(const char *text, int *width, int *height, char *err, size_t errlen);
 
-typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE, PARAM_U64 } param_type;
+typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE, PARAM_U64, PARAM_SIZE } param_type;
 /* Which methods read a parameter: the panel shows it with them, the help groups by it. PARAM_RENDER:
  * every method (the method itself, the path depth, the seed), which each command's help lists with
- * its own options and default (params_render_help), not in params_help's sections. */
-typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS, PARAM_RENDER } param_group;
-/* Masks of groups (1 << group) a front end takes. */
+ * its own options and default (params_render_help), not in params_help's sections; PARAM_SETUP the
+ * same, but given when a render is set up, never changed while it runs (the image's size). */
+typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS, PARAM_RENDER, PARAM_SETUP } param_group;
+/* Masks of groups (1 << group) a front end takes: the many-light ones, those a running render
+ * takes (the viewer's script and panel), all (a command line). */
 #define PARAM_GROUPS_VL ((1u << PARAM_MANY_LIGHT) | (1u << PARAM_HIGHLIGHTS))
-#define PARAM_GROUPS_ALL (PARAM_GROUPS_VL | (1u << PARAM_RENDER))
+#define PARAM_GROUPS_LIVE (PARAM_GROUPS_VL | (1u << PARAM_RENDER))
+#define PARAM_GROUPS_ALL (PARAM_GROUPS_LIVE | (1u << PARAM_SETUP))
 
 typedef struct {
     const char *name; /* the word on the command line and in scripts; NULL: the panel's only */
@@ -267,7 +279,7 @@ typedef struct {
 } param_choice;
 
 /* One parameter: an int, float or uint64_t field of render_params (a choice is an int field; the
- * many-light ones are in its vl). */
+ * many-light ones are in its vl), or a size (two ints, width then height). */
 typedef struct {
     const char *name; /* the option without "--", and the script's `set` name */
     param_type type;
@@ -309,7 +321,7 @@ int params_set(render_params *p, unsigned groups, const char *name, const char *
 /* The field's value as param_parse reads it back (a choice's name, the off word, a number). */
 void param_format(const param_desc *d, const render_params *p, char *out, size_t n);
 /* The field as a number (choices their value, off -1; a seed beyond 2^53 rounded: param_format
- * gives it exactly). */
+ * gives it exactly; a size as width x 65536 + height). */
 double param_get(const param_desc *d, const render_params *p);
 void param_put(const param_desc *d, render_params *p, double v);
 /* The many-light options' help text, one section per group; the returned text is static. */

@@ -23,6 +23,7 @@ static double example(const param_desc *d, char *text, size_t n) {
         return snprintf(text, n, "?"), 0.0;
     }
     if (d->type == PARAM_U64) return snprintf(text, n, "7"), 7.0;
+    if (d->type == PARAM_SIZE) return snprintf(text, n, "32x18"), 32.0 * 65536.0 + 18.0;
     if (d->type == PARAM_INT) {
         int v = (int)d->lo != (int)d->def ? (int)d->lo : (int)d->lo + 1;
         snprintf(text, n, "%d", v);
@@ -60,11 +61,10 @@ static void test_entry(const param_desc *d, const char *help) {
         CHECK(param_get(d, &c) == 1.0, "%s alone is not on", option);
     else
         CHECK(memcmp(&a, &c, sizeof a) == 0, "cli_param_option %s %s differs from set", option, text);
-    /* the many-light sections list their own; each command lists the method and depth (test_program) */
-    CHECK((strstr(help, option) != NULL) == (d->group != PARAM_RENDER),
-          "the help does not list %s (or lists it "
-          "among the many-light options)",
-          option);
+    /* the many-light sections list their own; each command lists the method, depth... (test_program) */
+    int many_light = (PARAM_GROUPS_VL >> d->group & 1u) != 0;
+    CHECK((strstr(help, option) != NULL) == many_light,
+          "the help does not list %s (or lists it among the many-light options)", option);
 
     /* A bad value is refused with a message and changes nothing; the off word is -1. */
     render_params bad = a;
@@ -115,7 +115,8 @@ static void test_table(void) {
                   t[i].name, t[j].name);
         size_t vl_at = offsetof(render_params, vl);
         int in_vl = t[i].offset >= vl_at && t[i].offset < vl_at + sizeof(vl_params);
-        CHECK(in_vl == (t[i].group != PARAM_RENDER), "%s: a field outside its group's struct", t[i].name);
+        CHECK(in_vl == ((PARAM_GROUPS_VL >> t[i].group & 1u) != 0), "%s: a field outside its group's struct",
+              t[i].name);
         if (in_vl) covered += t[i].type == PARAM_FLOAT ? sizeof(float) : sizeof(int);
     }
     /* A vl_params field without an entry would be out of reach of every front end. */
@@ -265,7 +266,7 @@ static void test_program(void) {
     /* Each command's help lists the method and the path depth as the table words them, with its
      * own default (the viewer opens on vsl). */
     const char *commands[] = {"render", "view", "info"},
-               *takes[] = {"method max-depth seed", "method max-depth seed", "method max-depth"};
+               *takes[] = {"method max-depth seed size", "size method max-depth seed", "method max-depth"};
     for (int k = 0; k < 3; k++) {
         char args[64];
         snprintf(args, sizeof args, "%s --help", commands[k]);
@@ -275,7 +276,7 @@ static void test_program(void) {
         for (int i = 0; i < n; i++) {
             char option[80];
             snprintf(option, sizeof option, "  --%s ", t[i].name);
-            CHECK(t[i].group != PARAM_RENDER || !strstr(takes[k], t[i].name) || strstr(lines, option),
+            CHECK((PARAM_GROUPS_VL >> t[i].group & 1u) || !strstr(takes[k], t[i].name) || strstr(lines, option),
                   "the help's lines lack --%s", t[i].name);
         }
     }

@@ -32,7 +32,6 @@ static void print_view_help(void) {
            "default: the default built-in scene).\n"
            "\n"
            "options:\n"
-           "  --size WxH           window and render size [%dx%d]\n"
            "%s"
            "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
@@ -51,8 +50,7 @@ static void print_view_help(void) {
            "%s"
            "\n"
            "keys and mouse (F1 in the window shows them):\n",
-           DEFAULT_WIDTH, DEFAULT_HEIGHT, params_render_help("method max-depth seed", method_name(DEFAULT_METHOD)),
-           cli_vl_help());
+           params_render_help("size method max-depth seed", method_name(DEFAULT_METHOD)), cli_vl_help());
     print_shortcuts(stdout);
 }
 
@@ -64,7 +62,6 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     o->params.max_depth = DEFAULT_MAX_DEPTH;
     o->params.method = DEFAULT_METHOD;
     const cli_opt opts[] = {
-        {.name = "--size", .kind = CLI_SIZE, .out = &o->width, .out2 = &o->height},
         {.name = "--plan", .kind = CLI_PLAN, .out = &o->params.plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
@@ -98,6 +95,9 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
             return -1;
         }
     }
+    /* the window's size; the render's follows the window, whatever it becomes */
+    if (o->params.width > 0) o->width = o->params.width, o->height = o->params.height;
+    o->params.width = o->params.height = 0;
     return 0;
 }
 

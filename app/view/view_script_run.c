@@ -56,6 +56,7 @@ static void print_stats(ui_thread *u) {
     int nparams;
     const param_desc *table = params_table(&nparams);
     for (int i = 0; i < nparams; i++) {
+        if (!(PARAM_GROUPS_LIVE >> table[i].group & 1u)) continue; /* the size: width= and height= above */
         char name[64], value[64];
         snprintf(name, sizeof name, "%s", table[i].name);
         for (char *c = name; *c; c++) *c = *c == '-' ? '_' : *c;
@@ -78,7 +79,10 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     char why[256];
     int limit = panel_set(u, name, value, err, errlen); /* spp, time */
     if (limit <= 0) return limit;
-    int applied = params_set(&u->ctl.params, PARAM_GROUPS_ALL, name, value, why, sizeof why);
+    const param_desc *setup = param_find(name);
+    if (setup && !(PARAM_GROUPS_LIVE >> setup->group & 1u))
+        return snprintf(err, errlen, "%s: given when the viewer opens (--%s)", name, name), -1;
+    int applied = params_set(&u->ctl.params, PARAM_GROUPS_LIVE, name, value, why, sizeof why);
     if (applied < 0) return snprintf(err, errlen, "%s: %s", name, why), -1;
     if (applied > 0) return 0;
     if (strcmp(name, "exposure") == 0) {
