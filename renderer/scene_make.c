@@ -95,6 +95,9 @@ int scene_finalize(scene *s, char *err, size_t errlen) {
     if (!scene_variants_emit(s)) warn_if_unlit(s);
     return 0;
 }
+
+/* ---- light edits and variants: the data changed, what depends on it built again ----------- */
+
 /* Group g, or -1 with err set. */
 static int find_group(const scene *s, int g, light_group *out, char *err, size_t errlen) {
     int n = scene_light_groups(s, NULL, 0);

@@ -4,8 +4,6 @@
 
 #include "scene_parts.h"
 
-/* ---- ray queries --------------------------------------------------------------------------- */
-
 static void init_ray(struct RTCRay *r, vec3 o, vec3 d, float tmax) {
     r->org_x = o.x;
     r->org_y = o.y;
