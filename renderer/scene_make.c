@@ -206,6 +206,7 @@ int scene_set_variant(scene *s, int v, char *err, size_t errlen) {
     warn_if_unlit(s);
     return 0;
 }
+
 int scene_select_variant(scene *s, const char *name, char *err, size_t errlen) {
     int v = scene_variant_find(s, name);
     if (v >= 0) return scene_set_variant(s, v, err, errlen);
