@@ -21,7 +21,6 @@ static void print_info_help(void) {
            "\n"
            "options (default in brackets):\n"
            "%s"
-           "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
            "  --env FILE           environment map, equirectangular .exr or .hdr [none]\n"
            "  --variant NAME       the scene's material variant NAME [the file's default materials]\n"
            "  --obj FILE.obj       the triangles as loaded (world space, with normals) as Wavefront\n"
@@ -29,7 +28,7 @@ static void print_info_help(void) {
            "                       (its base colour or Phong/Ward kd; nothing else of the material):\n"
            "                       the same geometry for another renderer\n"
            "\n",
-           params_render_help("method max-depth", method_name(DEFAULT_METHOD)));
+           params_render_help("method max-depth plan", method_name(DEFAULT_METHOD)));
     cli_print_scenes();
 }
 
@@ -82,11 +81,10 @@ static int write_obj(const scene *s, const char *obj_path) {
 int cmd_info(int argc, char **argv) {
     const char *path = NULL, *env = NULL, *obj = NULL, *variant = NULL;
     render_params p = {.method = DEFAULT_METHOD, .max_depth = DEFAULT_MAX_DEPTH};
-    int plan_mode = PLAN_AUTO;
     const cli_opt opts[] = {
         {.name = "--env", .kind = CLI_TEXT, .out = &env},   {.name = "--variant", .kind = CLI_TEXT, .out = &variant},
         {.name = "--method", .kind = CLI_PARAM, .out = &p}, {.name = "--max-depth", .kind = CLI_PARAM, .out = &p},
-        {.name = "--obj", .kind = CLI_TEXT, .out = &obj},   {.name = "--plan", .kind = CLI_PLAN, .out = &plan_mode},
+        {.name = "--obj", .kind = CLI_TEXT, .out = &obj},   {.name = "--plan", .kind = CLI_PARAM, .out = &p},
     };
     for (int i = 0; i < argc; i++) {
         int r;
@@ -162,7 +160,7 @@ int cmd_info(int argc, char **argv) {
         scene_destroy(s);
         return EXIT_FAILURE_;
     }
-    effect_plan plan = plan_make(&a, p.method, p.max_depth, plan_mode);
+    effect_plan plan = plan_make(&a, p.method, p.max_depth, p.plan);
     printf("method:     %s\n", method_name(p.method));
     plan_print(stdout, s, &a, &plan);
     scene_analysis_free(&a);

@@ -50,8 +50,6 @@ static void print_render_help(void) {
            "%s"
            "  --spp N              samples per pixel (frames) [%d]\n"
            "  --time SECONDS       render until this much time has passed instead of --spp\n"
-           "  --plan auto|full     auto: only the passes the scene calls for (glint info shows\n"
-           "                       them); full: every pass, for comparison [auto]\n"
            "  --env FILE           environment map, equirectangular .exr or .hdr [none]\n"
            "  --env-rotation DEG   rotate the environment about +Y [0]\n"
            "  --variant NAME       the scene's material variant NAME (KHR_materials_variants;\n"
@@ -83,7 +81,7 @@ static void print_render_help(void) {
            "\n"
            "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
            "new file render.png (render-1.png, ... if taken).\n",
-           params_render_help("method max-depth seed size", NULL), DEFAULT_SPP, cli_vl_help());
+           params_render_help("method max-depth seed size plan", NULL), DEFAULT_SPP, cli_vl_help());
 }
 
 /* Whether name ends in suffix, in either case. */
@@ -179,7 +177,6 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--highlights-layer", .kind = CLI_FLAG, .out = &p->pt_highlights},
         {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000, .given = &spp_given},
         {.name = "--time", .kind = CLI_FLOAT, .out = &o->seconds, .lo = 1e-3, .hi = 1e7, .given = &time_given},
-        {.name = "--plan", .kind = CLI_PLAN, .out = &p->plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
         {.name = "--env-rotation", .kind = CLI_FLOAT, .out = &o->env_rotation_deg, .lo = -36000.0, .hi = 36000.0},

@@ -82,6 +82,7 @@ _Static_assert(offsetof(render_params, height) == offsetof(render_params, width)
 /* clang-format off */
 static const param_choice methods[METHOD_COUNT] = {{"pt", METHOD_PT, "pt"}, {"vpl", METHOD_VPL, "vpl"},
                                                   {"vsl", METHOD_VSL, "vsl"}, {"vsl+hl", METHOD_VSL_HL, "vsl+hl"}};
+static const param_choice plans[] = {{"auto", PLAN_AUTO, "auto"}, {"full", PLAN_FULL, "full"}};
 static const param_choice on_off[] = {{"on", 1, "on"}, {"off", 0, "off"}};
 static const param_choice clamps[] = {{NULL, VL_CLAMP_DEFAULT, "method default"}, {"on", VL_CLAMP_ON, "on"},
                                       {"off", VL_CLAMP_OFF, "off"}};
@@ -105,6 +106,11 @@ static const param_desc table[] = {
      .lo = 1, .hi = MAX_DEPTH_LIMIT, .def = DEFAULT_MAX_DEPTH, .value_name = "D",
      .help = "scattering events per path; 1 = direct light only", .label = "max depth",
      .unit = "scattering events per path", .panel_lo = 1, .panel_hi = 64, .panel_format = "%d"},
+    {.name = "plan", .type = PARAM_CHOICE, .group = PARAM_RENDER, .offset = offsetof(render_params, plan),
+     .choices = plans, .num_choices = 2, .def = PLAN_AUTO,
+     .help = "auto: only the passes the scene calls for (glint info shows\n"
+             "them); full: every pass, for comparison",
+     .label = "effect plan"},
     {.name = "size", .type = PARAM_SIZE, .group = PARAM_SETUP, .offset = offsetof(render_params, width), .lo = 1,
      .hi = PARAM_MAX_SIDE, .def = DEFAULT_WIDTH * 65536.0 + DEFAULT_HEIGHT,
      .def_text = STR(DEFAULT_WIDTH) "x" STR(DEFAULT_HEIGHT), .value_name = "WxH",

@@ -156,6 +156,9 @@ static inline uint64_t shard_frame_index(long long total, int index, int count, 
     return (k / b) * n * b + i * b + k % b;
 }
 
+/* The effect plan's modes (render_params.plan; plan.h makes the plan). */
+enum { PLAN_AUTO = 0, PLAN_FULL };
+
 /* Zero means default for every field. */
 typedef struct {
     int width, height; /* 0: DEFAULT_WIDTH x DEFAULT_HEIGHT */
@@ -164,7 +167,7 @@ typedef struct {
     uint64_t seed;
     int threads;       /* 0: one per core */
     int pt_highlights; /* pt: camera - glossy - glossy - light paths in their own component */
-    int plan;          /* PLAN_AUTO: only the passes the scene calls for; PLAN_FULL: all */
+    int plan;          /* PLAN_AUTO: only the passes the scene calls for; PLAN_FULL: all (plan.h) */
     unsigned only;     /* many-light methods: render only these film components (a mask of
                         * 1 << COMP_*), skipping the others' passes, to time one estimator alone;
                         * the path tracer renders whole paths regardless; 0: all */

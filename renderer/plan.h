@@ -54,8 +54,6 @@ int scene_analyse(const scene *s, scene_analysis *a, char *err, size_t errlen);
 int scene_analyse_within(const scene *s, scene_analysis *a, double seconds, char *err, size_t errlen);
 void scene_analysis_free(scene_analysis *a);
 
-enum { PLAN_AUTO = 0, PLAN_FULL };
-
 /* The passes of one session. */
 typedef struct {
     int full;               /* PLAN_FULL: every pass on */

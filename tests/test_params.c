@@ -266,7 +266,8 @@ static void test_program(void) {
     /* Each command's help lists the method and the path depth as the table words them, with its
      * own default (the viewer opens on vsl). */
     const char *commands[] = {"render", "view", "info"},
-               *takes[] = {"method max-depth seed size", "size method max-depth seed", "method max-depth"};
+               *takes[] = {"method max-depth seed size plan", "size method max-depth seed plan",
+                           "method max-depth plan"};
     for (int k = 0; k < 3; k++) {
         char args[64];
         snprintf(args, sizeof args, "%s --help", commands[k]);

@@ -33,7 +33,6 @@ static void print_view_help(void) {
            "\n"
            "options:\n"
            "%s"
-           "  --plan auto|full     auto: only the passes the scene calls for; full: every pass [auto]\n"
            "  --env FILE           environment map (.exr or .hdr)\n"
            "  --variant NAME       the scene's material variant NAME (the panel switches them)\n"
            "  --camera INDEX       start from the scene's camera INDEX\n"
@@ -50,7 +49,7 @@ static void print_view_help(void) {
            "%s"
            "\n"
            "keys and mouse (F1 in the window shows them):\n",
-           params_render_help("size method max-depth seed", method_name(DEFAULT_METHOD)), cli_vl_help());
+           params_render_help("size method max-depth seed plan", method_name(DEFAULT_METHOD)), cli_vl_help());
     print_shortcuts(stdout);
 }
 
@@ -62,7 +61,6 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     o->params.max_depth = DEFAULT_MAX_DEPTH;
     o->params.method = DEFAULT_METHOD;
     const cli_opt opts[] = {
-        {.name = "--plan", .kind = CLI_PLAN, .out = &o->params.plan},
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
         {.name = "--camera", .kind = CLI_INT, .out = &o->camera, .lo = 0, .hi = CLI_CAMERA_MAX},
