@@ -412,6 +412,16 @@ int params_set(render_params *p, unsigned groups, const char *name, const char *
     return param_parse(d, text, p, err, errlen) == 0 ? 1 : -1;
 }
 
+int params_differ(const render_params *a, const render_params *b, unsigned groups) {
+    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++) {
+        const param_desc *d = &table[i];
+        size_t size = d->type == PARAM_U64 || d->type == PARAM_SIZE ? 8 : 4; /* two ints, or one of 64 bits */
+        if (groups >> d->group & 1u && memcmp((const char *)a + d->offset, (const char *)b + d->offset, size) != 0)
+            return 1;
+    }
+    return 0;
+}
+
 void param_format(const param_desc *d, const render_params *p, char *out, size_t n) {
     double v = param_get(d, p);
     if (d->type == PARAM_U64) {

@@ -321,6 +321,9 @@ int param_set_value(const param_desc *d, render_params *p, double v, const char 
 /* Like param_parse by name, of the groups in mask (PARAM_GROUPS_*): 1 applied, 0 no such
  * parameter, -1 a bad value (err set). */
 int params_set(render_params *p, unsigned groups, const char *name, const char *text, char *err, size_t errlen);
+/* Whether a and b differ in an entry of the groups in mask (PARAM_GROUPS_*): what a viewer sends
+ * the renderer again, whichever entry of the table changed. */
+int params_differ(const render_params *a, const render_params *b, unsigned groups);
 /* The field's value as param_parse reads it back (a choice's name, the off word, a number). */
 void param_format(const param_desc *d, const render_params *p, char *out, size_t n);
 /* The field as a number (choices their value, off -1; a seed beyond 2^53 rounded: param_format

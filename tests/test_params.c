@@ -47,6 +47,10 @@ static void test_entry(const param_desc *d, const char *help) {
     render_params other = a;
     param_put(d, &other, 0.0);
     CHECK(memcmp(&other, &zero, sizeof zero) == 0, "set %s changed another field", d->name);
+    /* what a viewer sends again: a change of this entry, seen in its group and no other */
+    unsigned mine = 1u << d->group;
+    CHECK(params_differ(&a, &zero, mine) && !params_differ(&a, &zero, PARAM_GROUPS_ALL & ~mine),
+          "params_differ misses set %s %s, or sees it in another group", d->name, text);
     CHECK(cli_set_param(d->name, text, &b, all) == 1 && memcmp(&a, &b, sizeof a) == 0, "--%s %s", d->name, text);
     /* a command that does not take the entry's group (bench's methods and depth are its own) */
     unsigned others = all & ~(1u << d->group);

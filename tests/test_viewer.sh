@@ -72,6 +72,28 @@ grep -q 'broken.gltf' err.txt || fail "the bad scene file's error was not report
 head -c 2000 image.exr | grep -q 'direct.R' || fail "EXR export lacks the direct layer"
 ls | grep -q '\.tmp' && fail "temporary files left behind: $(ls)"
 
+# The effect plan and the seed are settings of the render too: each change restarts the
+# accumulation (the panel's and the script's through the parameter table).
+cat >plan.txt <<'EOF'
+wait 1
+stats
+set plan full
+wait 1
+stats
+set seed 7
+wait 1
+stats
+quit
+EOF
+view --size 48x27 --script plan.txt
+rc=$?
+[ $rc -eq 0 ] || fail "plan and seed session exited $rc: $(cat err.txt)"
+grep '^stats ' out.txt >stats.txt
+[ "$(field 2 plan)" = "full" ] && [ "$(field 2 resets)" -gt "$(field 1 resets)" ] ||
+  fail "set plan full did not restart the accumulation: $(sed -n 2p stats.txt)"
+[ "$(field 3 seed)" = "7" ] && [ "$(field 3 resets)" -gt "$(field 2 resets)" ] ||
+  fail "set seed 7 did not restart the accumulation: $(sed -n 3p stats.txt)"
+
 # The many-light parameters change live: each change resets the accumulation and shows in the
 # stats; a bad value is reported with its line and leaves the last good value. Then the same for
 # vsl+hl's highlight parameters, whose component the display can show alone and the export holds.

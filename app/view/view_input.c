@@ -25,8 +25,7 @@ static unsigned show_mask_of(int show) {
  * accumulation; display settings only change how the image is shown. */
 void apply_controls(ui_thread *u, int camera_changed) {
     const render_params *p = &u->ctl.params, *was = &u->applied_ctl.params;
-    int estimator_changed =
-        p->method != was->method || p->max_depth != was->max_depth || memcmp(&p->vl, &was->vl, sizeof p->vl) != 0;
+    int estimator_changed = params_differ(p, was, PARAM_GROUPS_LIVE); /* any entry of the table a viewer takes */
     /* the panel compares the new settings' cost with the last ones' (once a full frame measured it) */
     if (estimator_changed && u->stats.frames_generation >= u->cost_generation)
         u->cost_before_ms = u->stats.full_frame_ms;
