@@ -61,12 +61,12 @@ typedef struct {
  * them, -1 a bad or missing value (reported). */
 int cli_table_option(int argc, char **argv, int *i, const cli_opt *opts, int n);
 
-/* The render parameters (params_table: the method, the path depth, the many-light ones), shared by
- * glint render, info, bench, the viewer's options and its script's `set`; each command takes those
- * of the groups in `groups` (PARAM_GROUPS_*). cli_set_param takes a name without the leading "--"
- * and a value (a flag such as vpl-glossy: on/off). Returns 1 when applied, 0 when name is not one
- * of them, -1 on a bad value (reported). cli_param_option does the same for argv[*i] and its value
- * (none for a flag), advancing *i. */
+/* The render parameters (params_table: the method, the path depth, the plan, the seed, the size, the
+ * many-light ones), shared by glint render, info, bench, the viewer's options and its script's
+ * `set`; each command takes those of the groups in `groups` (PARAM_GROUPS_*). cli_set_param takes
+ * a name without the leading "--" and a value (a flag such as vpl-glossy: on/off). Returns 1 when
+ * applied, 0 when name is not one of them, -1 on a bad value (reported). cli_param_option does the
+ * same for argv[*i] and its value (none for a flag), advancing *i. */
 int cli_set_param(const char *name, const char *value, render_params *p, unsigned groups);
 int cli_param_option(int argc, char **argv, int *i, render_params *p, unsigned groups);
 /* The many-light options' help text, one option per line (params_help). */
