@@ -266,8 +266,8 @@ static void append_base(bench_options *o, const char *a, const char *v) {
     snprintf(o->base_text + len, sizeof o->base_text - len, "%s%s%s%s", len ? " " : "", a, v ? " " : "", v ? v : "");
 }
 
-/* A many-light option of the table into vl (cli_param_option); the methods and the depth are
- * bench's own options (--methods, --max-depth). */
+/* A many-light option of the table into vl (cli_param_option); the methods, depth, size, seed and
+ * plan are bench's own options (--methods, its runs' reference depth and size, --seed S --seeds N). */
 static int vl_option(int argc, char **argv, int *i, vl_params *vl) {
     render_params p = {.vl = *vl};
     int r = cli_param_option(argc, argv, i, &p, PARAM_GROUPS_VL);
