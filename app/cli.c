@@ -222,7 +222,13 @@ int cli_param_option(int argc, char **argv, int *i, render_params *p, unsigned g
     if (strncmp(a, "--", 2) != 0) return 0;
     const param_desc *d = param_find(a + 2);
     if (!d || !(groups >> d->group & 1u)) return 0;
-    if (d->flag) return cli_set_param(d->name, "on", p, groups);
+    if (d->flag) { /* alone it is on; a choice of its own may follow (--denoise off) */
+        const char *next = *i + 1 < argc ? argv[*i + 1] : NULL;
+        for (int c = 0; next && c < d->num_choices; c++)
+            if (d->choices[c].name && strcmp(next, d->choices[c].name) == 0)
+                return cli_set_param(d->name, argv[++*i], p, groups);
+        return cli_set_param(d->name, "on", p, groups);
+    }
     const char *v = cli_value(argc, argv, i);
     if (!v) return -1;
     return cli_set_param(d->name, v, p, groups);

@@ -28,7 +28,7 @@ static void print_info_help(void) {
            "                       (its base colour or Phong/Ward kd; nothing else of the material):\n"
            "                       the same geometry for another renderer\n"
            "\n",
-           params_render_help("method max-depth plan", method_name(DEFAULT_METHOD)));
+           params_render_help("method max-depth plan", "method=" DEFAULT_METHOD_NAME));
     cli_print_scenes();
 }
 

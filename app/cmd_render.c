@@ -33,9 +33,7 @@ typedef struct {
     const char *out_exr, *out_png, *out_stats;
     const char *shard;   /* --shard I/N as given; its numbers are in params */
     long long spp_total; /* a shard's: the whole render's --spp (spp is the shard's share) */
-    double exposure;
     int quiet;
-    int denoise; /* --denoise: the display's filtered image as an extra layer */
 } render_options;
 
 #define DEFAULT_SPP 64
@@ -67,21 +65,17 @@ static void print_render_help(void) {
            "  --shard I/N          render shard I (from 0) of N: its share of the frames of the\n"
            "                       render --spp asks for, in a row, with the moments glint merge\n"
            "                       needs, to --out\n"
-           "  --denoise            also the image the viewer would show, filtered (denoise.h), as the\n"
-           "                       EXR's layer denoised.*: a view of the estimate, never in its place\n"
            "  --highlights-layer   camera-glossy-glossy-light paths (the highlight estimator's share)\n"
            "                       go to their own highlights.* layer, not indirect.*: pt, vsl+hl\n"
-           "  --png FILE.png       tone-mapped 8-bit sRGB PNG (Reinhard global operator) [none]\n"
-           "  --exposure EV        exposure for the PNG, in stops [0]\n"
+           "  --png FILE.png       tone-mapped 8-bit sRGB PNG (--tonemap, --exposure) [none]\n"
            "  --stats FILE.json    statistics: frames, spp, seconds, rays by kind, rejected samples [none]\n"
            "  --quiet              no progress line\n"
-           "  --help               this text\n"
-           "\n"
-           "%s"
-           "\n"
-           "Named outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
+           "  --help               this text\n",
+           params_render_help("method max-depth seed size plan", NULL), DEFAULT_SPP);
+    /* the look's entries after the outputs they shape (the help's text is the table's, static) */
+    printf("%s\n%s\nNamed outputs are replaced atomically. Without --out, --png or --stats, the PNG goes to a\n"
            "new file render.png (render-1.png, ... if taken).\n",
-           params_render_help("method max-depth seed size plan", NULL), DEFAULT_SPP, cli_vl_help());
+           params_render_help("exposure tonemap denoise", NULL), cli_vl_help());
 }
 
 /* Whether name ends in suffix, in either case. */
@@ -173,7 +167,6 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
     render_params *p = &o->params;
     const cli_opt opts[] = {
         {.name = "--quiet", .kind = CLI_FLAG, .out = &o->quiet},
-        {.name = "--denoise", .kind = CLI_FLAG, .out = &o->denoise},
         {.name = "--highlights-layer", .kind = CLI_FLAG, .out = &p->pt_highlights},
         {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000, .given = &spp_given},
         {.name = "--time", .kind = CLI_FLOAT, .out = &o->seconds, .lo = 1e-3, .hi = 1e7, .given = &time_given},
@@ -185,7 +178,6 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         {.name = "--out", .kind = CLI_TEXT, .out = &o->out_exr},
         {.name = "--png", .kind = CLI_TEXT, .out = &o->out_png},
         {.name = "--stats", .kind = CLI_TEXT, .out = &o->out_stats},
-        {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -50.0, .hi = 50.0},
         {.name = "--shard", .kind = CLI_TEXT, .out = &o->shard},
         {.name = "--camera-from", .kind = CLI_TEXT, .out = &o->camera_from},
     };
@@ -215,8 +207,9 @@ static int parse_render_options(int argc, char **argv, render_options *o) {
         return cli_error("%s: --out writes OpenEXR: name it .exr (--png writes a PNG)", o->out_exr), -1;
     if (o->out_png && !has_suffix(o->out_png, ".png"))
         return cli_error("%s: --png writes a PNG: name it .png (--out writes OpenEXR)", o->out_png), -1;
-    if (o->denoise && !o->out_exr) return cli_error("--denoise: the filtered image is a layer of --out FILE.exr"), -1;
-    if (o->denoise && o->shard)
+    if (p->look.denoise && !o->out_exr)
+        return cli_error("--denoise: the filtered image is a layer of --out FILE.exr"), -1;
+    if (p->look.denoise && o->shard)
         return cli_error("--denoise: a shard is part of a render; filter the merged reference's render instead"), -1;
     if (!spp_given) o->spp = time_given ? 0 : DEFAULT_SPP;
     if (o->shard) return parse_shard(o);
@@ -394,7 +387,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
         png = fallback;
     }
     if (png) {
-        tonemap_params tp = {(float)o->exposure, 0.0f, 0.0f, TONEMAP_REINHARD};
+        tonemap_params tp = {o->params.look.exposure, 0.0f, 0.0f, (tonemap_op)o->params.look.tonemap};
         if (film_save_png(fm, COMP_MASK_ALL, &tp, png, png == fallback ? WRITE_NO_REPLACE : WRITE_REPLACE, err,
                           sizeof err) != 0) {
             cli_error("%s", err);
@@ -508,7 +501,7 @@ int cmd_render(int argc, char **argv) {
     /* --denoise: the display takes every frame's samples as the viewer's does, and filters at the end */
     display *disp = NULL;
     float *denoised = NULL;
-    if (o.denoise) {
+    if (o.params.look.denoise) {
         disp = display_create(p.width, p.height, p.threads, err, sizeof err);
         denoised = disp ? malloc(sizeof(float) * 3 * (size_t)p.width * (size_t)p.height) : NULL;
         if (!denoised) {

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "image_io.h"
+#include "params.h"
 
 /* Path-space components, each in its own buffer: the image is their sum. */
 typedef enum {
@@ -85,15 +86,7 @@ void film_moments_var_layer(const char *layer, char *out, size_t n);
 /* Values film_save_exr would clamp: in the whole image and in the layers of layers_mask. */
 size_t film_count_clamped(const film *f, unsigned layers_mask);
 
-/* Global tone operators, all followed by the sRGB transfer function to 8 bits. */
-typedef enum {
-    TONEMAP_REINHARD = 0, /* Reinhard et al. 2002: key / log-average luminance, L/(1+L), hue kept */
-    TONEMAP_CLAMP,        /* radiance x 2^exposure, clipped at 1: what the numbers say */
-    TONEMAP_EXPONENTIAL,  /* 1 - exp(-radiance x 2^exposure) per channel: a soft shoulder, no
-                           * image statistics, so brightness never shifts while noise settles */
-    TONEMAP_COUNT
-} tonemap_op;
-
+/* The tone operators (tonemap_op, params.h: a render's look chooses one). */
 extern const char *const tonemap_names[TONEMAP_COUNT]; /* "reinhard", "clamp", "exponential" */
 int tonemap_from_name(const char *name);               /* -1 when unknown */
 

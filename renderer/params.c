@@ -83,6 +83,9 @@ _Static_assert(offsetof(render_params, height) == offsetof(render_params, width)
 static const param_choice methods[METHOD_COUNT] = {{"pt", METHOD_PT, "pt"}, {"vpl", METHOD_VPL, "vpl"},
                                                   {"vsl", METHOD_VSL, "vsl"}, {"vsl+hl", METHOD_VSL_HL, "vsl+hl"}};
 static const param_choice plans[] = {{"auto", PLAN_AUTO, "auto"}, {"full", PLAN_FULL, "full"}};
+static const param_choice tonemaps[] = {{"reinhard", TONEMAP_REINHARD, "reinhard"},
+                                        {"clamp", TONEMAP_CLAMP, "clamp"},
+                                        {"exponential", TONEMAP_EXPONENTIAL, "exponential"}};
 static const param_choice on_off[] = {{"on", 1, "on"}, {"off", 0, "off"}};
 static const param_choice clamps[] = {{NULL, VL_CLAMP_DEFAULT, "method default"}, {"on", VL_CLAMP_ON, "on"},
                                       {"off", VL_CLAMP_OFF, "off"}};
@@ -118,6 +121,21 @@ static const param_desc table[] = {
     {.name = "seed", .type = PARAM_U64, .group = PARAM_RENDER, .offset = offsetof(render_params, seed), .lo = 0,
      .hi = 18446744073709551615.0, .def = 0, .value_name = "S", .help = "random seed; runs with the same seed reproduce",
      .label = "seed", .no_panel = 1},
+    {.name = "exposure", .type = PARAM_FLOAT, .group = PARAM_DISPLAY, .offset = offsetof(render_params, look.exposure),
+     .lo = -50, .hi = 50, .def = 0, .value_name = "STOPS", .help = "exposure of the image shown and of the PNG",
+     .label = "exposure", .unit = "stops", .panel_lo = -8, .panel_hi = 8, .panel_format = "%.1f stops"},
+    {.name = "tonemap", .type = PARAM_CHOICE, .group = PARAM_DISPLAY, .offset = offsetof(render_params, look.tonemap),
+     .choices = tonemaps, .num_choices = 3, .def = TONEMAP_REINHARD,
+     .help = "tone mapper of the image shown and of the PNG: reinhard (to the\n"
+             "image's log-average), clamp, exponential (a soft shoulder)",
+     .label = "tone mapper"},
+    {.name = "denoise", .type = PARAM_CHOICE, .group = PARAM_DISPLAY, .offset = offsetof(render_params, look.denoise),
+     .choices = on_off, .num_choices = 2, .flag = 1, .def = 0,
+     .help = "the image shown filtered while it is young and sampled more where\n"
+             "it errs most (the viewer's N toggles both); glint render: that\n"
+             "image as the EXR's layer denoised.*; the estimate, exports and\n"
+             "the error never see either",
+     .label = "denoise (N)"},
     {.name = "vsl-count", .type = PARAM_INT, .offset = F(count), .lo = 1, .hi = 50000000,
      .bytes_each = VL_BYTES_PER_LIGHT, .def = VL_DEFAULT_COUNT,
      .value_name = "N", .help = "virtual lights traced per frame", .label = "lights/frame",
@@ -451,7 +469,7 @@ void param_format(const param_desc *d, const render_params *p, char *out, size_t
 static size_t help_line(const param_desc *d, const char *def_given, char *text, size_t n) {
     char option[64], words[64], def[64];
     value_words(d, "|", words, sizeof words);
-    int olen = d->flag ? snprintf(option, sizeof option, "  --%s", d->name)
+    int olen = d->flag ? snprintf(option, sizeof option, "  --%s [%s]", d->name, words)
                        : snprintf(option, sizeof option, "  --%s %s", d->name, words);
     if (def_given || d->def_text)
         snprintf(def, sizeof def, "%s", def_given ? def_given : d->def_text);
@@ -492,14 +510,31 @@ static int listed(const char *list, const char *name) {
     return 0;
 }
 
-const char *params_render_help(const char *names, const char *method_default) {
-    static char text[2048];
+/* name's value in a list of "name=value" words, into out (n bytes); NULL when not there. */
+static const char *listed_value(const char *list, const char *name, char *out, size_t n) {
+    size_t k = strlen(name);
+    for (const char *w = list ? list : ""; *w;) {
+        size_t len = strcspn(w, " ");
+        if (len > k && strncmp(w, name, k) == 0 && w[k] == '=') {
+            snprintf(out, n, "%.*s", (int)(len - k - 1), w + k + 1);
+            return out;
+        }
+        w += len;
+        w += strspn(w, " ");
+    }
+    return NULL;
+}
+
+const char *params_render_help(const char *names, const char *defaults) {
+    static char text[4096];
     size_t len = 0;
     text[0] = '\0';
-    for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++)
+    for (size_t i = 0; i < sizeof table / sizeof table[0] && len < sizeof text; i++) {
+        char own[64];
         if (!(PARAM_GROUPS_VL >> table[i].group & 1u) && listed(names, table[i].name))
-            len += help_line(&table[i], table[i].offset == offsetof(render_params, method) ? method_default : NULL,
-                             text + len, sizeof text - len);
+            len += help_line(&table[i], listed_value(defaults, table[i].name, own, sizeof own), text + len,
+                             sizeof text - len);
+    }
     return text;
 }
 

@@ -1,9 +1,10 @@
 /* glint — what a render is asked to do: the method, its parameters and their defaults, and the
  * statistics a session reports. Every estimator and front end includes this header (not
- * session.h) for these types. The method, the path depth and the many-light parameters are
- * described once, in a table (params_table) that the command line, the viewer's script `set`, its
- * panel and the help text all read, so a new parameter is one render_params (or vl_params) field
- * and one entry (docs/design.md, "Parameters"). */
+ * session.h) for these types. Every setting of a render (the method, the path depth, the plan,
+ * the seed, the size, the many-light parameters, the look) is described once, in a table
+ * (params_table) that the command line, the viewer's script `set`, its panel and the help text all
+ * read, so a new parameter is one render_params field and one entry (docs/design.md,
+ * "Parameters"). */
 #ifndef GLINT_PARAMS_H
 #define GLINT_PARAMS_H
 
@@ -30,6 +31,7 @@ int method_from_name(const char *name);
  * the default scene (docs/benchmarks.md). glint render keeps path tracing, its references'
  * unbiased method, unless told otherwise. */
 #define DEFAULT_METHOD METHOD_VSL
+#define DEFAULT_METHOD_NAME "vsl" /* its name, for help texts (test_params checks it) */
 #define DEFAULT_MAX_DEPTH 16
 #define MAX_DEPTH_LIMIT 10000 /* the deepest path any front end accepts */
 #define DEFAULT_WIDTH 960
@@ -156,6 +158,24 @@ static inline uint64_t shard_frame_index(long long total, int index, int count, 
     return (k / b) * n * b + i * b + k % b;
 }
 
+/* Global tone operators, all followed by the sRGB transfer function to 8 bits (film.h applies them). */
+typedef enum {
+    TONEMAP_REINHARD = 0, /* Reinhard et al. 2002: key / log-average luminance, L/(1+L), hue kept */
+    TONEMAP_CLAMP,        /* radiance x 2^exposure, clipped at 1: what the numbers say */
+    TONEMAP_EXPONENTIAL,  /* 1 - exp(-radiance x 2^exposure) per channel: a soft shoulder, no
+                           * image statistics, so brightness never shifts while noise settles */
+    TONEMAP_COUNT
+} tonemap_op;
+
+/* How the image is shown and written, never the estimate: a change of these restarts no
+ * accumulation (PARAM_DISPLAY). The viewer's look; glint render's PNG and filtered layer. */
+typedef struct {
+    float exposure; /* stops */
+    int tonemap;    /* tonemap_op */
+    int denoise;    /* 1: the image shown filtered while young and sampled more where it errs most
+                     * (the viewer's default); glint render: that image as an extra layer */
+} look_params;
+
 /* The effect plan's modes (render_params.plan; plan.h makes the plan). */
 enum { PLAN_AUTO = 0, PLAN_FULL };
 
@@ -178,6 +198,7 @@ typedef struct {
     int shard_index, shard_count;
     long long shard_spp_total;
     vl_params vl;
+    look_params look;
 } render_params;
 
 /* Work done, by kind of ray; summed over the frames since the last reset. */
@@ -268,12 +289,13 @@ typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE, PARAM_U64, PARAM_SIZE } par
  * every method (the method itself, the path depth, the seed), which each command's help lists with
  * its own options and default (params_render_help), not in params_help's sections; PARAM_SETUP the
  * same, but given when a render is set up, never changed while it runs (the image's size). */
-typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS, PARAM_RENDER, PARAM_SETUP } param_group;
+typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS, PARAM_RENDER, PARAM_SETUP, PARAM_DISPLAY } param_group;
 /* Masks of groups (1 << group) a front end takes: the many-light ones, those a running render
  * takes (the viewer's script and panel), all (a command line). */
 #define PARAM_GROUPS_VL ((1u << PARAM_MANY_LIGHT) | (1u << PARAM_HIGHLIGHTS))
 #define PARAM_GROUPS_LIVE (PARAM_GROUPS_VL | (1u << PARAM_RENDER))
-#define PARAM_GROUPS_ALL (PARAM_GROUPS_LIVE | (1u << PARAM_SETUP))
+#define PARAM_GROUPS_LOOK (1u << PARAM_DISPLAY)
+#define PARAM_GROUPS_ALL (PARAM_GROUPS_LIVE | (1u << PARAM_SETUP) | PARAM_GROUPS_LOOK)
 
 typedef struct {
     const char *name; /* the word on the command line and in scripts; NULL: the panel's only */
@@ -295,9 +317,9 @@ typedef struct {
     int zero_is_off;      /* 0 is stored as -1 too (0 in vl_params means the default) */
     const param_choice *choices;
     int num_choices;
-    int flag;               /* the command line takes it alone, as "on" */
+    int flag;               /* the command line takes it alone, as "on", or with one of its choices */
     double def;             /* the default, as render_params_resolve gives it */
-    const char *def_text;   /* the help's default when it is no one value */
+    const char *def_text;   /* the help's default when it is no one value (or each command's own) */
     const char *value_name; /* the help's name for the value (a choice's: its names, unless set) */
     const char *help;       /* lines for --help, '\n' between them */
     const char *label;      /* the panel's */
@@ -332,11 +354,11 @@ double param_get(const param_desc *d, const render_params *p);
 void param_put(const param_desc *d, render_params *p, double v);
 /* The many-light options' help text, one section per group; the returned text is static. */
 const char *params_help(void);
-/* The options every method takes (PARAM_RENDER) that a command takes, named in `names` (separated by
- * spaces: "method max-depth seed"), as params_help words its own, for the command's help, with
- * method_default as the method's default (NULL: the table's); the text is static until the next
- * call. */
-const char *params_render_help(const char *names, const char *method_default);
+/* The options of every method (every group but the many-light ones) that a command takes, named in
+ * `names` (separated by spaces: "method max-depth seed"), as params_help words its own, for the
+ * command's help, with the command's own defaults where they are not the table's (`defaults`:
+ * "method=vsl denoise=on", or NULL); the text is static until the next call. */
+const char *params_render_help(const char *names, const char *defaults);
 
 #ifdef __cplusplus
 }

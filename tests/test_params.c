@@ -61,9 +61,14 @@ static void test_entry(const param_desc *d, const char *help) {
     int i = 0;
     CHECK(cli_param_option(2, argv, &i, &c, all) == 1, "cli_param_option %s", option);
     CHECK(i == (d->flag ? 0 : 1), "%s took %d arguments", option, i);
-    if (d->flag)
+    if (d->flag) {
         CHECK(param_get(d, &c) == 1.0, "%s alone is not on", option);
-    else
+        char *with[] = {option, (char *)"off", NULL}; /* ... and takes a choice that follows it */
+        render_params off = c;
+        i = 0;
+        CHECK(cli_param_option(2, with, &i, &off, all) == 1 && i == 1 && param_get(d, &off) == 0.0,
+              "%s off: took %d arguments, stored %g", option, i, param_get(d, &off));
+    } else
         CHECK(memcmp(&a, &c, sizeof a) == 0, "cli_param_option %s %s differs from set", option, text);
     /* the many-light sections list their own; each command lists the method, depth... (test_program) */
     int many_light = (PARAM_GROUPS_VL >> d->group & 1u) != 0;
@@ -262,29 +267,44 @@ static void test_program(void) {
     for (int i = 0; i < n; i++) {
         char text[64], args[512];
         example(&t[i], text, sizeof text);
-        snprintf(args, sizeof args, "render --method %s --size 8x6 --spp 1 --vsl-count 16 --quiet --png p.png --%s %s",
+        snprintf(args, sizeof args,
+                 "render --method %s --size 8x6 --spp 1 --vsl-count 16 --quiet --png p.png --out p.exr --%s %s",
                  t[i].group == PARAM_HIGHLIGHTS ? "vsl+hl" : "vsl", t[i].name, t[i].flag ? "" : text);
         int rc = run(args);
         CHECK(rc == 0, "glint %s: exit %d: %s", args, rc, err_text);
     }
-    /* Each command's help lists the method and the path depth as the table words them, with its
-     * own default (the viewer opens on vsl). */
-    const char *commands[] = {"render", "view", "info"},
-               *takes[] = {"method max-depth seed size plan", "size method max-depth seed plan",
-                           "method max-depth plan"};
+    /* Each command's help lists the entries of every method that it takes as the table words them,
+     * in blocks where they fit its own options, with its own defaults (the viewer opens on vsl, its
+     * image filtered); every entry of those groups is taken by some command. */
+    static const struct {
+        const char *args, *blocks[2], *defaults;
+    } helps[] = {
+        {"render --help", {"method max-depth seed size plan", "exposure tonemap denoise"}, NULL},
+        {"view --help",
+         {"size method max-depth seed plan exposure tonemap denoise", NULL},
+         "method=" DEFAULT_METHOD_NAME " denoise=on"},
+        {"info --help", {"method max-depth plan", NULL}, "method=" DEFAULT_METHOD_NAME},
+    };
+    CHECK(strcmp(method_name(DEFAULT_METHOD), DEFAULT_METHOD_NAME) == 0, "DEFAULT_METHOD_NAME is not its name");
+    int taken[64] = {0};
     for (int k = 0; k < 3; k++) {
-        char args[64];
-        snprintf(args, sizeof args, "%s --help", commands[k]);
-        CHECK(run(args) == 0, "glint %s: %s", args, err_text);
-        const char *lines = params_render_help(takes[k], k > 0 ? method_name(DEFAULT_METHOD) : NULL);
-        CHECK(strstr(out_text, lines) != NULL, "glint %s does not list these as:\n%s", args, lines);
-        for (int i = 0; i < n; i++) {
-            char option[80];
-            snprintf(option, sizeof option, "  --%s ", t[i].name);
-            CHECK((PARAM_GROUPS_VL >> t[i].group & 1u) || !strstr(takes[k], t[i].name) || strstr(lines, option),
-                  "the help's lines lack --%s", t[i].name);
+        CHECK(run(helps[k].args) == 0, "glint %s: %s", helps[k].args, err_text);
+        for (int b = 0; b < 2 && helps[k].blocks[b]; b++) {
+            const char *lines = params_render_help(helps[k].blocks[b], helps[k].defaults);
+            CHECK(lines[0] && strstr(out_text, lines) != NULL, "glint %s does not list these as:\n%s", helps[k].args,
+                  lines);
+            for (int i = 0; i < n && i < 64; i++) {
+                char option[80];
+                snprintf(option, sizeof option, "  --%s ", t[i].name);
+                taken[i] |= strstr(lines, option) != NULL;
+            }
         }
     }
+    for (int i = 0; i < n && i < 64; i++)
+        CHECK((PARAM_GROUPS_VL >> t[i].group & 1u) || taken[i], "no command's help lists --%s", t[i].name);
+    /* a flag alone is on; one of its choices may follow it (glint view --denoise off) */
+    CHECK(run("render --size 8x6 --spp 1 --quiet --png p.png --vpl-glossy off --denoise off") == 0,
+          "--vpl-glossy off --denoise off: %s", err_text);
     /* the seed, all 64 bits of it, as glint render takes it */
     CHECK(run("render --size 8x6 --spp 1 --quiet --png p.png --seed 18446744073709551615") == 0, "--seed 2^64 - 1: %s",
           err_text);

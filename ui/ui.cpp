@@ -241,6 +241,12 @@ static void param_widgets(param_group group, render_params *p) {
         const param_desc *d = &table[i];
         if (d->group != group || d->no_panel) continue;
         double v = param_get(d, p);
+        if (d->type == PARAM_CHOICE && d->flag) { // on or off: a checkbox (choices[0] is on)
+            bool on = (int)v == d->choices[0].value;
+            if (ImGui::Checkbox(d->label, &on)) param_put(d, p, d->choices[on ? 0 : 1].value);
+            help_tooltip(d->help);
+            continue;
+        }
         if (d->type == PARAM_CHOICE) {
             const char *labels[8];
             int k = 0, cur = 0;
@@ -463,15 +469,9 @@ static void panel(ui_controls *c, const ui_stats *s) {
     }
 
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
-        ImGui::SliderFloat("exposure", &c->exposure, -8.0f, 8.0f, "%.1f stops");
-        if (s->num_tonemaps > 0) ImGui::Combo("tone mapper", &c->tonemap, s->tonemap_names, s->num_tonemaps);
+        param_widgets(PARAM_DISPLAY, &c->params); /* exposure, tone mapper, denoise (N) */
         static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
         ImGui::Combo("show", &c->show, shows, s->reference ? UI_SHOW_COUNT : UI_SHOW_ERROR);
-        bool denoise = c->denoise != 0;
-        if (ImGui::Checkbox("denoise (N)", &denoise)) c->denoise = denoise;
-        help_tooltip("Filters the image shown while it is young (an edge-avoiding wavelet on the light over the "
-                     "albedo, as strong as the pixels' noise): a view of the estimate. The estimate itself (exports, "
-                     "the error against a reference, glint render) is never filtered.");
         if (c->show == UI_SHOW_ERROR)
             ImGui::TextUnformatted("per-pixel relative error:\nblue 1%, green 10%, red 100% and more");
     }

@@ -27,12 +27,9 @@ typedef struct {
     /* the selected light and its intensity: a change of intensity resets */
     int light;        /* light group, -1 for none */
     float light_gain; /* its intensity multiplier */
-    /* display settings: a change never resets */
-    float exposure; /* stops */
-    int tonemap;    /* index into the tone mapper names given to ui_panel */
-    int show;       /* UI_SHOW_* */
+    /* display settings: a change never resets (and params.look: exposure, tone mapper, denoise) */
+    int show; /* UI_SHOW_* */
     int show_panel;
-    int denoise; /* the display's filter: on while the image is young, a view of the estimate only */
     /* one-shot actions, set by the panel, cleared by the viewer */
     int screenshot, export_exr, reset_view, load_scene, load_env, load_reference;
     char path[1024]; /* the panel's path field for loading */
@@ -68,10 +65,8 @@ typedef struct {
     double cost_ms, cost_before_ms;
     int width, height; /* of the image shown */
     int num_cameras;
-    int many_light; /* the current method uses virtual lights: show their settings */
-    int highlights; /* the current method is vsl+hl: show the highlight settings */
-    const char *const *tonemap_names;
-    int num_tonemaps;
+    int many_light;                 /* the current method uses virtual lights: show their settings */
+    int highlights;                 /* the current method is vsl+hl: show the highlight settings */
     const char *const *light_names; /* the scene's light groups, "name (type)" */
     int num_lights;
     int light_movable;      /* the selected light has a position */

@@ -17,12 +17,9 @@ typedef struct {
     int width, height;
     render_params params;
     int camera;
-    double exposure;
-    int tonemap;
     const char *reference_path;
     long long spp;  /* refinement stops here; 0: never */
     double seconds; /* ...or after this long; 0: never */
-    int no_denoise; /* the image shown unfiltered */
 } view_options;
 
 static void print_view_help(void) {
@@ -36,11 +33,6 @@ static void print_view_help(void) {
            "  --env FILE           environment map (.exr or .hdr)\n"
            "  --variant NAME       the scene's material variant NAME (the panel switches them)\n"
            "  --camera INDEX       start from the scene's camera INDEX\n"
-           "  --exposure STOPS     display exposure [0]\n"
-           "  --tonemap NAME       display tone mapper: reinhard, clamp, exponential [reinhard]\n"
-           "  --denoise on|off     filter the image shown while it is young, and sample it more\n"
-           "                       where it errs most (N toggles both; the estimate, exports and\n"
-           "                       the error never see either) [on]\n"
            "  --reference FILE.exr an image of the render's size: error view and plot\n"
            "  --spp N              stop refining at N samples per pixel (frames) [never]\n"
            "  --time SECONDS       stop refining after this long [never]\n"
@@ -49,7 +41,9 @@ static void print_view_help(void) {
            "%s"
            "\n"
            "keys and mouse (F1 in the window shows them):\n",
-           params_render_help("size method max-depth seed plan", method_name(DEFAULT_METHOD)), cli_vl_help());
+           params_render_help("size method max-depth seed plan exposure tonemap denoise",
+                              "method=" DEFAULT_METHOD_NAME " denoise=on"),
+           cli_vl_help());
     print_shortcuts(stdout);
 }
 
@@ -60,18 +54,18 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
     o->camera = -1;
     o->params.max_depth = DEFAULT_MAX_DEPTH;
     o->params.method = DEFAULT_METHOD;
+    o->params.look.denoise = 1; /* the viewer's image is filtered while young, unless asked not to */
     const cli_opt opts[] = {
         {.name = "--env", .kind = CLI_TEXT, .out = &o->env_path},
         {.name = "--variant", .kind = CLI_TEXT, .out = &o->variant},
         {.name = "--camera", .kind = CLI_INT, .out = &o->camera, .lo = 0, .hi = CLI_CAMERA_MAX},
-        {.name = "--exposure", .kind = CLI_FLOAT, .out = &o->exposure, .lo = -30.0, .hi = 30.0},
         {.name = "--reference", .kind = CLI_TEXT, .out = &o->reference_path},
         {.name = "--script", .kind = CLI_TEXT, .out = &o->script_path},
         {.name = "--spp", .kind = CLI_LONG, .out = &o->spp, .lo = 1, .hi = 100000000},
         {.name = "--time", .kind = CLI_FLOAT, .out = &o->seconds, .lo = 1e-3, .hi = 1e7},
     };
     for (int i = 0; i < argc; i++) {
-        const char *a = argv[i], *v;
+        const char *a = argv[i];
         int r;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             print_view_help();
@@ -79,16 +73,6 @@ static int parse_view_options(int argc, char **argv, view_options *o) {
         } else if ((r = cli_table_option(argc, argv, &i, opts, (int)(sizeof opts / sizeof opts[0]))) != 0 ||
                    (r = cli_param_option(argc, argv, &i, &o->params, PARAM_GROUPS_ALL)) != 0) {
             if (r < 0) return -1;
-        } else if (strcmp(a, "--denoise") == 0) {
-            if (!(v = cli_value(argc, argv, &i))) return -1;
-            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
-                return cli_error("--denoise: on or off, not '%s'", v), -1;
-            o->no_denoise = strcmp(v, "off") == 0;
-        } else if (strcmp(a, "--tonemap") == 0) {
-            if (!(v = cli_value(argc, argv, &i))) return -1;
-            if ((o->tonemap = tonemap_from_name(v)) < 0)
-                return cli_error("--tonemap: unknown tone mapper '%s' (available: reinhard, clamp, exponential)", v),
-                       -1;
         } else if (cli_scene_argument("view", a, &o->scene_path) != 0) {
             return -1;
         }
@@ -181,11 +165,8 @@ int cmd_view(int argc, char **argv) {
     /* The panel shows the values in use, so it edits the parameters with their defaults resolved. */
     u.ctl = (ui_controls){.params = o.params,
                           .camera = o.camera,
-                          .exposure = (float)o.exposure,
-                          .tonemap = o.tonemap,
                           .show = UI_SHOW_ALL,
                           .show_panel = 1,
-                          .denoise = !o.no_denoise,
                           .spp_limit = o.spp,
                           .time_limit = o.seconds,
                           .variant = u.info.variant};
@@ -207,7 +188,7 @@ int cmd_view(int argc, char **argv) {
                         .width = fw > 0 ? fw : o.width,
                         .height = fh > 0 ? fh : o.height,
                         .env = o.env_path,
-                        .denoise = u.ctl.denoise,
+                        .denoise = u.ctl.params.look.denoise,
                         .wake = glfwPostEmptyEvent}; /* the UI thread, waiting for events, takes the image */
     if (!(u.vc = controller_start(s, &start, err, sizeof err))) {
         cli_error("%s", err);

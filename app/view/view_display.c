@@ -299,8 +299,6 @@ void draw_image_and_panel(ui_thread *u) {
                    .num_cameras = u->info.num_cameras,
                    .many_light = u->ctl.params.method != METHOD_PT,
                    .highlights = u->ctl.params.method == METHOD_VSL_HL,
-                   .tonemap_names = tonemap_names,
-                   .num_tonemaps = TONEMAP_COUNT,
                    .light_names = u->light_label_ptrs,
                    .num_lights = u->info.num_lights,
                    .light_movable = light_movable(u, u->ctl.light),

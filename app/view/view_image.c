@@ -59,7 +59,8 @@ void tonemap_and_upload(ui_thread *u) {
     if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
         false_colour_error(u->front.rgb, ref->rgb, w * h, u->pixels);
     } else { /* also an image of another size than the reference's */
-        tonemap_params tp = {u->ctl.exposure, 0.0f, 0.0f, (tonemap_op)u->ctl.tonemap};
+        const look_params *look = &u->ctl.params.look;
+        tonemap_params tp = {look->exposure, 0.0f, 0.0f, (tonemap_op)look->tonemap};
         tonemap_apply(u->front.rgb, w * h, &tp, u->pixels);
     }
     make_texture(u);

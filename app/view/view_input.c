@@ -40,9 +40,10 @@ void apply_controls(ui_thread *u, int camera_changed) {
     }
     if (camera_changed) send_change(u);
     if (estimator_changed) u->cost_generation = u->sent_generation;
-    if (u->ctl.exposure != u->applied_ctl.exposure || u->ctl.tonemap != u->applied_ctl.tonemap) u->need_tonemap = 1;
-    if (u->ctl.show != u->applied_ctl.show || u->ctl.denoise != u->applied_ctl.denoise) {
-        controller_set_look(u->vc, show_mask_of(u->ctl.show), u->ctl.denoise);
+    /* the look (the table's display entries, and the component shown): never the estimate */
+    if (params_differ(p, was, PARAM_GROUPS_LOOK)) u->need_tonemap = 1;
+    if (u->ctl.show != u->applied_ctl.show || p->look.denoise != was->look.denoise) {
+        controller_set_look(u->vc, show_mask_of(u->ctl.show), p->look.denoise);
         u->need_tonemap = 1;
     }
     u->applied_ctl = u->ctl;

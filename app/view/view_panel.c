@@ -159,7 +159,7 @@ static void panel_keys(ui_thread *u) {
     int slash = u->keys_pressed[GLFW_KEY_SLASH];
     if (u->keys_pressed[GLFW_KEY_F1] || (slash && ((slash - 1) & GLFW_MOD_SHIFT))) u->ctl.show_help = !u->ctl.show_help;
     if (u->keys_pressed[GLFW_KEY_SPACE]) u->ctl.paused = !u->ctl.paused;
-    if (u->keys_pressed[GLFW_KEY_N]) u->ctl.denoise = !u->ctl.denoise;
+    if (u->keys_pressed[GLFW_KEY_N]) u->ctl.params.look.denoise = !u->ctl.params.look.denoise;
 }
 
 void panel_frame(ui_thread *u, ui_stats *st) {

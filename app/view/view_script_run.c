@@ -29,22 +29,20 @@ static void print_stats(ui_thread *u) {
     marks[nb] = 0;
     /* One line, whole: a capture's thread says "glint: wrote" on stdout too. */
     flockfile(stdout);
-    printf(
-        "stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f tonemap=%s mean=%.6g "
-        "rel_error=%.6g displayed_error=%.6g time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
-        u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z,
-        (double)lx, (double)ly, tonemap_names[u->ctl.tonemap], mean, u->rel_error, u->shown_error,
-        seconds_since(u->started_at), (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z,
-        nb ? marks : "-");
-    printf("scene=%s frames=%lld width=%d height=%d exposure=%g show=%d ", u->info.name, frames_of_current_state(u),
-           u->front.width, u->front.height, (double)u->ctl.exposure, u->ctl.show);
+    printf("stats lights=%d light=%d light_intensity=%g light_pos=%.5f,%.5f,%.5f light_xy=%.1f,%.1f mean=%.6g "
+           "rel_error=%.6g displayed_error=%.6g time=%.3f cam=%.5f,%.5f,%.5f bookmarks=%s ",
+           u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z,
+           (double)lx, (double)ly, mean, u->rel_error, u->shown_error, seconds_since(u->started_at),
+           (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z, nb ? marks : "-");
+    printf("scene=%s frames=%lld width=%d height=%d show=%d ", u->info.name, frames_of_current_state(u), u->front.width,
+           u->front.height, u->ctl.show);
     /* The environment, and the standing notes (the panel's status line) as flags. */
     char env[1024];
     controller_env(u->vc, env, sizeof env);
     if (!env[0]) snprintf(env, sizeof env, "-");
-    printf("env=%s unlit_note=%d paused_note=%d step_ms=%.1f cost_ms=%.1f cost_before_ms=%.1f denoise=%d", env,
+    printf("env=%s unlit_note=%d paused_note=%d step_ms=%.1f cost_ms=%.1f cost_before_ms=%.1f", env,
            strstr(u->status, "no light") != NULL, strstr(u->status, "paused") != NULL, u->step_ms, view_cost_ms(u),
-           u->cost_before_ms, u->ctl.denoise);
+           u->cost_before_ms);
     /* Images taken from the render side (what the window showed), those at full resolution, their
      * pixels in all, and the size they render at: updates a second and their resolution. */
     printf(" images=%llu images_full=%llu image_pixels=%llu render_size=%dx%d", u->images_shown, u->images_full,
@@ -56,7 +54,7 @@ static void print_stats(ui_thread *u) {
     int nparams;
     const param_desc *table = params_table(&nparams);
     for (int i = 0; i < nparams; i++) {
-        if (!(PARAM_GROUPS_LIVE >> table[i].group & 1u)) continue; /* the size: width= and height= above */
+        if (table[i].group == PARAM_SETUP) continue; /* the size: width= and height= above */
         char name[64], value[64];
         snprintf(name, sizeof name, "%s", table[i].name);
         for (char *c = name; *c; c++) *c = *c == '-' ? '_' : *c;
@@ -79,16 +77,14 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     char why[256];
     int limit = panel_set(u, name, value, err, errlen); /* spp, time */
     if (limit <= 0) return limit;
+    const unsigned live = PARAM_GROUPS_LIVE | PARAM_GROUPS_LOOK;
     const param_desc *setup = param_find(name);
-    if (setup && !(PARAM_GROUPS_LIVE >> setup->group & 1u))
+    if (setup && !(live >> setup->group & 1u))
         return snprintf(err, errlen, "%s: given when the viewer opens (--%s)", name, name), -1;
-    int applied = params_set(&u->ctl.params, PARAM_GROUPS_LIVE, name, value, why, sizeof why);
+    int applied = params_set(&u->ctl.params, live, name, value, why, sizeof why);
     if (applied < 0) return snprintf(err, errlen, "%s: %s", name, why), -1;
     if (applied > 0) return 0;
-    if (strcmp(name, "exposure") == 0) {
-        if (cli_parse_float(opt, value, -30, 30, &x) != 0) return snprintf(err, errlen, "bad value '%s'", value), -1;
-        u->ctl.exposure = (float)x;
-    } else if (strcmp(name, "show") == 0) {
+    if (strcmp(name, "show") == 0) {
         static const char *names[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
         int found = -1;
         for (int i = 0; i < UI_SHOW_COUNT; i++)
@@ -97,10 +93,6 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
         if (found == UI_SHOW_ERROR && !u->reference.rgb)
             return snprintf(err, errlen, "show error: no reference loaded"), -1;
         u->ctl.show = found;
-    } else if (strcmp(name, "tonemap") == 0) {
-        int t = tonemap_from_name(value);
-        if (t < 0) return snprintf(err, errlen, "tonemap: one of reinhard, clamp, exponential"), -1;
-        u->ctl.tonemap = t;
     } else if (strcmp(name, "light") == 0) {
         if (cli_parse_int(opt, value, 0, u->info.num_lights - 1, &n) != 0)
             return snprintf(err, errlen, "no light %s", value), -1;
@@ -113,10 +105,6 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
         if (cli_parse_int(opt, value, -1, u->info.num_cameras - 1, &n) != 0)
             return snprintf(err, errlen, "no camera %s", value), -1;
         u->ctl.camera = (int)n;
-    } else if (strcmp(name, "denoise") == 0) {
-        if (strcmp(value, "on") != 0 && strcmp(value, "off") != 0)
-            return snprintf(err, errlen, "denoise: on or off"), -1;
-        u->ctl.denoise = strcmp(value, "on") == 0;
     } else if (strcmp(name, "panel") == 0) {
         if (cli_parse_int(opt, value, 0, 1, &n) != 0) return snprintf(err, errlen, "panel: 0 or 1"), -1;
         u->ctl.show_panel = (int)n;
@@ -177,7 +165,7 @@ void run_script(ui_thread *u) {
             break;
         case ACT_SET:
             if (u->script_waiting) { /* `set denoise`: until an image resolved so is shown */
-                if (u->front.denoise != u->ctl.denoise) return;
+                if (u->front.denoise != u->ctl.params.look.denoise) return;
                 u->script_waiting = 0;
                 break;
             }
@@ -191,7 +179,7 @@ void run_script(ui_thread *u) {
             } else {
                 apply_controls(u, 0);
             }
-            if (strcmp(a->name, "denoise") == 0 && u->front.denoise != u->ctl.denoise) {
+            if (strcmp(a->name, "denoise") == 0 && u->front.denoise != u->ctl.params.look.denoise) {
                 u->script_waiting = 1;
                 return;
             }
