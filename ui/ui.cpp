@@ -469,7 +469,7 @@ static void panel(ui_controls *c, const ui_stats *s) {
     }
 
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
-        param_widgets(PARAM_DISPLAY, &c->params); /* exposure, tone mapper, denoise (N) */
+        param_widgets(PARAM_DISPLAY, &c->params); // exposure, tone mapper, denoise (N)
         static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
         ImGui::Combo("show", &c->show, shows, s->reference ? UI_SHOW_COUNT : UI_SHOW_ERROR);
         if (c->show == UI_SHOW_ERROR)
