@@ -125,7 +125,7 @@ static const param_desc table[] = {
      .lo = -50, .hi = 50, .def = 0, .value_name = "STOPS", .help = "exposure of the image shown and of the PNG",
      .label = "exposure", .unit = "stops", .panel_lo = -8, .panel_hi = 8, .panel_format = "%.1f stops"},
     {.name = "tonemap", .type = PARAM_CHOICE, .group = PARAM_DISPLAY, .offset = offsetof(render_params, look.tonemap),
-     .choices = tonemaps, .num_choices = 3, .def = TONEMAP_REINHARD,
+     .choices = tonemaps, .num_choices = 3, .def = TONEMAP_REINHARD, .value_name = "NAME",
      .help = "tone mapper of the image shown and of the PNG: reinhard (to the\n"
              "image's log-average), clamp, exponential (a soft shoulder)",
      .label = "tone mapper"},
