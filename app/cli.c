@@ -75,12 +75,10 @@ int cli_parse_float(const char *option, const char *text, double lo, double hi, 
 }
 
 int cli_parse_plan(const char *option, const char *text, int *plan) {
-    if (strcmp(text, "auto") == 0)
-        *plan = PLAN_AUTO;
-    else if (strcmp(text, "full") == 0)
-        *plan = PLAN_FULL;
-    else
-        return cli_error("%s: expected auto or full, got '%s'", option, text), -1;
+    render_params p = {0};
+    char err[256];
+    if (param_parse(param_find("plan"), text, &p, err, sizeof err) != 0) return cli_error("%s: %s", option, err), -1;
+    *plan = p.plan;
     return 0;
 }
 

@@ -19,7 +19,8 @@ void cli_print_warning(void *user, const char *message);
 int cli_parse_int(const char *option, const char *text, long long lo, long long hi, long long *out);
 int cli_parse_u64(const char *option, const char *text, uint64_t *out);
 int cli_parse_float(const char *option, const char *text, double lo, double hi, double *out);
-/* "auto" or "full" (PLAN_AUTO, PLAN_FULL). */
+/* "auto" or "full" (PLAN_AUTO, PLAN_FULL), as the parameter table's plan takes them (glint bench's
+ * --plan and its runs' plan=, which are its own options). */
 int cli_parse_plan(const char *option, const char *text, int *plan);
 /* "WxH" as params_parse_size takes it (the memory rule included), its error reported as option's. */
 int cli_parse_size(const char *option, const char *text, int *width, int *height);

@@ -318,11 +318,12 @@ void param_put(const param_desc *d, render_params *p, double v) {
     }
 }
 
-/* The accepted values in words, for messages and the help: "on|off", "A|off". */
-static void value_words(const param_desc *d, const char *sep, char *out, size_t n) {
+/* The accepted values in words, for messages and the help: "on|off", "A|off"; a choice's names,
+ * or its placeholder (value_name) where it has one and `placeholder` is set (the help's NAME). */
+static void value_words(const param_desc *d, const char *sep, int placeholder, char *out, size_t n) {
     out[0] = 0;
     size_t len = 0;
-    if (d->type == PARAM_CHOICE && !d->value_name) {
+    if (d->type == PARAM_CHOICE && !(placeholder && d->value_name)) {
         for (int c = 0; c < d->num_choices; c++) {
             if (!d->choices[c].name) continue;
             len += (size_t)snprintf(out + len, n - len, "%s%s", len ? sep : "", d->choices[c].name);
@@ -340,9 +341,7 @@ int param_parse(const param_desc *d, const char *text, render_params *p, char *e
             if (d->choices[c].name && strcmp(text, d->choices[c].name) == 0)
                 return param_put(d, p, d->choices[c].value), 0;
         char words[128];
-        param_desc names = *d;
-        names.value_name = NULL; /* the choices, not their placeholder */
-        value_words(&names, ", ", words, sizeof words);
+        value_words(d, ", ", 0, words, sizeof words);
         return snprintf(err, errlen, "expected one of %s, got '%s'", words, text), -1;
     }
     if (d->off_word && strcmp(text, d->off_word) == 0) return param_put(d, p, -1.0), 0;
@@ -468,7 +467,7 @@ void param_format(const param_desc *d, const render_params *p, char *out, size_t
  * (NULL: the table's). Returns the length written (clipped to n). */
 static size_t help_line(const param_desc *d, const char *def_given, char *text, size_t n) {
     char option[64], words[64], def[64];
-    value_words(d, "|", words, sizeof words);
+    value_words(d, "|", 1, words, sizeof words);
     int olen = d->flag ? snprintf(option, sizeof option, "  --%s [%s]", d->name, words)
                        : snprintf(option, sizeof option, "  --%s %s", d->name, words);
     if (def_given || d->def_text)
