@@ -286,12 +286,13 @@ int params_parse_size(const char *text, int *width, int *height, char *err, size
 
 typedef enum { PARAM_INT, PARAM_FLOAT, PARAM_CHOICE, PARAM_U64, PARAM_SIZE } param_type;
 /* Which methods read a parameter: the panel shows it with them, the help groups by it. PARAM_RENDER:
- * every method (the method itself, the path depth, the seed), which each command's help lists with
- * its own options and default (params_render_help), not in params_help's sections; PARAM_SETUP the
- * same, but given when a render is set up, never changed while it runs (the image's size). */
+ * every method (the method itself, the path depth, the plan, the seed), which each command's help
+ * lists with its own options and default (params_render_help), not in params_help's sections;
+ * PARAM_SETUP the same, but given when a render is set up, never changed while it runs (the
+ * image's size); PARAM_DISPLAY the look (look_params), which never changes the estimate. */
 typedef enum { PARAM_MANY_LIGHT, PARAM_HIGHLIGHTS, PARAM_RENDER, PARAM_SETUP, PARAM_DISPLAY } param_group;
-/* Masks of groups (1 << group) a front end takes: the many-light ones, those a running render
- * takes (the viewer's script and panel), all (a command line). */
+/* Masks of groups (1 << group) a front end takes: the many-light ones, those that restart a
+ * running render when they change, the look (which restarts nothing), all (a command line). */
 #define PARAM_GROUPS_VL ((1u << PARAM_MANY_LIGHT) | (1u << PARAM_HIGHLIGHTS))
 #define PARAM_GROUPS_LIVE (PARAM_GROUPS_VL | (1u << PARAM_RENDER))
 #define PARAM_GROUPS_LOOK (1u << PARAM_DISPLAY)
