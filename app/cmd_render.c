@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "camera.h"
+#include "choice.h"
 #include "cli.h"
 #include "commands.h"
 #include "display.h"
@@ -309,6 +310,11 @@ static int write_stats(const char *path, const render_options *o, const render_s
                 : hl.mode == HL_UNMERGED ? "\"off\""
                                          : "\"trace\"");
         json_counters(f, &st, STATS_HIGHLIGHTS, ", ");
+        fputc('}', f);
+    }
+    if (p->method == METHOD_AUTO) {
+        fprintf(f, ",\n  \"auto\": {\"tile\": %d", CHOICE_TILE);
+        json_counters(f, &st, STATS_AUTO, ", ");
         fputc('}', f);
     }
     /* The effect plan and what each pass cost: a skipped pass shows zero seconds. */

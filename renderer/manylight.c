@@ -428,7 +428,7 @@ int manylight_begin_frame(manylight *m, const scene *s, const camera *cam, const
     const render_params r = render_params_resolve(p); /* the defaults, in one place */
     const vl_params *vp = &r.vl;
     long long i = frame + 1;
-    m->kernel = p->method == METHOD_VSL || p->method == METHOD_VSL_HL
+    m->kernel = p->method == METHOD_VSL || p->method == METHOD_VSL_HL || p->method == METHOD_AUTO
                     ? VL_KERNEL_VSL
                     : (vp->vpl_glossy ? VL_KERNEL_VPL_GLOSSY : VL_KERNEL_VPL);
     m->terms = plan->highlights ? VL_TERMS_NO_HIGHLIGHTS : VL_TERMS_ALL;

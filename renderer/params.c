@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl", "vsl+hl"};
+static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl", "vsl+hl", "auto"};
 const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
 const char *const pass_names[PASS_COUNT] = {"paths", "direct", "virtual_lights", "gather", "highlights"};
 
@@ -81,7 +81,8 @@ _Static_assert(offsetof(render_params, height) == offsetof(render_params, width)
 /* One row per parameter reads better than one line per field. */
 /* clang-format off */
 static const param_choice methods[METHOD_COUNT] = {{"pt", METHOD_PT, "pt"}, {"vpl", METHOD_VPL, "vpl"},
-                                                  {"vsl", METHOD_VSL, "vsl"}, {"vsl+hl", METHOD_VSL_HL, "vsl+hl"}};
+                                                  {"vsl", METHOD_VSL, "vsl"}, {"vsl+hl", METHOD_VSL_HL, "vsl+hl"},
+                                                  {"auto", METHOD_AUTO, "auto"}};
 static const param_choice plans[] = {{"auto", PLAN_AUTO, "auto"}, {"full", PLAN_FULL, "full"}};
 static const param_choice tonemaps[] = {{"reinhard", TONEMAP_REINHARD, "reinhard"},
                                         {"clamp", TONEMAP_CLAMP, "clamp"},
@@ -103,7 +104,8 @@ static const param_desc table[] = {
      .choices = methods, .num_choices = METHOD_COUNT, .def = METHOD_PT, .value_name = "NAME",
      .help = "estimator: pt (path tracing, the reference), vpl (clamped virtual\n"
              "point lights), vsl (virtual spherical lights), vsl+hl (VSLs plus\n"
-             "vMF-merged indirect highlights)",
+             "vMF-merged indirect highlights), auto (pt or vsl, per 16x16 tile,\n"
+             "whichever measures the less error for its time there)",
      .label = "method"},
     {.name = "max-depth", .type = PARAM_INT, .group = PARAM_RENDER, .offset = offsetof(render_params, max_depth),
      .lo = 1, .hi = MAX_DEPTH_LIMIT, .def = DEFAULT_MAX_DEPTH, .value_name = "D",

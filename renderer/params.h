@@ -20,6 +20,7 @@ typedef enum {
     METHOD_VPL,    /* virtual point lights (instant radiosity), clamped */
     METHOD_VSL,    /* virtual spherical lights */
     METHOD_VSL_HL, /* virtual spherical lights plus vMF-merged indirect highlights */
+    METHOD_AUTO,   /* per tile, path tracing or the virtual spherical lights, by what each measured there */
     METHOD_COUNT
 } render_method;
 
@@ -213,12 +214,12 @@ extern const char *const pass_names[PASS_COUNT];
 
 /* The counters a session keeps, declared once: X(field, name, section, scale), the field of
  * render_stats, its name in `glint render --stats` (inside its "highlights" object for
- * STATS_HIGHLIGHTS), the methods that report it (STATS_ALL every one, STATS_MANY_LIGHT vpl, vsl and
- * vsl+hl, STATS_HIGHLIGHTS vsl+hl) and what the JSON multiplies it by (1: a count; 1e-9: nanoseconds
+ * STATS_HIGHLIGHTS, "auto" for STATS_AUTO), the methods that report it (STATS_ALL every one,
+ * STATS_MANY_LIGHT vpl, vsl, vsl+hl and auto, STATS_HIGHLIGHTS vsl+hl, STATS_AUTO auto) and what the JSON multiplies it by (1: a count; 1e-9: nanoseconds
  * as seconds). render_stats, its sum (render_stats_add: over threads, over rows) and the JSON's
  * counters are made from this list: a counter added here is summed and reported with nothing else
  * to change. */
-typedef enum { STATS_ALL, STATS_MANY_LIGHT, STATS_HIGHLIGHTS } stats_section;
+typedef enum { STATS_ALL, STATS_MANY_LIGHT, STATS_HIGHLIGHTS, STATS_AUTO } stats_section;
 #define RENDER_COUNTERS(X)                                                                                             \
     X(rejected_samples, "rejected_samples", STATS_ALL, 1.0)             /* samples dropped: NaN or Inf */              \
     X(virtual_lights, "virtual_lights_total", STATS_MANY_LIGHT, 1.0)    /* deposited, over frames */                   \
@@ -233,7 +234,10 @@ typedef enum { STATS_ALL, STATS_MANY_LIGHT, STATS_HIGHLIGHTS } stats_section;
     X(hl_lobes, "lobes_lit", STATS_HIGHLIGHTS, 1.0)                     /* merged, or one per secondary hit */         \
     X(hl_merge_ns, "merge_seconds", STATS_HIGHLIGHTS, 1e-9)             /* clustering and merging (thread time) */     \
     X(hl_traced_pixels, "traced_pixels", STATS_HIGHLIGHTS, 1.0)         /* --merge auto: at the last judgement */      \
-    X(env_filter_bytes, "env_filter_bytes", STATS_HIGHLIGHTS, 1.0)      /* the prefiltered map's memory */
+    X(env_filter_bytes, "env_filter_bytes", STATS_HIGHLIGHTS, 1.0)      /* the prefiltered map's memory */             \
+    X(auto_pt_paths, "pt_paths", STATS_AUTO, 1.0)                       /* auto: path-traced samples */                \
+    X(auto_vl_samples, "vl_samples", STATS_AUTO, 1.0)                   /* ... virtual lights' samples */              \
+    X(auto_vl_tiles, "vl_tiles", STATS_AUTO, 1.0)                       /* ... tiles of them, last judged */
 
 /* Rays by kind, the list's counters and each pass's time; summed over the frames since the last reset. */
 typedef struct {

@@ -200,8 +200,8 @@ effect_plan plan_make(const scene_analysis *a, int method, int max_depth, int mo
     memset(&p, 0, sizeof p);
     p.full = mode == PLAN_FULL || a->cut; /* what a cut probe did not find may be there */
     p.max_depth = max_depth;
-    int many = method == METHOD_VPL || method == METHOD_VSL || method == METHOD_VSL_HL;
-    int vsl = method == METHOD_VSL || method == METHOD_VSL_HL;
+    int many = method == METHOD_VPL || method == METHOD_VSL || method == METHOD_VSL_HL || method == METHOD_AUTO;
+    int vsl = method == METHOD_VSL || method == METHOD_VSL_HL || method == METHOD_AUTO;
     int emitters = a->punctual + a->area + a->env;
     int each = nee_each_count(a->punctual), candidates = each + (emitters > each); /* lights.h */
     snprintf(p.why_direct, sizeof p.why_direct, "%s%s%s%s%s%s%s", emitters ? "" : "none: no emitters",

@@ -5,84 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
 #include "clock.h"
-#include "envfilter.h"
-#include "highlights.h"
 #include "lights.h"
-#include "manylight.h"
 #include "pt.h"
-#include "rng.h"
-#include "threadpool.h"
-
-#define TILE 16
-#define PACKET_W SESSION_PACKET /* PACKET_W x PACKET_H = SCENE_PACKET, dividing TILE */
-#define PACKET_H SESSION_PACKET
-
-/* Per-worker counters, padded so threads never share a cache line. */
-typedef struct {
-    render_stats st;
-    char pad[64];
-} worker_stats;
-
-/* Direct-light samples at each camera hit in a many-light frame. Such a frame costs several path
- * tracer frames (the gather), so one direct sample a frame leaves the direct light noisier than
- * the path tracer's at equal time. 4 took the whole image's noise x time down 1.7x on doorway and
- * 2.4x on showcase at 14% more time a frame; 8 did better there but cost atelier (whose direct
- * light is easy) a third of its frames for little (docs/benchmarks.md). */
-#define MANYLIGHT_DIRECT_SAMPLES 4
-#define MANYLIGHT_MAX_DIRECT_SAMPLES 64 /* per pixel, with --adapt */
-#define HL_PIXEL_POINTS 8     /* camera hits a pixel's highlight rays start from, once it has met a sharp lobe */
-#define HL_SHARP_RAY_FACTOR 4 /* ... and N times this many secondary rays (docs/benchmarks.md, 2026-11-28) */
-
-/* One part of a frame: the packets (x + a i, y + b j) of a lattice cell, cols of them a row, row
- * major, handed out `chunk` at a time. */
-typedef struct {
-    part_cell cell;
-    int cols, packets, chunk;
-    const uint32_t *list; /* or, in a frame ordered by need, these packets (y * packets_x + x) */
-} part_job;
-#define PART_CHUNK 16          /* packets at most a task: the atomic counter is read once per chunk */
-#define PART_CHUNKS_A_THREAD 8 /* ... and at least this many chunks a thread where the part has them */
-
-struct render_session {
-    const scene *scene;
-    camera cam;
-    render_params params;
-    vl_params vl; /* params.vl with its defaults, resolved once (take_params) */
-    film film;
-    long long frames;
-    threadpool *pool;
-    worker_stats *workers;
-    render_stats totals;
-    int tiles_x, tiles_y;
-    manylight ml; /* vpl, vsl, vsl+hl: this frame's virtual lights */
-    /* Many-light frames with --adapt: each pixel's directions through sharp lobes and direct-light
-     * samples, from the spread of one sample's light in earlier frames */
-    int adapt;
-    pixel_alloc glossy, direct;
-    uint32_t *direct_taken;    /* per pixel: the points of its direct samples' run taken so far */
-    uint8_t *hl_state;         /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
-    hl_merge_record *hl_merge; /* per pixel with --merge auto: merge against trace; NULL until used */
-    hl_setup hl;               /* vsl+hl: this frame's highlight settings */
-    env_vmf_filter *envf;      /* vsl+hl under a map: the map prefiltered, built on first use */
-    const env_map *envf_map;   /* ... the map it was built from */
-    scene_analysis analysis;
-    effect_plan plan;
-    const atomic_int *abort_flag; /* polled per tile or chunk; NULL: none */
-    const sample_sink *sink;      /* NULL: none */
-    /* A frame in parts (session_render_part): its count (0: no frame under way), the parts done and
-     * the rank of its first; the rank after the last part begun, which session_reset keeps. */
-    int frame_parts, parts_done, first_part, next_part;
-    part_job part;       /* the part being rendered */
-    const uint8_t *need; /* per packet, the caller's (session_set_packet_need); NULL: none */
-    uint32_t *order;     /* the frame's packets by need, when it is ordered (else NULL) */
-    size_t order_size;
-    int frame_begun;      /* a frame began since the last reset: its estimators serve extra samples */
-    uint64_t extra_calls; /* session_render_extra's calls: each its own random numbers */
-    extra_request *extra; /* the call's requests */
-    char error[256];
-};
+#include "session_parts.h"
 
 /* The plan for the session's parameters, less the passes of the components it does not render. */
 static effect_plan session_make_plan(const render_session *rs) {
@@ -147,6 +73,7 @@ void session_destroy(render_session *rs) {
     free(rs->direct_taken);
     free(rs->order);
     free(rs->hl_merge);
+    choice_free(&rs->choice);
     env_vmf_filter_destroy(rs->envf);
     scene_analysis_free(&rs->analysis);
     free(rs->workers);
@@ -162,10 +89,8 @@ static uint64_t next_frame_index(const render_session *rs) {
     return shard_frame_index(p->shard_spp_total, p->shard_index, p->shard_count, (uint64_t)rs->frames);
 }
 
-/* The camera ray through position u ([0,1)^2) of a pixel past the frame's own: its direction to
- * *dir, its hit to *hit, returned (NULL: none). Counts the point; its camera ray is the caller's. */
-static const surface_hit *pixel_hit(const render_session *rs, render_stats *st, const camera_raster *raster, int pixel,
-                                    vec2 u, vec3 *dir, surface_hit *hit) {
+const surface_hit *session_pixel_hit(const render_session *rs, render_stats *st, const camera_raster *raster, int pixel,
+                                     vec2 u, vec3 *dir, surface_hit *hit) {
     int w = rs->params.width;
     *dir = camera_raster_dir(raster, (float)(pixel % w) + u.x, (float)(pixel / w) + u.y);
     st->pixel_points++;
@@ -187,7 +112,7 @@ static void pixel_points(render_session *rs, render_stats *st, const camera_rast
         if (j > 0) {
             int index = (int)((next_frame_index(rs) * (HL_PIXEL_POINTS - 1) + (uint64_t)j) & 0x3fffffff);
             st->rays[RAY_CAMERA]++;
-            h = pixel_hit(rs, st, raster, pixel, sample_r2(index, shift), &dir, &hit);
+            h = session_pixel_hit(rs, st, raster, pixel, sample_r2(index, shift), &dir, &hit);
         }
         if (h) {
             xs[j] = shading_point_at(s, h, dir);
@@ -198,21 +123,7 @@ static void pixel_points(render_session *rs, render_stats *st, const camera_rast
     }
 }
 
-/* The pixel's run of the low-discrepancy sequence for one of its estimators (stream, < 16): the
- * same scramble every frame, starting after the `taken` points its earlier frames used. Counted in
- * the whole render's frames (next_frame_index) where a frame's count is fixed, so a shard's points
- * are the whole render's and merged shards equal one render; a count only this session knows
- * (own_count: the record's, with --adapt) gets a scramble per shard, so shards never repeat each
- * other's points. */
-enum {
-    RUN_PATH = 0,
-    RUN_HIGHLIGHTS = 1,
-    RUN_HIGHLIGHT_POINTS = 2,
-    RUN_HIGHLIGHT_BLOCK = 2 + HL_PIXEL_POINTS,
-    RUN_DIRECT_POINTS,
-    RUN_STREAMS = 16
-};
-static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken, int own_count) {
+qmc_run session_pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken, int own_count) {
     const render_params *p = &rs->params;
     uint64_t shard = own_count && p->shard_count > 0 ? (uint64_t)p->shard_index + 1 : 0;
     rng_state start = rng_for((uint64_t)pixel, UINT64_MAX - 2 - (shard * RUN_STREAMS + stream), p->seed);
@@ -220,8 +131,7 @@ static qmc_run pixel_run(const render_session *rs, int pixel, uint64_t stream, u
     return (qmc_run){(uint32_t)taken, sx, rng_next_u32(&start)};
 }
 
-/* A display-only sample's run (session_render_extra): scrambled afresh from its own stream. */
-static qmc_run fresh_run(rng_state *rng) {
+qmc_run session_fresh_run(rng_state *rng) {
     uint32_t sx = rng_next_u32(rng);
     return (qmc_run){0, sx, rng_next_u32(rng)};
 }
@@ -238,7 +148,7 @@ static qmc_run fresh_run(rng_state *rng) {
 static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
                          const surface_hit *first, int samples, pixel_record *rec, rng_state *rng, vec3 *glossy) {
     const scene *s = rs->scene;
-    qmc_run run = pixel_run(rs, pixel, RUN_DIRECT_POINTS, rs->direct_taken[pixel], 1);
+    qmc_run run = session_pixel_run(rs, pixel, RUN_DIRECT_POINTS, rs->direct_taken[pixel], 1);
     if (samples > 1) rs->direct_taken[pixel] += (uint32_t)(samples - 1); /* one: nothing written (extra samples) */
     float u_select = rng_float(rng);
     vec3 sum = v3(0, 0, 0), sum_g = v3(0, 0, 0);
@@ -247,7 +157,7 @@ static vec3 pixel_direct(render_session *rs, render_stats *st, const camera_rast
         surface_hit hit;
         const surface_hit *h = first;
         if (k > 0) {
-            h = pixel_hit(rs, st, raster, pixel, qmc_run_point(run, (uint32_t)(k - 1)), &dir, &hit);
+            h = session_pixel_hit(rs, st, raster, pixel, qmc_run_point(run, (uint32_t)(k - 1)), &dir, &hit);
         }
         float u = fminf(((float)k + u_select) / (float)samples, 0x1.fffffep-1f);
         vec3 g;
@@ -270,7 +180,7 @@ static int probe_state(render_session *rs, render_stats *st, const camera_raster
     vec3 dir;
     surface_hit h;
     st->rays[RAY_CAMERA]++;
-    if (!pixel_hit(rs, st, raster, pixel, rng_vec2(&r), &dir, &h)) return HL_PIXEL_BROAD;
+    if (!session_pixel_hit(rs, st, raster, pixel, rng_vec2(&r), &dir, &h)) return HL_PIXEL_BROAD;
     shading_point x = shading_point_at(rs->scene, &h, dir);
     return hl_point_sharp(&rs->hl, &x) ? HL_PIXEL_SHARP : HL_PIXEL_BROAD;
 }
@@ -317,9 +227,9 @@ static vec3 pixel_highlights(render_session *rs, render_stats *st, const camera_
     /* Each point its own run (its rays' directions over frames); spread points get fresh ones. */
     qmc_run runs[HL_PIXEL_POINTS];
     for (int j = 0; j < points; j++) {
-        runs[j] =
-            extra ? fresh_run(&hl_rng)
-                  : pixel_run(rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
+        runs[j] = extra ? session_fresh_run(&hl_rng)
+                        : session_pixel_run(
+                              rs, pixel, points > 1 ? RUN_HIGHLIGHT_POINTS + (uint64_t)j : RUN_HIGHLIGHTS,
                               next_frame_index(rs) * (uint64_t)hl_rays_of_point(setup.secondary_rays, points, j), 0);
     }
     vec3 traced;
@@ -341,23 +251,15 @@ static void sink_put(const sample_sink *k, int pixel, const float sample[COMP_CO
     k->stamp[pixel] = k->serial;
 }
 
-/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL; its
- * highlights, when its block shared them, in shared_hl; into L, and with G (not NULL) the part of
- * each component that left the camera hit through its view-dependent lobes into G (pt_radiance;
- * the highlights are all such light). A display's extra sample (extra) reads the pixel's records
- * but writes none, takes its one direct sample at its own camera hit and draws its runs afresh from
- * rng. */
-static void estimate_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                            const surface_hit *first, rng_state *rng, const vec3 *shared_hl, int extra,
-                            vec3 L[COMP_COUNT], vec3 *G) {
+void session_many_light_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                               const surface_hit *first, rng_state *rng, const vec3 *shared_hl, int extra,
+                               vec3 L[COMP_COUNT], vec3 *G) {
     const scene *s = rs->scene;
     const render_params *p = &rs->params;
     /* render_tile probed the pixel's highlight state */
     int spread = rs->adapt && !extra && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_SHARP;
     int dim = rs->adapt && rs->plan.highlights && rs->hl_state[pixel] == HL_PIXEL_DIM;
-    int direct_samples = p->method == METHOD_PT || extra ? 1
-                         : rs->adapt                     ? rs->direct.samples[pixel]
-                                                         : MANYLIGHT_DIRECT_SAMPLES;
+    int direct_samples = extra == SAMPLE_EXTRA ? 1 : rs->adapt ? rs->direct.samples[pixel] : MANYLIGHT_DIRECT_SAMPLES;
     for (int c = 0; c < COMP_COUNT; c++) L[c] = v3(0, 0, 0);
     if (G)
         for (int c = 0; c < COMP_COUNT; c++) G[c] = v3(0, 0, 0);
@@ -367,14 +269,8 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
         return;
     }
     int depth = rs->plan.max_depth;
-    if (p->method == METHOD_PT) {
-        pt_radiance(s, depth, p->pt_highlights, rs->cam.position, d, first,
-                    extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, next_frame_index(rs), 0), rng, L, G,
-                    st->rays);
-        return;
-    }
-    /* Many lights: the shared direct estimator, then the virtual lights at the hit and the
-     * highlights, each pass timed. */
+    /* The shared direct estimator, then the virtual lights at the hit and the highlights, each
+     * pass timed. */
     int record = rs->adapt && !extra;
     uint64_t t0 = clock_ns();
     if (!p->only || p->only & (1u << COMP_DIRECT))
@@ -389,10 +285,10 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
         int split = rs->adapt ? rs->glossy.samples[pixel] : rs->ml.glossy_split;
         /* Directions taken so far: counted by the record with --adapt, else `split` a frame. */
         uint64_t taken = rs->adapt ? (uint64_t)rs->glossy.rec[pixel].n : next_frame_index(rs) * (uint64_t)split;
-        L[COMP_INDIRECT] =
-            manylight_indirect(&rs->ml, s, &sp, dim ? &L[COMP_HIGHLIGHTS] : NULL, G ? &G[COMP_INDIRECT] : NULL, depth,
-                               split, extra ? fresh_run(rng) : pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
-                               record ? &rs->glossy.rec[pixel] : NULL, rng, st);
+        L[COMP_INDIRECT] = manylight_indirect(
+            &rs->ml, s, &sp, dim ? &L[COMP_HIGHLIGHTS] : NULL, G ? &G[COMP_INDIRECT] : NULL, depth, split,
+            extra ? session_fresh_run(rng) : session_pixel_run(rs, pixel, RUN_PATH, taken, rs->adapt),
+            record ? &rs->glossy.rec[pixel] : NULL, rng, st);
         uint64_t t2 = clock_ns();
         st->pass_ns[PASS_GATHER] += t2 - t1;
         t1 = t2;
@@ -402,6 +298,27 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
         st->pass_ns[PASS_HIGHLIGHTS] += clock_ns() - t1;
     }
     if (G) G[COMP_HIGHLIGHTS] = L[COMP_HIGHLIGHTS];
+}
+
+/* One sample of a pixel whose camera ray (along d) the caller traced: its hit, or NULL; its
+ * highlights, when its block shared them, in shared_hl; into L, and with G (not NULL) the part of
+ * each component that left the camera hit through its view-dependent lobes into G (pt_radiance;
+ * the highlights are all such light). A display's extra sample (extra) reads the pixel's records
+ * but writes none, takes its one direct sample at its own camera hit and draws its runs afresh from
+ * rng. */
+static void estimate_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
+                            const surface_hit *first, rng_state *rng, const vec3 *shared_hl, int extra,
+                            vec3 L[COMP_COUNT], vec3 *G) {
+    const render_params *p = &rs->params;
+    if (p->method == METHOD_AUTO) {
+        session_auto_sample(rs, st, raster, pixel, d, first, rng, extra ? SAMPLE_EXTRA : SAMPLE_FILM, L, G);
+    } else if (p->method == METHOD_PT) {
+        pt_radiance(rs->scene, rs->plan.max_depth, p->pt_highlights, rs->cam.position, d, first,
+                    extra ? session_fresh_run(rng) : session_pixel_run(rs, pixel, RUN_PATH, next_frame_index(rs), 0),
+                    rng, L, G, st->rays);
+    } else {
+        session_many_light_sample(rs, st, raster, pixel, d, first, rng, shared_hl, extra, L, G);
+    }
 }
 
 /* The film's sample of a pixel (as estimate_sample), added, or dropped and counted when it is not
@@ -476,8 +393,8 @@ static void block_highlights(render_session *rs, render_stats *st, const int *pi
         }
         if (m == 0) continue;
         /* The block's run, named by its top-left pixel: a pixel's points never collide with it. */
-        qmc_run run =
-            pixel_run(rs, corner, RUN_HIGHLIGHT_BLOCK, frame * (uint64_t)(HL_SHARE_POINTS * rs->hl.secondary_rays), 0);
+        qmc_run run = session_pixel_run(rs, corner, RUN_HIGHLIGHT_BLOCK,
+                                        frame * (uint64_t)(HL_SHARE_POINTS * rs->hl.secondary_rays), 0);
         vec3 out[HL_SHARE_POINTS];
         unsigned estimated = hl_estimate_shared(&rs->hl, rs->scene, xs, m, run, slot, rngs, st, out);
         for (int j = 0; j < m; j++)
@@ -579,6 +496,10 @@ static int begin_frame(render_session *rs) {
     const render_params *p = &rs->params;
     const uint64_t frame = next_frame_index(rs);
     rs->adapt = p->method != METHOD_PT && rs->vl.adapt == VL_ADAPT_ON;
+    if (p->method == METHOD_AUTO && !rs->choice.rec && choice_init(&rs->choice, p->width, p->height) != 0) {
+        snprintf(rs->error, sizeof rs->error, "out of memory for a %dx%d image", p->width, p->height);
+        return -1;
+    }
     if (rs->adapt) {
         pixel_alloc_plan(&rs->direct, MANYLIGHT_DIRECT_SAMPLES, MANYLIGHT_MAX_DIRECT_SAMPLES, frame,
                          p->seed ^ 0x646972656374ULL);
@@ -605,6 +526,13 @@ static int begin_frame(render_session *rs) {
                                   &rs->totals, rs->error, sizeof rs->error) != 0)
             return -1;
         rs->totals.pass_ns[PASS_VIRTUAL_LIGHTS] += clock_ns() - t0;
+    }
+    if (p->method == METHOD_AUTO) { /* its virtual lights made: a new accumulation's probe, then judged */
+        if (rs->frames == 0) threadpool_run(rs->pool, session_auto_probe, rs, rs->choice.tiles_y);
+        if (choice_judge_due(rs->frames)) {
+            choice_judge(&rs->choice);
+            rs->totals.auto_vl_tiles = (uint64_t)rs->choice.vl_tiles;
+        }
     }
     if (dim_judged(rs) && hl_judge_due(rs->frames)) judge_dim_pixels(rs, rs->hl.dim_share);
     if (rs->plan.highlights && rs->adapt && rs->hl.choose && hl_judge_due(rs->frames)) {
@@ -814,6 +742,7 @@ void session_reset(render_session *rs) {
     memset(rs->direct_taken, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->direct_taken);
     if (rs->hl_merge)
         memset(rs->hl_merge, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->hl_merge);
+    choice_reset(&rs->choice);
     rs->frames = 0;
     rs->frame_parts = 0; /* a frame under way is abandoned; next_part stays, so the next part differs */
     rs->frame_begun = 0;

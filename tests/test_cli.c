@@ -181,7 +181,7 @@ static void test_outputs(void) {
     for (int i = 0; i < 2; i++) {
         char cmd[128];
         snprintf(cmd, sizeof cmd, "%s --method bogus", commands[i]);
-        expect_failure(cmd, 2, "--method: expected one of pt, vpl, vsl, vsl+hl, got 'bogus'");
+        expect_failure(cmd, 2, "--method: expected one of pt, vpl, vsl, vsl+hl, auto, got 'bogus'");
         snprintf(cmd, sizeof cmd, "%s --max-depth 0", commands[i]);
         expect_failure(cmd, 2, "--max-depth: expected an integer in [1, 10000], got '0'");
     }

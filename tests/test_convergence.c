@@ -2,7 +2,8 @@
  * error against a much longer render is V/n + V/N_ref for per-sample variance V; a bias would show
  * as a floor, a wrong weighting of samples as a different slope. The VSL estimator with its
  * default, consistent schedule converges to the path tracer's answer in a closed diffuse and a
- * closed glossy room, along the edges (where a fixed radius loses light) as in the open. */
+ * closed glossy room, along the edges (where a fixed radius loses light) as in the open; so does
+ * auto in the diffuse room, exploring with both and then choosing per tile. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -185,6 +186,20 @@ static void test_vsl_converges(int glossy) {
         CHECK(fabs(b[2]) < fabs(fb) || fabs(fb) < 3.0 * fse + 0.01,
               "%s, %s: the schedule leaves %+.4f, no less than the fixed radius's %+.4f", s->path, regions[r], b[2],
               fb);
+    }
+    if (!glossy) { /* auto, its tiles choosing on the way, converges as its estimators do */
+        p.vl.radius_shrink = 0.0f;
+        p.method = METHOD_AUTO;
+        vsl_runs(s, &cam, p, mask, schedule, schedule_se);
+        for (int r = 0; r < 2; r++) {
+            double b, se;
+            bias_of(schedule[CHECKPOINTS - 1][r], ref_mean[r], schedule_se[CHECKPOINTS - 1][r], &b, &se);
+            printf("%s, %s: auto's bias %+.4f (%.4f) after %d frames\n", s->path, regions[r], b, se,
+                   checkpoint_frames[CHECKPOINTS - 1]);
+            CHECK(fabs(b) < 3.0 * se + 0.01,
+                  "%s, %s: auto's mean is %+.4f off path tracing after %d frames (noise %.4f)", s->path, regions[r], b,
+                  checkpoint_frames[CHECKPOINTS - 1], se);
+        }
     }
     free(ref);
     scene_destroy(s);

@@ -255,13 +255,22 @@ static void test_program(void) {
               strstr(err_text, "glint: error: --vsl-count: 50000000 would take 23.8 GiB") &&
               strchr(err_text, '\n') == err_text + strlen(err_text) - 1,
           "--vsl-count 50000000: %s", err_text);
-    /* --stats reports every counter of the list (vsl+hl reports every section) */
+    /* --stats reports every counter of the list (vsl+hl every section but auto's, auto its own) */
     static char json[16384];
     CHECK(run("render builtin:showcase --method vsl+hl --size 16x12 --spp 1 --vsl-count 16 --quiet --png p.png "
               "--stats s.json") == 0 &&
               read_file("s.json", json, sizeof json) > 0,
           "vsl+hl --stats: %s", err_text);
-#define IN_JSON(field, name, section, scale) CHECK(strstr(json, "\"" name "\": ") != NULL, "--stats lacks %s", name);
+#define IN_JSON(field, name, section, scale)                                                                           \
+    if ((section) != STATS_AUTO) CHECK(strstr(json, "\"" name "\": ") != NULL, "--stats lacks %s", name);
+    RENDER_COUNTERS(IN_JSON)
+#undef IN_JSON
+    CHECK(run("render builtin:showcase --method auto --size 16x12 --spp 1 --vsl-count 16 --quiet --png p.png "
+              "--stats s.json") == 0 &&
+              read_file("s.json", json, sizeof json) > 0,
+          "auto --stats: %s", err_text);
+#define IN_JSON(field, name, section, scale)                                                                           \
+    if ((section) == STATS_AUTO) CHECK(strstr(json, "\"" name "\": ") != NULL, "auto's --stats lacks %s", name);
     RENDER_COUNTERS(IN_JSON)
 #undef IN_JSON
     for (int i = 0; i < n; i++) {

@@ -2,7 +2,7 @@
  * same frame: after frames rendered whole, in 4, 16, 256 parts or one, from any rotation, or begun in
  * parts and finished by session_render_frame, the films (every component's sums, the rejected counts)
  * and the statistics' counts are equal bit for bit, for pt, vsl and vsl+hl with shared 2x2 blocks and
- * --adapt (its records, probes and judgements). The parts' order, checked against the lattice by
+ * --adapt (its records, probes and judgements), and auto through its probe and judgements. The parts' order, checked against the lattice by
  * brute force: every aligned run of 2^m ranks one cell in each block of the lattice's own shape
  * (ordered dither; Bayer's matrix at 4x4). The sink, as parts go: each part stamps exactly the
  * pixels of its cell's packets, every pixel once a frame (those into the void too), the first
@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "choice.h"
 #include "test_scenes.h"
 
 enum { W = 70, H = 42 }; /* neither a multiple of 4: edge packets and tiles are clipped */
@@ -61,12 +62,13 @@ static int same_counts(const render_session *a, const render_session *b) {
     render_stats x = session_stats(a), y = session_stats(b);
     int same = x.rejected_samples == y.rejected_samples && x.pixel_points == y.pixel_points &&
                x.vsl_samples == y.vsl_samples && x.vl_connections == y.vl_connections && x.hl_points == y.hl_points &&
-               x.hl_secondary_rays == y.hl_secondary_rays && x.glossy_bounces == y.glossy_bounces;
+               x.hl_secondary_rays == y.hl_secondary_rays && x.glossy_bounces == y.glossy_bounces &&
+               x.auto_pt_paths == y.auto_pt_paths && x.auto_vl_samples == y.auto_vl_samples;
     for (int k = 0; k < RAY_KIND_COUNT; k++) same &= x.rays[k] == y.rays[k];
     return same;
 }
 
-/* Four frames of p on showcase: whole (a); in 4, 16, 256 parts and one (b); the same from a rotation
+/* Four frames of p on showcase (auto: six, through its judgements at 1, 2 and 4): whole (a); in 4, 16, 256 parts and one (b); the same from a rotation
  * advanced by 3 parts of 8 and a reset (c); and begun in f + 1 parts of 16, finished by
  * session_render_frame (d). The third frame begins with --adapt's first judgements
  * (HL_DIM_FRAMES). */
@@ -78,10 +80,11 @@ static void check_same_frames(const scene *s, const camera *cam, const render_pa
     for (int k = 0; k < 3; k++) CHECK(session_render_part(c, 8, NULL) == 0, "%s: a part of 8", name);
     session_reset(c);
     CHECK(session_frame_parts(c) == 0 && session_frames(c) == 0, "%s: a reset must abandon the frame", name);
-    for (int f = 0; f < 4; f++) {
+    int frames = p->method == METHOD_AUTO ? 6 : 4;
+    for (int f = 0; f < frames; f++) {
         CHECK(session_render_frame(a) == 0, "%s: frame %d: %s", name, f, session_error(a));
-        frame_in_parts(b, counts[f]);
-        frame_in_parts(c, counts[f]);
+        frame_in_parts(b, counts[f % 4]);
+        frame_in_parts(c, counts[f % 4]);
         for (int k = 0; k <= f; k++) CHECK(session_render_part(d, 16, NULL) == 0, "%s: a part of 16", name);
         CHECK(session_frame_parts(d) == 16 && session_render_frame(d) == 0 && session_frame_parts(d) == 0 &&
                   session_frames(d) == f + 1,
@@ -94,8 +97,9 @@ static void check_same_frames(const scene *s, const camera *cam, const render_pa
                   "%s: extra samples between parts", name);
         }
         CHECK(same_film(a, e), "%s: frame %d with extra samples between its parts: the film differs", name, f);
-        CHECK(same_film(a, b), "%s: frame %d in %d parts: the film differs from whole frames'", name, f, counts[f]);
-        CHECK(same_film(a, c), "%s: frame %d in %d parts from a rotation of 3: the film differs", name, f, counts[f]);
+        CHECK(same_film(a, b), "%s: frame %d in %d parts: the film differs from whole frames'", name, f, counts[f % 4]);
+        CHECK(same_film(a, c), "%s: frame %d in %d parts from a rotation of 3: the film differs", name, f,
+              counts[f % 4]);
         CHECK(same_film(a, d), "%s: frame %d finished by session_render_frame: the film differs", name, f);
     }
     CHECK(same_counts(a, b) && same_counts(a, c) && same_counts(a, d),
@@ -106,6 +110,9 @@ static void check_same_frames(const scene *s, const camera *cam, const render_pa
     if (p->method == METHOD_VSL_HL)
         CHECK(session_plan(a)->highlights && session_stats(a).hl_points > 0 && session_stats(a).hl_secondary_rays > 0,
               "%s: the highlight estimator must run", name);
+    if (p->method == METHOD_AUTO)
+        CHECK(session_stats(a).auto_pt_paths > 0 && session_stats(a).auto_vl_samples > 0,
+              "%s: both estimators must have run", name);
     session_destroy(a);
     session_destroy(b);
     session_destroy(c);
@@ -450,11 +457,15 @@ int main(void) {
     p.method = METHOD_VSL_HL;
     p.vl.share = HL_SHARE_ON;
     check_same_frames(showcase, &cam, &p, "vsl+hl");
+    p.method = METHOD_AUTO;
+    p.vl.share = HL_SHARE_DEFAULT;
+    check_same_frames(showcase, &cam, &p, "auto");
     scene_destroy(showcase);
 
     scene *s = half_void_scene(&cam);
     check_sink(s, &cam, METHOD_PT);
     check_sink(s, &cam, METHOD_VSL);
+    check_sink(s, &cam, METHOD_AUTO);
     check_rotation(s, &cam);
     check_need_order(s, &cam);
     check_clamp_and_abort(s, &cam);

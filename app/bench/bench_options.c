@@ -70,7 +70,7 @@ static void print_bench_help(void) {
            "  --reference REF.exr  the reference image (required)\n"
            "  --preset NAME        a named comparison (below): its options go before yours, so yours\n"
            "                       that take one value replace its, and --run, --sweep add runs\n"
-           "  --methods LIST       comma-separated: pt, vpl, vsl, vsl+hl [pt,vpl,vsl,vsl+hl]\n"
+           "  --methods LIST       comma-separated: pt, vpl, vsl, vsl+hl, auto [pt,vpl,vsl,vsl+hl]\n"
            "  --run METHOD[:NAME=VALUE,...]\n"
            "                       one more run, of METHOD with settings of its own: many-light\n"
            "                       options by name and plan=auto|full (repeatable; --methods A,B is\n"
@@ -146,9 +146,9 @@ static int split_list(const char *text, char items[][32], int max) {
 }
 
 unsigned bench_sweep_methods(const char *name) {
-    const unsigned many = (1u << METHOD_VPL) | (1u << METHOD_VSL) | (1u << METHOD_VSL_HL);
+    const unsigned many = (1u << METHOD_VPL) | (1u << METHOD_VSL) | (1u << METHOD_VSL_HL) | (1u << METHOD_AUTO);
     if (strcmp(name, "radius-mult") == 0 || strcmp(name, "radius-shrink") == 0)
-        return (1u << METHOD_VSL) | (1u << METHOD_VSL_HL);
+        return (1u << METHOD_VSL) | (1u << METHOD_VSL_HL) | (1u << METHOD_AUTO);
     if (strcmp(name, "secondary-rays") == 0 || strcmp(name, "clusters") == 0 || strcmp(name, "merge") == 0)
         return 1u << METHOD_VSL_HL;
     if (strcmp(name, "vpl-glossy") == 0 || strcmp(name, "clamp-growth") == 0) return 1u << METHOD_VPL;
@@ -207,7 +207,7 @@ static int parse_run(const char *text, bench_variant *v) {
     memcpy(method, text, len);
     method[len] = '\0';
     int m = method_from_name(method);
-    if (m < 0) return cli_error("--run: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", method), -1;
+    if (m < 0) return cli_error("--run: unknown method '%s' (available: pt, vpl, vsl, vsl+hl, auto)", method), -1;
     v->method = (render_method)m;
     snprintf(v->label, sizeof v->label, "%s", method);
     if (!colon) return 0;
@@ -388,7 +388,8 @@ int bench_parse_options(int argc, char **argv, bench_options *o) {
     for (int k = 0; k < n; k++) {
         bench_variant v = {0};
         int m = method_from_name(items[k]);
-        if (m < 0) return cli_error("--methods: unknown method '%s' (available: pt, vpl, vsl, vsl+hl)", items[k]), -1;
+        if (m < 0)
+            return cli_error("--methods: unknown method '%s' (available: pt, vpl, vsl, vsl+hl, auto)", items[k]), -1;
         v.method = (render_method)m;
         snprintf(v.label, sizeof v.label, "%s", items[k]);
         if (add_variant(o, &v)) return -1;

@@ -1,0 +1,82 @@
+#include "choice.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int choice_init(estimator_choice *c, int width, int height) {
+    memset(c, 0, sizeof *c);
+    c->width = width, c->height = height;
+    c->tiles_x = (width + CHOICE_TILE - 1) / CHOICE_TILE;
+    c->tiles_y = (height + CHOICE_TILE - 1) / CHOICE_TILE;
+    size_t tiles = (size_t)c->tiles_x * (size_t)c->tiles_y;
+    c->rec = calloc((size_t)width * (size_t)height, sizeof *c->rec);
+    c->mode = malloc(tiles);
+    c->paths = malloc(tiles);
+    if (!c->rec || !c->mode || !c->paths) {
+        choice_free(c);
+        return -1;
+    }
+    choice_reset(c);
+    return 0;
+}
+
+void choice_free(estimator_choice *c) {
+    free(c->rec);
+    free(c->mode);
+    free(c->paths);
+    memset(c, 0, sizeof *c);
+}
+
+void choice_reset(estimator_choice *c) {
+    if (!c->rec) return;
+    memset(c->rec, 0, (size_t)c->width * (size_t)c->height * sizeof *c->rec);
+    memset(c->mode, CHOICE_VL, (size_t)c->tiles_x * (size_t)c->tiles_y);
+    memset(c->paths, 1, (size_t)c->tiles_x * (size_t)c->tiles_y);
+    c->vl_tiles = 0;
+}
+
+/* A tile judged by its pixels' records. At equal time a pixel's error from an estimator whose
+ * sample has variance V and costs C is V C / T: the tile takes the estimator of the smaller V C.
+ * V is pooled over the tile's pixels, each pixel's spread about its own mean (the light's changes
+ * across the tile are no estimator's noise). A tile taking path tracing traces as many paths a
+ * frame as one virtual-light sample costs, so that it spends the frame's time a pixel as the rest
+ * of the image does. A tile whose samples do not vary at all (the sky, a black wall) takes one path. */
+static void judge_tile(estimator_choice *c, int tx, int ty) {
+    double m2[EST_COUNT] = {0}, dof[EST_COUNT] = {0}, work[EST_COUNT] = {0}, n[EST_COUNT] = {0};
+    int x1 = (tx + 1) * CHOICE_TILE < c->width ? (tx + 1) * CHOICE_TILE : c->width;
+    int y1 = (ty + 1) * CHOICE_TILE < c->height ? (ty + 1) * CHOICE_TILE : c->height;
+    for (int y = ty * CHOICE_TILE; y < y1; y++)
+        for (int x = tx * CHOICE_TILE; x < x1; x++) {
+            const choice_record *r = &c->rec[(size_t)y * (size_t)c->width + (size_t)x];
+            for (int e = 0; e < EST_COUNT; e++) {
+                if (r->e[e].n >= 2.0f) m2[e] += (double)r->e[e].m2, dof[e] += (double)r->e[e].n - 1.0;
+                work[e] += (double)r->e[e].work, n[e] += (double)r->e[e].n;
+            }
+        }
+    double var[EST_COUNT], cost[EST_COUNT];
+    for (int e = 0; e < EST_COUNT; e++) {
+        var[e] = dof[e] > 0.0 ? m2[e] / dof[e] : 0.0;
+        cost[e] = n[e] > 0.0 ? work[e] / n[e] : 0.0;
+    }
+    size_t t = (size_t)ty * (size_t)c->tiles_x + (size_t)tx;
+    int vl = n[EST_VL] > 0.0 && var[EST_VL] * cost[EST_VL] < var[EST_PT] * cost[EST_PT];
+    c->mode[t] = (uint8_t)(vl ? CHOICE_VL : CHOICE_PT);
+    double paths = cost[EST_PT] > 0.0 && var[EST_PT] > 0.0 ? floor(cost[EST_VL] / cost[EST_PT] + 0.5) : 1.0;
+    c->paths[t] = (uint8_t)(paths < 1.0 ? 1 : paths > CHOICE_MAX_PATHS ? CHOICE_MAX_PATHS : paths);
+}
+
+void choice_judge(estimator_choice *c) {
+    if (!c->rec) return;
+    c->vl_tiles = 0;
+    for (int ty = 0; ty < c->tiles_y; ty++)
+        for (int tx = 0; tx < c->tiles_x; tx++) {
+            judge_tile(c, tx, ty);
+            c->vl_tiles += c->mode[ty * c->tiles_x + tx] == CHOICE_VL;
+        }
+}
+
+float choice_vl_share(const estimator_choice *c, int pixel, double film_samples) {
+    if (!c->rec || !(film_samples > 0.0)) return 0.0f;
+    return (float)((double)c->rec[pixel].vl_weight / film_samples);
+}
