@@ -364,7 +364,8 @@ static char *describe_reference(const render_options *o, const render_session *r
     return json;
 }
 
-/* denoised: --denoise's image (NULL without), the layer denoised.* after the film's. */
+/* denoised: --denoise's image (NULL without), the layer denoised.* after the film's; with --method
+ * auto, the layer vsl_share.* (session_auto_share) after it. */
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, const camera *cam,
                          int cam_index, double seconds, reference_noise *rn, size_t clamped, const float *denoised) {
     const film *fm = session_film(rs);
@@ -374,9 +375,20 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
         char *json = describe_reference(o, rs, s, cam, cam_index, seconds, rn);
         if (!json) return -1;
         exr_text_attr attr = {REFERENCE_ATTR, json};
-        exr_layer extra = {"denoised", denoised};
-        int st = film_save_exr_extra(fm, layers, o->out_exr, &attr, 1, &extra, denoised ? 1 : 0, WRITE_REPLACE, err,
-                                     sizeof err);
+        exr_layer extra[2];
+        int n = 0;
+        if (denoised) extra[n++] = (exr_layer){"denoised", denoised};
+        float *share = NULL;
+        if (o->params.method == METHOD_AUTO) {
+            if (!(share = malloc(sizeof(float) * 3 * (size_t)fm->width * (size_t)fm->height))) {
+                free(json);
+                return cli_error("%s: out of memory", o->out_exr), -1;
+            }
+            session_auto_share(rs, share);
+            extra[n++] = (exr_layer){"vsl_share", share};
+        }
+        int st = film_save_exr_extra(fm, layers, o->out_exr, &attr, 1, extra, n, WRITE_REPLACE, err, sizeof err);
+        free(share);
         free(json);
         if (st != 0) {
             cli_error("%s", err);

@@ -128,5 +128,8 @@ render_stats session_stats(const render_session *rs);
 /* What the scene calls for (analysed when the session is created) and the passes it runs. */
 const scene_analysis *session_analysis(const render_session *rs);
 const effect_plan *session_plan(const render_session *rs);
+/* --method auto's map: the share of each pixel's film samples the virtual lights gave, 0 to 1, as
+ * RGB (three equal floats a pixel); 0 everywhere with another method or before a sample. */
+void session_auto_share(const render_session *rs, float *rgb);
 
 #endif

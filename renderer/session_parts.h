@@ -116,11 +116,11 @@ const surface_hit *session_pixel_hit(const render_session *rs, render_stats *st,
 enum { SAMPLE_FILM = 0, SAMPLE_EXTRA, SAMPLE_PROBE };
 
 /* A many-light method's sample of a pixel whose camera ray (along d) the caller traced (its hit,
- * or NULL), `kind` a SAMPLE_ kind: the shared direct estimator's, the virtual lights' at the hit
+ * or NULL), `extra` a SAMPLE_ kind: the shared direct estimator's, the virtual lights' at the hit
  * and the highlights' (shared_hl: its block's, or NULL), into L and with G (not NULL) the part of
  * each component that left the camera hit through its view-dependent lobes. */
 void session_many_light_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
-                               const surface_hit *first, rng_state *rng, const vec3 *shared_hl, int kind,
+                               const surface_hit *first, rng_state *rng, const vec3 *shared_hl, int extra,
                                vec3 L[COMP_COUNT], vec3 *G);
 
 /* --method auto (session_auto.c): a pixel's sample as its tile takes it (as many_light_sample's),

@@ -6,7 +6,7 @@
  * and at each power of two; the probe takes one pixel in each 4x4 block, the frames measure the
  * other estimator at each pixel of an 8x8 block once in 64 frames. The records' moments equal a
  * two-pass computation's. A render of an indirect-lit room (doorway) gives most tiles to the
- * virtual lights, and its probe samples every tile. (test_convergence checks auto's image against
+ * virtual lights, its probe samples every tile and its map of shares stays in [0, 1]. (test_convergence checks auto's image against
  * path tracing, test_parts that its frames are the same whole and in parts.) */
 #include <math.h>
 #include <stdlib.h>
@@ -125,6 +125,17 @@ static double vl_share_of_tiles(const scene *s, const camera *cam, int w, int h,
     CHECK(first.auto_pt_paths > 0 && first.auto_vl_samples > 0, "the first frame must probe both estimators");
     for (int f = 1; f < 8; f++) session_render_frame(rs);
     render_stats st = session_stats(rs);
+    /* the map: each pixel's share of film samples from the virtual lights, in [0, 1], whole */
+    float *share = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
+    session_auto_share(rs, share);
+    int off = 0, whole = 0;
+    for (int i = 0; i < w * h; i++) {
+        off += !(share[3 * i] >= 0.0f && share[3 * i] <= 1.0f) || share[3 * i + 1] != share[3 * i];
+        whole += share[3 * i] == 1.0f;
+    }
+    CHECK(off == 0 && whole > 0, "the share map: %d pixels off [0, 1] or grey, %d wholly the virtual lights'", off,
+          whole);
+    free(share);
     int tiles = ((w + CHOICE_TILE - 1) / CHOICE_TILE) * ((h + CHOICE_TILE - 1) / CHOICE_TILE);
     session_destroy(rs);
     estimator_choice c;
