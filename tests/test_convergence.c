@@ -3,7 +3,7 @@
  * as a floor, a wrong weighting of samples as a different slope. The VSL estimator with its
  * default, consistent schedule converges to the path tracer's answer in a closed diffuse and a
  * closed glossy room, along the edges (where a fixed radius loses light) as in the open; so does
- * auto in the diffuse room, exploring with both and then choosing per tile. */
+ * auto in the diffuse room, probing both and then choosing per tile. */
 #include <math.h>
 #include <stdlib.h>
 

@@ -2,8 +2,8 @@
  * same frame: after frames rendered whole, in 4, 16, 256 parts or one, from any rotation, or begun in
  * parts and finished by session_render_frame, the films (every component's sums, the rejected counts)
  * and the statistics' counts are equal bit for bit, for pt, vsl and vsl+hl with shared 2x2 blocks and
- * --adapt (its records, probes and judgements), and auto through its probe and judgements. The parts' order, checked against the lattice by
- * brute force: every aligned run of 2^m ranks one cell in each block of the lattice's own shape
+ * --adapt (its records, probes and judgements), and auto through its probe and judgements. The
+ * parts' order, checked against the lattice by brute force: every aligned run of 2^m ranks one cell in each block of the lattice's own shape
  * (ordered dither; Bayer's matrix at 4x4). The sink, as parts go: each part stamps exactly the
  * pixels of its cell's packets, every pixel once a frame (those into the void too), the first
  * quarter and half of a frame's parts cover the image evenly, the statistics count each part, the
@@ -68,8 +68,8 @@ static int same_counts(const render_session *a, const render_session *b) {
     return same;
 }
 
-/* Four frames of p on showcase (auto: six, through its judgements at 1, 2 and 4): whole (a); in 4, 16, 256 parts and one (b); the same from a rotation
- * advanced by 3 parts of 8 and a reset (c); and begun in f + 1 parts of 16, finished by
+/* Four frames of p on showcase (auto: six, through its judgements at 1, 2 and 4): whole (a); in 4,
+ * 16, 256 parts and one (b); the same from a rotation advanced by 3 parts of 8 and a reset (c); and begun in f + 1 parts of 16, finished by
  * session_render_frame (d). The third frame begins with --adapt's first judgements
  * (HL_DIM_FRAMES). */
 static void check_same_frames(const scene *s, const camera *cam, const render_params *p, const char *name) {
