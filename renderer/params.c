@@ -6,17 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const method_names[METHOD_COUNT] = {"pt", "vpl", "vsl", "vsl+hl", "auto"};
 const char *const ray_kind_names[RAY_KIND_COUNT] = {"camera", "shadow", "bounce"};
 const char *const pass_names[PASS_COUNT] = {"paths", "direct", "virtual_lights", "gather", "highlights"};
-
-const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? method_names[m] : "?"; }
-
-int method_from_name(const char *name) {
-    for (int i = 0; i < METHOD_COUNT; i++)
-        if (strcmp(name, method_names[i]) == 0) return i;
-    return -1;
-}
 
 /* ---- defaults ---------------------------------------------------------------------------------- */
 
@@ -83,6 +74,18 @@ _Static_assert(offsetof(render_params, height) == offsetof(render_params, width)
 static const param_choice methods[METHOD_COUNT] = {{"pt", METHOD_PT, "pt"}, {"vpl", METHOD_VPL, "vpl"},
                                                   {"vsl", METHOD_VSL, "vsl"}, {"vsl+hl", METHOD_VSL_HL, "vsl+hl"},
                                                   {"auto", METHOD_AUTO, "auto"}};
+/* clang-format on */
+
+/* The method's names are the table's. */
+const char *method_name(render_method m) { return (unsigned)m < METHOD_COUNT ? methods[m].name : "?"; }
+
+int method_from_name(const char *name) {
+    for (int i = 0; i < METHOD_COUNT; i++)
+        if (strcmp(name, methods[i].name) == 0) return methods[i].value;
+    return -1;
+}
+
+/* clang-format off */
 static const param_choice plans[] = {{"auto", PLAN_AUTO, "auto"}, {"full", PLAN_FULL, "full"}};
 static const param_choice tonemaps[] = {{"reinhard", TONEMAP_REINHARD, "reinhard"},
                                         {"clamp", TONEMAP_CLAMP, "clamp"},

@@ -72,9 +72,12 @@ void session_auto_sample(render_session *rs, render_stats *st, const camera_rast
     choice_mode mode = choice_of(c, pixel);
     choice_record *rec = kind == SAMPLE_FILM ? &c->rec[pixel] : NULL;
     int measure = rec && choice_measures(c, pixel, rs->frames);
-    qmc_run dirs = rec ? session_pixel_run(rs, pixel, RUN_AUTO_PATHS, rec->pt_taken, 1) : session_fresh_run(rng);
-    qmc_run points = rec ? session_pixel_run(rs, pixel, RUN_AUTO_POINTS, rec->pt_taken, 1) : session_fresh_run(rng);
     int paths = mode == CHOICE_PT ? c->paths[choice_tile_of(c, pixel)] : measure;
+    qmc_run dirs = {0}, points = {0}; /* hashed only where a path is traced */
+    if (paths) {
+        dirs = rec ? session_pixel_run(rs, pixel, RUN_AUTO_PATHS, rec->pt_taken, 1) : session_fresh_run(rng);
+        points = rec ? session_pixel_run(rs, pixel, RUN_AUTO_POINTS, rec->pt_taken, 1) : session_fresh_run(rng);
+    }
     if (rec) rec->pt_taken += (uint32_t)paths;
     if (mode == CHOICE_PT) {
         traced_paths(rs, st, raster, pixel, d, first, paths, dirs, points, rng, rec ? &rec->e[EST_PT] : NULL, L, G);
