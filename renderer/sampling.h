@@ -69,6 +69,15 @@ static inline vec2 qmc_run_point(qmc_run r, uint32_t k) {
     return v2((float)((x ^ r.scramble_x) >> 8) * 0x1p-24f, (float)((y ^ r.scramble_y) >> 8) * 0x1p-24f);
 }
 
+/* Point k of a pixel's run of positions: R2 (sample_r2) from the run's index, shifted by its
+ * scramble. For positions beside a Sobol run of directions counted alike (several paths a frame):
+ * points of two Sobol runs at related indices tie a direction's digits to the position's (the j-th
+ * path of every frame would pair one quarter of the pixel with one quarter of the directions). */
+static inline vec2 qmc_run_r2(qmc_run r, uint32_t k) {
+    vec2 shift = v2((float)(r.scramble_x >> 8) * 0x1p-24f, (float)(r.scramble_y >> 8) * 0x1p-24f);
+    return sample_r2((int)((r.index + k) & 0x3fffffffu), shift);
+}
+
 /* Multiple importance sampling weights for strategy a against b (one sample each). */
 static inline float mis_balance(float pdf_a, float pdf_b) {
     /* As a ratio: the sum of two pdfs near FLT_MAX would overflow. */

@@ -36,7 +36,7 @@ static void traced_paths(render_session *rs, render_stats *st, const camera_rast
         vec3 dir = d, Lk[COMP_COUNT], Gk[COMP_COUNT];
         surface_hit hit;
         const surface_hit *h = first; /* pt_radiance counts the camera ray */
-        if (k > 0) h = session_pixel_hit(rs, st, raster, pixel, qmc_run_point(points, (uint32_t)(k - 1)), &dir, &hit);
+        if (k > 0) h = session_pixel_hit(rs, st, raster, pixel, qmc_run_r2(points, (uint32_t)(k - 1)), &dir, &hit);
         qmc_run run = dirs;
         run.index += (uint32_t)k;
         pt_radiance(rs->scene, rs->plan.max_depth, rs->params.pt_highlights, rs->cam.position, dir, h, run, rng, Lk,

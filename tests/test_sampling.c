@@ -458,6 +458,41 @@ static void test_qmc_run_independent_of_positions(void) {
     CHECK(worst < 0.004, "positions and directions over frames are tied: a share of 1/16 off by %.4f", worst);
 }
 
+/* Several paths a frame (--method auto's path-traced tiles): path j of a frame takes direction
+ * t + j of a Sobol run and, for j > 0, position t + j - 1 of a run of positions (qmc_run_r2), t
+ * growing by the paths a frame. Within a frame the paths' directions are stratified (slot j's lie
+ * in one quarter); the positions paired with each quarter of the directions must cover the pixel,
+ * a quarter of them in each quarter of it. Positions from a second Sobol run fail it: slot j's low
+ * index bits fix the top bits of both, and each quarter of directions meets one of the pixel. */
+static double worst_pairing_share(int sobol_positions) {
+    enum { PATHS = 4, FRAMES = 1 << 12 };
+    rng_state rng = rng_for(17, 0, 0);
+    double worst = 0.0;
+    for (int trial = 0; trial < 8; trial++) {
+        qmc_run dirs = {0, rng_next_u32(&rng), rng_next_u32(&rng)};
+        qmc_run points = {0, rng_next_u32(&rng), rng_next_u32(&rng)};
+        int cells[4][4] = {{0}}, column[4] = {0};
+        for (uint32_t t = 0; t < PATHS * FRAMES; t += PATHS)
+            for (uint32_t j = 1; j < PATHS; j++) {
+                vec2 dir = qmc_run_point(dirs, t + j);
+                vec2 pos = sobol_positions ? qmc_run_point(points, t + j - 1) : qmc_run_r2(points, t + j - 1);
+                int b = (int)(4.0f * dir.x);
+                cells[(int)(4.0f * pos.x)][b]++, column[b]++;
+            }
+        for (int b = 0; b < 4; b++) /* slot 0's quarter of directions has no position here */
+            for (int a = 0; a < 4 && column[b]; a++) worst = fmax(worst, fabs((double)cells[a][b] / column[b] - 0.25));
+    }
+    return worst;
+}
+
+static void test_qmc_runs_of_several_paths(void) {
+    double worst = worst_pairing_share(0), tied = worst_pairing_share(1);
+    printf("4 paths a frame over 4096 frames: largest error of a quarter's share %.5f (Sobol positions %.5f)\n", worst,
+           tied);
+    CHECK(worst < 0.01, "a path's position is tied to its direction: a share of 1/4 off by %.4f", worst);
+    CHECK(tied > 0.5, "the check cannot see two Sobol runs' tie (off by only %.4f)", tied);
+}
+
 int main(void) {
     test_fmax_fmin();
     significance = chi2_significance(0.01, NUM_CHI2_TESTS);
@@ -475,5 +510,6 @@ int main(void) {
     test_qmc_run_nets();
     test_qmc_run_uniform();
     test_qmc_run_independent_of_positions();
+    test_qmc_runs_of_several_paths();
     return check_exit("test_sampling");
 }
