@@ -5,9 +5,12 @@
 #include <string.h>
 #include <sys/resource.h>
 
+#include "camera.h"
+#include "choice.h"
 #include "cli.h"
 #include "commands.h"
 #include "image_io.h"
+#include "session.h"
 
 static void print_info_help(void) {
     printf("usage: glint info [SCENE] [--env FILE] [--variant NAME] [--method NAME] [--max-depth D]\n"
@@ -17,7 +20,8 @@ static void print_info_help(void) {
            "(with --variant NAME, of that variant); then what the\n"
            "scene calls for (material classes, emitters, whether indirect and glossy-to-glossy\n"
            "transport exist) and the passes the method would run (vsl+hl has every pass), each with\n"
-           "its reason.\n"
+           "its reason. With --method auto, also what auto chose after a short render from the first\n"
+           "camera: a map of its tiles, each the path tracer's or the virtual lights'.\n"
            "\n"
            "options (default in brackets):\n"
            "%s"
@@ -30,6 +34,55 @@ static void print_info_help(void) {
            "\n",
            params_render_help("method max-depth plan", "method=" DEFAULT_METHOD_NAME));
     cli_print_scenes();
+}
+
+/* --method auto's choice, as it stands after AUTO_FRAMES frames at AUTO_W x AUTO_H from camera 0
+ * (judged after its probe and frames 1, 2, 4): a character a tile, '#' where the virtual lights
+ * took two thirds of its samples or more, '.' where the path tracer did, '+' between. */
+#define AUTO_W (20 * CHOICE_TILE)
+#define AUTO_H (12 * CHOICE_TILE)
+#define AUTO_FRAMES 8
+static int print_auto_choice(const scene *s, const render_params *given) {
+    render_params p = {.method = METHOD_AUTO, .max_depth = given->max_depth, .plan = given->plan};
+    p.width = AUTO_W, p.height = AUTO_H, p.seed = 1;
+    camera cam = scene_camera(s, 0, (float)AUTO_W / (float)AUTO_H);
+    char err[256];
+    render_session *rs = session_create(s, &cam, &p, err, sizeof err);
+    float *share = malloc(sizeof(float) * 3 * AUTO_W * AUTO_H);
+    int ok = rs && share;
+    for (int f = 0; ok && f < AUTO_FRAMES; f++) ok = session_render_frame(rs) == 0;
+    if (!ok) {
+        cli_error("%s: auto's choice: %s", s->path, rs ? session_error(rs) : err);
+        free(share);
+        if (rs) session_destroy(rs);
+        return -1;
+    }
+    session_vl_share(rs, share);
+    int vl = 0, tiles = (AUTO_W / CHOICE_TILE) * (AUTO_H / CHOICE_TILE);
+    double sum = 0.0;
+    printf("auto:       after %d frames at %dx%d from the first camera, a tile a character: the share\n"
+           "            of its samples the virtual lights took ('#' two thirds or more, '.' a third or less):\n",
+           AUTO_FRAMES, AUTO_W, AUTO_H);
+    for (int ty = 0; ty < AUTO_H / CHOICE_TILE; ty++) {
+        char row[AUTO_W / CHOICE_TILE + 1];
+        for (int tx = 0; tx < AUTO_W / CHOICE_TILE; tx++) {
+            double t = 0.0;
+            for (int y = ty * CHOICE_TILE; y < (ty + 1) * CHOICE_TILE; y++)
+                for (int x = tx * CHOICE_TILE; x < (tx + 1) * CHOICE_TILE; x++)
+                    t += (double)share[3 * (y * AUTO_W + x)];
+            t /= CHOICE_TILE * CHOICE_TILE;
+            sum += t;
+            vl += t >= 2.0 / 3.0;
+            row[tx] = t >= 2.0 / 3.0 ? '#' : t <= 1.0 / 3.0 ? '.' : '+';
+        }
+        row[AUTO_W / CHOICE_TILE] = '\0';
+        printf("            %s\n", row);
+    }
+    printf("            %d of %d tiles mostly the virtual lights', %.0f%% of all samples\n", vl, tiles,
+           100.0 * sum / tiles);
+    free(share);
+    session_destroy(rs);
+    return 0;
 }
 
 /* FILE.obj and FILE.mtl (FILE.obj.mtl for another extension), each written atomically. */
@@ -164,6 +217,7 @@ int cmd_info(int argc, char **argv) {
     printf("method:     %s\n", method_name(p.method));
     plan_print(stdout, s, &a, &plan);
     scene_analysis_free(&a);
+    int failed = p.method == METHOD_AUTO && print_auto_choice(s, &p) != 0;
     scene_destroy(s);
-    return EXIT_OK;
+    return failed ? EXIT_FAILURE_ : EXIT_OK;
 }

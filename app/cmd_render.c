@@ -365,7 +365,7 @@ static char *describe_reference(const render_options *o, const render_session *r
 }
 
 /* denoised: --denoise's image (NULL without), the layer denoised.* after the film's; with --method
- * auto, the layer vsl_share.* (session_auto_share) after it. */
+ * auto, the layer vsl_share.* (session_vl_share) after it. */
 static int write_outputs(const render_options *o, const render_session *rs, const scene *s, const camera *cam,
                          int cam_index, double seconds, reference_noise *rn, size_t clamped, const float *denoised) {
     const film *fm = session_film(rs);
@@ -384,7 +384,7 @@ static int write_outputs(const render_options *o, const render_session *rs, cons
                 free(json);
                 return cli_error("%s: out of memory", o->out_exr), -1;
             }
-            session_auto_share(rs, share);
+            session_vl_share(rs, share);
             extra[n++] = (exr_layer){"vsl_share", share};
         }
         int st = film_save_exr_extra(fm, layers, o->out_exr, &attr, 1, extra, n, WRITE_REPLACE, err, sizeof err);

@@ -128,8 +128,9 @@ render_stats session_stats(const render_session *rs);
 /* What the scene calls for (analysed when the session is created) and the passes it runs. */
 const scene_analysis *session_analysis(const render_session *rs);
 const effect_plan *session_plan(const render_session *rs);
-/* --method auto's map: the share of each pixel's film samples the virtual lights gave, 0 to 1, as
- * RGB (three equal floats a pixel); 0 everywhere with another method or before a sample. */
-void session_auto_share(const render_session *rs, float *rgb);
+/* The share of each pixel's film samples the virtual lights gave, 0 to 1, as RGB (three equal
+ * floats a pixel): --method auto's map of its choice; 1 with vpl, vsl and vsl+hl, 0 with pt; 0
+ * before a pixel's first sample. */
+void session_vl_share(const render_session *rs, float *rgb);
 
 #endif

@@ -123,11 +123,12 @@ void session_auto_probe(void *ctx, int row, int worker) {
         }
 }
 
-void session_auto_share(const render_session *rs, float *rgb) {
+void session_vl_share(const render_session *rs, float *rgb) {
     const film *f = &rs->film;
+    render_method m = rs->params.method;
     for (int i = 0; i < f->width * f->height; i++) {
         double n = (double)f->passes - (double)f->rejected[i];
-        float share = rs->params.method == METHOD_AUTO ? choice_vl_share(&rs->choice, i, n) : 0.0f;
+        float share = m == METHOD_AUTO ? choice_vl_share(&rs->choice, i, n) : m != METHOD_PT && n > 0.0 ? 1.0f : 0.0f;
         rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = share;
     }
 }

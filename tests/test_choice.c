@@ -127,7 +127,7 @@ static double vl_share_of_tiles(const scene *s, const camera *cam, int w, int h,
     render_stats st = session_stats(rs);
     /* the map: each pixel's share of film samples from the virtual lights, in [0, 1], whole */
     float *share = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
-    session_auto_share(rs, share);
+    session_vl_share(rs, share);
     int off = 0, whole = 0;
     for (int i = 0; i < w * h; i++) {
         off += !(share[3 * i] >= 0.0f && share[3 * i] <= 1.0f) || share[3 * i + 1] != share[3 * i];

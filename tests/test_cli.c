@@ -177,6 +177,26 @@ static void test_outputs(void) {
     rc = run("info --method vsl --max-depth 4");
     CHECK(rc == 0 && strstr(out_text, "method:     vsl\n") && strstr(out_text, "max depth: 4"),
           "info --method vsl: %s%s", out_text, err_text);
+    /* with auto, its choice as a map of tiles: 12 rows of 20, counted as the summary says; doorway
+     * is the virtual lights' regime (test_choice), most of its tiles theirs */
+    rc = run("info builtin:doorway --method auto --max-depth 4");
+    const char *map = strstr(out_text, "auto:       after 8 frames at 320x192");
+    int rows = 0, hashes = 0, said = -1;
+    for (const char *line = map ? strchr(map, '\n') : NULL; line && rows < 13; line = strchr(line + 1, '\n')) {
+        const char *t = line + 1 + strspn(line + 1, " ");
+        size_t n = strspn(t, "#.+");
+        if (n == 20 && t[n] == '\n') {
+            rows++;
+            for (size_t k = 0; k < n; k++) hashes += t[k] == '#';
+        }
+    }
+    const char *summary = map ? strstr(map, " of 240 tiles mostly the virtual lights'") : NULL;
+    if (summary) {
+        while (summary > map && summary[-1] != ' ') summary--;
+        said = atoi(summary);
+    }
+    CHECK(rc == 0 && rows == 12 && said == hashes && hashes >= 120,
+          "info --method auto: %d rows, %d '#', said %d: %s%s", rows, hashes, said, out_text, err_text);
     const char *commands[] = {"info", "render --spp 1 --size 8x8"};
     for (int i = 0; i < 2; i++) {
         char cmd[128];

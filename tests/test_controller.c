@@ -4,7 +4,8 @@
  * frames (nothing more is rendered while it stands); an export written after two whole frames is,
  * bit for bit, the film a session makes of the same two frames (the display never touches the
  * estimate); a load that fails changes nothing and says why; quitting reports its counts; a change
- * at rest stops the part in flight, those while things move do not. Waits are for what happens,
+ * at rest stops the part in flight, those while things move do not; the estimator's map is shown
+ * in place of light when asked. Waits are for what happens,
  * counted, never for a time. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -111,9 +112,28 @@ int main(void) {
           img.full_w, img.full_h);
     CHECK(finite_image(&img), "the image shown is finite");
 
+    /* the estimator's map in place of light: vsl gave every sampled pixel all its samples */
+    view_stats st;
+    controller_stats(c, &st);
+    uint64_t asked = st.updates;
+    controller_set_look(c, SHOW_ESTIMATOR_SHARE, 1);
+    do { /* two updates after the look changed: the second began after it */
+        nap();
+        controller_stats(c, &st);
+    } while (st.updates < asked + 2);
+    controller_take_image(c, &serial, &img);
+    CHECK(img.mask == SHOW_ESTIMATOR_SHARE, "the image asked for the estimator's map shows mask %#x", img.mask);
+    int ones = 0;
+    for (int i = 0; i < 3 * W * H; i++) ones += img.rgb[i] == 1.0f;
+    CHECK(ones == 3 * W * H, "the estimator's map under vsl: %d of %d values 1", ones, 3 * W * H);
+    controller_set_look(c, COMP_MASK_ALL, 1);
+    do {
+        nap();
+        controller_take_image(c, &serial, &img);
+    } while (img.mask != COMP_MASK_ALL);
+
     /* pause: refinement stands once the frame under way is whole; nothing is rendered meanwhile */
     controller_set_refinement(c, 1, 0, 0.0);
-    view_stats st;
     do {
         nap();
         controller_stats(c, &st);

@@ -25,10 +25,11 @@ set exposure 1.5
 set show direct
 wait 1
 stats
-set show all
+set show estimator
 set max-depth 3
 wait 1
 stats
+set show all
 orbit 25 -10
 pan 0.1 0.05
 zoom 0.8
@@ -59,8 +60,9 @@ case $default_scene in builtin:?*) ;; *) fail "the viewer did not open a built-i
 [ "$(field 1 frames)" -ge 2 ] || fail "no frames rendered"
 [ "$(field 2 resets)" = "$(field 1 resets)" ] || fail "a display change reset the accumulation"
 [ "$(field 2 frames)" -gt "$(field 1 frames)" ] || fail "frames did not keep accumulating across a display change"
-[ "$(field 2 exposure)" = "1.5" ] && [ "$(field 2 show)" = "1" ] || fail "display settings not applied"
+[ "$(field 2 exposure)" = "1.5" ] && [ "$(field 2 show)" = "direct" ] || fail "display settings not applied"
 [ "$(field 3 resets)" -gt "$(field 2 resets)" ] || fail "max-depth did not reset the accumulation"
+[ "$(field 3 show)" = "estimator" ] || fail "show estimator not applied"
 [ "$(field 3 max_depth)" = "3" ] || fail "max-depth not applied"
 [ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "camera motion did not reset the accumulation"
 [ "$(field 5 scene)" = "$default_scene" ] || fail "a bad scene file replaced the scene"
@@ -161,7 +163,7 @@ below 0 "$(field 2 cost_ms)" && below 0 "$(field 2 cost_before_ms)" ||
 [ "$(field 4 resets)" -gt "$(field 3 resets)" ] || fail "switching to vsl+hl did not reset the accumulation"
 [ "$(field 4 hl_lobes)" -gt 0 ] || fail "vsl+hl lit no highlight lobes"
 [ "$(field 4 plan_highlights)" = "1" ] || fail "the default scene's plan must run the highlight pass"
-[ "$(field 5 show)" = "3" ] || fail "show highlights not applied"
+[ "$(field 5 show)" = "highlights" ] || fail "show highlights not applied"
 [ "$(field 5 resets)" = "$(field 4 resets)" ] || fail "showing the highlights reset the accumulation"
 [ "$(field 5 frames)" -gt "$(field 4 frames)" ] || fail "frames did not keep accumulating when showing the highlights"
 for change in "6 secondary_rays 4" "7 clusters 2" "8 merge off" "9 merge trace" "10 merge on"; do
@@ -288,7 +290,7 @@ rc=$?
 grep '^stats ' out.txt >stats.txt
 [ "$(wc -l <stats.txt)" -eq 3 ] || fail "reference session: expected 3 stats lines, got: $(cat out.txt)"
 below 0.05 "$(field 1 rel_error)" && below "$(field 1 rel_error)" 100 || fail "no plausible error against the reference: $(field 1 rel_error)"
-[ "$(field 2 show)" = "4" ] || fail "the error view not shown"
+[ "$(field 2 show)" = "error" ] || fail "the error view not shown"
 [ "$(field 2 resets)" = "$(field 1 resets)" ] || fail "the error view reset the accumulation"
 [ -s error.png ] || fail "no screenshot of the error view"
 grep -q 'highlights.exr: the reference is 48x27 but the render is 96x54' err.txt ||

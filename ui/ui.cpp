@@ -470,10 +470,13 @@ static void panel(ui_controls *c, const ui_stats *s) {
 
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
         param_widgets(PARAM_DISPLAY, &c->params); // exposure, tone mapper, denoise (N)
-        static const char *shows[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
+        const char *shows[UI_SHOW_COUNT];
+        for (int i = 0; i < UI_SHOW_COUNT; i++) shows[i] = ui_show_name(i);
         ImGui::Combo("show", &c->show, shows, s->reference ? UI_SHOW_COUNT : UI_SHOW_ERROR);
         if (c->show == UI_SHOW_ERROR)
             ImGui::TextUnformatted("per-pixel relative error:\nblue 1%, green 10%, red 100% and more");
+        if (c->show == UI_SHOW_ESTIMATOR)
+            ImGui::TextUnformatted("each pixel's samples: blue path tracing,\norange the virtual lights (auto: mixed)");
     }
 
     if (s->reference && ImGui::CollapsingHeader("Reference", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -31,6 +31,17 @@ static void false_colour_error(const float *img, const float *ref, int num_pixel
     }
 }
 
+/* The share of a pixel's samples the virtual lights gave (SHOW_ESTIMATOR_SHARE's image) as a
+ * colour from blue (path tracing) to orange (the virtual lights); a pixel of both is in between.
+ * Before its first sample a pixel shows blue. */
+static void false_colour_share(const float *share, int num_pixels, unsigned char *out) {
+    for (int i = 0; i < num_pixels; i++) {
+        float s = clampf(share[3 * (size_t)i], 0.0f, 1.0f);
+        float rgb[3] = {0.15f + 0.8f * s, 0.35f + 0.2f * s, 0.9f - 0.8f * s};
+        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+    }
+}
+
 /* The texture the image is drawn from; black until the first image (it has no storage yet).
  * Linear filtering: an image shown in a place of another size is scaled smoothly. */
 void make_texture(ui_thread *u) {
@@ -56,7 +67,9 @@ void tonemap_and_upload(ui_thread *u) {
         if (!u->pixels) return;
     }
     const image_rgb *ref = &u->reference;
-    if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
+    if (u->front.mask == SHOW_ESTIMATOR_SHARE) {
+        false_colour_share(u->front.rgb, w * h, u->pixels);
+    } else if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
         false_colour_error(u->front.rgb, ref->rgb, w * h, u->pixels);
     } else { /* also an image of another size than the reference's */
         const look_params *look = &u->ctl.params.look;

@@ -367,7 +367,10 @@ static void publish(render_thread *rt, const update_info *up) {
     unsigned mask = sh->show_mask;
     int denoise = sh->denoise;
     pthread_mutex_unlock(&sh->lock);
-    display_resolve(rt->disp, mask, denoise, rt->back.rgb);
+    if (mask == SHOW_ESTIMATOR_SHARE)
+        session_vl_share(rs, rt->back.rgb);
+    else
+        display_resolve(rt->disp, mask, denoise, rt->back.rgb);
     rt->shown_mask = mask;
     rt->shown_denoise = denoise;
     display_stats ds = display_get_stats(rt->disp);
@@ -379,6 +382,7 @@ static void publish(render_thread *rt, const update_info *up) {
     rt->back.frames = session_frames(rs);
     rt->back.seed = session_params(rs)->seed;
     rt->back.denoise = denoise;
+    rt->back.mask = mask;
     rt->back.published_at = cli_now();
     /* what is shown against the reference (the whole image only: another component has none) */
     double shown_error =

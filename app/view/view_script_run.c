@@ -34,8 +34,8 @@ static void print_stats(ui_thread *u) {
            u->info.num_lights, u->ctl.light, (double)u->ctl.light_gain, (double)lp.x, (double)lp.y, (double)lp.z,
            (double)lx, (double)ly, mean, u->rel_error, u->shown_error, seconds_since(u->started_at),
            (double)u->cam.pos.x, (double)u->cam.pos.y, (double)u->cam.pos.z, nb ? marks : "-");
-    printf("scene=%s frames=%lld width=%d height=%d show=%d ", u->info.name, frames_of_current_state(u), u->front.width,
-           u->front.height, u->ctl.show);
+    printf("scene=%s frames=%lld width=%d height=%d show=%s ", u->info.name, frames_of_current_state(u), u->front.width,
+           u->front.height, ui_show_name(u->ctl.show));
     /* The environment, and the standing notes (the panel's status line) as flags. */
     char env[1024];
     controller_env(u->vc, env, sizeof env);
@@ -85,11 +85,11 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
     if (applied < 0) return snprintf(err, errlen, "%s: %s", name, why), -1;
     if (applied > 0) return 0;
     if (strcmp(name, "show") == 0) {
-        static const char *names[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "error"};
         int found = -1;
         for (int i = 0; i < UI_SHOW_COUNT; i++)
-            if (strcmp(value, names[i]) == 0) found = i;
-        if (found < 0) return snprintf(err, errlen, "show: one of all, direct, indirect, highlights, error"), -1;
+            if (strcmp(value, ui_show_name(i)) == 0) found = i;
+        if (found < 0)
+            return snprintf(err, errlen, "show: one of all, direct, indirect, highlights, estimator, error"), -1;
         if (found == UI_SHOW_ERROR && !u->reference.rgb)
             return snprintf(err, errlen, "show error: no reference loaded"), -1;
         u->ctl.show = found;
