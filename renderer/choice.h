@@ -42,6 +42,7 @@ typedef struct {
     uint8_t *mode;      /* per tile, choice_mode, this frame */
     uint8_t *paths;     /* per tile taking CHOICE_PT: its pixels' paths a frame */
     int vl_tiles;       /* tiles taking the virtual lights, at the last judgement */
+    int judgements;     /* made since the last reset (the first after the probe) */
 } estimator_choice;
 
 /* 0, or -1 out of memory (c left empty). */

@@ -2,7 +2,8 @@
  * A tile takes the estimator whose samples' variance times work is the smaller, the variance
  * pooled over its pixels about each pixel's own mean (a tile whose light changes across it but
  * whose samples do not vary has none); a path-traced tile traces as many paths as a virtual-light
- * sample costs, within [1, CHOICE_MAX_PATHS]. Judgements come before an accumulation's first frame
+ * sample costs, within [1, CHOICE_MAX_PATHS]; a tile turns to the estimator it has not taken only
+ * if that one measures better around it too. Judgements come before an accumulation's first frame
  * and at each power of two; the probe takes one pixel in each 4x4 block, the frames measure the
  * other estimator at each pixel of an 8x8 block once in 64 frames. The records' moments equal a
  * two-pass computation's. A render of an indirect-lit room (doorway) gives most tiles to the
@@ -63,6 +64,27 @@ static void test_judgement(void) {
     for (long long f = 0; f < 70; f++)
         CHECK(choice_judge_due(f) == (f == 0 || f == 1 || f == 2 || f == 4 || f == 8 || f == 16 || f == 32 || f == 64),
               "a judgement before frame %lld: %d", f, choice_judge_due(f));
+}
+
+/* A tile turns to the estimator it has not taken only on evidence that holds around it: that
+ * estimator's variance is the larger of the tile's and its 3x3 tiles'. Three tiles take the
+ * virtual lights; then the middle one's path tracing measures quiet (400 samples). With its
+ * neighbours' few path-traced samples as quiet as its first ones, it turns; with theirs wild (a
+ * variance 100 times, which its own few would have missed), it stays. */
+static void test_turn_needs_neighbours(void) {
+    for (int wild = 0; wild < 2; wild++) {
+        estimator_choice c;
+        CHECK(choice_init(&c, 3 * CHOICE_TILE, CHOICE_TILE) == 0, "choice_init");
+        for (int t = 0; t < 3; t++)
+            fill(&c, t, EST_PT, 4, t != 1 && wild ? 10.0 : 1.0, 2.0), fill(&c, t, EST_VL, 4, sqrt(0.1), 10.0);
+        choice_judge(&c);
+        CHECK(c.vl_tiles == 3, "all three tiles first take the virtual lights (%d)", c.vl_tiles);
+        fill(&c, 1, EST_PT, 400, 0.01, 2.0);
+        choice_judge(&c);
+        CHECK(c.mode[1] == (wild ? CHOICE_VL : CHOICE_PT), "neighbours %s: the middle tile must %s (mode %d)",
+              wild ? "wild" : "quiet", wild ? "stay with the virtual lights" : "turn to path tracing", c.mode[1]);
+        choice_free(&c);
+    }
 }
 
 /* The probe's and the frames' measuring patterns: one probed pixel in each 4x4 block; each pixel of
@@ -168,6 +190,7 @@ static void test_direction(void) {
 
 int main(void) {
     test_judgement();
+    test_turn_needs_neighbours();
     test_patterns();
     test_moments();
     test_direction();
