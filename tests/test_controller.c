@@ -5,8 +5,7 @@
  * bit for bit, the film a session makes of the same two frames (the display never touches the
  * estimate); a load that fails changes nothing and says why; quitting reports its counts; a change
  * at rest stops the part in flight, those while things move do not; the estimator's map is shown
- * in place of light when asked. Waits are for what happens,
- * counted, never for a time. */
+ * in place of light when asked. Waits are for what happens, counted, never for a time. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdlib.h>
@@ -36,6 +35,21 @@ static void wait_for(view_controller *c, uint64_t *serial, image_buf *img, uint6
             return;
         nap();
     }
+}
+
+/* Shows the film components in mask (or SHOW_ESTIMATOR_SHARE), the filter on; the image of the
+ * second update after the change (the first may have begun before it) into *img. */
+static void set_look(view_controller *c, uint64_t *serial, image_buf *img, unsigned mask) {
+    view_stats st;
+    controller_stats(c, &st);
+    uint64_t asked = st.updates;
+    controller_set_look(c, mask, 1);
+    do {
+        nap();
+        controller_stats(c, &st);
+    } while (st.updates < asked + 2);
+    controller_take_image(c, serial, img);
+    CHECK(img->mask == mask, "the image asked to show %#x shows %#x", mask, img->mask);
 }
 
 static int finite_image(const image_buf *img) {
@@ -113,24 +127,12 @@ int main(void) {
     CHECK(finite_image(&img), "the image shown is finite");
 
     /* the estimator's map in place of light: vsl gave every sampled pixel all its samples */
-    view_stats st;
-    controller_stats(c, &st);
-    uint64_t asked = st.updates;
-    controller_set_look(c, SHOW_ESTIMATOR_SHARE, 1);
-    do { /* two updates after the look changed: the second began after it */
-        nap();
-        controller_stats(c, &st);
-    } while (st.updates < asked + 2);
-    controller_take_image(c, &serial, &img);
-    CHECK(img.mask == SHOW_ESTIMATOR_SHARE, "the image asked for the estimator's map shows mask %#x", img.mask);
+    set_look(c, &serial, &img, SHOW_ESTIMATOR_SHARE);
     int ones = 0;
     for (int i = 0; i < 3 * W * H; i++) ones += img.rgb[i] == 1.0f;
     CHECK(ones == 3 * W * H, "the estimator's map under vsl: %d of %d values 1", ones, 3 * W * H);
-    controller_set_look(c, COMP_MASK_ALL, 1);
-    do {
-        nap();
-        controller_take_image(c, &serial, &img);
-    } while (img.mask != COMP_MASK_ALL);
+    set_look(c, &serial, &img, COMP_MASK_ALL);
+    view_stats st;
 
     /* pause: refinement stands once the frame under way is whole; nothing is rendered meanwhile */
     controller_set_refinement(c, 1, 0, 0.0);
