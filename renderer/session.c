@@ -53,7 +53,8 @@ render_session *session_create(const scene *s, const camera *cam, const render_p
     if (pixel_alloc_init(&rs->glossy, p->width * p->height) != 0 ||
         pixel_alloc_init(&rs->direct, p->width * p->height) != 0 ||
         !(rs->hl_state = calloc((size_t)p->width * (size_t)p->height, 1)) ||
-        !(rs->direct_taken = calloc((size_t)p->width * (size_t)p->height, sizeof *rs->direct_taken))) {
+        !(rs->direct_taken = calloc((size_t)p->width * (size_t)p->height, sizeof *rs->direct_taken)) ||
+        !(rs->pixel_rays = calloc((size_t)p->width * (size_t)p->height, sizeof *rs->pixel_rays))) {
         session_destroy(rs);
         return snprintf(err, errlen, "out of memory for a %dx%d image", p->width, p->height), NULL;
     }
@@ -71,6 +72,7 @@ void session_destroy(render_session *rs) {
     pixel_alloc_free(&rs->direct);
     free(rs->hl_state);
     free(rs->direct_taken);
+    free(rs->pixel_rays);
     free(rs->order);
     free(rs->hl_merge);
     choice_free(&rs->choice);
@@ -322,12 +324,14 @@ static void estimate_sample(render_session *rs, render_stats *st, const camera_r
 }
 
 /* The film's sample of a pixel (as estimate_sample), added, or dropped and counted when it is not
- * finite (a NaN or Inf never reaches the film); and to the sink. */
+ * finite (a NaN or Inf never reaches the film); and to the sink. Its rays go to the map of work. */
 static void render_sample(render_session *rs, render_stats *st, const camera_raster *raster, int pixel, vec3 d,
                           const surface_hit *first, rng_state *rng, const vec3 *shared_hl) {
     vec3 L[COMP_COUNT], G[COMP_COUNT];
     int split = rs->sink && rs->sink->glossy[0];
+    uint64_t rays = session_rays_counted(st);
     estimate_sample(rs, st, raster, pixel, d, first, rng, shared_hl, 0, L, split ? G : NULL);
+    rs->pixel_rays[pixel] += (float)(session_rays_counted(st) - rays);
     float sample[COMP_COUNT][3];
     int finite = 1;
     for (int c = 0; c < COMP_COUNT; c++) {
@@ -734,12 +738,21 @@ void session_set_abort_flag(render_session *rs, const atomic_int *flag) { rs->ab
 
 const char *session_error(const render_session *rs) { return rs->error; }
 
+void session_work_map(const render_session *rs, float *rgb) {
+    size_t n = (size_t)rs->params.width * (size_t)rs->params.height;
+    float most = 0.0f;
+    for (size_t i = 0; i < n; i++) most = fmaxf(most, rs->pixel_rays[i]);
+    for (size_t i = 0; i < n; i++)
+        rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = most > 0.0f ? rs->pixel_rays[i] / most : 0.0f;
+}
+
 void session_reset(render_session *rs) {
     film_clear(&rs->film);
     pixel_alloc_reset(&rs->glossy);
     pixel_alloc_reset(&rs->direct);
     memset(rs->hl_state, HL_PIXEL_UNPROBED, (size_t)rs->params.width * (size_t)rs->params.height);
     memset(rs->direct_taken, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->direct_taken);
+    memset(rs->pixel_rays, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->pixel_rays);
     if (rs->hl_merge)
         memset(rs->hl_merge, 0, (size_t)rs->params.width * (size_t)rs->params.height * sizeof *rs->hl_merge);
     choice_reset(&rs->choice);

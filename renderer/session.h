@@ -132,5 +132,10 @@ const effect_plan *session_plan(const render_session *rs);
  * floats a pixel): --method auto's map of its choice; 1 with vpl, vsl and vsl+hl, 0 with pt; 0
  * before a pixel's first sample. */
 void session_vl_share(const render_session *rs, float *rgb);
+/* The rays traced for each pixel's film samples since the reset (their camera rays counted, and
+ * auto's measuring samples beside them; highlights a block of pixels shares, not), over the
+ * image's most, 0 to 1, as RGB: where the work goes (the adaptive allocation's budgets, auto's
+ * paths a tile). 0 everywhere before a sample. */
+void session_work_map(const render_session *rs, float *rgb);
 
 #endif

@@ -16,9 +16,7 @@ static float sample_luminance(const vec3 L[COMP_COUNT]) {
 /* The work a worker's counters have counted, in rays (choice.h's cost: a count, not a clock, so
  * that a seed's render is the same render every time). */
 static double counted_work(const render_stats *st) {
-    uint64_t rays = 0;
-    for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st->rays[k];
-    return choice_work((double)rays, (double)st->vl_connections);
+    return choice_work((double)session_rays_counted(st), (double)st->vl_connections);
 }
 
 /* `paths` path-traced samples of a pixel, the first through the camera hit `first` (along d), the

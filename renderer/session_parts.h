@@ -62,6 +62,7 @@ struct render_session {
     int adapt;
     pixel_alloc glossy, direct;
     uint32_t *direct_taken;    /* per pixel: the points of its direct samples' run taken so far */
+    float *pixel_rays;         /* per pixel: the rays its film samples traced since the reset (the map of work) */
     uint8_t *hl_state;         /* per pixel, HL_PIXEL_*: sharp ones spread their highlights over the pixel */
     hl_merge_record *hl_merge; /* per pixel with --merge auto: merge against trace; NULL until used */
     hl_setup hl;               /* vsl+hl: this frame's highlight settings */
@@ -104,6 +105,12 @@ enum {
 qmc_run session_pixel_run(const render_session *rs, int pixel, uint64_t stream, uint64_t taken, int own_count);
 /* A display-only sample's run (session_render_extra): scrambled afresh from its own stream. */
 qmc_run session_fresh_run(rng_state *rng);
+/* The rays a worker's counters have counted, of every kind. */
+static inline uint64_t session_rays_counted(const render_stats *st) {
+    uint64_t rays = 0;
+    for (int k = 0; k < RAY_KIND_COUNT; k++) rays += st->rays[k];
+    return rays;
+}
 
 /* The camera ray through position u ([0,1)^2) of a pixel past the frame's own: its direction to
  * *dir, its hit to *hit, returned (NULL: none). Counts the point; its camera ray is the caller's. */

@@ -5,7 +5,7 @@
  * bit for bit, the film a session makes of the same two frames (the display never touches the
  * estimate); a load that fails changes nothing and says why; quitting reports its counts; a change
  * at rest stops the part in flight, those while things move do not; the estimator's map is shown
- * in place of light when asked. Waits are for what happens, counted, never for a time. */
+ * in place of light when asked, as is the map of each pixel's rays. Waits are for what happens, counted, never for a time. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdlib.h>
@@ -131,6 +131,11 @@ int main(void) {
     int ones = 0;
     for (int i = 0; i < 3 * W * H; i++) ones += img.rgb[i] == 1.0f;
     CHECK(ones == 3 * W * H, "the estimator's map under vsl: %d of %d values 1", ones, 3 * W * H);
+    /* the map of work: each pixel's rays against the most, in [0, 1], the most at 1, not all alike */
+    set_look(c, &serial, &img, SHOW_WORK_MAP);
+    float least = 1.0f, most = 0.0f;
+    for (int i = 0; i < 3 * W * H; i++) least = fminf(least, img.rgb[i]), most = fmaxf(most, img.rgb[i]);
+    CHECK(most == 1.0f && least >= 0.0f && least < 0.9f, "the map of work spans %g to %g", least, most);
     set_look(c, &serial, &img, COMP_MASK_ALL);
     view_stats st;
 

@@ -475,6 +475,8 @@ static void panel(ui_controls *c, const ui_stats *s) {
         ImGui::Combo("show", &c->show, shows, s->reference ? UI_SHOW_COUNT : UI_SHOW_ERROR);
         if (c->show == UI_SHOW_ERROR)
             ImGui::TextUnformatted("per-pixel relative error:\nblue 1%, green 10%, red 100% and more");
+        if (c->show == UI_SHOW_WORK)
+            ImGui::TextUnformatted("rays each pixel took, against the most:\nblack none, red half, yellow the most");
         if (c->show == UI_SHOW_ESTIMATOR)
             ImGui::TextUnformatted("each pixel's samples: blue path tracing,\norange the virtual lights (auto: mixed)");
     }

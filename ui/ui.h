@@ -15,21 +15,23 @@ extern "C" {
 
 struct GLFWwindow;
 
-/* What the display shows: film components, their sum, which estimator took each pixel's samples
- * (--method auto's choice) or the sum's error against a reference, in false colour. The error
- * comes last: it is offered only with a reference. */
+/* What the display shows: film components, their sum, in false colour the rays each pixel took
+ * (against the image's most), which estimator took its samples (--method auto's choice) or the
+ * sum's error against a reference. The error comes last: it is offered only with a reference. */
 enum {
     UI_SHOW_ALL = 0,
     UI_SHOW_DIRECT,
     UI_SHOW_INDIRECT,
     UI_SHOW_HIGHLIGHTS,
+    UI_SHOW_WORK,
     UI_SHOW_ESTIMATOR,
     UI_SHOW_ERROR,
     UI_SHOW_COUNT
 };
 /* Their names, as the panel and the script's `set show` give them. */
 static inline const char *ui_show_name(int show) {
-    static const char *const names[UI_SHOW_COUNT] = {"all", "direct", "indirect", "highlights", "estimator", "error"};
+    static const char *const names[UI_SHOW_COUNT] = {"all",  "direct",    "indirect", "highlights",
+                                                     "work", "estimator", "error"};
     return show >= 0 && show < UI_SHOW_COUNT ? names[show] : "";
 }
 

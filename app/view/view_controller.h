@@ -40,9 +40,11 @@ void controller_stop(view_controller *c, view_stats *last);
 uint64_t controller_change(view_controller *c, const camera *cam, const render_params *p, const light_edits *lights,
                            uint64_t lights_scene);
 /* How the image is shown (the film components in mask, the display's filter): never a restart.
- * SHOW_ESTIMATOR_SHARE as the mask shows, in place of light, the share of each pixel's film
- * samples the virtual lights gave (session_vl_share: 0 path tracing, 1 the virtual lights). */
+ * In place of light, SHOW_ESTIMATOR_SHARE as the mask shows the share of each pixel's film
+ * samples the virtual lights gave (session_vl_share: 0 path tracing, 1 the virtual lights),
+ * SHOW_WORK_MAP the rays they took against the image's most (session_work_map, 0 to 1). */
 #define SHOW_ESTIMATOR_SHARE (1u << 31)
+#define SHOW_WORK_MAP (1u << 30)
 void controller_set_look(view_controller *c, unsigned show_mask, int denoise);
 /* The render size (the next change restarts at it) and the one asked for last. */
 void controller_set_size(view_controller *c, int width, int height);

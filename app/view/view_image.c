@@ -42,6 +42,16 @@ static void false_colour_share(const float *share, int num_pixels, unsigned char
     }
 }
 
+/* A pixel's rays against the image's most (SHOW_WORK_MAP's image, 0 to 1) as black through red
+ * (half) to yellow (the most). */
+static void false_colour_work(const float *work, int num_pixels, unsigned char *out) {
+    for (int i = 0; i < num_pixels; i++) {
+        float t = clampf(work[3 * (size_t)i], 0.0f, 1.0f);
+        float rgb[3] = {fminf(2.0f * t, 1.0f), fmaxf(2.0f * t - 1.0f, 0.0f), 0.0f};
+        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+    }
+}
+
 /* The texture the image is drawn from; black until the first image (it has no storage yet).
  * Linear filtering: an image shown in a place of another size is scaled smoothly. */
 void make_texture(ui_thread *u) {
@@ -69,6 +79,8 @@ void tonemap_and_upload(ui_thread *u) {
     const image_rgb *ref = &u->reference;
     if (u->front.mask == SHOW_ESTIMATOR_SHARE) {
         false_colour_share(u->front.rgb, w * h, u->pixels);
+    } else if (u->front.mask == SHOW_WORK_MAP) {
+        false_colour_work(u->front.rgb, w * h, u->pixels);
     } else if (u->ctl.show == UI_SHOW_ERROR && ref->rgb && ref->width == w && ref->height == h) {
         false_colour_error(u->front.rgb, ref->rgb, w * h, u->pixels);
     } else { /* also an image of another size than the reference's */

@@ -17,6 +17,7 @@ static unsigned show_mask_of(int show) {
     case UI_SHOW_DIRECT: return 1u << COMP_DIRECT;
     case UI_SHOW_INDIRECT: return 1u << COMP_INDIRECT;
     case UI_SHOW_HIGHLIGHTS: return 1u << COMP_HIGHLIGHTS;
+    case UI_SHOW_WORK: return SHOW_WORK_MAP;
     case UI_SHOW_ESTIMATOR: return SHOW_ESTIMATOR_SHARE;
     default: return COMP_MASK_ALL;
     }

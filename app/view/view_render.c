@@ -369,6 +369,8 @@ static void publish(render_thread *rt, const update_info *up) {
     pthread_mutex_unlock(&sh->lock);
     if (mask == SHOW_ESTIMATOR_SHARE)
         session_vl_share(rs, rt->back.rgb);
+    else if (mask == SHOW_WORK_MAP)
+        session_work_map(rs, rt->back.rgb);
     else
         display_resolve(rt->disp, mask, denoise, rt->back.rgb);
     rt->shown_mask = mask;

@@ -89,7 +89,7 @@ static int set_parameter(ui_thread *u, const char *name, const char *value, char
         for (int i = 0; i < UI_SHOW_COUNT; i++)
             if (strcmp(value, ui_show_name(i)) == 0) found = i;
         if (found < 0)
-            return snprintf(err, errlen, "show: one of all, direct, indirect, highlights, estimator, error"), -1;
+            return snprintf(err, errlen, "show: one of all, direct, indirect, highlights, work, estimator, error"), -1;
         if (found == UI_SHOW_ERROR && !u->reference.rgb)
             return snprintf(err, errlen, "show error: no reference loaded"), -1;
         u->ctl.show = found;

@@ -35,7 +35,7 @@ typedef struct {
     long long frames;    /* frames of the film behind it (the display adds what came before) */
     uint64_t seed;       /* the film's random seed (each accumulation its own) */
     int denoise;         /* resolved with the display's filter on */
-    unsigned mask;       /* what it shows: the film components, or SHOW_ESTIMATOR_SHARE */
+    unsigned mask;       /* what it shows: the film components, SHOW_ESTIMATOR_SHARE or SHOW_WORK_MAP */
     double published_at; /* cli_now() */
 } image_buf;
 
