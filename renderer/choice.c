@@ -4,6 +4,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A tile's sums over its pixels' records, per estimator: each pixel's squared deviations about
+ * its own mean (the light's changes across a tile are no estimator's noise) and their degrees of
+ * freedom, the work and the samples. */
+struct tile_sums {
+    double m2[EST_COUNT], dof[EST_COUNT], work[EST_COUNT], n[EST_COUNT];
+};
+
 int choice_init(estimator_choice *c, int width, int height) {
     memset(c, 0, sizeof *c);
     c->width = width, c->height = height;
@@ -13,7 +20,8 @@ int choice_init(estimator_choice *c, int width, int height) {
     c->rec = calloc((size_t)width * (size_t)height, sizeof *c->rec);
     c->mode = malloc(tiles);
     c->paths = malloc(tiles);
-    if (!c->rec || !c->mode || !c->paths) {
+    c->sums = malloc(tiles * sizeof *c->sums);
+    if (!c->rec || !c->mode || !c->paths || !c->sums) {
         choice_free(c);
         return -1;
     }
@@ -25,6 +33,7 @@ void choice_free(estimator_choice *c) {
     free(c->rec);
     free(c->mode);
     free(c->paths);
+    free(c->sums);
     memset(c, 0, sizeof *c);
 }
 
@@ -36,13 +45,6 @@ void choice_reset(estimator_choice *c) {
     c->vl_tiles = 0;
     c->judgements = 0;
 }
-
-/* A tile's sums over its pixels' records, per estimator: each pixel's squared deviations about
- * its own mean (the light's changes across a tile are no estimator's noise) and their degrees of
- * freedom, the work and the samples. */
-typedef struct {
-    double m2[EST_COUNT], dof[EST_COUNT], work[EST_COUNT], n[EST_COUNT];
-} tile_sums;
 
 static void add_tile_sums(const estimator_choice *c, int tx, int ty, tile_sums *s) {
     int x1 = (tx + 1) * CHOICE_TILE < c->width ? (tx + 1) * CHOICE_TILE : c->width;
@@ -72,12 +74,18 @@ static double sums_variance(const tile_sums *s, int e) { return s->dof[e] > 0.0 
  * rest of the image does. A tile whose samples do not vary at all (the sky, a black wall) takes
  * one path. */
 static void judge_tile(estimator_choice *c, int tx, int ty) {
-    tile_sums own = {0}, around = {0};
-    add_tile_sums(c, tx, ty, &own);
-    for (int y = ty - 1; y <= ty + 1; y++)
-        for (int x = tx - 1; x <= tx + 1; x++)
-            if (x >= 0 && y >= 0 && x < c->tiles_x && y < c->tiles_y) add_tile_sums(c, x, y, &around);
     size_t t = (size_t)ty * (size_t)c->tiles_x + (size_t)tx;
+    const tile_sums own = c->sums[t];
+    tile_sums around = {0};
+    for (int y = ty - 1; y <= ty + 1; y++)
+        for (int x = tx - 1; x <= tx + 1; x++) {
+            if (x < 0 || y < 0 || x >= c->tiles_x || y >= c->tiles_y) continue;
+            const tile_sums *s = &c->sums[(size_t)y * (size_t)c->tiles_x + (size_t)x];
+            for (int e = 0; e < EST_COUNT; e++) {
+                around.m2[e] += s->m2[e], around.dof[e] += s->dof[e];
+                around.work[e] += s->work[e], around.n[e] += s->n[e];
+            }
+        }
     int taken = c->judgements == 0 ? -1 : c->mode[t] == CHOICE_VL ? EST_VL : EST_PT;
     double var[EST_COUNT], cost[EST_COUNT];
     for (int e = 0; e < EST_COUNT; e++) {
@@ -94,6 +102,9 @@ static void judge_tile(estimator_choice *c, int tx, int ty) {
 
 void choice_judge(estimator_choice *c) {
     if (!c->rec) return;
+    memset(c->sums, 0, (size_t)c->tiles_x * (size_t)c->tiles_y * sizeof *c->sums);
+    for (int ty = 0; ty < c->tiles_y; ty++) /* each tile's once, for itself and its neighbours */
+        for (int tx = 0; tx < c->tiles_x; tx++) add_tile_sums(c, tx, ty, &c->sums[ty * c->tiles_x + tx]);
     c->vl_tiles = 0;
     for (int ty = 0; ty < c->tiles_y; ty++)
         for (int tx = 0; tx < c->tiles_x; tx++) {

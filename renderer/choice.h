@@ -36,6 +36,8 @@ typedef struct {
     uint32_t pt_taken; /* the path-traced samples' run: points taken so far */
 } choice_record;
 
+typedef struct tile_sums tile_sums; /* choice.c's */
+
 typedef struct {
     int width, height, tiles_x, tiles_y;
     choice_record *rec; /* per pixel */
@@ -43,6 +45,7 @@ typedef struct {
     uint8_t *paths;     /* per tile taking CHOICE_PT: its pixels' paths a frame */
     int vl_tiles;       /* tiles taking the virtual lights, at the last judgement */
     int judgements;     /* made since the last reset (the first after the probe) */
+    tile_sums *sums;    /* per tile, a judgement's sums of its records */
 } estimator_choice;
 
 /* 0, or -1 out of memory (c left empty). */
