@@ -9,6 +9,11 @@
 #include "image_io.h"
 #include "view.h"
 
+/* A false colour's three floats in [0, 1] as pixel i's bytes. */
+static void put_colour(unsigned char *out, int i, const float rgb[3]) {
+    for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+}
+
 /* Per-pixel relative error |I - R| / (|R| + eps) as colours on a log scale: blue 1%, green 10%,
  * red 100% and more. eps, a hundredth of the mean reference, keeps black pixels from glaring. */
 static void false_colour_error(const float *img, const float *ref, int num_pixels, unsigned char *out) {
@@ -27,7 +32,7 @@ static void false_colour_error(const float *img, const float *ref, int num_pixel
         float t = isfinite(e) ? clampf(0.5f * (log10f(fmaxf(e, 1e-6f)) + 2.0f), 0.0f, 1.0f) : 1.0f;
         float rgb[3] = {clampf(2.0f * t - 1.0f, 0.0f, 1.0f), 1.0f - fabsf(2.0f * t - 1.0f),
                         clampf(1.0f - 2.0f * t, 0.0f, 1.0f)};
-        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+        put_colour(out, i, rgb);
     }
 }
 
@@ -38,7 +43,7 @@ static void false_colour_share(const float *share, int num_pixels, unsigned char
     for (int i = 0; i < num_pixels; i++) {
         float s = clampf(share[3 * (size_t)i], 0.0f, 1.0f);
         float rgb[3] = {0.15f + 0.8f * s, 0.35f + 0.2f * s, 0.9f - 0.8f * s};
-        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+        put_colour(out, i, rgb);
     }
 }
 
@@ -48,7 +53,7 @@ static void false_colour_work(const float *work, int num_pixels, unsigned char *
     for (int i = 0; i < num_pixels; i++) {
         float t = clampf(work[3 * (size_t)i], 0.0f, 1.0f);
         float rgb[3] = {fminf(2.0f * t, 1.0f), fmaxf(2.0f * t - 1.0f, 0.0f), 0.0f};
-        for (int k = 0; k < 3; k++) out[3 * (size_t)i + (size_t)k] = (unsigned char)(255.0f * rgb[k] + 0.5f);
+        put_colour(out, i, rgb);
     }
 }
 
